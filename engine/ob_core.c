@@ -1,0 +1,365 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_core.h"
+
+#include <errno.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* ---------------------------------------------------------------- results */
+
+static const char *const result_names[] = {
+#define OB_RESULT_NAME(name, text) #name,
+    OB_RESULT_LIST(OB_RESULT_NAME)
+#undef OB_RESULT_NAME
+};
+static const char *const result_texts[] = {
+#define OB_RESULT_TEXT(name, text) text,
+    OB_RESULT_LIST(OB_RESULT_TEXT)
+#undef OB_RESULT_TEXT
+};
+
+const char *ob_result_name(ob_result r)
+{
+    return (unsigned)r < OB_RESULT_COUNT ? result_names[r] : "OB_RESULT_UNKNOWN";
+}
+
+const char *ob_result_text(ob_result r)
+{
+    return (unsigned)r < OB_RESULT_COUNT ? result_texts[r] : "unknown result";
+}
+
+/* ---------------------------------------------------------------- logging */
+
+static _Atomic(ob_log_fn) log_sink;
+static _Atomic(void *) log_user;
+static atomic_uint_fast64_t log_counts[4];
+
+static void default_sink(void *user, ob_log_level level, const char *module,
+                         const char *file, int line, const char *message)
+{
+    static const char *const names[] = {"debug", "info", "warn", "error"};
+    (void)user;
+    ob_log_level threshold = OB_LOG_WARN;
+    const char *env = getenv("OB_LOG");
+    if (env && strcmp(env, "debug") == 0) threshold = OB_LOG_DEBUG;
+    else if (env && strcmp(env, "info") == 0) threshold = OB_LOG_INFO;
+    if (level < threshold) return;
+    const char *base = strrchr(file, '/');
+    fprintf(stderr, "[%s][%s] %s (%s:%d)\n", names[level], module, message,
+            base ? base + 1 : file, line);
+}
+
+ob_log_fn ob_log_set_sink(ob_log_fn fn, void *user, void **out_prev_user)
+{
+    ob_log_fn prev = atomic_exchange(&log_sink, fn);
+    void *prev_user = atomic_exchange(&log_user, user);
+    if (out_prev_user) *out_prev_user = prev_user;
+    return prev;
+}
+
+uint64_t ob_log_count(ob_log_level level)
+{
+    return (unsigned)level < 4 ? atomic_load(&log_counts[level]) : 0;
+}
+
+void ob_log_writev(ob_log_level level, const char *module, const char *file,
+                   int line, const char *fmt, va_list ap)
+{
+    char msg[1024];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if ((unsigned)level < 4) atomic_fetch_add(&log_counts[level], 1);
+    ob_log_fn fn = atomic_load(&log_sink);
+    if (!fn) fn = default_sink;
+    fn(atomic_load(&log_user), level, module, file, line, msg);
+}
+
+void ob_log_write(ob_log_level level, const char *module, const char *file,
+                  int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    ob_log_writev(level, module, file, line, fmt, ap);
+    va_end(ap);
+}
+
+/* ---------------------------------------------------------- fault injection */
+
+static atomic_uint_fast64_t fault_nth[OB_FAULT_KIND_COUNT];
+static atomic_uint_fast64_t fault_calls[OB_FAULT_KIND_COUNT];
+static atomic_bool fault_fired[OB_FAULT_KIND_COUNT];
+
+void ob_fault_arm(ob_fault_kind kind, uint64_t nth)
+{
+    atomic_store(&fault_calls[kind], 0);
+    atomic_store(&fault_fired[kind], false);
+    atomic_store(&fault_nth[kind], nth);
+}
+
+bool ob_fault_hit(ob_fault_kind kind) { return atomic_load(&fault_fired[kind]); }
+
+uint64_t ob_fault_count(ob_fault_kind kind) { return atomic_load(&fault_calls[kind]); }
+
+bool ob_fault_should_fail(ob_fault_kind kind)
+{
+    uint64_t n = atomic_fetch_add(&fault_calls[kind], 1) + 1;
+    uint64_t nth = atomic_load(&fault_nth[kind]);
+    if (nth != 0 && n == nth) {
+        atomic_store(&fault_fired[kind], true);
+        return true;
+    }
+    return false;
+}
+
+/* ------------------------------------------------------------- allocation */
+
+void *ob_malloc(size_t size)
+{
+    if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
+    return malloc(size ? size : 1);
+}
+
+void *ob_calloc(size_t count, size_t size)
+{
+    if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
+    return calloc(count ? count : 1, size ? size : 1);
+}
+
+void *ob_realloc(void *ptr, size_t size)
+{
+    if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
+    return realloc(ptr, size ? size : 1);
+}
+
+void ob_free(void *ptr) { free(ptr); }
+
+void *ob_aligned_alloc(size_t alignment, size_t size)
+{
+    if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
+    void *p = NULL;
+    if (alignment < sizeof(void *)) alignment = sizeof(void *);
+    if (posix_memalign(&p, alignment, size ? size : 1) != 0) return NULL;
+    return p;
+}
+
+void ob_aligned_free(void *ptr) { free(ptr); }
+
+char *ob_strdup(const char *s)
+{
+    if (!s) return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = ob_malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t elem_size)
+{
+    if (need <= *cap) return OB_OK;
+    uint32_t new_cap = *cap ? *cap : 8;
+    while (new_cap < need) {
+        if (new_cap > UINT32_MAX / 2) return OB_ERR_LIMIT;
+        new_cap *= 2;
+    }
+    void *p = ob_realloc(*items, (size_t)new_cap * elem_size);
+    if (!p) return OB_ERR_OUT_OF_HOST_MEMORY;
+    *items = p;
+    *cap = new_cap;
+    return OB_OK;
+}
+
+/* ---------------------------------------------------------------- handles */
+
+#define GEN_SHIFT OB_HANDLE_INDEX_BITS
+#define GEN_MASK 0xfffu
+
+void ob_pool_init(ob_pool *pool) { memset(pool, 0, sizeof *pool); }
+
+void ob_pool_release(ob_pool *pool)
+{
+    ob_free(pool->gen);
+    ob_free(pool->next_free);
+    ob_free(pool->items);
+    memset(pool, 0, sizeof *pool);
+}
+
+uint32_t ob_pool_insert(ob_pool *pool, void *item, ob_result *out_result)
+{
+    if (out_result) *out_result = OB_OK;
+    if (!pool->free_head) {
+        if (pool->cap >= OB_HANDLE_MAX_SLOTS) {
+            if (out_result) *out_result = OB_ERR_LIMIT;
+            return 0;
+        }
+        uint32_t new_cap = pool->cap ? pool->cap * 2 : 16;
+        if (new_cap > OB_HANDLE_MAX_SLOTS) new_cap = OB_HANDLE_MAX_SLOTS;
+        uint32_t *gen = ob_realloc(pool->gen, new_cap * sizeof *gen);
+        if (gen) pool->gen = gen;
+        uint32_t *nf = gen ? ob_realloc(pool->next_free, new_cap * sizeof *nf) : NULL;
+        if (nf) pool->next_free = nf;
+        void **items = nf ? ob_realloc(pool->items, new_cap * sizeof *items) : NULL;
+        if (!items) {
+            if (out_result) *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
+            return 0;
+        }
+        pool->items = items;
+        for (uint32_t i = new_cap; i > pool->cap; i--) {
+            pool->gen[i - 1] = 1;
+            pool->items[i - 1] = NULL;
+            pool->next_free[i - 1] = pool->free_head;
+            pool->free_head = i;
+        }
+        pool->cap = new_cap;
+    }
+    uint32_t slot = pool->free_head; /* 1-based */
+    pool->free_head = pool->next_free[slot - 1];
+    pool->items[slot - 1] = item;
+    pool->count++;
+    return (pool->gen[slot - 1] << GEN_SHIFT) | slot;
+}
+
+static uint32_t pool_slot(const ob_pool *pool, uint32_t id)
+{
+    uint32_t slot = id & OB_HANDLE_INDEX_MASK;
+    if (id == 0 || slot == 0 || slot > pool->cap) return 0;
+    if (pool->gen[slot - 1] != (id >> GEN_SHIFT) || !pool->items[slot - 1]) return 0;
+    return slot;
+}
+
+void *ob_pool_get(const ob_pool *pool, uint32_t id)
+{
+    uint32_t slot = pool_slot(pool, id);
+    return slot ? pool->items[slot - 1] : NULL;
+}
+
+void *ob_pool_remove(ob_pool *pool, uint32_t id)
+{
+    uint32_t slot = pool_slot(pool, id);
+    if (!slot) return NULL;
+    void *item = pool->items[slot - 1];
+    pool->items[slot - 1] = NULL;
+    uint32_t g = (pool->gen[slot - 1] + 1) & GEN_MASK;
+    pool->gen[slot - 1] = g ? g : 1;
+    pool->next_free[slot - 1] = pool->free_head;
+    pool->free_head = slot;
+    pool->count--;
+    return item;
+}
+
+void *ob_pool_next(const ob_pool *pool, uint32_t *cursor, uint32_t *out_id)
+{
+    while (*cursor < pool->cap) {
+        uint32_t i = (*cursor)++;
+        if (pool->items[i]) {
+            if (out_id) *out_id = (pool->gen[i] << GEN_SHIFT) | (i + 1);
+            return pool->items[i];
+        }
+    }
+    return NULL;
+}
+
+/* ----------------------------------------------------------- hash & time */
+
+uint64_t ob_hash_bytes(uint64_t h, const void *data, size_t size)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+uint64_t ob_hash_u64(uint64_t h, uint64_t v)
+{
+    /* splitmix-style mixing: much faster than bytewise FNV on the hot path. */
+    h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h ^= h >> 31;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 27;
+    return h;
+}
+
+uint64_t ob_time_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
+}
+
+/* ----------------------------------------------------------------- files */
+
+char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    char *buf = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        OB_LOG_E("io", "cannot open '%s': %s", path, strerror(errno));
+        r = OB_ERR_IO;
+        goto done;
+    }
+    if (fseek(f, 0, SEEK_END) != 0) { r = OB_ERR_IO; goto fail_close; }
+    long len = ftell(f);
+    if (len < 0 || fseek(f, 0, SEEK_SET) != 0) { r = OB_ERR_IO; goto fail_close; }
+    buf = ob_malloc((size_t)len + 1);
+    if (!buf) { r = OB_ERR_OUT_OF_HOST_MEMORY; goto fail_close; }
+    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
+        OB_LOG_E("io", "short read of '%s'", path);
+        ob_free(buf);
+        buf = NULL;
+        r = OB_ERR_IO;
+        goto fail_close;
+    }
+    buf[len] = '\0';
+    if (out_size) *out_size = (size_t)len;
+fail_close:
+    fclose(f);
+done:
+    if (out_result) *out_result = r;
+    return buf;
+}
+
+ob_result ob_file_write(const char *path, const void *data, size_t size)
+{
+    char tmp[4096];
+    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    if (n < 0 || (size_t)n >= sizeof tmp) return OB_ERR_INVALID_ARGUMENT;
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        OB_LOG_E("io", "cannot create '%s': %s", tmp, strerror(errno));
+        return OB_ERR_IO;
+    }
+    size_t w = fwrite(data, 1, size, f);
+    int closed = fclose(f);
+    if (w != size || closed != 0 || rename(tmp, path) != 0) {
+        OB_LOG_E("io", "cannot write '%s': %s", path, strerror(errno));
+        remove(tmp);
+        return OB_ERR_IO;
+    }
+    return OB_OK;
+}
+
+ob_result ob_dir_make(const char *path)
+{
+    char buf[4096];
+    size_t n = strlen(path);
+    if (n == 0 || n >= sizeof buf) return OB_ERR_INVALID_ARGUMENT;
+    memcpy(buf, path, n + 1);
+    for (size_t i = 1; i <= n; i++) {
+        if (buf[i] == '/' || buf[i] == '\0') {
+            char c = buf[i];
+            buf[i] = '\0';
+            if (mkdir(buf, 0755) != 0 && errno != EEXIST) {
+                OB_LOG_E("io", "cannot create directory '%s': %s", buf, strerror(errno));
+                return OB_ERR_IO;
+            }
+            buf[i] = c;
+        }
+    }
+    return OB_OK;
+}

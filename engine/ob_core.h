@@ -1,0 +1,197 @@
+/* ob_core.h — results, logging, allocation, handles, hashing and time.
+ *
+ * The bottom of the engine: every other module includes this header and
+ * nothing below it but libc. It has no lifecycle of its own.
+ *
+ * Thread rule: every function here is [any thread]. The log sink and the
+ * fault-injection counters are the only process-wide state in Obelisk; both
+ * are atomics, set up by tests or the application before renderers exist.
+ */
+#ifndef OB_CORE_H
+#define OB_CORE_H
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- results */
+
+/* X-macro: one place defines every result and its name. */
+#define OB_RESULT_LIST(X)                                                        \
+    X(OB_OK, "ok")                                                               \
+    X(OB_ERR_INVALID_ARGUMENT, "invalid argument")                               \
+    X(OB_ERR_INVALID_HANDLE, "invalid or stale handle")                          \
+    X(OB_ERR_OUT_OF_HOST_MEMORY, "out of host memory")                           \
+    X(OB_ERR_OUT_OF_DEVICE_MEMORY, "out of device memory")                       \
+    X(OB_ERR_NO_DEVICE, "no suitable Vulkan device")                             \
+    X(OB_ERR_DEVICE_LOST, "device lost")                                         \
+    X(OB_ERR_VULKAN, "Vulkan call failed")                                       \
+    X(OB_ERR_UNSUPPORTED, "unsupported")                                         \
+    X(OB_ERR_IO, "file input/output error")                                      \
+    X(OB_ERR_PARSE, "parse error")                                               \
+    X(OB_ERR_SHADER_COMPILE, "shader compile error")                             \
+    X(OB_ERR_TYPE_MISMATCH, "type mismatch")                                     \
+    X(OB_ERR_OUT_OF_RANGE, "out of range")                                       \
+    X(OB_ERR_DUPLICATE, "duplicate")                                             \
+    X(OB_ERR_NOT_FOUND, "not found")                                             \
+    X(OB_ERR_WRONG_STATE, "call not allowed in the current state")               \
+    X(OB_ERR_NON_FINITE, "non-finite value")                                     \
+    X(OB_ERR_BAD_MODEL, "model failed validation")                               \
+    X(OB_ERR_LIMIT, "limit exceeded")
+
+typedef enum ob_result {
+#define OB_RESULT_ENUM(name, text) name,
+    OB_RESULT_LIST(OB_RESULT_ENUM)
+#undef OB_RESULT_ENUM
+    OB_RESULT_COUNT
+} ob_result;
+
+/* Stable name of a result ("OB_ERR_IO"); never NULL. */
+const char *ob_result_name(ob_result r);
+/* Human text of a result ("file input/output error"); never NULL. */
+const char *ob_result_text(ob_result r);
+
+/* ---------------------------------------------------------------- logging */
+
+typedef enum ob_log_level {
+    OB_LOG_DEBUG = 0,
+    OB_LOG_INFO = 1,
+    OB_LOG_WARN = 2,
+    OB_LOG_ERROR = 3,
+} ob_log_level;
+
+/* A sink receives one fully formatted line (no trailing newline).
+ * module is a short tag ("vk", "params", "shader", ...); file/line locate the
+ * caller. The default sink prints "[level][module] message (file:line)" to
+ * stderr for WARN and above, and for INFO when OB_LOG=info|debug is set. */
+typedef void (*ob_log_fn)(void *user, ob_log_level level, const char *module,
+                          const char *file, int line, const char *message);
+
+/* Replace the sink (NULL restores the default). [any thread] but meant to be
+ * called once, before work starts; returns the previous sink. */
+ob_log_fn ob_log_set_sink(ob_log_fn fn, void *user, void **out_prev_user);
+
+/* Count of lines logged at WARN and at ERROR since start (any sink). */
+uint64_t ob_log_count(ob_log_level level);
+
+void ob_log_write(ob_log_level level, const char *module, const char *file,
+                  int line, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+void ob_log_writev(ob_log_level level, const char *module, const char *file,
+                   int line, const char *fmt, va_list ap);
+
+#define OB_LOG_E(module, ...) ob_log_write(OB_LOG_ERROR, module, __FILE__, __LINE__, __VA_ARGS__)
+#define OB_LOG_W(module, ...) ob_log_write(OB_LOG_WARN, module, __FILE__, __LINE__, __VA_ARGS__)
+#define OB_LOG_I(module, ...) ob_log_write(OB_LOG_INFO, module, __FILE__, __LINE__, __VA_ARGS__)
+#define OB_LOG_D(module, ...) ob_log_write(OB_LOG_DEBUG, module, __FILE__, __LINE__, __VA_ARGS__)
+
+/* ------------------------------------------------------------- allocation */
+
+/* Every host allocation in Obelisk goes through these, so tests can fail the
+ * Nth one (ob_fault_*). They behave like malloc/calloc/realloc/free;
+ * ob_free(NULL) is a no-op. ob_aligned_alloc's memory is freed with
+ * ob_aligned_free (alignment must be a power of two). */
+void *ob_malloc(size_t size);
+void *ob_calloc(size_t count, size_t size);
+void *ob_realloc(void *ptr, size_t size);
+void ob_free(void *ptr);
+void *ob_aligned_alloc(size_t alignment, size_t size);
+void ob_aligned_free(void *ptr);
+char *ob_strdup(const char *s);
+
+/* Grow a dynamic array so it holds at least `need` elements of elem_size.
+ * *items and *cap are updated only on success. */
+ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t elem_size);
+
+/* ---------------------------------------------------------- fault injection */
+
+typedef enum ob_fault_kind {
+    OB_FAULT_HOST_ALLOC = 0,   /* ob_malloc & co. return NULL */
+    OB_FAULT_VK_OBJECT = 1,    /* a Vulkan allocation or object creation fails */
+    OB_FAULT_KIND_COUNT
+} ob_fault_kind;
+
+/* Arm: the nth (1-based) call of that kind from now on fails; 0 disarms.
+ * ob_fault_hit says whether an armed fault fired since arming; ob_fault_count
+ * how many calls of that kind were made since arming (walk every point by
+ * running once unarmed and looping n from 1 to that count). [any thread] */
+void ob_fault_arm(ob_fault_kind kind, uint64_t nth);
+bool ob_fault_hit(ob_fault_kind kind);
+uint64_t ob_fault_count(ob_fault_kind kind);
+/* Called at each fault point; true means "fail this one". */
+bool ob_fault_should_fail(ob_fault_kind kind);
+
+/* ---------------------------------------------------------------- handles */
+
+/* Resource handles: id 0 is invalid; the low 20 bits are a pool index + 1,
+ * the high 12 bits a generation that changes on every reuse of the slot. */
+typedef struct ob_buffer { uint32_t id; } ob_buffer;
+typedef struct ob_image { uint32_t id; } ob_image;
+typedef struct ob_sampler { uint32_t id; } ob_sampler;
+
+#define OB_HANDLE_INDEX_BITS 20u
+#define OB_HANDLE_INDEX_MASK ((1u << OB_HANDLE_INDEX_BITS) - 1u)
+#define OB_HANDLE_MAX_SLOTS (OB_HANDLE_INDEX_MASK - 1u)
+
+/* A generation-checked slot pool (render thread). Slots hold a user pointer. */
+typedef struct ob_pool {
+    uint32_t cap;        /* allocated slots */
+    uint32_t count;      /* live slots */
+    uint32_t free_head;  /* 1-based index of the first free slot, 0 = none */
+    uint32_t *gen;       /* generation per slot (1..4095) */
+    uint32_t *next_free; /* free-list links */
+    void **items;        /* payload per slot, NULL when free */
+} ob_pool;
+
+void ob_pool_init(ob_pool *pool);
+void ob_pool_release(ob_pool *pool);
+/* Stores item, returns its id (0 with *out_result set on failure). */
+uint32_t ob_pool_insert(ob_pool *pool, void *item, ob_result *out_result);
+/* The item for id, or NULL if id is zero, out of range or stale. */
+void *ob_pool_get(const ob_pool *pool, uint32_t id);
+/* Frees id's slot and returns its item (NULL if stale). */
+void *ob_pool_remove(ob_pool *pool, uint32_t id);
+/* Iterate live items: start with *cursor = 0; returns NULL at the end. */
+void *ob_pool_next(const ob_pool *pool, uint32_t *cursor, uint32_t *out_id);
+
+/* ----------------------------------------------------------- hash & time */
+
+#define OB_HASH_SEED 0xcbf29ce484222325ull
+/* 64-bit hash of bytes, continuing from h (start with OB_HASH_SEED).
+ * Stable across runs and platforms of the same endianness. */
+uint64_t ob_hash_bytes(uint64_t h, const void *data, size_t size);
+uint64_t ob_hash_u64(uint64_t h, uint64_t v);
+static inline uint64_t ob_hash_str(uint64_t h, const char *s);
+
+/* Monotonic time in nanoseconds. */
+uint64_t ob_time_ns(void);
+
+/* Read a whole file into a NUL-terminated buffer (ob_free it). On failure
+ * returns NULL, logs the path and the OS error, and sets *out_result. */
+char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result);
+/* Write a file atomically (temp file + rename). */
+ob_result ob_file_write(const char *path, const void *data, size_t size);
+/* mkdir -p. */
+ob_result ob_dir_make(const char *path);
+
+static inline uint64_t ob_hash_str(uint64_t h, const char *s)
+{
+    size_t n = 0;
+    while (s[n]) n++;
+    return ob_hash_bytes(h, s, n);
+}
+
+#define OB_ARRAY_COUNT(a) (sizeof(a) / sizeof((a)[0]))
+#define OB_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define OB_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define OB_CACHE_LINE 64u
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_CORE_H */

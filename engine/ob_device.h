@@ -1,0 +1,119 @@
+/* ob_device.h — the Vulkan instance, physical device, logical device and queue.
+ *
+ * Lifecycle: ob_device_create → (frames) → ob_device_destroy. The renderer
+ * creates one device and exposes it through ob_renderer_device(); tests and
+ * tools may create a device alone.
+ *
+ * Device choice: a real GPU (discrete, then integrated) is preferred; lavapipe
+ * (VK_PHYSICAL_DEVICE_TYPE_CPU) is the fallback. OB_DEVICE=lavapipe|gpu|<index>
+ * overrides, as does ob_device_desc.device. Requirements: Vulkan 1.3 with
+ * dynamicRendering and synchronization2, one queue family with graphics +
+ * compute + transfer, VK_KHR_push_descriptor.
+ *
+ * Validation: with OB_VALIDATION=1 (or desc.validation > 0) the instance
+ * enables VK_LAYER_KHRONOS_validation with synchronization validation. Every
+ * message goes into the engine log (module "vk") and is counted; tests read
+ * the counts through ob_device_validation_counts().
+ *
+ * Thread rule: creation and destruction [render thread]. The accessors are
+ * [any thread]. The queue is owned by the render thread (submission).
+ */
+#ifndef OB_DEVICE_H
+#define OB_DEVICE_H
+
+#include "ob_core.h"
+
+#include <vulkan/vulkan.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Always runs `call`; on failure logs file, line, the call text and the
+ * VkResult name (module "vk") and evaluates to the VkResult. Never returns
+ * from the caller by itself. */
+#define OB_VK_CHECK(call) ob_vk_check((call), #call, __FILE__, __LINE__)
+VkResult ob_vk_check(VkResult res, const char *call_text, const char *file, int line);
+const char *ob_vk_result_name(VkResult res);
+/* Wrap every vkCreate* / vkAllocate* call of the engine in OB_VK_CREATE so the
+ * fault-injection tests can fail the Nth one (it then yields
+ * VK_ERROR_OUT_OF_DEVICE_MEMORY without making the call). */
+#define OB_VK_CREATE(call) \
+    (ob_fault_should_fail(OB_FAULT_VK_OBJECT) ? VK_ERROR_OUT_OF_DEVICE_MEMORY : (call))
+/* Maps a VkResult to an ob_result (OUT_OF_DEVICE_MEMORY, DEVICE_LOST, ...). */
+ob_result ob_result_from_vk(VkResult res);
+
+typedef struct ob_device ob_device;
+
+typedef struct ob_device_desc {
+    const char *app_name;     /* NULL → "obelisk" */
+    const char *device;       /* NULL → $OB_DEVICE → auto ("lavapipe", "gpu" or an index) */
+    int validation;           /* 0 → $OB_VALIDATION; >0 on; <0 off */
+    uint32_t frames_in_flight;/* 0 → 2; the number of frame slots for deferred deletion */
+} ob_device_desc;
+
+typedef struct ob_validation_counts {
+    uint32_t errors;
+    uint32_t warnings;   /* warnings + performance warnings */
+    uint32_t infos;
+} ob_validation_counts;
+
+/* Creates the device. On failure returns NULL, sets *out_result
+ * (OB_ERR_NO_DEVICE when no device meets the requirements) and logs why. */
+ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result);
+/* Waits idle, runs every deferred deletion, destroys. NULL is a no-op. */
+void ob_device_destroy(ob_device *dev);
+
+VkInstance ob_device_vk_instance(const ob_device *dev);
+VkPhysicalDevice ob_device_vk_physical(const ob_device *dev);
+VkDevice ob_device_vk(const ob_device *dev);
+VkQueue ob_device_vk_queue(const ob_device *dev);
+uint32_t ob_device_queue_family(const ob_device *dev);
+const VkPhysicalDeviceProperties *ob_device_properties(const ob_device *dev);
+/* "llvmpipe (LLVM 15.0.6, 256 bits)" and "Mesa 22.3.6 (LLVM 15.0.6)". */
+const char *ob_device_name(const ob_device *dev);
+const char *ob_device_driver_info(const ob_device *dev);
+bool ob_device_is_cpu(const ob_device *dev);
+/* Nanoseconds per timestamp tick (0 if timestamps are unsupported). */
+double ob_device_timestamp_period_ns(const ob_device *dev);
+PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev);
+
+ob_validation_counts ob_device_validation_counts(const ob_device *dev);
+bool ob_device_validation_enabled(const ob_device *dev);
+
+/* Give a Vulkan object a debug name (no-op without debug utils). */
+void ob_device_set_name(ob_device *dev, VkObjectType type, uint64_t handle, const char *name);
+
+/* Returns the memory type index with all `required` property flags among
+ * type_bits, or UINT32_MAX. */
+uint32_t ob_device_memory_type(const ob_device *dev, uint32_t type_bits,
+                               VkMemoryPropertyFlags required);
+
+/* ---- frame slots and deferred deletion --------------------------------
+ * The renderer tells the device which frame slot it is recording (after the
+ * slot's fence has signalled). Destruction of a resource used in the current
+ * frame is deferred until that slot comes round again. */
+uint32_t ob_device_frames_in_flight(const ob_device *dev);
+/* The slot's previous work is complete: run its deferred deletions and make
+ * it current. [render thread] */
+void ob_device_begin_frame_slot(ob_device *dev, uint32_t slot);
+uint32_t ob_device_current_slot(const ob_device *dev);
+typedef void (*ob_deferred_fn)(ob_device *dev, void *payload);
+/* Queue fn(dev, payload) to run when the current slot's work is complete.
+ * If the queue cannot grow, waits idle and runs it now. [render thread] */
+void ob_device_defer(ob_device *dev, ob_deferred_fn fn, void *payload);
+
+/* One-shot command buffer for uploads and read-backs: begin, record, then
+ * submit and wait. [render thread] */
+ob_result ob_device_oneshot_begin(ob_device *dev, VkCommandBuffer *out_cmd);
+ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd);
+
+/* Records a device-loss or out-of-memory result seen anywhere; once lost the
+ * device refuses new work with OB_ERR_DEVICE_LOST but can still be destroyed. */
+void ob_device_note_result(ob_device *dev, VkResult res);
+bool ob_device_is_lost(const ob_device *dev);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_DEVICE_H */

@@ -1,0 +1,136 @@
+/* ob_resources.h — buffers, images and samplers behind generation-checked handles.
+ *
+ * Lifecycle: create → use in frames → destroy. Destruction is deferred until
+ * the frame slot that was current at destroy time has finished on the GPU
+ * (ob_device_defer), so a handle may be destroyed right after recording a
+ * draw that uses it. The handle itself is invalid at once.
+ *
+ * Memory: one VkDeviceMemory per resource (no sub-allocation). Simple and
+ * exact to free; its limit is maxMemoryAllocationCount (4096 on many
+ * desktop drivers, unlimited on lavapipe), so geometry should be batched
+ * into few large buffers on a real GPU. Uniform data does not allocate per
+ * draw: it goes through per-thread rings (one buffer each).
+ *
+ * Thread rule: create/destroy/upload/read-back are [render thread]. The
+ * ob_*_vk accessors are [any thread] during recording: workers may resolve
+ * handles while the render thread does not create or destroy resources.
+ * Failure: creation returns a zero handle and sets *out_result; a zero or stale
+ * handle anywhere returns OB_ERR_INVALID_HANDLE (and logs), never crashes.
+ */
+#ifndef OB_RESOURCES_H
+#define OB_RESOURCES_H
+
+#include "ob_device.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum ob_buffer_usage {
+    OB_BUFFER_VERTEX = 1u << 0,
+    OB_BUFFER_INDEX = 1u << 1,
+    OB_BUFFER_UNIFORM = 1u << 2,
+    OB_BUFFER_STORAGE = 1u << 3,
+    OB_BUFFER_INDIRECT = 1u << 4,
+    OB_BUFFER_TRANSFER_SRC = 1u << 5,
+    OB_BUFFER_TRANSFER_DST = 1u << 6,
+} ob_buffer_usage;
+
+typedef struct ob_buffer_desc {
+    uint64_t size;          /* bytes; 0 is an error */
+    uint32_t usage;         /* ob_buffer_usage bits */
+    bool host_visible;      /* mapped, host-coherent (rings, read-back); else device-local */
+    const void *data;       /* optional initial contents (staged when not host visible) */
+    uint64_t data_size;     /* bytes of data (≤ size); 0 → size when data is set */
+    const char *name;       /* debug name (copied) */
+} ob_buffer_desc;
+
+ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result *out_result);
+void ob_buffer_destroy(ob_device *dev, ob_buffer buf);   /* deferred; zero handle is a no-op */
+bool ob_buffer_is_valid(const ob_device *dev, ob_buffer buf);
+VkBuffer ob_buffer_vk(const ob_device *dev, ob_buffer buf);        /* VK_NULL_HANDLE if invalid */
+uint64_t ob_buffer_size(const ob_device *dev, ob_buffer buf);
+void *ob_buffer_mapped(const ob_device *dev, ob_buffer buf);       /* NULL unless host visible */
+/* Copies data into the buffer (memcpy when host visible, else staging + one-shot
+ * copy that waits). Range-checked. */
+ob_result ob_buffer_upload(ob_device *dev, ob_buffer buf, uint64_t offset,
+                           const void *data, uint64_t size);
+
+typedef enum ob_image_usage {
+    OB_IMAGE_SAMPLED = 1u << 0,
+    OB_IMAGE_COLOR_TARGET = 1u << 1,
+    OB_IMAGE_DEPTH_TARGET = 1u << 2,
+    OB_IMAGE_STORAGE = 1u << 3,
+    OB_IMAGE_TRANSFER_SRC = 1u << 4,   /* read-back */
+    OB_IMAGE_TRANSFER_DST = 1u << 5,   /* upload */
+} ob_image_usage;
+
+typedef struct ob_image_desc {
+    uint32_t width, height;  /* 0 is an error */
+    uint32_t layers;         /* 0 → 1; >1 makes a 2D array (paraboloid maps use 2) */
+    VkFormat format;         /* must support the usage on this device, else OB_ERR_UNSUPPORTED */
+    uint32_t usage;          /* ob_image_usage bits */
+    const void *data;        /* optional tightly packed texels for every layer */
+    const char *name;
+} ob_image_desc;
+
+ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *out_result);
+void ob_image_destroy(ob_device *dev, ob_image img);      /* deferred */
+bool ob_image_is_valid(const ob_device *dev, ob_image img);
+VkImage ob_image_vk(const ob_device *dev, ob_image img);
+/* The view over all layers (2D or 2D array), and a view of a single layer
+ * (for rendering into one paraboloid half). */
+VkImageView ob_image_view(const ob_device *dev, ob_image img);
+VkImageView ob_image_layer_view(const ob_device *dev, ob_image img, uint32_t layer);
+typedef struct ob_image_info {
+    uint32_t width, height, layers;
+    VkFormat format;
+    uint32_t usage;
+    VkImageAspectFlags aspect;
+} ob_image_info;
+ob_result ob_image_get_info(const ob_device *dev, ob_image img, ob_image_info *out_info);
+
+/* Layout tracking for barrier generation, whole image. The state is what the
+ * image will be in after all work recorded so far (render thread only). */
+typedef struct ob_image_state {
+    VkImageLayout layout;
+    VkPipelineStageFlags2 stages;
+    VkAccessFlags2 access;
+} ob_image_state;
+ob_result ob_image_get_state(const ob_device *dev, ob_image img, ob_image_state *out_state);
+/* Fills *out_barrier for moving img to `next` and records next as the state.
+ * Returns false (no barrier needed) when the image is already in a read-only
+ * state equal to next. */
+bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *next,
+                         VkImageMemoryBarrier2 *out_barrier);
+
+/* Reads the image (layer 0) back as tightly packed RGBA8 (colour formats
+ * R8G8B8A8/B8G8R8A8, swizzled to RGBA). Waits for the device to be idle.
+ * out must hold width*height*4 bytes. */
+ob_result ob_image_read_rgba8(ob_device *dev, ob_image img, uint8_t *out);
+/* Reads back and writes a PNG (stb_image_write). */
+ob_result ob_image_write_png(ob_device *dev, ob_image img, const char *path);
+
+typedef struct ob_sampler_desc {
+    VkFilter filter;                   /* 0 = NEAREST; use LINEAR explicitly */
+    VkSamplerAddressMode address;      /* 0 = REPEAT */
+    bool compare;                      /* depth comparison (shadow maps) */
+    VkCompareOp compare_op;
+    const char *name;
+} ob_sampler_desc;
+
+ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_result *out_result);
+void ob_sampler_destroy(ob_device *dev, ob_sampler s);    /* deferred */
+VkSampler ob_sampler_vk(const ob_device *dev, ob_sampler s);
+
+/* Counts of live resources (leak checks in tests). */
+typedef struct ob_resource_counts {
+    uint32_t buffers, images, samplers;
+    uint64_t device_bytes;
+} ob_resource_counts;
+ob_resource_counts ob_resource_counts_get(const ob_device *dev);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_RESOURCES_H */

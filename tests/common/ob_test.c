@@ -1,0 +1,91 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_test.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CAPTURE_MAX 4096
+
+static pthread_mutex_t capture_lock = PTHREAD_MUTEX_INITIALIZER;
+static char *captured[CAPTURE_MAX];
+static ob_log_level captured_level[CAPTURE_MAX];
+static uint32_t captured_count;
+
+static void capture_sink(void *user, ob_log_level level, const char *module,
+                         const char *file, int line, const char *message)
+{
+    (void)user;
+    char buf[1400];
+    const char *base = strrchr(file, '/');
+    snprintf(buf, sizeof buf, "[%s] %s (%s:%d)", module, message, base ? base + 1 : file, line);
+    if (level >= OB_LOG_WARN || getenv("OB_LOG")) fprintf(stderr, "%s\n", buf);
+    pthread_mutex_lock(&capture_lock);
+    if (captured_count < CAPTURE_MAX) {
+        size_t n = strlen(buf) + 1;
+        char *copy = malloc(n); /* test-side bookkeeping: not an engine allocation */
+        if (copy) {
+            memcpy(copy, buf, n);
+            captured_level[captured_count] = level;
+            captured[captured_count++] = copy;
+        }
+    }
+    pthread_mutex_unlock(&capture_lock);
+}
+
+static void free_captured(void)
+{
+    pthread_mutex_lock(&capture_lock);
+    for (uint32_t i = 0; i < captured_count; i++) free(captured[i]);
+    captured_count = 0;
+    pthread_mutex_unlock(&capture_lock);
+}
+
+void ob_test_setup_log(void)
+{
+    static int installed;
+    if (installed) return;
+    installed = 1;
+    ob_log_set_sink(capture_sink, NULL, NULL);
+    atexit(free_captured);
+}
+
+void ob_test_log_clear(void) { free_captured(); }
+
+bool ob_test_log_has(const char *needle, ...)
+{
+    bool found = false;
+    pthread_mutex_lock(&capture_lock);
+    for (uint32_t i = 0; i < captured_count && !found; i++) {
+        va_list ap;
+        va_start(ap, needle);
+        bool all = true;
+        for (const char *n = needle; n; n = va_arg(ap, const char *)) {
+            if (!strstr(captured[i], n)) { all = false; break; }
+        }
+        va_end(ap);
+        found = all;
+    }
+    pthread_mutex_unlock(&capture_lock);
+    return found;
+}
+
+uint32_t ob_test_log_count(ob_log_level min_level)
+{
+    uint32_t n = 0;
+    pthread_mutex_lock(&capture_lock);
+    for (uint32_t i = 0; i < captured_count; i++) n += captured_level[i] >= min_level;
+    pthread_mutex_unlock(&capture_lock);
+    return n;
+}
+
+uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h)
+{
+    uint32_t m = 0;
+    for (size_t i = 0; i < (size_t)w * h * 4; i++) {
+        uint32_t d = a[i] > b[i] ? a[i] - b[i] : b[i] - a[i];
+        if (d > m) m = d;
+    }
+    return m;
+}

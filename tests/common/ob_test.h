@@ -1,0 +1,38 @@
+/* ob_test.h — helpers shared by every test suite.
+ *
+ * Log capture: every test installs the capture sink (ob_test_setup_log) so a
+ * test can assert on the messages a user would see, and so any message from
+ * the Vulkan validation layer (module "vk-validation") fails the test.
+ */
+#ifndef OB_TEST_H
+#define OB_TEST_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "ob_core.h"
+#include "ob_device.h"
+
+/* Install the capturing log sink (idempotent). Lines are kept and echoed to stderr. */
+void ob_test_setup_log(void);
+/* Forget captured lines. */
+void ob_test_log_clear(void);
+/* True if any captured line (since the last clear) contains every given
+ * substring (NULL-terminated list). */
+bool ob_test_log_has(const char *needle, ...);
+/* Count of captured lines at or above level since the last clear. */
+uint32_t ob_test_log_count(ob_log_level min_level);
+
+/* A device with validation (and synchronization validation) forced on.
+ * Fails the test if no device exists. */
+ob_device *ob_test_device_create(void);
+/* Fails the test if the validation layer reported any error or warning. */
+void ob_test_assert_no_validation(const ob_device *dev);
+
+/* Largest absolute per-channel difference of two RGBA8 images. */
+uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h);
+
+#endif

@@ -1,0 +1,91 @@
+/* Core services every module relies on: handles, results, allocation faults. */
+#include "ob_test.h"
+
+#include <string.h>
+
+static void handle_generation_rejects_stale(void **state)
+{
+    (void)state;
+    ob_pool pool;
+    ob_pool_init(&pool);
+    int a = 1, b = 2;
+    ob_result r;
+    uint32_t ida = ob_pool_insert(&pool, &a, &r);
+    assert_int_equal(r, OB_OK);
+    assert_ptr_equal(ob_pool_get(&pool, ida), &a);
+    assert_ptr_equal(ob_pool_remove(&pool, ida), &a);
+    assert_null(ob_pool_get(&pool, ida));
+    uint32_t idb = ob_pool_insert(&pool, &b, &r);
+    /* The slot is reused but the old handle stays dead. */
+    assert_int_equal(idb & OB_HANDLE_INDEX_MASK, ida & OB_HANDLE_INDEX_MASK);
+    assert_int_not_equal(idb, ida);
+    assert_null(ob_pool_get(&pool, ida));
+    assert_ptr_equal(ob_pool_get(&pool, idb), &b);
+    assert_null(ob_pool_get(&pool, 0));
+    assert_null(ob_pool_remove(&pool, ida));
+    ob_pool_release(&pool);
+}
+
+static void pool_grows_and_iterates(void **state)
+{
+    (void)state;
+    ob_pool pool;
+    ob_pool_init(&pool);
+    static int items[1000];
+    uint32_t ids[1000];
+    for (int i = 0; i < 1000; i++) ids[i] = ob_pool_insert(&pool, &items[i], NULL);
+    for (int i = 0; i < 1000; i += 2) ob_pool_remove(&pool, ids[i]);
+    uint32_t cursor = 0, id, seen = 0;
+    while (ob_pool_next(&pool, &cursor, &id)) seen++;
+    assert_int_equal(seen, 500);
+    assert_int_equal(pool.count, 500);
+    ob_pool_release(&pool);
+}
+
+static void result_names_are_stable(void **state)
+{
+    (void)state;
+    assert_string_equal(ob_result_name(OB_OK), "OB_OK");
+    assert_string_equal(ob_result_name(OB_ERR_INVALID_HANDLE), "OB_ERR_INVALID_HANDLE");
+    assert_string_equal(ob_result_name((ob_result)9999), "OB_RESULT_UNKNOWN");
+}
+
+static void nth_host_allocation_fails(void **state)
+{
+    (void)state;
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 3);
+    void *a = ob_malloc(8), *b = ob_malloc(8), *c = ob_malloc(8), *d = ob_malloc(8);
+    assert_non_null(a);
+    assert_non_null(b);
+    assert_null(c);
+    assert_non_null(d);
+    assert_true(ob_fault_hit(OB_FAULT_HOST_ALLOC));
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+    ob_free(a);
+    ob_free(b);
+    ob_free(d);
+}
+
+static void missing_file_names_path(void **state)
+{
+    (void)state;
+    ob_test_log_clear();
+    ob_result r;
+    char *s = ob_file_read("/nonexistent/obelisk.txt", NULL, &r);
+    assert_null(s);
+    assert_int_equal(r, OB_ERR_IO);
+    assert_true(ob_test_log_has("/nonexistent/obelisk.txt", NULL));
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(handle_generation_rejects_stale),
+        cmocka_unit_test(pool_grows_and_iterates),
+        cmocka_unit_test(result_names_are_stable),
+        cmocka_unit_test(nth_host_allocation_fails),
+        cmocka_unit_test(missing_file_names_path),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
