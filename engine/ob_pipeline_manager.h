@@ -1,0 +1,112 @@
+/* ob_pipeline_manager.h — records one thread's commands with redundant-state filtering.
+ *
+ * Hieroglyph 3's PipelineManagerDX11: a pipeline manager wraps one command
+ * buffer — the primary (immediate) or a secondary (deferred) — and is the only
+ * code that calls vkCmd* for draws. Views and entities set desired state
+ * (pipeline + program, vertex/index buffers, viewport, scissor) and issue draws;
+ * the manager binds only what differs from the current state and counts
+ * requested vs issued binds.
+ *
+ * Uniform data: at each draw the manager packs the program's uniform blocks
+ * from its parameter slot into its uniform ring (one per frame slot) — only
+ * when a mapped parameter changed since the block was last packed — and binds
+ * them with dynamic offsets. Images, samplers and storage buffers go through
+ * push descriptors; push-constant blocks are packed from parameters too.
+ *
+ * Command hash: every draw folds the state it draws with (stable ids and
+ * uniform contents, never pointers or ring offsets) into a polynomial rolling
+ * hash. Hashes of consecutive chunks combine (ob_cmd_hash_concat) into the hash
+ * of the whole sequence, so a view recorded inline, or split into chunks
+ * recorded by different threads, hashes the same.
+ *
+ * Lifecycle: create (render thread) → per frame: begin_frame(slot) → any number
+ * of begin(cmd)/.../end() → destroy (after the device is idle).
+ * Thread rule: a manager belongs to one thread at a time [worker: own slot only];
+ * it only reads shared immutable data (programs, geometry, parameter registry).
+ */
+#ifndef OB_PIPELINE_MANAGER_H
+#define OB_PIPELINE_MANAGER_H
+
+#include "ob_params.h"
+#include "ob_program.h"
+#include "ob_resources.h"
+
+typedef struct ob_pipeline_manager ob_pipeline_manager;
+
+typedef struct ob_pipeline_manager_desc {
+    ob_device *device;
+    ob_param_registry *registry;
+    uint32_t slot;              /* parameter slot: 0 immediate, i = worker i */
+    uint32_t frames_in_flight;  /* 0 → 2 */
+    uint64_t ring_chunk_size;   /* 0 → 4 MiB; the ring grows by chunks when full */
+    const char *name;
+} ob_pipeline_manager_desc;
+
+typedef struct ob_cmd_hash {
+    uint64_t hash;              /* polynomial rolling hash of the draw states */
+    uint64_t scale;             /* OB_CMD_HASH_BASE ^ draw count (mod 2^64) */
+    uint32_t draws;
+} ob_cmd_hash;
+
+#define OB_CMD_HASH_BASE 0x100000001b3ull
+static inline ob_cmd_hash ob_cmd_hash_empty(void) { return (ob_cmd_hash){0, 1, 0}; }
+/* Hash of sequence a followed by sequence b. */
+static inline ob_cmd_hash ob_cmd_hash_concat(ob_cmd_hash a, ob_cmd_hash b)
+{
+    return (ob_cmd_hash){a.hash * b.scale + b.hash, a.scale * b.scale, a.draws + b.draws};
+}
+
+typedef struct ob_pm_stats {
+    uint32_t draws, dispatches;
+    uint32_t pipeline_binds_requested, pipeline_binds_issued;
+    uint32_t descriptor_binds_requested, descriptor_binds_issued;  /* set 0 (dynamic UBOs) */
+    uint32_t push_descriptor_requested, push_descriptor_issued;     /* set 1 */
+    uint32_t push_constant_requested, push_constant_issued;
+    uint32_t vertex_binds_requested, vertex_binds_issued;
+    uint32_t index_binds_requested, index_binds_issued;
+    uint32_t blocks_packed, blocks_reused;
+    uint64_t uniform_bytes;
+    uint32_t skipped_draws;     /* draws refused: invalid handles, no pipeline */
+} ob_pm_stats;
+
+ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,
+                                                ob_result *out_result);
+void ob_pipeline_manager_destroy(ob_pipeline_manager *pm);
+
+/* Start of a frame in frame slot `slot` (its previous use has completed):
+ * rewinds the slot's uniform ring. frame_serial increases every frame. */
+void ob_pm_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial);
+
+/* Wrap cmd (already begun by the caller) and forget all current state. */
+void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd);
+/* Stop wrapping; returns the hash of what was drawn since begin. */
+ob_cmd_hash ob_pm_end(ob_pipeline_manager *pm);
+VkCommandBuffer ob_pm_command_buffer(const ob_pipeline_manager *pm);
+ob_params *ob_pm_params(ob_pipeline_manager *pm);
+
+/* Desired state. The pipeline id is stable (for hashes). */
+void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
+                        const ob_program *program);
+void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset);
+void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
+                            VkIndexType type);
+void ob_pm_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h);
+void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h);
+
+/* Draws apply the desired state, then record. They return OB_ERR_WRONG_STATE
+ * (no pipeline), OB_ERR_INVALID_HANDLE (a stale buffer/image parameter) or
+ * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) and skip the draw. */
+ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
+                     uint32_t first_vertex, uint32_t first_instance);
+ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+                             uint32_t instance_count, uint32_t first_index,
+                             int32_t vertex_offset, uint32_t first_instance);
+ob_result ob_pm_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+                              uint32_t draw_count);
+ob_result ob_pm_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z);
+
+/* Stats since the last ob_pm_stats_take (which resets them). */
+ob_pm_stats ob_pm_stats_take(ob_pipeline_manager *pm);
+void ob_pm_stats_add(ob_pm_stats *into, const ob_pm_stats *s);
+
+#endif /* OB_PIPELINE_MANAGER_H */

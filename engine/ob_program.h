@@ -1,0 +1,74 @@
+/* ob_program.h — the binding plan of one shader program, derived from reflection.
+ *
+ * A program turns a merged ob_reflection into what the pipeline manager needs
+ * to bind a draw's inputs with no string lookups:
+ *   set 0: every uniform block, as UNIFORM_BUFFER_DYNAMIC, packed from the
+ *          parameter system into the recording thread's uniform ring and bound
+ *          through dynamic offsets;
+ *   set 1: images, samplers and storage buffers, bound with push descriptors
+ *          (VK_KHR_push_descriptor) from resource parameters of the same name;
+ *   push constants: one block, packed from parameters like a uniform block.
+ * Every block member, image, sampler and buffer is matched to the parameter of
+ * the same name; a name with no parameter yet is registered with the type the
+ * shader declares, so a shader can add `vec4 Tint;` and the application can
+ * set "Tint" with no C change. A combined image sampler named "X" takes its
+ * image from parameter "X" and its sampler from parameter "XSampler".
+ *
+ * Lifecycle: create (render thread, not while recording: it may register
+ * parameters) → used by any number of pipeline managers → destroy (deferred
+ * by the caller until no frame uses it; the effect owns its programs).
+ * Thread rule: immutable after creation; [any thread] reads.
+ */
+#ifndef OB_PROGRAM_H
+#define OB_PROGRAM_H
+
+#include "ob_device.h"
+#include "ob_params.h"
+#include "ob_reflect.h"
+
+#define OB_PROGRAM_MAX_UBOS 8
+#define OB_PROGRAM_MAX_RESOURCES 8
+
+typedef enum ob_program_set {
+    OB_PROGRAM_SET_UNIFORMS = 0,
+    OB_PROGRAM_SET_RESOURCES = 1,
+} ob_program_set;
+
+typedef struct ob_program_ubo {
+    uint32_t binding;
+    uint32_t size;                 /* block size, rounded up to 16 */
+    ob_param_mapping *mapping;
+} ob_program_ubo;
+
+typedef struct ob_program_resource {
+    uint32_t binding;
+    ob_binding_kind kind;
+    ob_param param;                /* image, buffer or sampler parameter */
+    ob_param sampler;              /* combined image samplers: the "<name>Sampler" parameter */
+} ob_program_resource;
+
+typedef struct ob_program {
+    uint32_t id;                   /* stable: hash of the program name (command hashes use it) */
+    char name[64];
+    VkPipelineBindPoint bind_point;
+    VkDescriptorSetLayout set_layouts[2];
+    VkPipelineLayout layout;
+    uint32_t ubo_count;
+    ob_program_ubo ubos[OB_PROGRAM_MAX_UBOS];
+    uint32_t resource_count;
+    ob_program_resource resources[OB_PROGRAM_MAX_RESOURCES];
+    ob_param_mapping *push_mapping; /* NULL when the program has no push constants */
+    uint32_t push_size;
+    VkShaderStageFlags push_stages;
+} ob_program;
+
+/* Builds set layouts, the pipeline layout and parameter mappings. Errors: a
+ * uniform block outside set 0 or a resource outside set 1, too many bindings
+ * (OB_ERR_UNSUPPORTED, naming the program and binding); Vulkan failures. */
+ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
+                              const ob_reflection *refl, bool compute,
+                              const char *name, ob_result *out_result);
+/* Destroys now: the caller guarantees no pending frame uses it. NULL ok. */
+void ob_program_destroy(ob_device *dev, ob_program *prog);
+
+#endif /* OB_PROGRAM_H */

@@ -1,0 +1,155 @@
+/* ob_renderer.h — the frame: view queue, worker pool, submission, stats.
+ *
+ * Hieroglyph 3's RendererDX11 with its multithreaded task processing, on
+ * Vulkan. During PreRender views queue themselves (ob_renderer_queue_view);
+ * ob_renderer_process_views records them — dependencies first — either
+ * inline into the primary command buffer through the immediate pipeline
+ * manager (single-threaded), or as jobs handed all at once to a pool of
+ * workers, worker i recording with pipeline manager i into secondaries from
+ * its own command pool (multi-threaded). The primary then executes every
+ * view in order, with the barriers each needs, in one submission.
+ *
+ * Lifecycle: create → { begin_frame → (camera views' pre_draw) →
+ * process_views → end_frame } * → destroy.
+ * Thread rule: every function is [render thread]; workers are internal.
+ * The threading mode and the active worker count change only at begin_frame.
+ */
+#ifndef OB_RENDERER_H
+#define OB_RENDERER_H
+
+#include "ob_device.h"
+#include "ob_params.h"
+#include "ob_pipeline_manager.h"
+#include "ob_resources.h"
+#include "ob_scene.h"
+#include "ob_view.h"
+
+#define OB_MAX_WORKERS 16
+#define OB_MAX_FRAME_VIEWS 128
+
+/* The engine calls up into materials and geometry through these (filled by
+ * the higher layers: see ob_views_install in views/ob_views.h). */
+typedef struct ob_material_iface {
+    /* Render flag for the view type (Hieroglyph's Params[type].bRender). */
+    bool (*renders)(const struct ob_material *m, ob_view_type type);
+    /* Sort class: 0 opaque, 1 blended; priority orders within a class. */
+    void (*sort_info)(const struct ob_material *m, ob_view_type type,
+                      uint32_t *out_class, uint32_t *out_priority);
+    /* An entity with this material is visible to view v: queue what it needs
+     * (env maps, ...), and make the pipeline for v's targets exist (render thread). */
+    void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
+    /* Set the pipeline and the material's parameters for v. false = not drawn. */
+    bool (*apply)(struct ob_material *m, ob_node *entity, ob_pipeline_manager *pm,
+                  const ob_view *v);
+} ob_material_iface;
+
+typedef struct ob_geometry_iface {
+    /* Bind buffers and draw. */
+    ob_result (*draw)(const struct ob_geometry *g, ob_pipeline_manager *pm);
+    /* Stable id for sorting and hashing. */
+    uint32_t (*id)(const struct ob_geometry *g);
+} ob_geometry_iface;
+
+typedef enum ob_threading {
+    OB_THREADING_SINGLE = 0,   /* immediate: record everything into the primary */
+    OB_THREADING_MULTI = 1,    /* workers record secondaries */
+    OB_THREADING_AUTO = 2,     /* decide per frame from last frames' measured cost */
+} ob_threading;
+
+typedef struct ob_renderer_desc {
+    ob_device_desc device;
+    uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
+    ob_threading threading;      /* initial mode */
+    uint32_t chunk_draws;        /* target draws per job when splitting a view; 0 → 2048 */
+} ob_renderer_desc;
+
+typedef enum ob_skip_reason {
+    OB_SKIP_NONE = 0,
+    OB_SKIP_EMPTY,               /* no draws: nothing recorded */
+    OB_SKIP_RECURSION,           /* queued deeper than the recursion bound */
+    OB_SKIP_NO_CASTERS,          /* shadow view with no caster in range */
+    OB_SKIP_NOT_NEEDED,          /* nobody visible asked for it */
+    OB_SKIP_DUPLICATE,           /* already queued this frame */
+    OB_SKIP_ERROR,               /* failed (see log) */
+} ob_skip_reason;
+const char *ob_skip_reason_name(ob_skip_reason r);
+
+typedef struct ob_view_stats {
+    char name[48];
+    ob_view_type type;
+    uint32_t draws, culled, items;
+    uint32_t chunks;
+    int32_t worker;              /* worker of the first chunk; -1 = immediate */
+    uint64_t cull_ns, record_ns; /* CPU */
+    double gpu_ms;               /* from timestamps, -1 if unavailable */
+    ob_cmd_hash hash;
+    ob_skip_reason skipped;
+} ob_view_stats;
+
+typedef struct ob_frame_stats {
+    uint64_t frame;
+    ob_threading mode;
+    uint32_t workers;            /* active workers (0 = single-threaded) */
+    uint64_t update_ns, pre_render_ns, record_ns, assemble_ns, submit_ns, wait_ns, frame_ns;
+    double gpu_ms;
+    uint32_t view_count;
+    ob_view_stats views[OB_MAX_FRAME_VIEWS];
+    uint32_t skipped_count;
+    struct { char name[48]; ob_skip_reason reason; } skipped[OB_MAX_FRAME_VIEWS];
+    uint32_t draws, culled;
+    ob_pm_stats pm;              /* summed over every manager */
+    uint32_t pipelines_created, variants_created;
+    uint64_t frame_hash;         /* all view hashes in order */
+} ob_frame_stats;
+
+ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result);
+/* Waits idle, stops and joins the workers, destroys everything it created. NULL ok. */
+void ob_renderer_destroy(ob_renderer *r);
+
+ob_device *ob_renderer_device(ob_renderer *r);
+ob_param_registry *ob_renderer_registry(ob_renderer *r);
+/* The immediate parameter manager (slot 0). */
+ob_params *ob_renderer_params(ob_renderer *r);
+uint32_t ob_renderer_worker_count(const ob_renderer *r);
+
+void ob_renderer_set_material_iface(ob_renderer *r, const ob_material_iface *iface);
+void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *iface);
+const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r);
+const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r);
+
+/* Takes effect at the next begin_frame. active_workers 0 → all. */
+void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
+ob_threading ob_renderer_threading(const ob_renderer *r);
+
+/* Waits for this frame slot's fence, collects its GPU timings, resets its
+ * pools and rings, applies a pending mode change. */
+ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene);
+ob_scene *ob_renderer_scene(ob_renderer *r);
+uint64_t ob_renderer_frame_serial(const ob_renderer *r);
+
+/* Queue v for this frame. Returns false (and records why in the stats) when v
+ * is already queued or the PreRender chain is deeper than max_recursion. The
+ * current recursion depth rises while a queued view runs its pre_draw. */
+bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
+void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
+void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
+uint32_t ob_renderer_recursion_depth(const ob_renderer *r);
+/* The view whose pre_draw is running (NULL outside PreRender). */
+ob_view *ob_renderer_current_view(const ob_renderer *r);
+
+/* Record every queued view (dependencies first) and submit. */
+ob_result ob_renderer_process_views(ob_renderer *r);
+
+/* Time the application spent updating the scene, for the stats. */
+void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns);
+
+/* Completes the frame. */
+ob_result ob_renderer_end_frame(ob_renderer *r);
+/* Waits for all submitted frames; their stats (with GPU times) become final. */
+ob_result ob_renderer_wait_idle(ob_renderer *r);
+/* Stats of the most recent frame whose GPU work is known complete. */
+const ob_frame_stats *ob_renderer_last_stats(const ob_renderer *r);
+/* Stats of the frame just submitted (CPU parts final, GPU times pending). */
+const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r);
+
+#endif /* OB_RENDERER_H */

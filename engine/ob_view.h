@@ -1,0 +1,126 @@
+/* ob_view.h — the render view interface (Hieroglyph 3's SceneRenderTask).
+ *
+ * A view is one pass of the frame: a camera's colour + depth, a light's shadow
+ * map, an environment map, a simulation, an overlay. Concrete views live in
+ * views/ and embed ob_view as their first member.
+ *
+ * Frame life of a view:
+ *   pre_draw   [render thread]  queue itself (ob_renderer_queue_view), cull the
+ *                               scene into its draw list (ob_view_cull), and let
+ *                               visible entities' materials queue the views they
+ *                               need (ob_renderer_pre_render_entities)
+ *   begin      [render thread]  before recording: fill per-view parameters
+ *                               (set_render_params into the recording slots)
+ *   record     [any one thread] record draw-list items [first, first+count) through
+ *                               a pipeline manager; may run as several chunks on
+ *                               several workers, each into its own secondary
+ *   set_usage_params            what consumers need (its output texture), applied
+ *                               by the renderer before a consumer records
+ *
+ * Ownership: the application (or the views layer) owns views; the renderer only
+ * holds them in its queue for one frame.
+ */
+#ifndef OB_VIEW_H
+#define OB_VIEW_H
+
+#include "ob_pipeline_manager.h"
+#include "ob_scene.h"
+
+typedef struct ob_renderer ob_renderer;
+
+typedef enum ob_view_type {
+    OB_VIEW_PERSPECTIVE = 0,
+    OB_VIEW_SHADOW,
+    OB_VIEW_PARABOLOID,
+    OB_VIEW_SIMULATION,
+    OB_VIEW_OVERLAY,
+    OB_VIEW_COMPOSITE,
+    OB_VIEW_TYPE_COUNT
+} ob_view_type;
+
+const char *ob_view_type_name(ob_view_type t);
+
+#define OB_VIEW_MAX_DEPS 8
+#define OB_VIEW_MAX_LAYERS 2
+
+typedef struct ob_view ob_view;
+
+/* One entry of a view's draw list. */
+typedef struct ob_draw_item {
+    uint64_t sort_key;      /* class, depth, priority; ties broken by entity id */
+    ob_node *node;
+} ob_draw_item;
+
+typedef struct ob_view_vtbl {
+    const char *type_name;
+    void (*pre_draw)(ob_view *v, ob_renderer *r);
+    /* Per-view parameters (matrices, lights) into a manager's slot. */
+    void (*set_render_params)(ob_view *v, ob_renderer *r, ob_params *params);
+    /* What consumers sample (e.g. the env map texture), into a manager's slot. */
+    void (*set_usage_params)(ob_view *v, ob_renderer *r, ob_params *params);
+    /* Record items [first, first+count) of layer `layer`. Compute views get
+     * count = 0 and record their dispatches with layer 0. */
+    void (*record)(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                   uint32_t layer, uint32_t first, uint32_t count);
+} ob_view_vtbl;
+
+struct ob_view {
+    const ob_view_vtbl *vtbl;
+    ob_view_type type;
+    char name[48];
+    uint32_t id;                      /* stable id: order ties, hashes */
+
+    /* Targets. A graphics view renders layer_count passes (2 for the dual
+     * paraboloid), each into layer i of color/depth (either may be zero). */
+    ob_image color, depth;
+    uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
+    uint32_t width, height;
+    float clear_color[4];
+    float clear_depth;                /* 0 with reversed-Z */
+    bool load_color;                  /* keep previous contents (overlay on final target) */
+
+    /* Inputs read by this view's draws (sampled in fragment shaders) and
+     * storage buffers written by a compute view / read by vertex shaders. */
+    uint32_t input_count;
+    ob_image inputs[OB_VIEW_MAX_DEPS];
+    ob_buffer storage_written;        /* compute views: buffer written */
+    ob_buffer storage_read;           /* graphics views: buffer read in vertex stage */
+
+    /* Per frame, filled during pre_draw; owned by the view. */
+    ob_draw_item *items;
+    uint32_t item_count, item_cap;
+    uint32_t culled;                  /* entities rejected by frustum or render flag */
+    uint32_t recursion_depth;         /* how deep in the PreRender chain it was queued */
+    ob_view *deps[OB_VIEW_MAX_DEPS];  /* views that must execute before this one */
+    uint32_t dep_count;
+    double origin[3];                 /* camera-relative rendering origin */
+    float view_proj[16];              /* culling matrix (relative to origin) */
+    uint64_t queued_frame;            /* renderer frame serial when last queued */
+    uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
+};
+
+/* Initialise the base part (name copied, id = hash of name). */
+void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const char *name);
+/* Free the draw list. */
+void ob_view_release(ob_view *v);
+
+/* Frustum-cull the scene's renderables into v->items for view type v->type,
+ * using v->origin and v->view_proj, skipping `exclude` (the owner of an env map)
+ * and entities whose material does not render in this view type; then sort
+ * the list (opaque front to back, blended back to front, priority, id).
+ * [render thread] */
+ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude);
+
+/* Record v->items[first..first+count) with the renderer's material and geometry
+ * interfaces: per item, set WorldMatrix (camera-relative), apply the material
+ * for v->type, draw the geometry. [any thread, own manager] */
+void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                          uint32_t first, uint32_t count);
+
+/* Let the material of every item queue the views it needs. [render thread] */
+void ob_view_pre_render_items(ob_view *v, ob_renderer *r);
+
+/* v cannot run before dep has: add the dependency edge (deduplicated). */
+void ob_view_add_dependency(ob_view *v, ob_view *dep);
+
+#endif /* OB_VIEW_H */
