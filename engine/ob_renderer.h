@@ -39,8 +39,8 @@ typedef struct ob_material_iface {
      * (env maps, ...), and make the pipeline for v's targets exist (render thread). */
     void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
     /* Set the pipeline and the material's parameters for v. false = not drawn. */
-    bool (*apply)(struct ob_material *m, ob_node *entity, ob_pipeline_manager *pm,
-                  const ob_view *v);
+    bool (*apply)(struct ob_material *m, ob_node *entity, ob_renderer *r,
+                  ob_pipeline_manager *pm, const ob_view *v);
 } ob_material_iface;
 
 typedef struct ob_geometry_iface {
@@ -131,11 +131,21 @@ uint64_t ob_renderer_frame_serial(const ob_renderer *r);
  * is already queued or the PreRender chain is deeper than max_recursion. The
  * current recursion depth rises while a queued view runs its pre_draw. */
 bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
+/* Run v's pre_draw with v as the current view (so views it queues become
+ * its dependencies and the recursion depth is known). Everyone starts a
+ * view's PreRender through this, never by calling pre_draw directly. */
+void ob_renderer_pre_draw(ob_renderer *r, ob_view *v);
 void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
 void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
 uint32_t ob_renderer_recursion_depth(const ob_renderer *r);
 /* The view whose pre_draw is running (NULL outside PreRender). */
 ob_view *ob_renderer_current_view(const ob_renderer *r);
+
+/* Views attached to an entity for this frame (its environment map): set by
+ * the views layer during PreRender [render thread], read by materials while
+ * recording [any thread]. Attachments are cleared at begin_frame. */
+ob_result ob_renderer_attach_view(ob_renderer *r, const ob_node *entity, ob_view *v);
+ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, ob_view_type type);
 
 /* Record every queued view (dependencies first) and submit. */
 ob_result ob_renderer_process_views(ob_renderer *r);

@@ -56,8 +56,13 @@ typedef struct ob_view_vtbl {
     void (*pre_draw)(ob_view *v, ob_renderer *r);
     /* Per-view parameters (matrices, lights) into a manager's slot. */
     void (*set_render_params)(ob_view *v, ob_renderer *r, ob_params *params);
-    /* What consumers sample (e.g. the env map texture), into a manager's slot. */
-    void (*set_usage_params)(ob_view *v, ob_renderer *r, ob_params *params);
+    /* What a consumer samples (e.g. the env map texture, the shadow map and
+     * the matrix into it from the consumer's camera-relative space), into a
+     * manager's slot. Called by the renderer for each dependency before a
+     * consumer records, and by materials per draw for views attached to an
+     * entity (ob_renderer_attached_view). [any thread: only reads v] */
+    void (*set_usage_params)(ob_view *v, ob_renderer *r, ob_params *params,
+                             const ob_view *consumer);
     /* Record items [first, first+count) of layer `layer`. Compute views get
      * count = 0 and record their dispatches with layer 0. */
     void (*record)(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,

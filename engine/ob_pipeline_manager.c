@@ -1,0 +1,692 @@
+#include "ob_pipeline_manager.h"
+
+#include <string.h>
+
+#define MAX_FRAME_SLOTS 4
+#define MAX_CHUNKS 64
+#define PACK_CACHE_SIZE 64      /* power of two */
+#define SET_CACHE_SIZE 64       /* power of two */
+#define SETS_PER_POOL 128
+#define MAX_POOLS 32
+
+typedef struct ring_chunk {
+    ob_buffer buffer;
+    VkBuffer vk;
+    uint8_t *mapped;
+    uint64_t size, used;
+} ring_chunk;
+
+/* Where a block was last packed in this frame, and what it contained. */
+typedef struct pack_entry {
+    const ob_param_mapping *mapping;
+    uint64_t frame_serial;
+    uint32_t chunk;
+    uint32_t offset;
+    uint64_t content_hash;
+} pack_entry;
+
+/* Set-0 descriptor set of a (layout, ring chunk) pair; sets live as long as
+ * the chunk, so they are written once. */
+typedef struct set_entry {
+    VkDescriptorSetLayout layout;
+    uint32_t chunk;
+    VkDescriptorSet set;
+} set_entry;
+
+typedef struct frame_ring {
+    ring_chunk chunks[MAX_CHUNKS];
+    uint32_t chunk_count, current;
+    VkDescriptorPool pools[MAX_POOLS];
+    uint32_t pool_count, sets_in_last_pool;
+    set_entry sets[SET_CACHE_SIZE];
+} frame_ring;
+
+typedef struct bound_state {
+    VkPipeline pipeline;
+    VkPipelineLayout layout;
+    VkDescriptorSet set0;
+    uint32_t offsets[OB_PROGRAM_MAX_UBOS];
+    uint32_t resource_ids[OB_PROGRAM_MAX_RESOURCES * 2];
+    bool resources_valid;
+    uint8_t push[128];
+    bool push_valid;
+    VkBuffer vb, ib;
+    uint64_t vb_offset, ib_offset;
+    VkIndexType index_type;
+    VkViewport viewport;
+    VkRect2D scissor;
+    bool viewport_valid, scissor_valid;
+} bound_state;
+
+struct ob_pipeline_manager {
+    ob_device *dev;
+    VkDevice vk;
+    ob_params params;
+    char name[32];
+    uint32_t frames_in_flight;
+    uint64_t chunk_size;
+    uint32_t ubo_align;
+    PFN_vkCmdPushDescriptorSetKHR push_descriptor;
+
+    frame_ring rings[MAX_FRAME_SLOTS];
+    frame_ring *ring;
+    uint64_t frame_serial;
+    pack_entry pack_cache[PACK_CACHE_SIZE];
+
+    VkCommandBuffer cmd;
+    bound_state cur;
+    /* desired */
+    VkPipeline pipeline;
+    uint32_t pipeline_id;
+    const ob_program *program;
+    ob_buffer vb, ib;
+    uint64_t vb_offset, ib_offset;
+    VkIndexType index_type;
+    VkViewport viewport;
+    VkRect2D scissor;
+    bool viewport_set, scissor_set;
+
+    ob_cmd_hash hash;
+    ob_pm_stats stats;
+    bool logged_error;
+};
+
+/* ------------------------------------------------------------ utilities */
+
+static uint64_t hash_words(uint64_t h, const void *data, size_t size)
+{
+    const uint8_t *p = data;
+    size_t i = 0;
+    for (; i + 8 <= size; i += 8) {
+        uint64_t w;
+        memcpy(&w, p + i, 8);
+        h = ob_hash_u64(h, w);
+    }
+    if (i < size) {
+        uint64_t w = 0;
+        memcpy(&w, p + i, size - i);
+        h = ob_hash_u64(h, w);
+    }
+    return h;
+}
+
+static void log_once(ob_pipeline_manager *pm, const char *what)
+{
+    if (pm->logged_error) return;
+    pm->logged_error = true;
+    OB_LOG_E("pm", "pipeline manager '%s': %s; draw skipped (further errors this frame "
+             "are counted, not logged)", pm->name, what);
+}
+
+/* ------------------------------------------------------------ lifecycle */
+
+ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,
+                                                ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    ob_pipeline_manager *pm = NULL;
+    if (!desc || !desc->device || !desc->registry) {
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto done;
+    }
+    pm = ob_calloc(1, sizeof *pm);
+    if (!pm) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto done;
+    }
+    pm->dev = desc->device;
+    pm->vk = ob_device_vk(desc->device);
+    r = ob_params_manager(desc->registry, desc->slot, &pm->params);
+    if (r != OB_OK) goto fail_free;
+    snprintf(pm->name, sizeof pm->name, "%s", desc->name ? desc->name : "pm");
+    pm->frames_in_flight = desc->frames_in_flight ? desc->frames_in_flight : 2;
+    if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
+    pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
+    const VkPhysicalDeviceLimits *lim = &ob_device_properties(pm->dev)->limits;
+    pm->ubo_align = (uint32_t)OB_MAX(lim->minUniformBufferOffsetAlignment, 16u);
+    pm->push_descriptor = ob_device_push_descriptor_fn(pm->dev);
+    pm->ring = &pm->rings[0];
+    pm->hash = ob_cmd_hash_empty();
+    goto done;
+
+fail_free:
+    ob_free(pm);
+    pm = NULL;
+done:
+    if (out_result) *out_result = r;
+    return pm;
+}
+
+void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
+{
+    if (!pm) return;
+    for (uint32_t s = 0; s < MAX_FRAME_SLOTS; s++) {
+        frame_ring *fr = &pm->rings[s];
+        for (uint32_t i = 0; i < fr->chunk_count; i++) ob_buffer_destroy(pm->dev, fr->chunks[i].buffer);
+        for (uint32_t i = 0; i < fr->pool_count; i++)
+            vkDestroyDescriptorPool(pm->vk, fr->pools[i], NULL);
+    }
+    ob_free(pm);
+}
+
+void ob_pm_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial)
+{
+    pm->ring = &pm->rings[slot % MAX_FRAME_SLOTS];
+    for (uint32_t i = 0; i < pm->ring->chunk_count; i++) pm->ring->chunks[i].used = 0;
+    pm->ring->current = 0;
+    pm->frame_serial = frame_serial;
+    pm->logged_error = false;
+}
+
+void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd)
+{
+    pm->cmd = cmd;
+    memset(&pm->cur, 0, sizeof pm->cur);
+    pm->pipeline = VK_NULL_HANDLE;
+    pm->program = NULL;
+    pm->vb = pm->ib = (ob_buffer){0};
+    pm->viewport_set = pm->scissor_set = false;
+    pm->hash = ob_cmd_hash_empty();
+}
+
+ob_cmd_hash ob_pm_end(ob_pipeline_manager *pm)
+{
+    ob_cmd_hash h = pm->hash;
+    pm->cmd = VK_NULL_HANDLE;
+    pm->hash = ob_cmd_hash_empty();
+    return h;
+}
+
+VkCommandBuffer ob_pm_command_buffer(const ob_pipeline_manager *pm) { return pm->cmd; }
+ob_params *ob_pm_params(ob_pipeline_manager *pm) { return &pm->params; }
+
+/* ------------------------------------------------------------ desired state */
+
+void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
+                        const ob_program *program)
+{
+    pm->pipeline = pipeline;
+    pm->pipeline_id = pipeline_id;
+    pm->program = program;
+}
+
+void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
+{
+    pm->vb = buf;
+    pm->vb_offset = offset;
+}
+
+void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
+                            VkIndexType type)
+{
+    pm->ib = buf;
+    pm->ib_offset = offset;
+    pm->index_type = type;
+}
+
+void ob_pm_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h)
+{
+    pm->viewport = (VkViewport){x, y, w, h, 0.0f, 1.0f};
+    pm->viewport_set = true;
+}
+
+void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h)
+{
+    pm->scissor = (VkRect2D){{x, y}, {w, h}};
+    pm->scissor_set = true;
+}
+
+/* ------------------------------------------------------------ uniform ring */
+
+static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *out_chunk,
+                            uint32_t *out_offset)
+{
+    frame_ring *fr = pm->ring;
+    for (;;) {
+        if (fr->current < fr->chunk_count) {
+            ring_chunk *c = &fr->chunks[fr->current];
+            uint64_t off = (c->used + pm->ubo_align - 1) & ~(uint64_t)(pm->ubo_align - 1);
+            if (off + size <= c->size) {
+                c->used = off + size;
+                *out_chunk = fr->current;
+                *out_offset = (uint32_t)off;
+                return OB_OK;
+            }
+            fr->current++;
+            continue;
+        }
+        if (fr->chunk_count >= MAX_CHUNKS) return OB_ERR_LIMIT;
+        ob_result r;
+        ob_buffer_desc bd = {
+            .size = pm->chunk_size,
+            .usage = OB_BUFFER_UNIFORM,
+            .host_visible = true,
+            .name = pm->name,
+        };
+        ring_chunk *c = &fr->chunks[fr->chunk_count];
+        c->buffer = ob_buffer_create(pm->dev, &bd, &r);
+        if (!c->buffer.id) return r;
+        c->vk = ob_buffer_vk(pm->dev, c->buffer);
+        c->mapped = ob_buffer_mapped(pm->dev, c->buffer);
+        c->size = pm->chunk_size;
+        c->used = 0;
+        fr->chunk_count++;
+    }
+}
+
+static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map)
+{
+    uint32_t h = (uint32_t)(((uintptr_t)map >> 4) * 2654435761u) & (PACK_CACHE_SIZE - 1);
+    for (uint32_t i = 0; i < PACK_CACHE_SIZE; i++) {
+        pack_entry *e = &pm->pack_cache[(h + i) & (PACK_CACHE_SIZE - 1)];
+        if (e->mapping == map || !e->mapping || e->frame_serial != pm->frame_serial) {
+            return e;
+        }
+    }
+    return &pm->pack_cache[h]; /* full: evict */
+}
+
+static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
+{
+    if (fr->pool_count >= MAX_POOLS) return OB_ERR_LIMIT;
+    VkDescriptorPoolSize size = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC,
+                                 SETS_PER_POOL * OB_PROGRAM_MAX_UBOS};
+    VkDescriptorPoolCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = SETS_PER_POOL,
+        .poolSizeCount = 1,
+        .pPoolSizes = &size,
+    };
+    VkResult vr = OB_VK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    fr->pool_count++;
+    fr->sets_in_last_pool = 0;
+    return OB_OK;
+}
+
+static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, uint32_t chunk,
+                             VkDescriptorSet *out_set)
+{
+    frame_ring *fr = pm->ring;
+    uint32_t h = (uint32_t)((((uintptr_t)prog->set_layouts[0] >> 4) ^ chunk) * 2654435761u);
+    set_entry *slot = NULL;
+    for (uint32_t i = 0; i < SET_CACHE_SIZE; i++) {
+        set_entry *e = &fr->sets[(h + i) & (SET_CACHE_SIZE - 1)];
+        if (e->set && e->layout == prog->set_layouts[0] && e->chunk == chunk) {
+            *out_set = e->set;
+            return OB_OK;
+        }
+        if (!e->set) {
+            slot = e;
+            break;
+        }
+    }
+    if (!slot) return OB_ERR_LIMIT;
+    if (fr->pool_count == 0 || fr->sets_in_last_pool >= SETS_PER_POOL) {
+        ob_result r = new_pool(pm, fr);
+        if (r != OB_OK) return r;
+    }
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = fr->pools[fr->pool_count - 1],
+        .descriptorSetCount = 1,
+        .pSetLayouts = &prog->set_layouts[0],
+    };
+    VkDescriptorSet set;
+    VkResult vr = OB_VK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    fr->sets_in_last_pool++;
+    VkDescriptorBufferInfo infos[OB_PROGRAM_MAX_UBOS];
+    VkWriteDescriptorSet writes[OB_PROGRAM_MAX_UBOS];
+    for (uint32_t i = 0; i < prog->ubo_count; i++) {
+        infos[i] = (VkDescriptorBufferInfo){fr->chunks[chunk].vk, 0, prog->ubos[i].size};
+        writes[i] = (VkWriteDescriptorSet){
+            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = set,
+            .dstBinding = prog->ubos[i].binding,
+            .descriptorCount = 1,
+            .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC,
+            .pBufferInfo = &infos[i],
+        };
+    }
+    vkUpdateDescriptorSets(pm->vk, prog->ubo_count, writes, 0, NULL);
+    *slot = (set_entry){prog->set_layouts[0], chunk, set};
+    *out_set = set;
+    return OB_OK;
+}
+
+/* Pack the program's uniform blocks (only those whose parameters changed)
+ * and bind set 0 if the set or any offset differs. */
+static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+{
+    if (prog->ubo_count == 0) return OB_OK;
+    pack_entry *entries[OB_PROGRAM_MAX_UBOS];
+    uint32_t chunk = UINT32_MAX;
+    bool all_same_chunk = true;
+    for (uint32_t i = 0; i < prog->ubo_count; i++) {
+        const ob_param_mapping *map = prog->ubos[i].mapping;
+        pack_entry *e = pack_slot(pm, map);
+        bool fresh = e->mapping == map && e->frame_serial == pm->frame_serial;
+        if (fresh && ob_params_pack_needed(&pm->params, map)) fresh = false;
+        if (!fresh) e->mapping = NULL; /* to pack */
+        else pm->stats.blocks_reused++;
+        entries[i] = e;
+        if (fresh) {
+            if (chunk == UINT32_MAX) chunk = e->chunk;
+            else if (chunk != e->chunk) all_same_chunk = false;
+        }
+    }
+    /* Blocks of one draw share one set, so they must sit in one chunk:
+     * repack everything when the fresh ones are spread or stale. */
+    if (!all_same_chunk || (chunk != UINT32_MAX && chunk != pm->ring->current)) {
+        for (uint32_t i = 0; i < prog->ubo_count; i++) entries[i]->mapping = NULL;
+        chunk = UINT32_MAX;
+    }
+    for (int attempt = 0; attempt < 2; attempt++) {
+        bool moved = false;
+        for (uint32_t i = 0; i < prog->ubo_count; i++) {
+            pack_entry *e = entries[i];
+            if (e->mapping) continue;
+            uint32_t c, off;
+            ob_result r = ring_alloc(pm, prog->ubos[i].size, &c, &off);
+            if (r != OB_OK) return r;
+            if (chunk != UINT32_MAX && c != chunk) {
+                /* Ring moved to a new chunk mid-draw: repack all there. */
+                for (uint32_t j = 0; j < prog->ubo_count; j++) entries[j]->mapping = NULL;
+                chunk = UINT32_MAX;
+                moved = true;
+                break;
+            }
+            chunk = c;
+            uint8_t *dst = pm->ring->chunks[c].mapped + off;
+            ob_params_pack(&pm->params, prog->ubos[i].mapping, dst, true);
+            *e = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, c, off,
+                              hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            pm->stats.blocks_packed++;
+            pm->stats.uniform_bytes += prog->ubos[i].size;
+        }
+        if (!moved) break;
+    }
+    VkDescriptorSet set;
+    ob_result r = uniform_set(pm, prog, chunk, &set);
+    if (r != OB_OK) return r;
+    uint32_t offsets[OB_PROGRAM_MAX_UBOS];
+    bool same = pm->cur.set0 == set;
+    for (uint32_t i = 0; i < prog->ubo_count; i++) {
+        offsets[i] = entries[i]->offset;
+        *h = ob_hash_u64(*h, entries[i]->content_hash);
+        if (pm->cur.offsets[i] != offsets[i]) same = false;
+    }
+    pm->stats.descriptor_binds_requested++;
+    if (!same) {
+        vkCmdBindDescriptorSets(pm->cmd, prog->bind_point, prog->layout, 0, 1, &set,
+                                prog->ubo_count, offsets);
+        pm->cur.set0 = set;
+        memcpy(pm->cur.offsets, offsets, sizeof offsets[0] * prog->ubo_count);
+        pm->stats.descriptor_binds_issued++;
+    }
+    return OB_OK;
+}
+
+/* Resolve the program's images, samplers and buffers from parameters and push
+ * them when any differs from what is bound. */
+static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+{
+    if (prog->resource_count == 0) return OB_OK;
+    uint32_t ids[OB_PROGRAM_MAX_RESOURCES * 2];
+    VkDescriptorImageInfo images[OB_PROGRAM_MAX_RESOURCES];
+    VkDescriptorBufferInfo buffers[OB_PROGRAM_MAX_RESOURCES];
+    VkWriteDescriptorSet writes[OB_PROGRAM_MAX_RESOURCES];
+    for (uint32_t i = 0; i < prog->resource_count; i++) {
+        const ob_program_resource *res = &prog->resources[i];
+        ob_image img = {0};
+        ob_sampler smp = {0};
+        ob_buffer buf = {0};
+        writes[i] = (VkWriteDescriptorSet){
+            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstBinding = res->binding,
+            .descriptorCount = 1,
+        };
+        images[i] = (VkDescriptorImageInfo){0};
+        switch (res->kind) {
+        case OB_BINDING_COMBINED_IMAGE_SAMPLER:
+            ob_params_get_texture(&pm->params, res->param, &img);
+            ob_params_get_sampler(&pm->params, res->sampler, &smp);
+            images[i].imageView = ob_image_view(pm->dev, img);
+            images[i].sampler = ob_sampler_vk(pm->dev, smp);
+            images[i].imageLayout = VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL;
+            if (!images[i].imageView || !images[i].sampler) return OB_ERR_INVALID_HANDLE;
+            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+            writes[i].pImageInfo = &images[i];
+            break;
+        case OB_BINDING_SAMPLED_IMAGE:
+        case OB_BINDING_STORAGE_IMAGE:
+            ob_params_get_texture(&pm->params, res->param, &img);
+            images[i].imageView = ob_image_view(pm->dev, img);
+            images[i].imageLayout = res->kind == OB_BINDING_STORAGE_IMAGE
+                                        ? VK_IMAGE_LAYOUT_GENERAL
+                                        : VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL;
+            if (!images[i].imageView) return OB_ERR_INVALID_HANDLE;
+            writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_IMAGE
+                                           ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE
+                                           : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+            writes[i].pImageInfo = &images[i];
+            break;
+        case OB_BINDING_SAMPLER:
+            ob_params_get_sampler(&pm->params, res->param, &smp);
+            images[i].sampler = ob_sampler_vk(pm->dev, smp);
+            if (!images[i].sampler) return OB_ERR_INVALID_HANDLE;
+            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_SAMPLER;
+            writes[i].pImageInfo = &images[i];
+            break;
+        case OB_BINDING_STORAGE_BUFFER:
+        case OB_BINDING_UNIFORM_BUFFER:
+            ob_params_get_buffer(&pm->params, res->param, &buf);
+            buffers[i] = (VkDescriptorBufferInfo){ob_buffer_vk(pm->dev, buf), 0, VK_WHOLE_SIZE};
+            if (!buffers[i].buffer) return OB_ERR_INVALID_HANDLE;
+            writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_BUFFER
+                                           ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                           : VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+            writes[i].pBufferInfo = &buffers[i];
+            break;
+        }
+        ids[2 * i] = img.id ? img.id : buf.id;
+        ids[2 * i + 1] = smp.id;
+        *h = ob_hash_u64(*h, ((uint64_t)ids[2 * i] << 32) | ids[2 * i + 1]);
+    }
+    pm->stats.push_descriptor_requested++;
+    size_t n = sizeof ids[0] * 2 * prog->resource_count;
+    if (!pm->cur.resources_valid || memcmp(pm->cur.resource_ids, ids, n) != 0) {
+        pm->push_descriptor(pm->cmd, prog->bind_point, prog->layout, OB_PROGRAM_SET_RESOURCES,
+                            prog->resource_count, writes);
+        memcpy(pm->cur.resource_ids, ids, n);
+        pm->cur.resources_valid = true;
+        pm->stats.push_descriptor_issued++;
+    }
+    return OB_OK;
+}
+
+static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+{
+    if (!prog->push_mapping) return;
+    uint8_t bytes[128];
+    ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
+    *h = hash_words(*h, bytes, prog->push_size);
+    pm->stats.push_constant_requested++;
+    if (!pm->cur.push_valid || memcmp(pm->cur.push, bytes, prog->push_size) != 0) {
+        vkCmdPushConstants(pm->cmd, prog->layout, prog->push_stages, 0, prog->push_size, bytes);
+        memcpy(pm->cur.push, bytes, prog->push_size);
+        pm->cur.push_valid = true;
+        pm->stats.push_constant_issued++;
+    }
+}
+
+/* Everything a draw or dispatch needs, bound only where it differs. Returns
+ * the draw-state hash through *h. */
+static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
+{
+    const ob_program *prog = pm->program;
+    if (!pm->cmd) return OB_ERR_WRONG_STATE;
+    if (!prog || !pm->pipeline) {
+        pm->stats.skipped_draws++;
+        log_once(pm, "no pipeline set");
+        return OB_ERR_WRONG_STATE;
+    }
+    *h = ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id);
+
+    pm->stats.pipeline_binds_requested++;
+    if (pm->cur.pipeline != pm->pipeline) {
+        vkCmdBindPipeline(pm->cmd, prog->bind_point, pm->pipeline);
+        pm->cur.pipeline = pm->pipeline;
+        pm->stats.pipeline_binds_issued++;
+    }
+    if (pm->cur.layout != prog->layout) {
+        /* Sets and push constants bound under another layout are not reusable. */
+        pm->cur.layout = prog->layout;
+        pm->cur.set0 = VK_NULL_HANDLE;
+        pm->cur.resources_valid = false;
+        pm->cur.push_valid = false;
+    }
+    ob_result r = apply_uniforms(pm, prog, h);
+    if (r == OB_OK) r = apply_resources(pm, prog, h);
+    if (r != OB_OK) {
+        pm->stats.skipped_draws++;
+        log_once(pm, r == OB_ERR_INVALID_HANDLE ? "a texture, sampler or buffer parameter holds "
+                                                  "an invalid handle"
+                                                : ob_result_text(r));
+        return r;
+    }
+    apply_push_constants(pm, prog, h);
+    if (prog->bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return OB_OK;
+
+    if (pm->vb.id) {
+        VkBuffer vb = ob_buffer_vk(pm->dev, pm->vb);
+        if (!vb) {
+            pm->stats.skipped_draws++;
+            log_once(pm, "the vertex buffer handle is invalid");
+            return OB_ERR_INVALID_HANDLE;
+        }
+        pm->stats.vertex_binds_requested++;
+        if (vb != pm->cur.vb || pm->vb_offset != pm->cur.vb_offset) {
+            vkCmdBindVertexBuffers(pm->cmd, 0, 1, &vb, &pm->vb_offset);
+            pm->cur.vb = vb;
+            pm->cur.vb_offset = pm->vb_offset;
+            pm->stats.vertex_binds_issued++;
+        }
+        *h = ob_hash_u64(*h, ((uint64_t)pm->vb.id << 32) ^ pm->vb_offset);
+    }
+    if (indexed) {
+        VkBuffer ib = ob_buffer_vk(pm->dev, pm->ib);
+        if (!ib) {
+            pm->stats.skipped_draws++;
+            log_once(pm, "the index buffer handle is invalid");
+            return OB_ERR_INVALID_HANDLE;
+        }
+        pm->stats.index_binds_requested++;
+        if (ib != pm->cur.ib || pm->ib_offset != pm->cur.ib_offset ||
+            pm->index_type != pm->cur.index_type) {
+            vkCmdBindIndexBuffer(pm->cmd, ib, pm->ib_offset, pm->index_type);
+            pm->cur.ib = ib;
+            pm->cur.ib_offset = pm->ib_offset;
+            pm->cur.index_type = pm->index_type;
+            pm->stats.index_binds_issued++;
+        }
+        *h = ob_hash_u64(*h, ((uint64_t)pm->ib.id << 32) ^ pm->ib_offset);
+    }
+    if (pm->viewport_set &&
+        (!pm->cur.viewport_valid || memcmp(&pm->cur.viewport, &pm->viewport, sizeof pm->viewport))) {
+        vkCmdSetViewport(pm->cmd, 0, 1, &pm->viewport);
+        pm->cur.viewport = pm->viewport;
+        pm->cur.viewport_valid = true;
+    }
+    if (pm->scissor_set &&
+        (!pm->cur.scissor_valid || memcmp(&pm->cur.scissor, &pm->scissor, sizeof pm->scissor))) {
+        vkCmdSetScissor(pm->cmd, 0, 1, &pm->scissor);
+        pm->cur.scissor = pm->scissor;
+        pm->cur.scissor_valid = true;
+    }
+    return OB_OK;
+}
+
+static void fold(ob_pipeline_manager *pm, uint64_t h)
+{
+    pm->hash = ob_cmd_hash_concat(pm->hash, (ob_cmd_hash){h, OB_CMD_HASH_BASE, 1});
+}
+
+ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
+                     uint32_t first_vertex, uint32_t first_instance)
+{
+    uint64_t h;
+    ob_result r = apply(pm, false, &h);
+    if (r != OB_OK) return r;
+    vkCmdDraw(pm->cmd, vertex_count, instance_count, first_vertex, first_instance);
+    h = ob_hash_u64(h, ((uint64_t)vertex_count << 32) | instance_count);
+    fold(pm, ob_hash_u64(h, ((uint64_t)first_vertex << 32) | first_instance));
+    pm->stats.draws++;
+    return OB_OK;
+}
+
+ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+                             uint32_t instance_count, uint32_t first_index,
+                             int32_t vertex_offset, uint32_t first_instance)
+{
+    uint64_t h;
+    ob_result r = apply(pm, true, &h);
+    if (r != OB_OK) return r;
+    vkCmdDrawIndexed(pm->cmd, index_count, instance_count, first_index, vertex_offset,
+                     first_instance);
+    h = ob_hash_u64(h, ((uint64_t)index_count << 32) | instance_count);
+    h = ob_hash_u64(h, ((uint64_t)first_index << 32) | (uint32_t)vertex_offset);
+    fold(pm, ob_hash_u64(h, first_instance));
+    pm->stats.draws++;
+    return OB_OK;
+}
+
+ob_result ob_pm_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+                              uint32_t draw_count)
+{
+    VkBuffer vk = ob_buffer_vk(pm->dev, args);
+    if (!vk) {
+        pm->stats.skipped_draws++;
+        log_once(pm, "the indirect argument buffer handle is invalid");
+        return OB_ERR_INVALID_HANDLE;
+    }
+    uint64_t h;
+    ob_result r = apply(pm, false, &h);
+    if (r != OB_OK) return r;
+    vkCmdDrawIndirect(pm->cmd, vk, offset, draw_count, sizeof(VkDrawIndirectCommand));
+    h = ob_hash_u64(h, ((uint64_t)args.id << 32) | draw_count);
+    fold(pm, ob_hash_u64(h, offset));
+    pm->stats.draws++;
+    return OB_OK;
+}
+
+ob_result ob_pm_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z)
+{
+    uint64_t h;
+    ob_result r = apply(pm, false, &h);
+    if (r != OB_OK) return r;
+    vkCmdDispatch(pm->cmd, x, y, z);
+    h = ob_hash_u64(h, ((uint64_t)x << 32) | y);
+    fold(pm, ob_hash_u64(h, z));
+    pm->stats.dispatches++;
+    return OB_OK;
+}
+
+ob_pm_stats ob_pm_stats_take(ob_pipeline_manager *pm)
+{
+    ob_pm_stats s = pm->stats;
+    memset(&pm->stats, 0, sizeof pm->stats);
+    return s;
+}
+
+void ob_pm_stats_add(ob_pm_stats *into, const ob_pm_stats *s)
+{
+    /* Every field is a counter: add them as an array of the same layout. */
+    uint32_t *a = (uint32_t *)into;
+    const uint32_t *b = (const uint32_t *)s;
+    size_t n32 = offsetof(ob_pm_stats, uniform_bytes) / sizeof(uint32_t);
+    for (size_t i = 0; i < n32; i++) a[i] += b[i];
+    into->uniform_bytes += s->uniform_bytes;
+    into->skipped_draws += s->skipped_draws;
+}
