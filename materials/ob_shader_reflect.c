@@ -323,12 +323,36 @@ static ob_result reflect_block(spv_ctx *x, const spvc_reflected_resource *res, o
     return OB_OK;
 }
 
-static ob_result get_resources(spv_ctx *x, spvc_resources res, spvc_resource_type type,
+static ob_result get_resources(spvc_resources res, spvc_resource_type type,
                                const spvc_reflected_resource **list, size_t *count)
 {
+    *list = NULL;
+    *count = 0;
     if (spvc_resources_get_resource_list_for_type(res, type, list, count) != SPVC_SUCCESS)
         return OB_ERR_SHADER_COMPILE;
-    (void)x;
+    return OB_OK;
+}
+
+/* The descriptor part of a binding: set, binding, array count, stage. */
+static ob_result describe_binding(spv_ctx *x, const spvc_reflected_resource *res,
+                                  ob_binding_kind kind, const char *name, ob_binding *out)
+{
+    memset(out, 0, sizeof *out);
+    ob_result r = copy_name(x, out->name, name, kind_name(kind));
+    if (r != OB_OK) return r;
+    out->kind = kind;
+    out->stages = ob_shader_stage_vk(x->stage);
+    out->block = -1;
+    out->set = spvc_compiler_get_decoration(x->comp, res->id, SpvDecorationDescriptorSet);
+    out->binding = spvc_compiler_get_decoration(x->comp, res->id, SpvDecorationBinding);
+    bool is_array;
+    uint32_t n = array_elements(spvc_compiler_get_type_handle(x->comp, res->type_id), &is_array);
+    if (is_array && n == 0) {
+        OB_LOG_E("shader", "%s: %s '%s' is an unsized array (descriptor indexing is not supported)",
+                 x->name, kind_name(kind), name);
+        return OB_ERR_UNSUPPORTED;
+    }
+    out->count = is_array ? n : 1;
     return OB_OK;
 }
 
@@ -337,24 +361,12 @@ static ob_result reflect_buffers(spv_ctx *x, spvc_resources res, spvc_resource_t
 {
     const spvc_reflected_resource *list;
     size_t count;
-    ob_result r = get_resources(x, res, type, &list, &count);
+    ob_result r = get_resources(res, type, &list, &count);
     for (size_t i = 0; i < count && r == OB_OK; i++) {
         ob_block_layout block;
+        ob_binding bnd;
         r = reflect_block(x, &list[i], &block);
-        ob_binding bnd = {.kind = kind, .count = 1, .stages = ob_shader_stage_vk(x->stage), .block = -1};
-        bnd.set = spvc_compiler_get_decoration(x->comp, list[i].id, SpvDecorationDescriptorSet);
-        bnd.binding = spvc_compiler_get_decoration(x->comp, list[i].id, SpvDecorationBinding);
-        if (r == OB_OK) {
-            memcpy(bnd.name, block.name, sizeof bnd.name);
-            bool is_array;
-            uint32_t n = array_elements(spvc_compiler_get_type_handle(x->comp, list[i].type_id), &is_array);
-            if (is_array && n == 0) {
-                OB_LOG_E("shader", "%s: %s '%s' is an unsized array (descriptor indexing is not supported)",
-                         x->name, kind_name(kind), block.name);
-                r = OB_ERR_UNSUPPORTED;
-            }
-            bnd.count = is_array ? n : 1;
-        }
+        if (r == OB_OK) r = describe_binding(x, &list[i], kind, block.name, &bnd);
         if (r == OB_OK) r = add_binding(&x->b, &bnd, &block, x->name);
         ob_free(block.members);
     }
@@ -366,30 +378,17 @@ static ob_result reflect_images(spv_ctx *x, spvc_resources res, spvc_resource_ty
 {
     const spvc_reflected_resource *list;
     size_t count;
-    ob_result r = get_resources(x, res, type, &list, &count);
+    ob_result r = get_resources(res, type, &list, &count);
     for (size_t i = 0; i < count && r == OB_OK; i++) {
-        ob_binding bnd = {.kind = kind, .stages = ob_shader_stage_vk(x->stage), .block = -1};
-        r = copy_name(x, bnd.name, list[i].name, kind_name(kind));
-        if (r != OB_OK) break;
         spvc_type base = spvc_compiler_get_type_handle(x->comp, list[i].base_type_id);
         if (kind != OB_BINDING_SAMPLER && spvc_type_get_image_dimension(base) == SpvDimBuffer) {
             OB_LOG_E("shader", "%s: '%s' is a texel buffer, which Obelisk does not bind", x->name,
                      list[i].name);
-            r = OB_ERR_UNSUPPORTED;
-            break;
+            return OB_ERR_UNSUPPORTED;
         }
-        bool is_array;
-        uint32_t n = array_elements(spvc_compiler_get_type_handle(x->comp, list[i].type_id), &is_array);
-        if (is_array && n == 0) {
-            OB_LOG_E("shader", "%s: %s '%s' is an unsized array (descriptor indexing is not supported)",
-                     x->name, kind_name(kind), list[i].name);
-            r = OB_ERR_UNSUPPORTED;
-            break;
-        }
-        bnd.count = is_array ? n : 1;
-        bnd.set = spvc_compiler_get_decoration(x->comp, list[i].id, SpvDecorationDescriptorSet);
-        bnd.binding = spvc_compiler_get_decoration(x->comp, list[i].id, SpvDecorationBinding);
-        r = add_binding(&x->b, &bnd, NULL, x->name);
+        ob_binding bnd;
+        r = describe_binding(x, &list[i], kind, list[i].name, &bnd);
+        if (r == OB_OK) r = add_binding(&x->b, &bnd, NULL, x->name);
     }
     return r;
 }
@@ -398,7 +397,7 @@ static ob_result reflect_push(spv_ctx *x, spvc_resources res)
 {
     const spvc_reflected_resource *list;
     size_t count;
-    ob_result r = get_resources(x, res, SPVC_RESOURCE_TYPE_PUSH_CONSTANT, &list, &count);
+    ob_result r = get_resources(res, SPVC_RESOURCE_TYPE_PUSH_CONSTANT, &list, &count);
     if (r != OB_OK || count == 0) return r;
     ob_block_layout block;
     r = reflect_block(x, &list[0], &block);
@@ -432,7 +431,7 @@ static ob_result reflect_vertex_inputs(spv_ctx *x, spvc_resources res)
 {
     const spvc_reflected_resource *list;
     size_t count;
-    ob_result r = get_resources(x, res, SPVC_RESOURCE_TYPE_STAGE_INPUT, &list, &count);
+    ob_result r = get_resources(res, SPVC_RESOURCE_TYPE_STAGE_INPUT, &list, &count);
     for (size_t i = 0; i < count && r == OB_OK; i++) {
         if (spvc_compiler_has_decoration(x->comp, list[i].id, SpvDecorationBuiltIn)) continue;
         spvc_type t = spvc_compiler_get_type_handle(x->comp, list[i].type_id);
@@ -491,7 +490,7 @@ static ob_result reject_unsupported(spv_ctx *x, spvc_resources res)
     for (size_t k = 0; k < OB_ARRAY_COUNT(kinds); k++) {
         const spvc_reflected_resource *list;
         size_t count;
-        ob_result r = get_resources(x, res, kinds[k].type, &list, &count);
+        ob_result r = get_resources(res, kinds[k].type, &list, &count);
         if (r != OB_OK) return r;
         if (count) {
             OB_LOG_E("shader", "%s: '%s' is a %s, which Obelisk does not bind", x->name,

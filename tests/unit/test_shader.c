@@ -335,6 +335,10 @@ static void error_in_include_names_the_included_file(void **state)
     assert_int_equal(get_fails(c, "include_error.frag", OB_SHADER_FRAGMENT), OB_ERR_SHADER_COMPILE);
     assert_true(ob_test_log_has("broken.glsl:3: ", "undefined_thing", NULL));
     assert_false(ob_test_log_has("include_error.frag:3:", NULL));
+    /* Lines of the including file stay right after inlined (nested) includes. */
+    ob_test_log_clear();
+    assert_int_equal(get_fails(c, "after_include.frag", OB_SHADER_FRAGMENT), OB_ERR_SHADER_COMPILE);
+    assert_true(ob_test_log_has("after_include.frag:5: ", "not_declared", NULL));
     ob_shader_compiler_destroy(c);
 }
 
