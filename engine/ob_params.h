@@ -14,7 +14,11 @@
  * Built-in matrices: setting WorldMatrix, ViewMatrix or ProjMatrix recomputes
  * WorldViewMatrix, ViewProjMatrix, WorldViewProjMatrix and (for World)
  * NormalMatrix in the same slot (cglm conventions, column-major:
- * WorldViewProj = Proj * View * World). All seven start as identity.
+ * WorldViewProj = Proj * View * World). All seven start as identity. A
+ * derived matrix may also be set directly; it then holds until one of its
+ * sources changes in that slot. NormalMatrix's upper 3x3 is the cofactor
+ * matrix of World's (det · inverse-transpose): finite even for a zero scale;
+ * the shader normalizes.
  *
  * Lifecycle: ob_param_registry_create → register parameters → per frame
  * begin_recording / (set, get, pack on workers) / end_recording → destroy.
