@@ -157,8 +157,8 @@ static bool derive(const ob_param_registry *reg, uint32_t slot, uint32_t role,
 {
     mat4 m[3];
     for (uint32_t r = OB_PARAM_ROLE_WORLD; r <= OB_PARAM_ROLE_PROJ; r++) {
-        const void *from = r == role ? (const void *)src : ob_param_cell_value(reg->role_info[r], slot);
-        memcpy(m[r - OB_PARAM_ROLE_WORLD], from, sizeof(mat4));
+        const void *stored = ob_param_cell_value(reg->role_info[r], slot);
+        memcpy(m[r - OB_PARAM_ROLE_WORLD], r == role ? (const void *)src : stored, sizeof(mat4));
     }
     glm_mat4_mul(m[1], m[0], d->world_view);
     glm_mat4_mul(m[2], m[1], d->view_proj);
@@ -175,10 +175,14 @@ static bool derive(const ob_param_registry *reg, uint32_t slot, uint32_t role,
 static void store_derived(const ob_param_registry *reg, uint32_t slot, uint32_t role,
                           const derived *d)
 {
-    if (role != OB_PARAM_ROLE_PROJ) cell_store(reg->role_info[OB_PARAM_ROLE_WORLD_VIEW], slot, d->world_view, 0, 64);
-    if (role != OB_PARAM_ROLE_WORLD) cell_store(reg->role_info[OB_PARAM_ROLE_VIEW_PROJ], slot, d->view_proj, 0, 64);
-    cell_store(reg->role_info[OB_PARAM_ROLE_WORLD_VIEW_PROJ], slot, d->world_view_proj, 0, 64);
-    if (role == OB_PARAM_ROLE_WORLD) cell_store(reg->role_info[OB_PARAM_ROLE_NORMAL], slot, d->normal, 0, 64);
+    ob_param_info *const *out = reg->role_info;
+    if (role != OB_PARAM_ROLE_PROJ)
+        cell_store(out[OB_PARAM_ROLE_WORLD_VIEW], slot, d->world_view, 0, 64);
+    if (role != OB_PARAM_ROLE_WORLD)
+        cell_store(out[OB_PARAM_ROLE_VIEW_PROJ], slot, d->view_proj, 0, 64);
+    cell_store(out[OB_PARAM_ROLE_WORLD_VIEW_PROJ], slot, d->world_view_proj, 0, 64);
+    if (role == OB_PARAM_ROLE_WORLD)
+        cell_store(out[OB_PARAM_ROLE_NORMAL], slot, d->normal, 0, 64);
 }
 
 /* A world/view/proj write: every affected slot is checked before any is
