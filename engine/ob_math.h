@@ -164,8 +164,8 @@ typedef enum ob_look_status {
  * the world) whose -Z looks along dir and whose +Y is as close to up as
  * possible. A degenerate basis falls back (dir → -Z; up → the world axis least
  * aligned with dir, preferring Z, then Y, then X) and says so, so the caller
- * can name the entity in a message. The result is always finite and
- * orthonormal. */
+ * can name the entity in a message: the result is OB_LOOK_OK or a bitwise OR
+ * of the two flags. The rotation is always finite and orthonormal. */
 ob_look_status ob_math_look_rotation(const double dir[3], const double up[3], double dest[9]);
 
 /* View matrix of a camera with orthonormal world axes `axes` (columns X, Y, Z)
