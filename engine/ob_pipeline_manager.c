@@ -1,5 +1,6 @@
 #include "ob_pipeline_manager.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #define MAX_FRAME_SLOTS 4
@@ -387,7 +388,7 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
         for (uint32_t i = 0; i < prog->ubo_count; i++) {
             pack_entry *e = entries[i];
             if (e->mapping) continue;
-            uint32_t c, off;
+            uint32_t c = 0, off = 0;
             ob_result r = ring_alloc(pm, prog->ubos[i].size, &c, &off);
             if (r != OB_OK) return r;
             if (chunk != UINT32_MAX && c != chunk) {

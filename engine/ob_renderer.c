@@ -219,6 +219,19 @@ static void collect_frame(ob_renderer *r, ob_frame_slot *fs)
         }
     }
     r->last = *st;
+    if (r->stats_fn) r->stats_fn(r->stats_user, st);
+}
+
+void ob_renderer_set_stats_callback(ob_renderer *r, ob_frame_stats_fn fn, void *user)
+{
+    r->stats_fn = fn;
+    r->stats_user = user;
+}
+
+void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants)
+{
+    r->cur.pipelines_created += pipelines;
+    r->cur.variants_created += variants;
 }
 
 const ob_frame_stats *ob_renderer_last_stats(const ob_renderer *r) { return &r->last; }

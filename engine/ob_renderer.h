@@ -152,6 +152,13 @@ ob_result ob_renderer_process_views(ob_renderer *r);
 
 /* Time the application spent updating the scene, for the stats. */
 void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns);
+/* Pipelines and shader variants the higher layers created this frame. */
+void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants);
+
+/* Called with each frame's final stats (GPU times included) once the frame
+ * is known complete, in frame order. [render thread] */
+typedef void (*ob_frame_stats_fn)(void *user, const ob_frame_stats *stats);
+void ob_renderer_set_stats_callback(ob_renderer *r, ob_frame_stats_fn fn, void *user);
 
 /* Completes the frame. */
 ob_result ob_renderer_end_frame(ob_renderer *r);

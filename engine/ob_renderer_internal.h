@@ -95,6 +95,8 @@ struct ob_renderer {
     atomic_uint next_job;
     bool quit;
 
+    ob_frame_stats_fn stats_fn;
+    void *stats_user;
     ob_frame_stats cur;         /* being built */
     ob_frame_stats last;        /* complete, with GPU times */
     uint64_t frame_start_ns;

@@ -395,4 +395,13 @@ void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
     ctx->shadow_map_size = size ? size : 1024;
 }
 
-void ob_views_render(ob_views *ctx, ob_view *final_view) { ob_renderer_pre_draw(ctx->r, final_view); }
+void ob_views_render(ob_views *ctx, ob_view *final_view)
+{
+    ob_renderer_pre_draw(ctx->r, final_view);
+    /* Variants and pipelines are created on first need during PreRender
+     * (and rarely while recording): report what this frame added. */
+    ob_effect_counters now = ob_effect_context_counters(ctx->effects);
+    ob_renderer_note_created(ctx->r, now.pipelines_created - ctx->counted.pipelines_created,
+                             now.variants_compiled - ctx->counted.variants_compiled);
+    ctx->counted = now;
+}

@@ -22,6 +22,7 @@ struct ob_views {
     uint32_t env_map_size, shadow_map_size;
     float ambient[4];
     double time, dt;
+    ob_effect_counters counted;  /* effect counters already reported to the stats */
 
     ob_views_entry *shadows;     /* one per shadow-casting light */
     uint32_t shadow_count, shadow_cap;

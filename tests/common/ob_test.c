@@ -89,3 +89,13 @@ uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, 
     }
     return m;
 }
+
+void ob_test_assert_near(double a, double b, double tol, const char *expr, const char *file,
+                         int line)
+{
+    double d = a > b ? a - b : b - a;
+    if (!(d <= tol)) {
+        print_error("%s: %.17g vs %.17g differ by %.3g (tolerance %.3g)\n", expr, a, b, d, tol);
+        _fail(file, line);
+    }
+}

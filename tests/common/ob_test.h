@@ -32,6 +32,11 @@ ob_device *ob_test_device_create(void);
 /* Fails the test if the validation layer reported any error or warning. */
 void ob_test_assert_no_validation(const ob_device *dev);
 
+/* |a - b| <= tol in double precision (cmocka's float assert casts to float). */
+void ob_test_assert_near(double a, double b, double tol, const char *expr, const char *file,
+                         int line);
+#define assert_near(a, b, tol) ob_test_assert_near((a), (b), (tol), #a " ~ " #b, __FILE__, __LINE__)
+
 /* Largest absolute per-channel difference of two RGBA8 images. */
 uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h);
 

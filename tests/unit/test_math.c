@@ -5,15 +5,6 @@
 
 #include <string.h>
 
-/* cmocka's float compare casts to float; these checks need double. */
-#define assert_near(a, b, tol) assert_near_at((a), (b), (tol), #a, __FILE__, __LINE__)
-static void assert_near_at(double a, double b, double tol, const char *expr, const char *file,
-                           int line)
-{
-    if (fabs(a - b) <= tol) return;
-    print_error("%s = %.17g, expected %.17g within %g\n", expr, a, b, tol);
-    _fail(file, line);
-}
 
 /* clip = M * v computed in float, as the GPU does. */
 static void clip_of(const float m[16], const float v[3], float clip[4])

@@ -6,14 +6,6 @@
 
 #include <string.h>
 
-#define assert_near(a, b, tol) assert_near_at((a), (b), (tol), #a, __FILE__, __LINE__)
-static void assert_near_at(double a, double b, double tol, const char *expr, const char *file,
-                           int line)
-{
-    if (fabs(a - b) <= tol) return;
-    print_error("%s = %.17g, expected %.17g within %g\n", expr, a, b, tol);
-    _fail(file, line);
-}
 
 static ob_scene *new_scene(void)
 {

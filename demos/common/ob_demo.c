@@ -1,0 +1,433 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_demo.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------------ options */
+
+static void usage(FILE *f, const char *prog, const char *extra, bool takes_input)
+{
+    fprintf(f,
+            "usage: %s [options]%s\n"
+            "  --frames F        frames to render (default 60)\n"
+            "  --threads T       0 = single-threaded, N = N workers, auto = decide per frame\n"
+            "  --toggle K        switch single/multi-threaded every K frames\n"
+            "  --size WxH        image size (default 640x480)\n"
+            "  --out FILE.png    write the final image\n"
+            "  --stats-json FILE write one object of stats per frame\n"
+            "  --seed S          scene seed\n"
+            "  --env-size N      environment map size (per paraboloid half)\n"
+            "  --shadow-size N   shadow map size\n"
+            "  --overlay         draw the text overlay (on by default with --window)\n"
+            "  --window          show the scene live (F1 toggles the mode)\n"
+            "  --quiet           no per-frame lines\n%s",
+            prog, takes_input ? " FILE" : "", extra ? extra : "");
+}
+
+static bool parse_u32(const char *s, uint32_t *out)
+{
+    char *end;
+    unsigned long v = strtoul(s, &end, 10);
+    if (!*s || *end || v > UINT32_MAX) return false;
+    *out = (uint32_t)v;
+    return true;
+}
+
+bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
+                           ob_demo_options *o, int *out_exit)
+{
+    *o = (ob_demo_options){.frames = 60, .threads = 0, .width = 640, .height = 480,
+                           .seed = 1, .objects = 200};
+    bool overlay_set = false;
+    *out_exit = 2;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        bool ok = true;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout, argv[0], usage_extra, takes_input);
+            *out_exit = 0;
+            return false;
+        } else if (!strcmp(a, "--overlay")) {
+            o->overlay = overlay_set = true;
+        } else if (!strcmp(a, "--no-overlay")) {
+            o->overlay = false;
+            overlay_set = true;
+        } else if (!strcmp(a, "--window")) {
+            o->window = true;
+        } else if (!strcmp(a, "--quiet")) {
+            o->quiet = true;
+        } else if (a[0] == '-' && a[1] == '-' && !v) {
+            fprintf(stderr, "%s: option %s needs a value\n", argv[0], a);
+            return false;
+        } else if (!strcmp(a, "--frames")) {
+            ok = parse_u32(v, &o->frames) && o->frames > 0;
+            i++;
+        } else if (!strcmp(a, "--threads")) {
+            uint32_t t;
+            if (!strcmp(v, "auto")) o->threads = -1;
+            else if ((ok = parse_u32(v, &t) && t <= OB_MAX_WORKERS)) o->threads = (int)t;
+            i++;
+        } else if (!strcmp(a, "--toggle")) {
+            ok = parse_u32(v, &o->toggle);
+            i++;
+        } else if (!strcmp(a, "--size")) {
+            ok = sscanf(v, "%ux%u", &o->width, &o->height) == 2 && o->width > 0 && o->height > 0 &&
+                 o->width <= 8192 && o->height <= 8192;
+            i++;
+        } else if (!strcmp(a, "--out")) {
+            o->out = v;
+            i++;
+        } else if (!strcmp(a, "--stats-json")) {
+            o->stats_json = v;
+            i++;
+        } else if (!strcmp(a, "--seed")) {
+            ok = parse_u32(v, &o->seed);
+            i++;
+        } else if (!strcmp(a, "--objects")) {
+            ok = parse_u32(v, &o->objects) && o->objects <= 100000;
+            i++;
+        } else if (!strcmp(a, "--env-size")) {
+            ok = parse_u32(v, &o->env_size) && o->env_size >= 8 && o->env_size <= 4096;
+            i++;
+        } else if (!strcmp(a, "--shadow-size")) {
+            ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= 16 && o->shadow_size <= 8192;
+            i++;
+        } else if (a[0] != '-' && takes_input && !o->input) {
+            o->input = a;
+        } else {
+            fprintf(stderr, "%s: unknown argument '%s'\n", argv[0], a);
+            usage(stderr, argv[0], usage_extra, takes_input);
+            return false;
+        }
+        if (!ok) {
+            fprintf(stderr, "%s: bad value '%s' for %s\n", argv[0], v, a);
+            return false;
+        }
+    }
+    if (takes_input && !o->input) {
+        usage(stderr, argv[0], usage_extra, takes_input);
+        return false;
+    }
+    if (!overlay_set) o->overlay = o->window;
+    *out_exit = 0;
+    return true;
+}
+
+/* ------------------------------------------------------------ set-up */
+
+static void on_stats(void *user, const ob_frame_stats *st)
+{
+    ob_demo *d = user;
+    if (ob_array_reserve((void **)&d->history, &d->history_cap, d->history_count + 1,
+                         sizeof *d->history) == OB_OK)
+        d->history[d->history_count++] = *st;
+    if (!d->opt.quiet) {
+        printf("frame %4llu %-3s workers %u  cpu %7.3f ms (update %.3f pre-render %.3f record %.3f "
+               "assemble %.3f submit %.3f)  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
+               (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
+               (double)st->frame_ns * 1e-6, (double)st->update_ns * 1e-6,
+               (double)st->pre_render_ns * 1e-6, (double)st->record_ns * 1e-6,
+               (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6, st->gpu_ms,
+               st->view_count, st->draws, st->culled, (unsigned long long)st->frame_hash);
+    }
+    if (d->json) {
+        if (d->history_count > 1) fputs(",\n", d->json);
+        ob_demo_write_stats_json(d->json, st);
+    }
+}
+
+ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
+{
+    memset(d, 0, sizeof *d);
+    d->opt = *o;
+    ob_result r;
+    ob_renderer_desc rd = {
+        .device = {.app_name = "obelisk-demo"},
+        .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
+        .threading = o->threads == 0 ? OB_THREADING_SINGLE
+                     : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
+    };
+    d->r = ob_renderer_create(&rd, &r);
+    if (!d->r) return r;
+    ob_renderer_set_stats_callback(d->r, on_stats, d);
+    d->fx = ob_effect_context_create(ob_renderer_device(d->r), ob_renderer_registry(d->r), NULL, &r);
+    if (!d->fx) return r;
+    d->lib = ob_material_library_create(d->fx, NULL, &r);
+    if (!d->lib) return r;
+    ob_views_desc vd = {.renderer = d->r, .materials = d->lib, .effects = d->fx,
+                        .env_map_size = o->env_size, .shadow_map_size = o->shadow_size};
+    d->views = ob_views_create(&vd, &r);
+    if (!d->views) return r;
+    d->scene = ob_scene_create(&r);
+    if (!d->scene) return r;
+    d->camera = ob_node_create(d->scene, NULL, "camera", &r);
+    if (!d->camera) return r;
+    ob_camera_desc cam = {.fovy = 1.0f, .znear = 0.05f};
+    if ((r = ob_node_set_camera(d->camera, &cam)) != OB_OK) return r;
+    ob_perspective_desc pd = {.name = "main", .camera = d->camera, .width = o->width,
+                              .height = o->height, .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
+    d->main = ob_perspective_view_create(d->views, &pd, &r);
+    if (!d->main) return r;
+    d->composite = ob_composite_view_create(d->views, ob_perspective_view_base(d->main), &r);
+    if (!d->composite) return r;
+    if (o->overlay) {
+        d->overlay = ob_overlay_view_create(d->views, ob_composite_view_base(d->composite), &r);
+        if (!d->overlay) return r;
+    }
+    if (o->stats_json) {
+        d->json = fopen(o->stats_json, "w");
+        if (!d->json) {
+            fprintf(stderr, "cannot write '%s'\n", o->stats_json);
+            return OB_ERR_IO;
+        }
+        fputs("[\n", d->json);
+    }
+    return OB_OK;
+}
+
+void ob_demo_shutdown(ob_demo *d)
+{
+    if (d->r) ob_renderer_wait_idle(d->r);
+    for (uint32_t i = 0; i < d->system_count; i++) ob_particle_system_destroy(d->views, d->systems[i]);
+    ob_overlay_view_destroy(d->views, d->overlay);
+    ob_composite_view_destroy(d->views, d->composite);
+    ob_perspective_view_destroy(d->views, d->main);
+    ob_scene_destroy(d->scene);
+    ob_views_destroy(d->views);
+    ob_material_library_destroy(d->lib);
+    for (uint32_t i = 0; i < d->geometry_count; i++)
+        ob_geometry_destroy(ob_renderer_device(d->r), d->geometries[i]);
+    ob_effect_context_destroy(d->fx);
+    ob_renderer_destroy(d->r);
+    if (d->json) {
+        fputs("\n]\n", d->json);
+        fclose(d->json);
+    }
+    ob_free(d->geometries);
+    ob_free(d->systems);
+    ob_free(d->history);
+    memset(d, 0, sizeof *d);
+}
+
+ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name)
+{
+    ob_result r;
+    if (ob_array_reserve((void **)&d->geometries, &d->geometry_cap, d->geometry_count + 1,
+                         sizeof *d->geometries) != OB_OK)
+        return NULL;
+    ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = d->geometry_count + 1};
+    ob_geometry *g = ob_geometry_create(ob_renderer_device(d->r), &gd, &r);
+    if (g) d->geometries[d->geometry_count++] = g;
+    return g;
+}
+
+ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
+                        ob_material *m)
+{
+    ob_result r;
+    ob_node *n = ob_node_create(d->scene, parent, name, &r);
+    if (!n) return NULL;
+    const ob_bounds *b = ob_geometry_bounds(g);
+    ob_renderable rd = {.material = m, .geometry = g, .local_radius = b->radius};
+    memcpy(rd.local_center, b->center, sizeof rd.local_center);
+    if (ob_node_set_renderable(n, &rd) != OB_OK) {
+        ob_node_destroy(d->scene, n);
+        return NULL;
+    }
+    return n;
+}
+
+ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc)
+{
+    ob_result r;
+    if (ob_array_reserve((void **)&d->systems, &d->system_cap, d->system_count + 1,
+                         sizeof *d->systems) != OB_OK)
+        return NULL;
+    ob_particle_system *ps = ob_particle_system_create(d->views, d->scene, parent, desc, &r);
+    if (ps) d->systems[d->system_count++] = ps;
+    return ps;
+}
+
+/* ------------------------------------------------------------ stats */
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* mode: 0 = single-threaded frames, 1 = multi-threaded frames, -1 = all. */
+double ob_demo_median_ms(const ob_demo *d, int mode, size_t phase_offset)
+{
+    double *v = ob_malloc(sizeof *v * (d->history_count + 1));
+    uint32_t n = 0;
+    if (!v) return NAN;
+    for (uint32_t i = 0; i < d->history_count; i++) {
+        const ob_frame_stats *st = &d->history[i];
+        if (mode >= 0 && (st->workers > 0) != (mode == 1)) continue;
+        if (phase_offset == offsetof(ob_frame_stats, gpu_ms)) {
+            if (st->gpu_ms < 0) continue;
+            v[n++] = st->gpu_ms;
+        } else {
+            uint64_t ns;
+            memcpy(&ns, (const char *)st + phase_offset, sizeof ns);
+            v[n++] = (double)ns * 1e-6;
+        }
+    }
+    double m = NAN;
+    if (n) {
+        qsort(v, n, sizeof *v, compare_double);
+        m = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    }
+    ob_free(v);
+    return m;
+}
+
+void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st)
+{
+    fprintf(f,
+            "{\"frame\":%llu,\"mode\":\"%s\",\"workers\":%u,\"update_ms\":%.4f,"
+            "\"pre_render_ms\":%.4f,\"record_ms\":%.4f,\"assemble_ms\":%.4f,\"submit_ms\":%.4f,"
+            "\"wait_ms\":%.4f,\"frame_ms\":%.4f,\"gpu_ms\":%.4f,\"draws\":%u,\"culled\":%u,"
+            "\"pipeline_binds\":[%u,%u],\"descriptor_binds\":[%u,%u],\"push_descriptors\":[%u,%u],"
+            "\"push_constants\":[%u,%u],\"vertex_binds\":[%u,%u],\"index_binds\":[%u,%u],"
+            "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
+            "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\",\"views\":[",
+            (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
+            st->update_ns * 1e-6, st->pre_render_ns * 1e-6, st->record_ns * 1e-6,
+            st->assemble_ns * 1e-6, st->submit_ns * 1e-6, st->wait_ns * 1e-6, st->frame_ns * 1e-6,
+            st->gpu_ms, st->draws, st->culled, st->pm.pipeline_binds_requested,
+            st->pm.pipeline_binds_issued, st->pm.descriptor_binds_requested,
+            st->pm.descriptor_binds_issued, st->pm.push_descriptor_requested,
+            st->pm.push_descriptor_issued, st->pm.push_constant_requested,
+            st->pm.push_constant_issued, st->pm.vertex_binds_requested, st->pm.vertex_binds_issued,
+            st->pm.index_binds_requested, st->pm.index_binds_issued,
+            (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
+            st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash);
+    for (uint32_t i = 0; i < st->view_count; i++) {
+        const ob_view_stats *v = &st->views[i];
+        fprintf(f,
+                "%s{\"name\":\"%s\",\"type\":\"%s\",\"items\":%u,\"draws\":%u,\"culled\":%u,"
+                "\"chunks\":%u,\"worker\":%d,\"cull_ms\":%.4f,\"record_ms\":%.4f,\"gpu_ms\":%.4f,"
+                "\"hash\":\"%016llx\",\"skipped\":\"%s\"}",
+                i ? "," : "", v->name, ob_view_type_name(v->type), v->items, v->draws, v->culled,
+                v->chunks, v->worker, v->cull_ns * 1e-6, v->record_ns * 1e-6, v->gpu_ms,
+                (unsigned long long)v->hash.hash, ob_skip_reason_name(v->skipped));
+    }
+    fputs("],\"skipped\":[", f);
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        fprintf(f, "%s{\"name\":\"%s\",\"reason\":\"%s\"}", i ? "," : "", st->skipped[i].name,
+                ob_skip_reason_name(st->skipped[i].reason));
+    fputs("]}", f);
+}
+
+static void print_summary(const ob_demo *d)
+{
+    static const struct { const char *name; size_t off; } phases[] = {
+        {"update", offsetof(ob_frame_stats, update_ns)},
+        {"pre-render", offsetof(ob_frame_stats, pre_render_ns)},
+        {"record", offsetof(ob_frame_stats, record_ns)},
+        {"assemble", offsetof(ob_frame_stats, assemble_ns)},
+        {"submit", offsetof(ob_frame_stats, submit_ns)},
+        {"frame", offsetof(ob_frame_stats, frame_ns)},
+        {"gpu", offsetof(ob_frame_stats, gpu_ms)},
+    };
+    uint32_t counts[2] = {0, 0};
+    for (uint32_t i = 0; i < d->history_count; i++) counts[d->history[i].workers > 0]++;
+    printf("summary: median ms per phase over %u frames\n  %-10s", d->history_count, "mode");
+    for (size_t p = 0; p < OB_ARRAY_COUNT(phases); p++) printf(" %10s", phases[p].name);
+    printf("\n");
+    double med[2][OB_ARRAY_COUNT(phases)];
+    for (int m = 0; m < 2; m++) {
+        if (!counts[m]) continue;
+        printf("  %-3s (%4u)", m ? "MT" : "ST", counts[m]);
+        for (size_t p = 0; p < OB_ARRAY_COUNT(phases); p++) {
+            med[m][p] = ob_demo_median_ms(d, m, phases[p].off);
+            printf(" %10.3f", med[m][p]);
+        }
+        printf("\n");
+    }
+    if (counts[0] && counts[1]) {
+        printf("  MT/ST     ");
+        for (size_t p = 0; p < OB_ARRAY_COUNT(phases); p++)
+            printf(" %10.3f", med[0][p] > 0 ? med[1][p] / med[0][p] : NAN);
+        printf("\n");
+    }
+}
+
+/* ------------------------------------------------------------ frames */
+
+static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame)
+{
+    ob_threading base = o->threads == 0 ? OB_THREADING_SINGLE
+                        : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
+    if (o->toggle && (frame / o->toggle) % 2 == 1)
+        return base == OB_THREADING_SINGLE ? OB_THREADING_MULTI : OB_THREADING_SINGLE;
+    return base;
+}
+
+static void overlay_text(ob_demo *d)
+{
+    if (!d->overlay) return;
+    const ob_frame_stats *st = ob_renderer_last_stats(d->r);
+    char text[512];
+    snprintf(text, sizeof text,
+             "OBELISK  %s  workers %u\nframe %.2f ms  record %.2f ms  gpu %.2f ms\n"
+             "views %u  draws %u  culled %u",
+             st->workers ? "multi-threaded" : "single-threaded", st->workers,
+             (double)st->frame_ns * 1e-6, (double)st->record_ns * 1e-6, st->gpu_ms,
+             st->view_count, st->draws, st->culled);
+    ob_overlay_view_set_text(d->overlay, text);
+}
+
+int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
+{
+    const double dt = 1.0 / 60.0;
+    ob_view *final = d->overlay ? ob_overlay_view_base(d->overlay)
+                                : ob_composite_view_base(d->composite);
+    for (uint32_t f = 0; f < d->opt.frames; f++) {
+        ob_renderer_set_threading(d->r, frame_mode(&d->opt, f),
+                                  d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
+        uint64_t t0 = ob_time_ns();
+        if (update) update(d, f, d->time, user);
+        ob_scene_update(d->scene, f == 0 ? 0.0 : dt);
+        ob_views_set_time(d->views, d->time, dt);
+        uint64_t update_ns = ob_time_ns() - t0;
+        ob_result r = ob_renderer_begin_frame(d->r, d->scene);
+        if (r != OB_OK) {
+            fprintf(stderr, "frame %u: begin_frame failed: %s\n", f, ob_result_name(r));
+            return 1;
+        }
+        ob_renderer_note_update_ns(d->r, update_ns);
+        overlay_text(d);
+        ob_views_render(d->views, final);
+        r = ob_renderer_end_frame(d->r);
+        if (r != OB_OK) {
+            fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
+            return 1;
+        }
+        d->time += dt;
+    }
+    if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
+    print_summary(d);
+    ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
+    if (ob_device_validation_enabled(ob_renderer_device(d->r)))
+        printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);
+    if (d->opt.out) {
+        ob_result r = ob_image_write_png(ob_renderer_device(d->r),
+                                         ob_composite_view_target(d->composite), d->opt.out);
+        if (r != OB_OK) {
+            fprintf(stderr, "cannot write '%s': %s\n", d->opt.out, ob_result_name(r));
+            return 1;
+        }
+        printf("wrote %s (%ux%u)\n", d->opt.out, d->opt.width, d->opt.height);
+    }
+    if (ob_device_validation_enabled(ob_renderer_device(d->r)) && (vc.errors || vc.warnings))
+        return 3;
+    return 0;
+}

@@ -1,0 +1,88 @@
+/* ob_demo.h — what the demo programs share: options, the standard set-up
+ * (renderer, effects, materials, views, scene, camera, final target), the
+ * frame loop with its ST/MT toggling, per-frame lines, the JSON stats and the
+ * summary of medians per mode.
+ *
+ * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
+ * ob_demo_run → ob_demo_shutdown. Thread rule: render thread only.
+ */
+#ifndef OB_DEMO_H
+#define OB_DEMO_H
+
+#include <stdio.h>
+
+#include "ob_geometry.h"
+#include "ob_mesh.h"
+#include "ob_views.h"
+
+typedef struct ob_demo_options {
+    uint32_t frames;          /* --frames F (default 60) */
+    int threads;              /* --threads T: 0 = single-threaded, N workers, -1 = auto */
+    uint32_t toggle;          /* --toggle K: switch ST/MT every K frames (0 = never) */
+    uint32_t width, height;   /* --size WxH (640x480) */
+    const char *out;          /* --out image.png */
+    const char *stats_json;   /* --stats-json stats.json */
+    uint32_t seed;            /* --seed S */
+    uint32_t objects;         /* --objects N (obelisk-mirror) */
+    uint32_t env_size;        /* --env-size (paraboloid map size) */
+    uint32_t shadow_size;     /* --shadow-size */
+    bool overlay;             /* --overlay / --no-overlay */
+    bool window;              /* --window */
+    bool quiet;               /* --quiet: no per-frame lines */
+    const char *input;        /* positional argument (obelisk-view FILE) */
+} ob_demo_options;
+
+/* Parses argv into *o (defaults first). Prints usage and returns false on
+ * --help or a bad option (*out_exit says the exit code). */
+bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
+                           ob_demo_options *o, int *out_exit);
+
+typedef struct ob_demo {
+    ob_demo_options opt;
+    ob_renderer *r;
+    ob_effect_context *fx;
+    ob_material_library *lib;
+    ob_views *views;
+    ob_scene *scene;
+    ob_node *camera;
+    ob_perspective_view *main;
+    ob_composite_view *composite;
+    ob_overlay_view *overlay;
+    ob_geometry **geometries;
+    uint32_t geometry_count, geometry_cap;
+    ob_particle_system **systems;
+    uint32_t system_count, system_cap;
+    ob_frame_stats *history;  /* completed frames' stats, in order */
+    uint32_t history_count, history_cap;
+    FILE *json;
+    double time;
+} ob_demo;
+
+/* Renderer (worker count from --threads), effect context, material library,
+ * views, an empty scene with a camera node, the main perspective view, the
+ * composite (final target) and the overlay. */
+ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o);
+void ob_demo_shutdown(ob_demo *d);
+
+/* Upload a mesh; the demo keeps the geometry and destroys it at shutdown. */
+ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name);
+/* A node with geometry and material; local bounds from the geometry. */
+ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
+                        ob_material *m);
+ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc);
+
+/* Frame callback: animate before the scene update. */
+typedef void (*ob_demo_update_fn)(ob_demo *d, uint32_t frame, double time, void *user);
+
+/* Runs opt.frames frames with fixed dt = 1/60 (so images do not depend on
+ * wall time), switching modes per --threads / --toggle, printing a line per
+ * frame and a summary, writing --stats-json and --out. Returns 0 on success. */
+int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user);
+
+/* Medians of a phase over the recorded frames of one mode (NAN if none). */
+double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase_offset);
+
+/* Writes one frame's stats as a JSON object. */
+void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st);
+
+#endif /* OB_DEMO_H */
