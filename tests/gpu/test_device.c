@@ -140,7 +140,45 @@ static void validation_messages_are_captured_and_counted(void **state)
     if (buf) vkDestroyBuffer(ob_device_vk(dev), buf, NULL);
     assert_true(ob_device_validation_counts(dev).errors >= 1);
     assert_true(ob_test_log_has("[vk-validation]", "VUID-VkBufferCreateInfo-size", NULL));
+
+    /* Synchronization validation is on: two unordered writes are a hazard. */
+    uint32_t errors = ob_device_validation_counts(dev).errors;
+    ob_result r;
+    ob_buffer target = ob_buffer_create(dev, &(ob_buffer_desc){.size = 64, .usage = OB_BUFFER_STORAGE, .name = "hazard"}, &r);
+    assert_int_equal(r, OB_OK);
+    VkCommandBuffer cmd;
+    assert_int_equal(ob_device_oneshot_begin(dev, &cmd), OB_OK);
+    vkCmdFillBuffer(cmd, ob_buffer_vk(dev, target), 0, VK_WHOLE_SIZE, 1);
+    vkCmdFillBuffer(cmd, ob_buffer_vk(dev, target), 0, VK_WHOLE_SIZE, 2);
+    assert_int_equal(ob_device_oneshot_submit(dev, cmd), OB_OK);
+    assert_true(ob_device_validation_counts(dev).errors > errors);
+    assert_true(ob_test_log_has("[vk-validation]", "SYNC-HAZARD-WRITE", "hazard", NULL));
+    ob_buffer_destroy(dev, target);
     ob_device_destroy(dev);
+}
+
+static void missing_validation_layer_refuses_to_run_unchecked(void **state)
+{
+    (void)state;
+    ob_test_setup_log();
+    ob_test_log_clear();
+    /* The loader hides the layer as if it were not installed. */
+    setenv("VK_LOADER_LAYERS_DISABLE", "VK_LAYER_KHRONOS_validation", 1);
+    ob_result r = OB_OK;
+    ob_device *dev = create_with(NULL, 1, &r);
+    if (dev) {
+        /* A loader older than 1.3.234 ignores the variable: nothing to test. */
+        unsetenv("VK_LOADER_LAYERS_DISABLE");
+        ob_device_destroy(dev);
+        skip();
+    }
+    ob_device *unchecked = create_with(NULL, -1, NULL);   /* without validation it works */
+    unsetenv("VK_LOADER_LAYERS_DISABLE");
+    assert_int_equal(r, OB_ERR_UNSUPPORTED);
+    assert_true(ob_test_log_has("VK_LAYER_KHRONOS_validation", "not installed", NULL));
+    assert_non_null(unchecked);
+    assert_false(ob_device_validation_enabled(unchecked));
+    ob_device_destroy(unchecked);
 }
 
 static void count_calls(ob_device *dev, void *payload)
@@ -212,6 +250,21 @@ static void deferred_deletion_waits_for_its_slot(void **state)
     ob_test_assert_no_validation(dev);
     ob_device_destroy(dev);
     assert_int_equal(calls, 3);
+
+    /* A queue that cannot grow: wait idle and run the deletion at once. */
+    dev = ob_device_create(&desc, &r);
+    assert_non_null(dev);
+    calls = 0;
+    ob_test_log_clear();
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 1);
+    ob_device_defer(dev, count_calls, &calls);
+    bool hit = ob_fault_hit(OB_FAULT_HOST_ALLOC);
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+    assert_true(hit);
+    assert_int_equal(calls, 1);
+    assert_true(ob_test_log_has("cannot grow", NULL));
+    ob_device_destroy(dev);
+    assert_int_equal(calls, 1);
 }
 
 static void device_loss_latches_and_refuses_work(void **state)
@@ -294,6 +347,7 @@ int main(void)
         cmocka_unit_test(unknown_index_fails_with_a_list_of_devices),
         cmocka_unit_test(vk_check_logs_call_text_and_result_name),
         cmocka_unit_test(validation_messages_are_captured_and_counted),
+        cmocka_unit_test(missing_validation_layer_refuses_to_run_unchecked),
         cmocka_unit_test(deferred_deletion_waits_for_its_slot),
         cmocka_unit_test(device_loss_latches_and_refuses_work),
         cmocka_unit_test(every_vulkan_creation_point_fails_cleanly),
