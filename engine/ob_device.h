@@ -12,11 +12,18 @@
  *
  * Validation: with OB_VALIDATION=1 (or desc.validation > 0) the instance
  * enables VK_LAYER_KHRONOS_validation with synchronization validation. Every
- * message goes into the engine log (module "vk") and is counted; tests read
- * the counts through ob_device_validation_counts().
+ * message goes into the engine log (module "vk-validation": errors at ERROR,
+ * warnings and performance warnings at WARN, info and verbose at DEBUG but
+ * only when OB_LOG=debug, as the loader alone sends ~90 per device) and is
+ * counted; tests read the counts through ob_device_validation_counts(). If
+ * validation is requested but the layer is not installed, creation fails with
+ * OB_ERR_UNSUPPORTED rather than running unchecked.
  *
  * Thread rule: creation and destruction [render thread]. The accessors are
- * [any thread]. The queue is owned by the render thread (submission).
+ * [any thread]. The queue is owned by the render thread (submission), and so
+ * are the frame slots, ob_device_defer and the one-shot command buffers.
+ * The validation callback may run on any thread that makes a Vulkan call; its
+ * counters are atomics, as are the device-lost latch and ob_device_note_result.
  */
 #ifndef OB_DEVICE_H
 #define OB_DEVICE_H
@@ -40,7 +47,10 @@ const char *ob_vk_result_name(VkResult res);
  * VK_ERROR_OUT_OF_DEVICE_MEMORY without making the call). */
 #define OB_VK_CREATE(call) \
     (ob_fault_should_fail(OB_FAULT_VK_OBJECT) ? VK_ERROR_OUT_OF_DEVICE_MEMORY : (call))
-/* Maps a VkResult to an ob_result (OUT_OF_DEVICE_MEMORY, DEVICE_LOST, ...). */
+/* OB_VK_CHECK(OB_VK_CREATE(call)) that logs the call text without the wrapper. */
+#define OB_VK_CHECK_CREATE(call) ob_vk_check(OB_VK_CREATE(call), #call, __FILE__, __LINE__)
+/* Maps a VkResult to an ob_result (OUT_OF_DEVICE_MEMORY, DEVICE_LOST, ...).
+ * Non-negative results (VK_SUCCESS, VK_INCOMPLETE, VK_TIMEOUT, ...) map to OB_OK. */
 ob_result ob_result_from_vk(VkResult res);
 
 typedef struct ob_device ob_device;
@@ -78,6 +88,24 @@ bool ob_device_is_cpu(const ob_device *dev);
 double ob_device_timestamp_period_ns(const ob_device *dev);
 PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev);
 
+/* Optional capabilities, enabled on the device when the hardware has them. */
+typedef struct ob_device_caps {
+    bool timeline_semaphore;     /* VkPhysicalDeviceVulkan12Features.timelineSemaphore */
+    bool host_query_reset;       /* vkResetQueryPool from the host */
+    bool sampler_anisotropy;
+    bool fill_mode_non_solid;    /* wireframe */
+    bool depth_clamp;
+    bool depth_bias_clamp;
+    bool wide_lines;
+    bool independent_blend;
+    bool multi_draw_indirect;
+    bool texture_compression_bc;
+    uint32_t timestamp_valid_bits;   /* of the chosen queue family; 0 = none */
+    uint32_t device_index;           /* index in vkEnumeratePhysicalDevices */
+    VkPhysicalDeviceType device_type;
+} ob_device_caps;
+const ob_device_caps *ob_device_get_caps(const ob_device *dev);
+
 ob_validation_counts ob_device_validation_counts(const ob_device *dev);
 bool ob_device_validation_enabled(const ob_device *dev);
 
@@ -107,6 +135,10 @@ void ob_device_defer(ob_device *dev, ob_deferred_fn fn, void *payload);
  * submit and wait. [render thread] */
 ob_result ob_device_oneshot_begin(ob_device *dev, VkCommandBuffer *out_cmd);
 ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd);
+/* Abandons a begun one-shot without submitting it (error paths). NULL is a no-op. */
+void ob_device_oneshot_cancel(ob_device *dev, VkCommandBuffer cmd);
+/* vkDeviceWaitIdle, with the result noted (device loss latches). [render thread] */
+ob_result ob_device_wait_idle(ob_device *dev);
 
 /* Records a device-loss or out-of-memory result seen anywhere; once lost the
  * device refuses new work with OB_ERR_DEVICE_LOST but can still be destroyed. */

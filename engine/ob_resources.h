@@ -55,6 +55,10 @@ void *ob_buffer_mapped(const ob_device *dev, ob_buffer buf);       /* NULL unles
  * copy that waits). Range-checked. */
 ob_result ob_buffer_upload(ob_device *dev, ob_buffer buf, uint64_t offset,
                            const void *data, uint64_t size);
+/* Copies `size` bytes at `offset` out of the buffer (staging + one-shot copy
+ * for device-local buffers, a host-visibility barrier for mapped ones).
+ * Waits for the device to be idle first. Range-checked. */
+ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_t size, void *out);
 
 typedef enum ob_image_usage {
     OB_IMAGE_SAMPLED = 1u << 0,
@@ -100,22 +104,33 @@ typedef struct ob_image_state {
 ob_result ob_image_get_state(const ob_device *dev, ob_image img, ob_image_state *out_state);
 /* Fills *out_barrier for moving img to `next` and records next as the state.
  * Returns false (no barrier needed) when the image is already in a read-only
- * state equal to next. */
+ * state equal to next — or, more generally, in the same layout with read
+ * accesses already made visible to next's stages and accesses (so a texture
+ * uploaded at creation, tracked as {SHADER_READ_ONLY_OPTIMAL, ALL_COMMANDS,
+ * SHADER_READ}, needs no barrier before a fragment shader samples it).
+ * A read-to-read barrier in one layout records the union of both states, so
+ * a later write waits for every reader. Layout is whole-image (all layers).
+ * src of the barrier = tracked stages/access/layout, dst = next. */
 bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *next,
                          VkImageMemoryBarrier2 *out_barrier);
 
 /* Reads the image (layer 0) back as tightly packed RGBA8 (colour formats
- * R8G8B8A8/B8G8R8A8, swizzled to RGBA). Waits for the device to be idle.
- * out must hold width*height*4 bytes. */
+ * R8G8B8A8/B8G8R8A8 UNORM/SRGB and R8G8B8A8_UINT, swizzled to RGBA). Waits
+ * for the device to be idle, so everything recorded for the image must have
+ * been submitted. Needs OB_IMAGE_TRANSFER_SRC usage and defined contents
+ * (OB_ERR_WRONG_STATE while the layout is UNDEFINED). The tracked state is
+ * restored afterwards. out must hold width*height*4 bytes. */
 ob_result ob_image_read_rgba8(ob_device *dev, ob_image img, uint8_t *out);
+/* The same for one layer of an array image (layer < layers). */
+ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer, uint8_t *out);
 /* Reads back and writes a PNG (stb_image_write). */
 ob_result ob_image_write_png(ob_device *dev, ob_image img, const char *path);
 
 typedef struct ob_sampler_desc {
     VkFilter filter;                   /* 0 = NEAREST; use LINEAR explicitly */
-    VkSamplerAddressMode address;      /* 0 = REPEAT */
+    VkSamplerAddressMode address;      /* 0 = REPEAT; CLAMP_TO_BORDER uses opaque white */
     bool compare;                      /* depth comparison (shadow maps) */
-    VkCompareOp compare_op;
+    VkCompareOp compare_op;            /* with compare: 0 (NEVER) → LESS_OR_EQUAL */
     const char *name;
 } ob_sampler_desc;
 

@@ -1,0 +1,680 @@
+/* ob_device.c — instance, validation capture, logical device, frame slots,
+ * deferred deletion and one-shot command buffers.
+ *
+ * Creation runs in stages (slots → instance → physical choice → logical
+ * device → one-shot objects → resource registry); each stage undoes itself
+ * on failure and create unwinds the earlier ones, so every fault-injection
+ * point leaves nothing behind.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "ob_device_internal.h"
+
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define OB_VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
+#define OB_MAX_FRAMES_IN_FLIGHT 16u
+
+typedef struct defer_item {
+    ob_deferred_fn fn;
+    void *payload;
+} defer_item;
+
+typedef struct defer_queue {
+    defer_item *items;
+    uint32_t count, cap;
+} defer_queue;
+
+struct ob_device {
+    VkInstance instance;
+    VkDebugUtilsMessengerEXT messenger;
+    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger;
+    PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
+    bool validation;
+    /* Info/verbose messages (about 90 loader lines per device) are logged
+     * only with OB_LOG=debug; otherwise they would swamp log captures. */
+    bool log_infos;
+
+    VkPhysicalDevice physical;
+    VkPhysicalDeviceProperties props;
+    VkPhysicalDeviceMemoryProperties mem_props;
+    char driver_info[VK_MAX_DRIVER_INFO_SIZE + VK_MAX_DRIVER_NAME_SIZE + 4];
+    ob_device_caps caps;
+
+    VkDevice device;
+    VkQueue queue;
+    uint32_t queue_family;
+    PFN_vkCmdPushDescriptorSetKHR push_descriptor;
+
+    /* Written by the validation callback on whichever thread made the call. */
+    atomic_uint val_errors, val_warnings, val_infos;
+    atomic_bool lost;
+
+    uint32_t frames_in_flight, current_slot;
+    defer_queue *deferred;   /* one queue per frame slot */
+
+    VkCommandPool oneshot_pool;
+    VkFence oneshot_fence;
+
+    ob_resource_registry *registry;
+};
+
+/* -------------------------------------------------------- validation capture */
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL validation_message(
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT types,
+    const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+{
+    ob_device *dev = user;
+    ob_log_level level;
+    if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
+        atomic_fetch_add(&dev->val_errors, 1);
+        level = OB_LOG_ERROR;
+    } else if ((severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) ||
+               ((types & VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT) &&
+                (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT))) {
+        atomic_fetch_add(&dev->val_warnings, 1);
+        level = OB_LOG_WARN;
+    } else {
+        atomic_fetch_add(&dev->val_infos, 1);
+        if (!dev->log_infos) return VK_FALSE;
+        level = OB_LOG_DEBUG;
+    }
+    const char *id = data && data->pMessageIdName ? data->pMessageIdName : NULL;
+    const char *msg = data && data->pMessage ? data->pMessage : "(no message text)";
+    if (id && !strstr(msg, id))
+        ob_log_write(level, "vk-validation", __FILE__, __LINE__, "[%s] %s", id, msg);
+    else
+        ob_log_write(level, "vk-validation", __FILE__, __LINE__, "%s", msg);
+    return VK_FALSE;   /* never abort the call: the test decides what fails */
+}
+
+static bool validation_wanted(int requested)
+{
+    if (requested > 0) return true;
+    if (requested < 0) return false;
+    const char *env = getenv("OB_VALIDATION");
+    return env && env[0] && strcmp(env, "0") != 0;
+}
+
+/* Fills *out_list (ob_free it) with the extensions of `layer` (NULL = the
+ * implementation and implicit layers). */
+static ob_result list_instance_extensions(const char *layer, VkExtensionProperties **out_list,
+                                          uint32_t *out_count)
+{
+    *out_list = NULL;
+    *out_count = 0;
+    uint32_t n = 0;
+    VkResult vr = OB_VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &n, NULL));
+    if (vr < 0) return ob_result_from_vk(vr);
+    VkExtensionProperties *list = ob_calloc(n, sizeof *list);
+    if (!list) return OB_ERR_OUT_OF_HOST_MEMORY;
+    vr = OB_VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &n, list));
+    if (vr < 0) {
+        ob_free(list);
+        return ob_result_from_vk(vr);
+    }
+    *out_list = list;
+    *out_count = n;
+    return OB_OK;
+}
+
+static bool list_has(const VkExtensionProperties *list, uint32_t n, const char *name)
+{
+    for (uint32_t i = 0; i < n; i++)
+        if (strcmp(list[i].extensionName, name) == 0) return true;
+    return false;
+}
+
+static ob_result validation_layer_present(bool *out_present)
+{
+    *out_present = false;
+    uint32_t n = 0;
+    VkResult vr = OB_VK_CHECK(vkEnumerateInstanceLayerProperties(&n, NULL));
+    if (vr < 0) return ob_result_from_vk(vr);
+    VkLayerProperties *layers = ob_calloc(n, sizeof *layers);
+    if (!layers) return OB_ERR_OUT_OF_HOST_MEMORY;
+    vr = OB_VK_CHECK(vkEnumerateInstanceLayerProperties(&n, layers));
+    for (uint32_t i = 0; vr >= 0 && i < n; i++)
+        if (strcmp(layers[i].layerName, OB_VALIDATION_LAYER) == 0) *out_present = true;
+    ob_free(layers);
+    return vr < 0 ? ob_result_from_vk(vr) : OB_OK;
+}
+
+/* ------------------------------------------------------------------ instance */
+
+static void instance_destroy(ob_device *dev)
+{
+    if (dev->messenger) dev->destroy_messenger(dev->instance, dev->messenger, NULL);
+    dev->messenger = VK_NULL_HANDLE;
+    /* The messenger chained into VkInstanceCreateInfo still reports here. */
+    if (dev->instance) vkDestroyInstance(dev->instance, NULL);
+    dev->instance = VK_NULL_HANDLE;
+}
+
+static ob_result instance_create(ob_device *dev, const char *app_name)
+{
+    uint32_t loader_version = VK_API_VERSION_1_0;
+    if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_3) {
+        OB_LOG_E("device", "the Vulkan loader supports %u.%u; Obelisk needs 1.3",
+                 VK_API_VERSION_MAJOR(loader_version), VK_API_VERSION_MINOR(loader_version));
+        return OB_ERR_NO_DEVICE;
+    }
+    bool sync_validation = false;
+    if (dev->validation) {
+        bool present;
+        ob_result r = validation_layer_present(&present);
+        if (r != OB_OK) return r;
+        if (!present) {
+            OB_LOG_E("device", "validation was requested (OB_VALIDATION / desc.validation) but %s is "
+                               "not installed (Debian: vulkan-validationlayers); refusing to run unchecked",
+                     OB_VALIDATION_LAYER);
+            return OB_ERR_UNSUPPORTED;
+        }
+        VkExtensionProperties *layer_exts;
+        uint32_t n;
+        r = list_instance_extensions(OB_VALIDATION_LAYER, &layer_exts, &n);
+        if (r != OB_OK) return r;
+        sync_validation = list_has(layer_exts, n, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        ob_free(layer_exts);
+        if (!sync_validation)
+            OB_LOG_W("device", "%s lacks %s: synchronization validation is off", OB_VALIDATION_LAYER,
+                     VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+    }
+    VkExtensionProperties *exts;
+    uint32_t ext_count;
+    ob_result r = list_instance_extensions(NULL, &exts, &ext_count);
+    if (r != OB_OK) return r;
+    /* The validation layer provides debug utils itself when the loader does not. */
+    bool debug_utils = dev->validation || list_has(exts, ext_count, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    ob_free(exts);
+
+    const char *enabled_exts[2];
+    uint32_t enabled_count = 0;
+    if (debug_utils) enabled_exts[enabled_count++] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    if (sync_validation) enabled_exts[enabled_count++] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
+    const char *layers[] = {OB_VALIDATION_LAYER};
+
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_VERBOSE_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = validation_message,
+        .pUserData = dev,
+    };
+    const VkValidationFeatureEnableEXT enables[] = {
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+    VkValidationFeaturesEXT features = {
+        .sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+        .pNext = &messenger_info,
+        .enabledValidationFeatureCount = OB_ARRAY_COUNT(enables),
+        .pEnabledValidationFeatures = enables,
+    };
+    VkApplicationInfo app = {
+        .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
+        .pApplicationName = app_name,
+        .applicationVersion = 1,
+        .pEngineName = "obelisk",
+        .engineVersion = VK_MAKE_API_VERSION(0, 0, 1, 0),
+        .apiVersion = VK_API_VERSION_1_3,
+    };
+    VkInstanceCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+        .pNext = dev->validation ? (sync_validation ? (const void *)&features : (const void *)&messenger_info)
+                                 : NULL,
+        .pApplicationInfo = &app,
+        .enabledLayerCount = dev->validation ? 1u : 0u,
+        .ppEnabledLayerNames = layers,
+        .enabledExtensionCount = enabled_count,
+        .ppEnabledExtensionNames = enabled_exts,
+    };
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateInstance(&info, NULL, &dev->instance));
+    if (vr < 0) {
+        dev->instance = VK_NULL_HANDLE;
+        return vr == VK_ERROR_INCOMPATIBLE_DRIVER ? OB_ERR_NO_DEVICE : ob_result_from_vk(vr);
+    }
+    if (debug_utils) {
+        dev->set_object_name = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetInstanceProcAddr(
+            dev->instance, "vkSetDebugUtilsObjectNameEXT");
+    }
+    if (dev->validation) {
+        PFN_vkCreateDebugUtilsMessengerEXT pfn_vkCreateDebugUtilsMessengerEXT =
+            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(dev->instance,
+                                                                      "vkCreateDebugUtilsMessengerEXT");
+        dev->destroy_messenger = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+            dev->instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (!pfn_vkCreateDebugUtilsMessengerEXT || !dev->destroy_messenger) {
+            OB_LOG_E("device", "validation is on but vkCreateDebugUtilsMessengerEXT is missing: "
+                               "messages could not be captured");
+            instance_destroy(dev);
+            return OB_ERR_UNSUPPORTED;
+        }
+        vr = OB_VK_CHECK_CREATE(pfn_vkCreateDebugUtilsMessengerEXT(dev->instance, &messenger_info, NULL, &dev->messenger));
+        if (vr < 0) {
+            dev->messenger = VK_NULL_HANDLE;
+            instance_destroy(dev);
+            return ob_result_from_vk(vr);
+        }
+    }
+    return OB_OK;
+}
+
+/* ------------------------------------------------------------ logical device */
+
+static void logical_destroy(ob_device *dev)
+{
+    if (dev->device) vkDestroyDevice(dev->device, NULL);
+    dev->device = VK_NULL_HANDLE;
+    dev->queue = VK_NULL_HANDLE;
+}
+
+static ob_result logical_create(ob_device *dev)
+{
+    const ob_device_caps *caps = &dev->caps;
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue_info = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+        .queueFamilyIndex = dev->queue_family,
+        .queueCount = 1,
+        .pQueuePriorities = &priority,
+    };
+    VkPhysicalDeviceVulkan13Features f13 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
+        .dynamicRendering = VK_TRUE,
+        .synchronization2 = VK_TRUE,
+    };
+    VkPhysicalDeviceVulkan12Features f12 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,
+        .pNext = &f13,
+        .timelineSemaphore = caps->timeline_semaphore,
+        .hostQueryReset = caps->host_query_reset,
+    };
+    VkPhysicalDeviceFeatures2 f2 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2,
+        .pNext = &f12,
+        .features = {
+            .samplerAnisotropy = caps->sampler_anisotropy,
+            .fillModeNonSolid = caps->fill_mode_non_solid,
+            .depthClamp = caps->depth_clamp,
+            .depthBiasClamp = caps->depth_bias_clamp,
+            .wideLines = caps->wide_lines,
+            .independentBlend = caps->independent_blend,
+            .multiDrawIndirect = caps->multi_draw_indirect,
+            .textureCompressionBC = caps->texture_compression_bc,
+        },
+    };
+    const char *exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    VkDeviceCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+        .pNext = &f2,
+        .queueCreateInfoCount = 1,
+        .pQueueCreateInfos = &queue_info,
+        .enabledExtensionCount = OB_ARRAY_COUNT(exts),
+        .ppEnabledExtensionNames = exts,
+    };
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateDevice(dev->physical, &info, NULL, &dev->device));
+    if (vr < 0) {
+        dev->device = VK_NULL_HANDLE;
+        return ob_result_from_vk(vr);
+    }
+    vkGetDeviceQueue(dev->device, dev->queue_family, 0, &dev->queue);
+    dev->push_descriptor =
+        (PFN_vkCmdPushDescriptorSetKHR)vkGetDeviceProcAddr(dev->device, "vkCmdPushDescriptorSetKHR");
+    if (!dev->push_descriptor) {
+        OB_LOG_E("device", "'%s' advertises %s but has no vkCmdPushDescriptorSetKHR",
+                 dev->props.deviceName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+        logical_destroy(dev);
+        return OB_ERR_UNSUPPORTED;
+    }
+    ob_device_set_name(dev, VK_OBJECT_TYPE_DEVICE, (uint64_t)(uintptr_t)dev->device, "obelisk device");
+    ob_device_set_name(dev, VK_OBJECT_TYPE_QUEUE, (uint64_t)(uintptr_t)dev->queue, "obelisk queue");
+    return OB_OK;
+}
+
+/* ----------------------------------------------------------------- one-shot */
+
+static void oneshot_destroy(ob_device *dev)
+{
+    if (dev->oneshot_fence) vkDestroyFence(dev->device, dev->oneshot_fence, NULL);
+    if (dev->oneshot_pool) vkDestroyCommandPool(dev->device, dev->oneshot_pool, NULL);
+    dev->oneshot_fence = VK_NULL_HANDLE;
+    dev->oneshot_pool = VK_NULL_HANDLE;
+}
+
+static ob_result oneshot_create(ob_device *dev)
+{
+    VkCommandPoolCreateInfo pool_info = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+        .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+        .queueFamilyIndex = dev->queue_family,
+    };
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(dev->device, &pool_info, NULL, &dev->oneshot_pool));
+    if (vr < 0) {
+        dev->oneshot_pool = VK_NULL_HANDLE;
+        return ob_result_from_vk(vr);
+    }
+    VkFenceCreateInfo fence_info = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    vr = OB_VK_CHECK_CREATE(vkCreateFence(dev->device, &fence_info, NULL, &dev->oneshot_fence));
+    if (vr < 0) {
+        dev->oneshot_fence = VK_NULL_HANDLE;
+        oneshot_destroy(dev);
+        return ob_result_from_vk(vr);
+    }
+    ob_device_set_name(dev, VK_OBJECT_TYPE_COMMAND_POOL, (uint64_t)(uintptr_t)dev->oneshot_pool,
+                       "obelisk one-shot pool");
+    ob_device_set_name(dev, VK_OBJECT_TYPE_FENCE, (uint64_t)(uintptr_t)dev->oneshot_fence,
+                       "obelisk one-shot fence");
+    return OB_OK;
+}
+
+ob_result ob_device_oneshot_begin(ob_device *dev, VkCommandBuffer *out_cmd)
+{
+    *out_cmd = VK_NULL_HANDLE;
+    if (ob_device_is_lost(dev)) return OB_ERR_DEVICE_LOST;
+    VkCommandBufferAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = dev->oneshot_pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    VkResult vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(dev->device, &alloc, &cmd));
+    if (vr < 0) {
+        ob_device_note_result(dev, vr);
+        return ob_result_from_vk(vr);
+    }
+    VkCommandBufferBeginInfo begin = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    vr = OB_VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
+    if (vr < 0) {
+        vkFreeCommandBuffers(dev->device, dev->oneshot_pool, 1, &cmd);
+        ob_device_note_result(dev, vr);
+        return ob_result_from_vk(vr);
+    }
+    *out_cmd = cmd;
+    return OB_OK;
+}
+
+void ob_device_oneshot_cancel(ob_device *dev, VkCommandBuffer cmd)
+{
+    if (!dev || !cmd) return;
+    vkFreeCommandBuffers(dev->device, dev->oneshot_pool, 1, &cmd);
+}
+
+ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd)
+{
+    if (!cmd) {
+        OB_LOG_E("device", "one-shot submit of a null command buffer");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    VkResult vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
+    if (vr >= 0 && ob_device_is_lost(dev)) vr = VK_ERROR_DEVICE_LOST;
+    if (vr >= 0) {
+        VkCommandBufferSubmitInfo cmd_info = {
+            .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+            .commandBuffer = cmd,
+        };
+        VkSubmitInfo2 submit = {
+            .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
+            .commandBufferInfoCount = 1,
+            .pCommandBufferInfos = &cmd_info,
+        };
+        vr = OB_VK_CHECK(vkQueueSubmit2(dev->queue, 1, &submit, dev->oneshot_fence));
+        if (vr >= 0) {
+            vr = OB_VK_CHECK(vkWaitForFences(dev->device, 1, &dev->oneshot_fence, VK_TRUE, UINT64_MAX));
+            OB_VK_CHECK(vkResetFences(dev->device, 1, &dev->oneshot_fence));
+            if (vr < 0) {
+                /* Possibly still pending: the pool frees it at destroy. */
+                ob_device_note_result(dev, vr);
+                return ob_result_from_vk(vr);
+            }
+        }
+    }
+    vkFreeCommandBuffers(dev->device, dev->oneshot_pool, 1, &cmd);
+    ob_device_note_result(dev, vr);
+    return ob_result_from_vk(vr);
+}
+
+ob_result ob_device_wait_idle(ob_device *dev)
+{
+    VkResult vr = OB_VK_CHECK(vkDeviceWaitIdle(dev->device));
+    ob_device_note_result(dev, vr);
+    return ob_result_from_vk(vr);
+}
+
+/* ------------------------------------------------- frame slots and deferral */
+
+static void slots_destroy(ob_device *dev)
+{
+    for (uint32_t i = 0; dev->deferred && i < dev->frames_in_flight; i++) ob_free(dev->deferred[i].items);
+    ob_free(dev->deferred);
+    dev->deferred = NULL;
+}
+
+static ob_result slots_create(ob_device *dev, uint32_t frames)
+{
+    if (frames > OB_MAX_FRAMES_IN_FLIGHT) {
+        OB_LOG_E("device", "frames_in_flight %u exceeds the limit of %u", frames, OB_MAX_FRAMES_IN_FLIGHT);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    dev->frames_in_flight = frames ? frames : 2;
+    dev->deferred = ob_calloc(dev->frames_in_flight, sizeof *dev->deferred);
+    return dev->deferred ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
+}
+
+/* Runs a slot's queue. The queue is detached first so that work deferred by
+ * a deferred function lands in a fresh queue and waits a full cycle. */
+static uint32_t run_deferred(ob_device *dev, uint32_t slot)
+{
+    defer_queue *q = &dev->deferred[slot];
+    defer_item *items = q->items;
+    uint32_t count = q->count, cap = q->cap;
+    q->items = NULL;
+    q->count = q->cap = 0;
+    for (uint32_t i = 0; i < count; i++) items[i].fn(dev, items[i].payload);
+    if (!q->items) {
+        q->items = items;   /* keep the capacity for the next cycle */
+        q->cap = cap;
+    } else {
+        ob_free(items);
+    }
+    return count;
+}
+
+uint32_t ob_device_frames_in_flight(const ob_device *dev) { return dev->frames_in_flight; }
+uint32_t ob_device_current_slot(const ob_device *dev) { return dev->current_slot; }
+
+void ob_device_begin_frame_slot(ob_device *dev, uint32_t slot)
+{
+    if (slot >= dev->frames_in_flight) {
+        OB_LOG_E("device", "frame slot %u out of range (frames in flight: %u); ignored", slot,
+                 dev->frames_in_flight);
+        return;
+    }
+    dev->current_slot = slot;
+    run_deferred(dev, slot);
+}
+
+void ob_device_defer(ob_device *dev, ob_deferred_fn fn, void *payload)
+{
+    if (!dev || !fn) return;
+    defer_queue *q = &dev->deferred[dev->current_slot];
+    if (ob_array_reserve((void **)&q->items, &q->cap, q->count + 1, sizeof *q->items) != OB_OK) {
+        OB_LOG_W("device", "deferred-deletion queue of slot %u cannot grow: waiting idle and running "
+                           "the deletion now", dev->current_slot);
+        ob_device_wait_idle(dev);
+        fn(dev, payload);
+        return;
+    }
+    q->items[q->count++] = (defer_item){fn, payload};
+}
+
+/* ------------------------------------------------------- create and destroy */
+
+ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
+{
+    static const ob_device_desc defaults = {0};
+    if (!desc) desc = &defaults;
+    ob_result r;
+    const char *stage = "device allocation";
+    ob_device *dev = ob_calloc(1, sizeof *dev);
+    if (!dev) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail;
+    }
+    atomic_init(&dev->val_errors, 0);
+    atomic_init(&dev->val_warnings, 0);
+    atomic_init(&dev->val_infos, 0);
+    atomic_init(&dev->lost, false);
+    dev->validation = validation_wanted(desc->validation);
+    const char *log_env = getenv("OB_LOG");
+    dev->log_infos = log_env && strcmp(log_env, "debug") == 0;
+
+    stage = "frame slots";
+    r = slots_create(dev, desc->frames_in_flight);
+    if (r != OB_OK) goto fail_free_dev;
+    stage = "instance";
+    r = instance_create(dev, desc->app_name ? desc->app_name : "obelisk");
+    if (r != OB_OK) goto fail_destroy_slots;
+
+    const char *selector = desc->device ? desc->device : getenv("OB_DEVICE");
+    ob_physical_choice choice;
+    stage = "device selection";
+    r = ob_device_select_physical(dev->instance, selector, &choice);
+    if (r != OB_OK) goto fail_destroy_instance;
+    dev->physical = choice.physical;
+    dev->props = choice.props;
+    dev->caps = choice.caps;
+    dev->queue_family = choice.queue_family;
+    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
+    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+
+    stage = "logical device";
+    r = logical_create(dev);
+    if (r != OB_OK) goto fail_destroy_instance;
+    stage = "one-shot command pool";
+    r = oneshot_create(dev);
+    if (r != OB_OK) goto fail_destroy_logical;
+    stage = "resource registry";
+    dev->registry = ob_resource_registry_create(&r);
+    if (!dev->registry) goto fail_destroy_oneshot;
+
+    OB_LOG_I("device", "using #%u '%s' (%s), Vulkan %u.%u.%u, validation %s", dev->caps.device_index,
+             dev->props.deviceName, dev->driver_info, VK_API_VERSION_MAJOR(dev->props.apiVersion),
+             VK_API_VERSION_MINOR(dev->props.apiVersion), VK_API_VERSION_PATCH(dev->props.apiVersion),
+             dev->validation ? "on" : "off");
+    if (out_result) *out_result = OB_OK;
+    return dev;
+
+fail_destroy_oneshot:
+    oneshot_destroy(dev);
+fail_destroy_logical:
+    logical_destroy(dev);
+fail_destroy_instance:
+    instance_destroy(dev);
+fail_destroy_slots:
+    slots_destroy(dev);
+fail_free_dev:
+    ob_free(dev);
+fail:
+    OB_LOG_E("device", "device creation failed at %s: %s", stage, ob_result_name(r));
+    if (out_result) *out_result = r;
+    return NULL;
+}
+
+void ob_device_destroy(ob_device *dev)
+{
+    if (!dev) return;
+    ob_device_wait_idle(dev);
+    /* Oldest slot first; repeat in case a deferred function deferred more. */
+    for (uint32_t pass = 0; pass < 4; pass++) {
+        uint32_t ran = 0;
+        for (uint32_t k = 1; k <= dev->frames_in_flight; k++)
+            ran += run_deferred(dev, (dev->current_slot + k) % dev->frames_in_flight);
+        if (!ran) break;
+    }
+    ob_resource_registry_destroy(dev, dev->registry);
+    dev->registry = NULL;
+    oneshot_destroy(dev);
+    logical_destroy(dev);
+    instance_destroy(dev);
+    slots_destroy(dev);
+    ob_free(dev);
+}
+
+/* ----------------------------------------------------------------- accessors */
+
+VkInstance ob_device_vk_instance(const ob_device *dev) { return dev->instance; }
+VkPhysicalDevice ob_device_vk_physical(const ob_device *dev) { return dev->physical; }
+VkDevice ob_device_vk(const ob_device *dev) { return dev->device; }
+VkQueue ob_device_vk_queue(const ob_device *dev) { return dev->queue; }
+uint32_t ob_device_queue_family(const ob_device *dev) { return dev->queue_family; }
+const VkPhysicalDeviceProperties *ob_device_properties(const ob_device *dev) { return &dev->props; }
+const char *ob_device_name(const ob_device *dev) { return dev->props.deviceName; }
+const char *ob_device_driver_info(const ob_device *dev) { return dev->driver_info; }
+bool ob_device_is_cpu(const ob_device *dev) { return dev->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev) { return dev->push_descriptor; }
+const ob_device_caps *ob_device_get_caps(const ob_device *dev) { return &dev->caps; }
+bool ob_device_validation_enabled(const ob_device *dev) { return dev->validation; }
+ob_resource_registry *ob_device_registry(const ob_device *dev) { return dev->registry; }
+
+double ob_device_timestamp_period_ns(const ob_device *dev)
+{
+    return dev->caps.timestamp_valid_bits ? (double)dev->props.limits.timestampPeriod : 0.0;
+}
+
+ob_validation_counts ob_device_validation_counts(const ob_device *dev)
+{
+    /* The counters are written from any thread; reading through a const
+     * device is still an atomic load. */
+    ob_device *d = (ob_device *)dev;
+    ob_validation_counts c = {
+        .errors = atomic_load(&d->val_errors),
+        .warnings = atomic_load(&d->val_warnings),
+        .infos = atomic_load(&d->val_infos),
+    };
+    return c;
+}
+
+void ob_device_set_name(ob_device *dev, VkObjectType type, uint64_t handle, const char *name)
+{
+    if (!dev || !dev->set_object_name || !dev->device || !handle || !name) return;
+    VkDebugUtilsObjectNameInfoEXT info = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT,
+        .objectType = type,
+        .objectHandle = handle,
+        .pObjectName = name,
+    };
+    OB_VK_CHECK(dev->set_object_name(dev->device, &info));
+}
+
+uint32_t ob_device_memory_type(const ob_device *dev, uint32_t type_bits, VkMemoryPropertyFlags required)
+{
+    for (uint32_t i = 0; i < dev->mem_props.memoryTypeCount; i++) {
+        if ((type_bits & (1u << i)) && (dev->mem_props.memoryTypes[i].propertyFlags & required) == required)
+            return i;
+    }
+    return UINT32_MAX;
+}
+
+void ob_device_note_result(ob_device *dev, VkResult res)
+{
+    if (res != VK_ERROR_DEVICE_LOST || !dev) return;
+    if (!atomic_exchange(&dev->lost, true))
+        OB_LOG_E("device", "device '%s' lost: new work is refused; destroy and recreate the device",
+                 dev->props.deviceName);
+}
+
+bool ob_device_is_lost(const ob_device *dev)
+{
+    return atomic_load(&((ob_device *)dev)->lost);
+}

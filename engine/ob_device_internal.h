@@ -1,0 +1,43 @@
+/* ob_device_internal.h — engine-private glue between the device and the
+ * resource modules. Not API: nothing outside engine/ob_device*.c and
+ * engine/ob_resources*.c / ob_readback.c includes it.
+ *
+ * The device owns the resource registry so that ob_device_destroy can free
+ * whatever the application leaked; the registry code lives with the
+ * resources. Physical-device probing lives in ob_device_select.c.
+ */
+#ifndef OB_DEVICE_INTERNAL_H
+#define OB_DEVICE_INTERNAL_H
+
+#include "ob_device.h"
+
+/* ---- physical device selection (ob_device_select.c) ---- */
+
+typedef struct ob_physical_choice {
+    VkPhysicalDevice physical;
+    uint32_t queue_family;
+    VkPhysicalDeviceProperties props;
+    char driver_info[VK_MAX_DRIVER_INFO_SIZE + VK_MAX_DRIVER_NAME_SIZE + 4];
+    ob_device_caps caps;   /* what the device supports; enabled as-is */
+} ob_physical_choice;
+
+/* Picks a physical device for `selector` (NULL/"" = automatic, "lavapipe",
+ * "gpu" or a decimal index). On failure logs every device seen with the
+ * reason it was rejected and returns OB_ERR_NO_DEVICE (or
+ * OB_ERR_INVALID_ARGUMENT for a malformed selector). */
+ob_result ob_device_select_physical(VkInstance instance, const char *selector,
+                                    ob_physical_choice *out_choice);
+
+/* ---- resource registry (ob_resources.c) ---- */
+
+typedef struct ob_resource_registry ob_resource_registry;
+
+ob_resource_registry *ob_resource_registry_create(ob_result *out_result);
+/* Frees every resource still registered (the application leaked them),
+ * logging one warning that names them, then the registry. The device must be
+ * idle. NULL is a no-op. */
+void ob_resource_registry_destroy(ob_device *dev, ob_resource_registry *reg);
+/* The device's registry (never NULL for a created device). */
+ob_resource_registry *ob_device_registry(const ob_device *dev);
+
+#endif /* OB_DEVICE_INTERNAL_H */

@@ -1,0 +1,78 @@
+/* ob_resources_internal.h — records behind the resource handles and the
+ * helpers shared by ob_resources.c (registry, buffers, samplers),
+ * ob_resources_image.c (images, layout tracking) and ob_readback.c.
+ * Engine-private: not API.
+ *
+ * Thread rule as in ob_resources.h: records are created, changed and freed
+ * on the render thread; workers only read them through the accessors.
+ */
+#ifndef OB_RESOURCES_INTERNAL_H
+#define OB_RESOURCES_INTERNAL_H
+
+#include "ob_device_internal.h"
+#include "ob_resources.h"
+
+typedef struct ob_buffer_rec {
+    VkBuffer buffer;
+    VkDeviceMemory memory;
+    uint64_t size;        /* requested bytes */
+    uint64_t mem_size;    /* bytes of the allocation */
+    uint32_t usage;       /* ob_buffer_usage bits */
+    bool host_visible;
+    void *mapped;         /* persistent mapping when host visible */
+    char *name;
+} ob_buffer_rec;
+
+typedef struct ob_image_rec {
+    VkImage image;
+    VkDeviceMemory memory;
+    VkImageView view;          /* all layers: 2D or 2D array */
+    VkImageView *layer_views;  /* one 2D view per layer when layers > 1 */
+    uint64_t mem_size;
+    ob_image_info info;
+    ob_image_state state;
+    char *name;
+} ob_image_rec;
+
+typedef struct ob_sampler_rec {
+    VkSampler sampler;
+    char *name;
+} ob_sampler_rec;
+
+struct ob_resource_registry {
+    ob_pool buffers, images, samplers;
+    uint64_t device_bytes;
+};
+
+/* A host-visible, coherent, mapped scratch buffer for one upload or
+ * read-back; destroyed right after its one-shot has completed. */
+typedef struct ob_staging {
+    VkBuffer buffer;
+    VkDeviceMemory memory;
+    void *mapped;
+} ob_staging;
+
+ob_result ob_staging_create(ob_device *dev, uint64_t size, const char *owner_name, ob_staging *out_staging);
+void ob_staging_destroy(ob_device *dev, ob_staging *staging);
+
+/* Allocates memory of `flags` for req (falls back to any type when no
+ * DEVICE_LOCAL type matches). Logs `what` 'name' on failure. */
+ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, VkMemoryPropertyFlags flags,
+                              const char *what, const char *name, VkDeviceMemory *out_memory);
+
+/* Gives obj the debug name "<name><suffix>". */
+void ob_res_set_name(ob_device *dev, VkObjectType type, uint64_t handle, const char *name, const char *suffix);
+
+/* Resolve a handle; log "<caller>: invalid or stale <kind> handle" and return
+ * NULL when it does not resolve. */
+ob_buffer_rec *ob_res_buffer_get(const ob_device *dev, ob_buffer buf, const char *caller);
+ob_image_rec *ob_res_image_get(const ob_device *dev, ob_image img, const char *caller);
+
+/* Fills *out_barrier for moving rec from its tracked state to next and
+ * records the new state; false when no barrier is needed. */
+bool ob_res_image_transition(ob_image_rec *rec, const ob_image_state *next, VkImageMemoryBarrier2 *out_barrier);
+
+/* Freed here so that the registry can release leaked images at destroy. */
+void ob_res_image_free(ob_device *dev, ob_image_rec *rec);
+
+#endif /* OB_RESOURCES_INTERNAL_H */
