@@ -68,6 +68,7 @@ static int compare_items(const void *a, const void *b)
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
 {
     const ob_material_iface *mi = ob_renderer_material_iface(r);
+    uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
     ob_node *const *nodes = ob_scene_renderables(scene, &count);
     v->item_count = 0;
@@ -76,7 +77,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
     if (res != OB_OK) return res;
     ob_frustum frustum;
-    ob_frustum_from_matrix(&frustum, v->view_proj);
+    ob_frustum_from_matrix(v->view_proj, &frustum);
     for (uint32_t i = 0; i < count; i++) {
         ob_node *n = nodes[i];
         const ob_renderable *rd = ob_node_renderable(n);
@@ -89,7 +90,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         ob_node_world_sphere(n, c, &radius);
         float rel[3] = {(float)(c[0] - v->origin[0]), (float)(c[1] - v->origin[1]),
                         (float)(c[2] - v->origin[2])};
-        if (!ob_frustum_test_sphere(&frustum, rel, radius)) {
+        if (!v->no_frustum && !ob_frustum_test_sphere(&frustum, rel, radius)) {
             v->culled++;
             continue;
         }
@@ -99,6 +100,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         v->items[v->item_count++] = (ob_draw_item){sort_key(cls, priority, d2), n};
     }
     qsort(v->items, v->item_count, sizeof *v->items, compare_items);
+    v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
 }
 

@@ -83,13 +83,15 @@ struct ob_view {
     float clear_color[4];
     float clear_depth;                /* 0 with reversed-Z */
     bool load_color;                  /* keep previous contents (overlay on final target) */
+    bool custom_record;               /* records its own draws (overlay, composite):
+                                         record() runs once per layer with count 0 */
+    bool no_frustum;                  /* cull by render flag only (environment maps) */
 
-    /* Inputs read by this view's draws (sampled in fragment shaders) and
-     * storage buffers written by a compute view / read by vertex shaders. */
+    /* Images read by this view's draws besides its dependencies' targets. */
     uint32_t input_count;
     ob_image inputs[OB_VIEW_MAX_DEPS];
-    ob_buffer storage_written;        /* compute views: buffer written */
-    ob_buffer storage_read;           /* graphics views: buffer read in vertex stage */
+    ob_buffer storage_written;        /* compute views: buffer written (consumers
+                                         read it in their vertex stage) */
 
     /* Per frame, filled during pre_draw; owned by the view. */
     ob_draw_item *items;
@@ -102,6 +104,7 @@ struct ob_view {
     float view_proj[16];              /* culling matrix (relative to origin) */
     uint64_t queued_frame;            /* renderer frame serial when last queued */
     uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
+    uint64_t cull_ns;                 /* this frame's ob_view_cull time */
 };
 
 /* Initialise the base part (name copied, id = hash of name). */

@@ -1,0 +1,432 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_renderer_internal.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+const char *ob_skip_reason_name(ob_skip_reason r)
+{
+    switch (r) {
+    case OB_SKIP_NONE: return "none";
+    case OB_SKIP_EMPTY: return "empty";
+    case OB_SKIP_RECURSION: return "recursion bound";
+    case OB_SKIP_NO_CASTERS: return "no shadow casters";
+    case OB_SKIP_NOT_NEEDED: return "not needed";
+    case OB_SKIP_DUPLICATE: return "already queued";
+    case OB_SKIP_ERROR: return "error";
+    }
+    return "unknown";
+}
+
+/* ------------------------------------------------------------ lifecycle */
+
+static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t index)
+{
+    VkDevice vk = ob_device_vk(r->dev);
+    VkCommandPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+        .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
+        .queueFamilyIndex = ob_device_queue_family(r->dev),
+    };
+    VkResult vr = OB_VK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkCommandBufferAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = fs->pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    vr = OB_VK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->primary));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    char name[32];
+    snprintf(name, sizeof name, "primary[%u]", index);
+    ob_device_set_name(r->dev, VK_OBJECT_TYPE_COMMAND_BUFFER, (uint64_t)(uintptr_t)fs->primary, name);
+    VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
+                             .flags = VK_FENCE_CREATE_SIGNALED_BIT};
+    vr = OB_VK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    if (ob_device_timestamp_period_ns(r->dev) > 0) {
+        fs->query_capacity = 2 * OB_MAX_FRAME_VIEWS + 2;
+        VkQueryPoolCreateInfo qci = {
+            .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+            .queryType = VK_QUERY_TYPE_TIMESTAMP,
+            .queryCount = fs->query_capacity,
+        };
+        vr = OB_VK_CREATE(vkCreateQueryPool(vk, &qci, NULL, &fs->queries));
+        if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    }
+    return OB_OK;
+}
+
+static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
+{
+    VkDevice vk = ob_device_vk(r->dev);
+    if (fs->queries) vkDestroyQueryPool(vk, fs->queries, NULL);
+    if (fs->fence) vkDestroyFence(vk, fs->fence, NULL);
+    if (fs->pool) vkDestroyCommandPool(vk, fs->pool, NULL);
+    memset(fs, 0, sizeof *fs);
+}
+
+ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result)
+{
+    ob_renderer_desc d = desc ? *desc : (ob_renderer_desc){0};
+    ob_result res = OB_OK;
+    ob_renderer *r = ob_calloc(1, sizeof *r);
+    if (!r) {
+        res = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail;
+    }
+    if (d.worker_count == 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        d.worker_count = n > 0 ? (uint32_t)n : 1;
+    }
+    if (d.worker_count > OB_MAX_WORKERS) d.worker_count = OB_MAX_WORKERS;
+    r->worker_count = d.worker_count;
+    r->chunk_draws = d.chunk_draws ? d.chunk_draws : 2048;
+    r->mode = r->pending_mode = d.threading;
+    r->active = r->pending_active = r->worker_count;
+    r->max_recursion = 4;
+    if (d.device.frames_in_flight == 0) d.device.frames_in_flight = 2;
+    if (d.device.frames_in_flight > OB_MAX_FRAMES_IN_FLIGHT)
+        d.device.frames_in_flight = OB_MAX_FRAMES_IN_FLIGHT;
+    r->frames_in_flight = d.device.frames_in_flight;
+    pthread_mutex_init(&r->lock, NULL);
+    pthread_cond_init(&r->wake, NULL);
+    pthread_cond_init(&r->done, NULL);
+
+    r->dev = ob_device_create(&d.device, &res);
+    if (!r->dev) goto fail_free;
+    r->reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 1 + r->worker_count}, &res);
+    if (!r->reg) goto fail_destroy;
+    res = ob_params_manager(r->reg, 0, &r->params0);
+    if (res != OB_OK) goto fail_destroy;
+    for (uint32_t i = 0; i < r->frames_in_flight; i++) {
+        res = create_frame_slot(r, &r->frames[i], i);
+        if (res != OB_OK) goto fail_destroy;
+    }
+    ob_pipeline_manager_desc pmd = {
+        .device = r->dev,
+        .registry = r->reg,
+        .slot = 0,
+        .frames_in_flight = r->frames_in_flight,
+        .name = "immediate",
+    };
+    r->immediate = ob_pipeline_manager_create(&pmd, &res);
+    if (!r->immediate) goto fail_destroy;
+    res = ob_renderer_workers_start(r);
+    if (res != OB_OK) goto fail_destroy;
+    if (out_result) *out_result = OB_OK;
+    return r;
+
+fail_destroy:
+    ob_renderer_destroy(r);
+    r = NULL;
+    goto fail;
+fail_free:
+    pthread_cond_destroy(&r->done);
+    pthread_cond_destroy(&r->wake);
+    pthread_mutex_destroy(&r->lock);
+    ob_free(r);
+    r = NULL;
+fail:
+    if (out_result) *out_result = res;
+    return NULL;
+}
+
+void ob_renderer_destroy(ob_renderer *r)
+{
+    if (!r) return;
+    if (r->dev) vkDeviceWaitIdle(ob_device_vk(r->dev));
+    ob_renderer_workers_stop(r);
+    ob_pipeline_manager_destroy(r->immediate);
+    for (uint32_t i = 0; i < OB_MAX_FRAMES_IN_FLIGHT; i++)
+        if (r->dev) destroy_frame_slot(r, &r->frames[i]);
+    ob_param_registry_destroy(r->reg);
+    ob_device_destroy(r->dev);
+    ob_free(r->jobs);
+    ob_free(r->attachments);
+    pthread_cond_destroy(&r->done);
+    pthread_cond_destroy(&r->wake);
+    pthread_mutex_destroy(&r->lock);
+    ob_free(r);
+}
+
+ob_device *ob_renderer_device(ob_renderer *r) { return r->dev; }
+ob_param_registry *ob_renderer_registry(ob_renderer *r) { return r->reg; }
+ob_params *ob_renderer_params(ob_renderer *r) { return &r->params0; }
+uint32_t ob_renderer_worker_count(const ob_renderer *r) { return r->worker_count; }
+ob_scene *ob_renderer_scene(ob_renderer *r) { return r->scene; }
+uint64_t ob_renderer_frame_serial(const ob_renderer *r) { return r->serial; }
+
+void ob_renderer_set_material_iface(ob_renderer *r, const ob_material_iface *iface)
+{
+    r->has_material_iface = iface != NULL;
+    if (iface) r->material_iface = *iface;
+}
+
+void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *iface)
+{
+    r->has_geometry_iface = iface != NULL;
+    if (iface) r->geometry_iface = *iface;
+}
+
+const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r)
+{
+    return r->has_material_iface ? &r->material_iface : NULL;
+}
+
+const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r)
+{
+    return r->has_geometry_iface ? &r->geometry_iface : NULL;
+}
+
+void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers)
+{
+    r->pending_mode = mode;
+    if (active_workers == 0 || active_workers > r->worker_count) active_workers = r->worker_count;
+    r->pending_active = active_workers;
+}
+
+ob_threading ob_renderer_threading(const ob_renderer *r) { return r->mode; }
+
+void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth)
+{
+    r->max_recursion = depth < OB_MAX_VIEW_STACK - 1 ? depth : OB_MAX_VIEW_STACK - 2;
+}
+
+/* ------------------------------------------------------------ stats */
+
+/* The frame in `fs` has completed: read its timestamps into its stats and
+ * make them the last complete stats. */
+static void collect_frame(ob_renderer *r, ob_frame_slot *fs)
+{
+    if (!fs->pending) return;
+    fs->pending = false;
+    ob_frame_stats *st = &fs->stats;
+    double period = ob_device_timestamp_period_ns(r->dev);
+    uint32_t n = 2 * fs->view_queries + 2;
+    uint64_t ts[2 * OB_MAX_FRAME_VIEWS + 2];
+    st->gpu_ms = -1.0;
+    for (uint32_t i = 0; i < st->view_count; i++) st->views[i].gpu_ms = -1.0;
+    if (fs->queries && n <= fs->query_capacity &&
+        vkGetQueryPoolResults(ob_device_vk(r->dev), fs->queries, 0, n, sizeof ts, ts,
+                              sizeof ts[0], VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
+        st->gpu_ms = (double)(ts[1] - ts[0]) * period * 1e-6;
+        for (uint32_t i = 0; i < fs->view_queries && i < st->view_count; i++) {
+            uint64_t a = ts[2 + 2 * i], b = ts[3 + 2 * i];
+            st->views[i].gpu_ms = (double)(b - a) * period * 1e-6;
+        }
+    }
+    r->last = *st;
+}
+
+const ob_frame_stats *ob_renderer_last_stats(const ob_renderer *r) { return &r->last; }
+const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r) { return &r->cur; }
+
+void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns) { r->cur.update_ns = ns; }
+
+void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason)
+{
+    ob_frame_stats *st = &r->cur;
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        if (strcmp(st->skipped[i].name, name) == 0 && st->skipped[i].reason == reason) return;
+    if (st->skipped_count >= OB_MAX_FRAME_VIEWS) return;
+    snprintf(st->skipped[st->skipped_count].name, sizeof st->skipped[0].name, "%s", name);
+    st->skipped[st->skipped_count].reason = reason;
+    st->skipped_count++;
+}
+
+/* ------------------------------------------------------------ frame */
+
+ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
+{
+    if (r->in_frame) {
+        OB_LOG_E("renderer", "begin_frame called twice without end_frame");
+        return OB_ERR_WRONG_STATE;
+    }
+    if (ob_device_is_lost(r->dev)) return OB_ERR_DEVICE_LOST;
+    uint64_t t0 = ob_time_ns();
+    r->slot = (uint32_t)(r->serial % r->frames_in_flight);
+    ob_frame_slot *fs = &r->frames[r->slot];
+    VkDevice vk = ob_device_vk(r->dev);
+    VkResult vr = OB_VK_CHECK(vkWaitForFences(vk, 1, &fs->fence, VK_TRUE, UINT64_MAX));
+    if (vr != VK_SUCCESS) {
+        ob_device_note_result(r->dev, vr);
+        return ob_result_from_vk(vr);
+    }
+    collect_frame(r, fs);
+    r->serial++;
+    ob_device_begin_frame_slot(r->dev, r->slot);
+    vr = OB_VK_CHECK(vkResetCommandPool(vk, fs->pool, 0));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        ob_worker *w = &r->workers[i];
+        vkResetCommandPool(vk, w->pools[r->slot], 0);
+        ob_pm_begin_frame(w->pm, r->slot, r->serial);
+    }
+    ob_pm_begin_frame(r->immediate, r->slot, r->serial);
+
+    r->mode = r->pending_mode;
+    r->active = r->pending_active;
+    if (r->mode == OB_THREADING_AUTO) {
+        /* Hand out work only when last frame's recording cost more than the
+         * hand-off costs (wake-ups and secondaries: tens of microseconds). */
+        r->auto_multi = r->last_record_cost_ns > 400000;
+    }
+    r->scene = scene;
+    r->queue_count = 0;
+    r->stack_depth = 0;
+    r->attachment_count = 0;
+    memset(&r->cur, 0, sizeof r->cur);
+    r->cur.frame = r->serial;
+    r->cur.mode = r->mode;
+    r->frame_start_ns = t0;
+    r->in_frame = true;
+    r->submitted = false;
+    r->cur.wait_ns = ob_time_ns() - t0;
+    return OB_OK;
+}
+
+/* ------------------------------------------------------------ view queue */
+
+bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
+{
+    if (!r->in_frame || !v) return false;
+    /* The stack top is v itself (ob_renderer_pre_draw pushed it); the view
+     * below it is the consumer that asked for v. */
+    ob_view *consumer = NULL;
+    uint32_t depth = 0;
+    if (r->stack_depth > 0 && r->stack[r->stack_depth - 1] == v) {
+        depth = r->stack_depth - 1;
+        consumer = depth > 0 ? r->stack[depth - 1] : NULL;
+    } else if (r->stack_depth > 0) {
+        depth = r->stack_depth;
+        consumer = r->stack[r->stack_depth - 1];
+    }
+    if (v->queued_frame == r->serial) {
+        /* A view queued earlier in this frame: the consumer still depends on it
+         * (if it comes later in the order it reads last frame's contents). */
+        if (consumer) ob_view_add_dependency(consumer, v);
+        return false;
+    }
+    if (depth > r->max_recursion) {
+        ob_renderer_note_skipped(r, v->name, OB_SKIP_RECURSION);
+        return false;
+    }
+    if (r->queue_count >= OB_MAX_FRAME_VIEWS) {
+        OB_LOG_E("renderer", "view '%s' not queued: more than %u views this frame", v->name,
+                 OB_MAX_FRAME_VIEWS);
+        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        return false;
+    }
+    v->queued_frame = r->serial;
+    v->recursion_depth = depth;
+    v->dep_count = 0;
+    v->item_count = 0;
+    v->culled = 0;
+    r->queue[r->queue_count++] = v;
+    if (consumer) ob_view_add_dependency(consumer, v);
+    return true;
+}
+
+void ob_renderer_pre_draw(ob_renderer *r, ob_view *v)
+{
+    if (!r->in_frame || !v || !v->vtbl || !v->vtbl->pre_draw) return;
+    if (r->stack_depth >= OB_MAX_VIEW_STACK) {
+        ob_renderer_note_skipped(r, v->name, OB_SKIP_RECURSION);
+        return;
+    }
+    uint64_t t0 = r->stack_depth == 0 ? ob_time_ns() : 0;
+    r->stack[r->stack_depth++] = v;
+    v->vtbl->pre_draw(v, r);
+    r->stack_depth--;
+    if (t0) r->cur.pre_render_ns += ob_time_ns() - t0;
+}
+
+uint32_t ob_renderer_recursion_depth(const ob_renderer *r)
+{
+    return r->stack_depth > 0 ? r->stack_depth - 1 : 0;
+}
+
+ob_view *ob_renderer_current_view(const ob_renderer *r)
+{
+    return r->stack_depth > 0 ? r->stack[r->stack_depth - 1] : NULL;
+}
+
+ob_result ob_renderer_attach_view(ob_renderer *r, const ob_node *entity, ob_view *v)
+{
+    uint32_t id = ob_node_id(entity);
+    for (uint32_t i = 0; i < r->attachment_count; i++) {
+        ob_attachment *a = &r->attachments[i];
+        if (a->node_id == id && a->view->type == v->type) {
+            a->view = v;
+            return OB_OK;
+        }
+    }
+    ob_result res = ob_array_reserve((void **)&r->attachments, &r->attachment_cap,
+                                     r->attachment_count + 1, sizeof *r->attachments);
+    if (res != OB_OK) return res;
+    r->attachments[r->attachment_count++] = (ob_attachment){id, v};
+    return OB_OK;
+}
+
+ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, ob_view_type type)
+{
+    uint32_t id = ob_node_id(entity);
+    for (uint32_t i = 0; i < r->attachment_count; i++)
+        if (r->attachments[i].node_id == id && r->attachments[i].view->type == type)
+            return r->attachments[i].view;
+    return NULL;
+}
+
+/* ------------------------------------------------------------ processing */
+
+ob_result ob_renderer_process_views(ob_renderer *r)
+{
+    if (!r->in_frame || r->submitted) {
+        OB_LOG_E("renderer", "process_views outside a frame or called twice");
+        return OB_ERR_WRONG_STATE;
+    }
+    /* Dependencies were queued after their consumers: reverse queue order
+     * runs them first (Hieroglyph's LIFO rule). The dependency lists make the
+     * rule checkable: an edge that points forward is a cycle (env maps seeing
+     * each other), resolved by reading the previous frame's contents. */
+    ob_view *order[OB_MAX_FRAME_VIEWS];
+    uint32_t n = r->queue_count;
+    for (uint32_t i = 0; i < n; i++) order[i] = r->queue[n - 1 - i];
+    ob_result res = ob_renderer_record_frame(r, order, n);
+    r->submitted = true;
+    return res;
+}
+
+ob_result ob_renderer_end_frame(ob_renderer *r)
+{
+    if (!r->in_frame) return OB_ERR_WRONG_STATE;
+    if (!r->submitted) {
+        ob_result res = ob_renderer_process_views(r);
+        if (res != OB_OK) {
+            r->in_frame = false;
+            return res;
+        }
+    }
+    r->in_frame = false;
+    r->cur.frame_ns = ob_time_ns() - r->frame_start_ns + r->cur.update_ns;
+    r->frames[r->slot].stats = r->cur;
+    return OB_OK;
+}
+
+ob_result ob_renderer_wait_idle(ob_renderer *r)
+{
+    VkResult vr = OB_VK_CHECK(vkDeviceWaitIdle(ob_device_vk(r->dev)));
+    if (vr != VK_SUCCESS) {
+        ob_device_note_result(r->dev, vr);
+        return ob_result_from_vk(vr);
+    }
+    /* Collect in submission order so `last` ends as the newest frame. */
+    for (uint64_t k = r->frames_in_flight; k > 0; k--) {
+        uint32_t slot = (uint32_t)((r->serial + r->frames_in_flight - k) % r->frames_in_flight);
+        if (r->serial >= k - 1) collect_frame(r, &r->frames[slot]);
+    }
+    return OB_OK;
+}

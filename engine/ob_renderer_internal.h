@@ -1,0 +1,108 @@
+/* ob_renderer_internal.h — renderer state shared by its implementation files
+ * (ob_renderer.c: frame and queue; ob_renderer_record.c: jobs, workers and the
+ * primary). Not part of the API. */
+#ifndef OB_RENDERER_INTERNAL_H
+#define OB_RENDERER_INTERNAL_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+
+#include "ob_renderer.h"
+
+#define OB_MAX_FRAMES_IN_FLIGHT 4
+#define OB_MAX_VIEW_STACK 32
+
+/* One unit of recording: a chunk of one layer of one view. */
+typedef struct ob_job {
+    ob_view *view;
+    uint32_t view_index;        /* position in processing order */
+    uint32_t layer, first, count;
+    uint64_t predicted_ns;
+    VkCommandBuffer cmd;        /* secondary, filled by the worker */
+    ob_cmd_hash hash;
+    ob_pm_stats stats;
+    uint64_t record_ns;
+    int32_t worker;
+} ob_job;
+
+typedef struct ob_worker {
+    ob_renderer *renderer;
+    pthread_t thread;
+    bool started;
+    uint32_t index;             /* 1-based: parameter slot and pair index */
+    ob_pipeline_manager *pm;
+    VkCommandPool pools[OB_MAX_FRAMES_IN_FLIGHT];
+    VkCommandBuffer *cmds[OB_MAX_FRAMES_IN_FLIGHT];
+    uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
+    uint32_t cmd_used;
+    ob_result error;
+} ob_worker;
+
+typedef struct ob_frame_slot {
+    VkCommandPool pool;
+    VkCommandBuffer primary;
+    VkFence fence;
+    VkQueryPool queries;
+    uint32_t query_capacity;
+    bool pending;               /* submitted, stats not yet collected */
+    uint32_t view_queries;      /* views with timestamps in the pending frame */
+    ob_frame_stats stats;
+} ob_frame_slot;
+
+typedef struct ob_attachment {
+    uint32_t node_id;
+    ob_view *view;
+} ob_attachment;
+
+struct ob_renderer {
+    ob_device *dev;
+    ob_param_registry *reg;
+    ob_params params0;
+    ob_pipeline_manager *immediate;
+    ob_worker workers[OB_MAX_WORKERS];
+    uint32_t worker_count;
+    uint32_t chunk_draws;
+
+    ob_frame_slot frames[OB_MAX_FRAMES_IN_FLIGHT];
+    uint32_t frames_in_flight, slot;
+    uint64_t serial;
+    bool in_frame, submitted;
+
+    ob_threading mode, pending_mode;
+    uint32_t active, pending_active;
+    bool auto_multi;            /* AUTO's decision for this frame */
+    uint64_t last_record_cost_ns;
+
+    ob_material_iface material_iface;
+    ob_geometry_iface geometry_iface;
+    bool has_material_iface, has_geometry_iface;
+    ob_scene *scene;
+
+    ob_view *queue[OB_MAX_FRAME_VIEWS];
+    uint32_t queue_count;
+    ob_view *stack[OB_MAX_VIEW_STACK];
+    uint32_t stack_depth, max_recursion;
+    ob_attachment *attachments;
+    uint32_t attachment_count, attachment_cap;
+
+    ob_job *jobs;
+    uint32_t job_count, job_cap;
+
+    pthread_mutex_t lock;
+    pthread_cond_t wake, done;
+    uint64_t batch;
+    uint32_t workers_done;
+    atomic_uint next_job;
+    bool quit;
+
+    ob_frame_stats cur;         /* being built */
+    ob_frame_stats last;        /* complete, with GPU times */
+    uint64_t frame_start_ns;
+};
+
+/* ob_renderer_record.c */
+ob_result ob_renderer_workers_start(ob_renderer *r);
+void ob_renderer_workers_stop(ob_renderer *r);
+ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
+
+#endif /* OB_RENDERER_INTERNAL_H */

@@ -1,0 +1,563 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_renderer_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------ worker pool */
+
+static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
+{
+    ob_result res;
+    w->renderer = r;
+    w->index = index;
+    char name[32];
+    snprintf(name, sizeof name, "worker%u", index);
+    ob_pipeline_manager_desc pmd = {
+        .device = r->dev,
+        .registry = r->reg,
+        .slot = index,
+        .frames_in_flight = r->frames_in_flight,
+        .name = name,
+    };
+    w->pm = ob_pipeline_manager_create(&pmd, &res);
+    if (!w->pm) return res;
+    for (uint32_t f = 0; f < r->frames_in_flight; f++) {
+        VkCommandPoolCreateInfo pci = {
+            .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+            .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
+            .queueFamilyIndex = ob_device_queue_family(r->dev),
+        };
+        VkResult vr = OB_VK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci, NULL, &w->pools[f]));
+        if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    }
+    return OB_OK;
+}
+
+static void worker_release(ob_renderer *r, ob_worker *w)
+{
+    for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) {
+        if (w->pools[f]) vkDestroyCommandPool(ob_device_vk(r->dev), w->pools[f], NULL);
+        ob_free(w->cmds[f]);
+    }
+    ob_pipeline_manager_destroy(w->pm);
+    memset(w, 0, sizeof *w);
+}
+
+/* Next secondary command buffer of this worker for the current frame slot
+ * (allocated once, reused every time the slot comes round). */
+static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
+{
+    uint32_t f = r->slot;
+    if (w->cmd_used >= w->cmd_count[f]) {
+        if (ob_array_reserve((void **)&w->cmds[f], &w->cmd_cap[f], w->cmd_count[f] + 1,
+                             sizeof(VkCommandBuffer)) != OB_OK)
+            return VK_NULL_HANDLE;
+        VkCommandBufferAllocateInfo ai = {
+            .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+            .commandPool = w->pools[f],
+            .level = VK_COMMAND_BUFFER_LEVEL_SECONDARY,
+            .commandBufferCount = 1,
+        };
+        VkCommandBuffer cmd;
+        VkResult vr = OB_VK_CREATE(vkAllocateCommandBuffers(ob_device_vk(r->dev), &ai, &cmd));
+        if (OB_VK_CHECK(vr) != VK_SUCCESS) return VK_NULL_HANDLE;
+        w->cmds[f][w->cmd_count[f]++] = cmd;
+    }
+    return w->cmds[f][w->cmd_used++];
+}
+
+static VkFormat image_format(ob_device *dev, ob_image img)
+{
+    ob_image_info info;
+    if (!img.id || ob_image_get_info(dev, img, &info) != OB_OK) return VK_FORMAT_UNDEFINED;
+    return info.format;
+}
+
+/* The per-view parameters a recording of v needs in a manager's slot. */
+static void set_view_params(ob_renderer *r, ob_view *v, ob_pipeline_manager *pm)
+{
+    ob_params *params = ob_pm_params(pm);
+    if (v->vtbl->set_render_params) v->vtbl->set_render_params(v, r, params);
+    for (uint32_t i = 0; i < v->dep_count; i++) {
+        ob_view *d = v->deps[i];
+        if (d->vtbl->set_usage_params) d->vtbl->set_usage_params(d, r, params, v);
+    }
+    if (v->layer_count > 0) {
+        ob_pm_set_viewport(pm, 0.0f, 0.0f, (float)v->width, (float)v->height);
+        ob_pm_set_scissor(pm, 0, 0, v->width, v->height);
+    }
+}
+
+static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
+{
+    ob_view *v = job->view;
+    uint64_t t0 = ob_time_ns();
+    job->worker = (int32_t)w->index;
+    job->cmd = worker_next_cmd(r, w);
+    if (!job->cmd) {
+        w->error = OB_ERR_OUT_OF_DEVICE_MEMORY;
+        return;
+    }
+    VkFormat color = image_format(r->dev, v->color);
+    VkCommandBufferInheritanceRenderingInfo rendering = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO,
+        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .pColorAttachmentFormats = &color,
+        .depthAttachmentFormat = image_format(r->dev, v->depth),
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+    };
+    bool graphics = v->layer_count > 0;
+    VkCommandBufferInheritanceInfo inherit = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO,
+        .pNext = graphics ? &rendering : NULL,
+    };
+    VkCommandBufferBeginInfo bi = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT |
+                 (graphics ? VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT : 0u),
+        .pInheritanceInfo = &inherit,
+    };
+    if (OB_VK_CHECK(vkBeginCommandBuffer(job->cmd, &bi)) != VK_SUCCESS) {
+        w->error = OB_ERR_VULKAN;
+        job->cmd = VK_NULL_HANDLE;
+        return;
+    }
+    ob_pm_begin(w->pm, job->cmd);
+    set_view_params(r, v, w->pm);
+    v->vtbl->record(v, r, w->pm, job->layer, job->first, job->count);
+    job->hash = ob_pm_end(w->pm);
+    job->stats = ob_pm_stats_take(w->pm);
+    if (OB_VK_CHECK(vkEndCommandBuffer(job->cmd)) != VK_SUCCESS) {
+        w->error = OB_ERR_VULKAN;
+        job->cmd = VK_NULL_HANDLE;
+    }
+    job->record_ns = ob_time_ns() - t0;
+}
+
+static void *worker_main(void *arg)
+{
+    ob_worker *w = arg;
+    ob_renderer *r = w->renderer;
+    uint64_t seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&r->lock);
+        while (r->batch == seen && !r->quit) pthread_cond_wait(&r->wake, &r->lock);
+        if (r->quit) {
+            pthread_mutex_unlock(&r->lock);
+            break;
+        }
+        seen = r->batch;
+        bool active = w->index <= r->active;
+        pthread_mutex_unlock(&r->lock);
+        if (active) {
+            w->cmd_used = 0;
+            for (;;) {
+                uint32_t j = atomic_fetch_add(&r->next_job, 1);
+                if (j >= r->job_count) break;
+                record_job(r, w, &r->jobs[j]);
+            }
+        }
+        pthread_mutex_lock(&r->lock);
+        r->workers_done++;
+        pthread_cond_signal(&r->done);
+        pthread_mutex_unlock(&r->lock);
+    }
+    return NULL;
+}
+
+ob_result ob_renderer_workers_start(ob_renderer *r)
+{
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        ob_result res = worker_init(r, &r->workers[i], i + 1);
+        if (res != OB_OK) return res;
+    }
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        if (pthread_create(&r->workers[i].thread, NULL, worker_main, &r->workers[i]) != 0) {
+            OB_LOG_E("renderer", "cannot start worker thread %u", i + 1);
+            return OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+        r->workers[i].started = true;
+    }
+    return OB_OK;
+}
+
+void ob_renderer_workers_stop(ob_renderer *r)
+{
+    pthread_mutex_lock(&r->lock);
+    r->quit = true;
+    pthread_cond_broadcast(&r->wake);
+    pthread_mutex_unlock(&r->lock);
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        if (r->workers[i].started) pthread_join(r->workers[i].thread, NULL);
+        worker_release(r, &r->workers[i]);
+    }
+}
+
+/* Hand every job of the frame to the workers at once and wait for all. */
+static void run_jobs(ob_renderer *r)
+{
+    pthread_mutex_lock(&r->lock);
+    atomic_store(&r->next_job, 0);
+    r->workers_done = 0;
+    r->batch++;
+    pthread_cond_broadcast(&r->wake);
+    while (r->workers_done < r->worker_count) pthread_cond_wait(&r->done, &r->lock);
+    pthread_mutex_unlock(&r->lock);
+}
+
+/* ------------------------------------------------------------ jobs */
+
+static int compare_jobs_by_cost(const void *a, const void *b)
+{
+    const ob_job *x = a, *y = b;
+    if (x->predicted_ns != y->predicted_ns) return x->predicted_ns > y->predicted_ns ? -1 : 1;
+    if (x->view_index != y->view_index) return x->view_index < y->view_index ? -1 : 1;
+    if (x->layer != y->layer) return x->layer < y->layer ? -1 : 1;
+    return (x->first > y->first) - (x->first < y->first);
+}
+
+/* Split views into jobs. A view is cut into chunks when it has many draws or
+ * took long to record last time, so one big view does not serialise a frame. */
+static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uint32_t active)
+{
+    r->job_count = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_view *v = order[i];
+        uint32_t layers = v->layer_count ? v->layer_count : 1;
+        bool compute = v->layer_count == 0;
+        if (!compute && !v->custom_record && v->item_count == 0) continue;
+        uint32_t chunks = 1;
+        if (!compute && !v->custom_record) {
+            chunks = (v->item_count + r->chunk_draws - 1) / r->chunk_draws;
+            uint64_t by_cost = v->cost_ns / (250u * 1000u * layers);
+            if (by_cost > chunks) chunks = (uint32_t)OB_MIN(by_cost, (uint64_t)active * 2);
+            if (chunks > v->item_count) chunks = v->item_count;
+            if (chunks == 0) chunks = 1;
+        }
+        uint64_t per_item = v->item_count ? v->cost_ns / ((uint64_t)v->item_count * layers) : 0;
+        if (per_item == 0) per_item = 300;
+        for (uint32_t l = 0; l < layers; l++) {
+            for (uint32_t c = 0; c < chunks; c++) {
+                uint32_t first = (uint32_t)((uint64_t)v->item_count * c / chunks);
+                uint32_t end = (uint32_t)((uint64_t)v->item_count * (c + 1) / chunks);
+                ob_result res = ob_array_reserve((void **)&r->jobs, &r->job_cap, r->job_count + 1,
+                                                 sizeof *r->jobs);
+                if (res != OB_OK) return res;
+                r->jobs[r->job_count++] = (ob_job){
+                    .view = v,
+                    .view_index = i,
+                    .layer = l,
+                    .first = first,
+                    .count = end - first,
+                    .predicted_ns = (compute || v->custom_record) ? 20000 : per_item * (end - first),
+                    .worker = -1,
+                };
+            }
+        }
+    }
+    /* Largest predicted cost first; assembly later walks views in order. */
+    qsort(r->jobs, r->job_count, sizeof *r->jobs, compare_jobs_by_cost);
+    return OB_OK;
+}
+
+/* ------------------------------------------------------------ primary */
+
+static void add_image_barrier(ob_renderer *r, ob_image img, VkImageLayout layout,
+                              VkPipelineStageFlags2 stages, VkAccessFlags2 access,
+                              VkImageMemoryBarrier2 *barriers, uint32_t *n)
+{
+    if (!img.id || *n >= 2 * OB_VIEW_MAX_DEPS + 4) return;
+    ob_image_state next = {layout, stages, access};
+    if (ob_image_transition(r->dev, img, &next, &barriers[*n])) (*n)++;
+}
+
+/* An input that was never written (an env map at the recursion bound on the
+ * first frame) is cleared so that sampling it is defined. */
+static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img)
+{
+    ob_image_state st;
+    ob_image_info info;
+    if (!img.id || ob_image_get_state(r->dev, img, &st) != OB_OK ||
+        st.layout != VK_IMAGE_LAYOUT_UNDEFINED || ob_image_get_info(r->dev, img, &info) != OB_OK)
+        return;
+    VkImageMemoryBarrier2 b;
+    ob_image_state dst = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                          VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    if (!ob_image_transition(r->dev, img, &dst, &b)) return;
+    VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                            .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
+    vkCmdPipelineBarrier2(cmd, &dep);
+    VkImageSubresourceRange range = {info.aspect, 0, 1, 0, info.layers};
+    if (info.aspect & VK_IMAGE_ASPECT_DEPTH_BIT) {
+        VkClearDepthStencilValue z = {0.0f, 0};
+        vkCmdClearDepthStencilImage(cmd, ob_image_vk(r->dev, img),
+                                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &z, 1, &range);
+    } else {
+        VkClearColorValue c = {{0.0f, 0.0f, 0.0f, 1.0f}};
+        vkCmdClearColorImage(cmd, ob_image_vk(r->dev, img), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                             &c, 1, &range);
+    }
+}
+
+static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
+{
+    VkImageMemoryBarrier2 barriers[2 * OB_VIEW_MAX_DEPS + 4];
+    uint32_t n = 0;
+    const VkPipelineStageFlags2 sample_stages =
+        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT;
+    for (uint32_t i = 0; i < v->dep_count; i++) {
+        ob_view *d = v->deps[i];
+        if (d->layer_count == 0) continue;
+        clear_if_undefined(r, cmd, d->color);
+        clear_if_undefined(r, cmd, d->depth);
+        add_image_barrier(r, d->color, VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+                          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
+        add_image_barrier(r, d->depth, VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+                          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
+    }
+    for (uint32_t i = 0; i < v->input_count; i++) {
+        clear_if_undefined(r, cmd, v->inputs[i]);
+        add_image_barrier(r, v->inputs[i], VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+                          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
+    }
+    if (v->layer_count > 0) {
+        add_image_barrier(r, v->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                          VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                          barriers, &n);
+        add_image_barrier(r, v->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                              VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                          barriers, &n);
+    }
+    /* Storage buffers: a simulation writes what a consumer's vertex shader
+     * reads. Before a write, wait for earlier reads and writes; before a
+     * consumer of a simulation, wait for its write. */
+    VkMemoryBarrier2 mem = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    bool need_mem = false;
+    if (v->storage_written.id) {
+        mem.srcStageMask = VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        mem.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        mem.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        mem.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        need_mem = true;
+    }
+    for (uint32_t i = 0; i < v->dep_count && !need_mem; i++) {
+        if (!v->deps[i]->storage_written.id) continue;
+        mem.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        mem.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        mem.dstStageMask = VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT;
+        mem.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+        need_mem = true;
+    }
+    if (n == 0 && !need_mem) return;
+    VkDependencyInfo dep = {
+        .sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+        .memoryBarrierCount = need_mem ? 1u : 0u,
+        .pMemoryBarriers = &mem,
+        .imageMemoryBarrierCount = n,
+        .pImageMemoryBarriers = barriers,
+    };
+    vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uint32_t layer,
+                            bool secondaries)
+{
+    VkRenderingAttachmentInfo color = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = v->color.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->color, layer)
+                                                       : ob_image_view(r->dev, v->color))
+                                 : VK_NULL_HANDLE,
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = v->load_color ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue.color = {{v->clear_color[0], v->clear_color[1], v->clear_color[2],
+                              v->clear_color[3]}},
+    };
+    VkRenderingAttachmentInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = v->depth.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->depth, layer)
+                                                       : ob_image_view(r->dev, v->depth))
+                                 : VK_NULL_HANDLE,
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue.depthStencil = {v->clear_depth, 0},
+    };
+    VkRenderingInfo ri = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .flags = secondaries ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0u,
+        .renderArea = {{0, 0}, {v->width, v->height}},
+        .layerCount = 1,
+        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .pColorAttachments = &color,
+        .pDepthAttachment = v->depth.id ? &depth : NULL,
+    };
+    vkCmdBeginRendering(cmd, &ri);
+}
+
+static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
+{
+    ob_view_stats *vs = &st->views[i];
+    snprintf(vs->name, sizeof vs->name, "%s", v->name);
+    vs->type = v->type;
+    vs->items = v->item_count;
+    vs->culled = v->culled;
+    vs->cull_ns = v->cull_ns;
+    vs->worker = -1;
+    vs->hash = ob_cmd_hash_empty();
+    vs->gpu_ms = -1.0;
+    vs->skipped = (v->layer_count > 0 && !v->custom_record && v->item_count == 0) ? OB_SKIP_EMPTY
+                                                                                 : OB_SKIP_NONE;
+    st->culled += v->culled;
+}
+
+ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count)
+{
+    ob_frame_slot *fs = &r->frames[r->slot];
+    ob_frame_stats *st = &r->cur;
+    VkDevice vk = ob_device_vk(r->dev);
+    bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
+    uint32_t active = multi ? r->active : 0;
+    st->workers = active;
+    st->view_count = count;
+    for (uint32_t i = 0; i < count; i++) stat_view(st, i, order[i]);
+
+    ob_param_registry_begin_recording(r->reg);
+    uint64_t t_record = ob_time_ns();
+    ob_result res = OB_OK;
+    if (multi) {
+        res = build_jobs(r, order, count, active);
+        if (res == OB_OK && r->job_count > 0) run_jobs(r);
+        for (uint32_t i = 0; i < r->worker_count; i++) {
+            if (r->workers[i].error != OB_OK && res == OB_OK) res = r->workers[i].error;
+            r->workers[i].error = OB_OK;
+        }
+    }
+    st->record_ns = multi ? ob_time_ns() - t_record : 0;
+
+    uint64_t t_assemble = ob_time_ns();
+    VkCommandBuffer cmd = fs->primary;
+    VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                   .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    if (OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi)) != VK_SUCCESS) {
+        ob_param_registry_end_recording(r->reg);
+        return OB_ERR_VULKAN;
+    }
+    bool timestamps = fs->queries && 2 * count + 2 <= fs->query_capacity;
+    if (timestamps) {
+        vkCmdResetQueryPool(cmd, fs->queries, 0, 2 * count + 2);
+        vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 0);
+    }
+    if (!multi) ob_pm_begin(r->immediate, cmd);
+
+    /* Jobs are sorted by cost; walk them per view in (layer, first) order. */
+    ob_job **by_view = NULL;
+    uint32_t job_total = multi ? r->job_count : 0;
+    if (job_total) {
+        by_view = ob_malloc(sizeof *by_view * job_total);
+        if (!by_view) res = OB_ERR_OUT_OF_HOST_MEMORY;
+        for (uint32_t j = 0; by_view && j < job_total; j++) {
+            ob_job *job = &r->jobs[j];
+            /* insertion into (view_index, layer, first) order */
+            uint32_t k = j;
+            while (k > 0) {
+                ob_job *p = by_view[k - 1];
+                bool after = p->view_index > job->view_index ||
+                             (p->view_index == job->view_index &&
+                              (p->layer > job->layer || (p->layer == job->layer && p->first > job->first)));
+                if (!after) break;
+                by_view[k] = p;
+                k--;
+            }
+            by_view[k] = job;
+        }
+    }
+    uint32_t next = 0;
+    uint64_t record_cost = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_view *v = order[i];
+        ob_view_stats *vs = &st->views[i];
+        view_barriers(r, cmd, v);
+        if (timestamps)
+            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 2 + 2 * i);
+        uint64_t tv = ob_time_ns();
+        uint32_t layers = v->layer_count ? v->layer_count : 1;
+        for (uint32_t l = 0; l < layers; l++) {
+            if (v->layer_count > 0) begin_rendering(r, cmd, v, l, multi);
+            if (multi) {
+                VkCommandBuffer secs[256];
+                uint32_t ns = 0;
+                while (by_view && next < job_total && by_view[next]->view_index == i &&
+                       by_view[next]->layer == l) {
+                    ob_job *job = by_view[next++];
+                    if (job->cmd && ns < OB_ARRAY_COUNT(secs)) secs[ns++] = job->cmd;
+                    vs->hash = ob_cmd_hash_concat(vs->hash, job->hash);
+                    ob_pm_stats_add(&st->pm, &job->stats);
+                    vs->draws += job->stats.draws;
+                    vs->record_ns += job->record_ns;
+                    if (vs->chunks++ == 0) vs->worker = job->worker;
+                }
+                if (ns) vkCmdExecuteCommands(cmd, ns, secs);
+            } else if (v->layer_count == 0 || v->custom_record || v->item_count > 0) {
+                ob_pm_begin(r->immediate, cmd);
+                set_view_params(r, v, r->immediate);
+                v->vtbl->record(v, r, r->immediate, l, 0, v->item_count);
+                ob_cmd_hash h = ob_pm_end(r->immediate);
+                vs->hash = ob_cmd_hash_concat(vs->hash, h);
+                vs->chunks++;
+            }
+            if (v->layer_count > 0) vkCmdEndRendering(cmd);
+        }
+        if (!multi) {
+            ob_pm_stats s = ob_pm_stats_take(r->immediate);
+            vs->draws = s.draws;
+            ob_pm_stats_add(&st->pm, &s);
+            vs->record_ns = ob_time_ns() - tv;
+        }
+        v->cost_ns = vs->record_ns;
+        record_cost += vs->record_ns;
+        if (timestamps)
+            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 3 + 2 * i);
+        st->draws += vs->draws;
+        st->frame_hash = ob_hash_u64(ob_hash_u64(st->frame_hash, v->id), vs->hash.hash);
+    }
+    ob_free(by_view);
+    if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 1);
+    ob_param_registry_end_recording(r->reg);
+    r->last_record_cost_ns = record_cost;
+    if (!multi) st->record_ns = ob_time_ns() - t_assemble;
+    st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
+
+    if (OB_VK_CHECK(vkEndCommandBuffer(cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    uint64_t t_submit = ob_time_ns();
+    VkResult vr = OB_VK_CHECK(vkResetFences(vk, 1, &fs->fence));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkCommandBufferSubmitInfo cbi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+                                     .commandBuffer = cmd};
+    VkSubmitInfo2 si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
+                        .commandBufferInfoCount = 1,
+                        .pCommandBufferInfos = &cbi};
+    vr = OB_VK_CHECK(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence));
+    if (vr != VK_SUCCESS) {
+        ob_device_note_result(r->dev, vr);
+        /* Nothing was submitted: leave the fence signalled so the slot can be reused. */
+        VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
+                                 .flags = VK_FENCE_CREATE_SIGNALED_BIT};
+        VkFence f;
+        if (vkCreateFence(vk, &fci, NULL, &f) == VK_SUCCESS) {
+            vkDestroyFence(vk, fs->fence, NULL);
+            fs->fence = f;
+        }
+        return ob_result_from_vk(vr);
+    }
+    st->submit_ns = ob_time_ns() - t_submit;
+    fs->pending = true;
+    fs->view_queries = timestamps ? count : 0;
+    return res;
+}

@@ -1,0 +1,221 @@
+/* ob_scene.h — the scene graph: entities (nodes) with transforms, controllers,
+ * renderables, cameras and lights (Hieroglyph 3's Entity3D/Node3D).
+ *
+ * Lifecycle: ob_scene_create → ob_node_create ... → once per frame
+ * ob_scene_update(dt) (controllers, then local and world transforms, bounds,
+ * and the frame's snapshot of renderables and lights) → render → ...
+ * → ob_scene_destroy (frees every node). Node pointers stay valid until the
+ * node (or an ancestor) is destroyed.
+ *
+ * Numerics: positions and world transforms are double. The GPU gets float
+ * matrices relative to a camera origin (ob_node_world_relative), so a scene
+ * far from the world origin renders exactly like one at the origin. A node
+ * whose transform is not finite (NaN/Inf given by the user or produced by a
+ * controller) is not rendered, nor is its subtree; one error line names it
+ * ("entity 'name' (id 42): non-finite transform; not rendered") and an info
+ * line says when it is fine again. Zero scale is allowed.
+ *
+ * Traversal never recurses: 100,000-level chains update with no stack growth.
+ *
+ * Thread rule: every mutating function (create/destroy/set_* /add_* /update)
+ * is [render thread] and must not run while workers read the scene. Queries
+ * (world_*, renderable, camera, light, snapshots, find) are [any thread]
+ * while no mutation runs: the snapshot from ob_scene_update is immutable until
+ * the next update, so workers may read it while recording.
+ *
+ * Controllers run inside ob_scene_update; a script controller may change
+ * transforms, visibility, renderables, cameras and lights of any node, but not
+ * the structure (create/destroy/set_parent/update return OB_ERR_WRONG_STATE
+ * there).
+ */
+#ifndef OB_SCENE_H
+#define OB_SCENE_H
+
+#include "ob_core.h"
+#include "ob_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ob_scene ob_scene;
+typedef struct ob_node ob_node;
+struct ob_material;   /* opaque to the engine (materials layer) */
+struct ob_geometry;   /* opaque to the engine (geometry layer) */
+
+/* What to draw for a node. The bounding sphere is in the node's local space,
+ * set by the caller from the geometry's bounds. */
+typedef struct ob_renderable {
+    struct ob_material *material;
+    struct ob_geometry *geometry;
+    float local_center[3];
+    float local_radius;   /* >= 0 */
+} ob_renderable;
+
+/* ------------------------------------------------------------------ scene */
+
+/* New scene holding only its root node (named "root"). NULL with
+ * *out_result set on failure (out_result may be NULL). */
+ob_scene *ob_scene_create(ob_result *out_result);
+/* Frees every node. NULL is a no-op. */
+void ob_scene_destroy(ob_scene *s);
+ob_node *ob_scene_root(ob_scene *s);
+/* Live nodes, the root included. */
+uint32_t ob_scene_node_count(const ob_scene *s);
+/* First node (lowest id) with that name, or NULL. Linear in the node count. */
+ob_node *ob_scene_find(const ob_scene *s, const char *name);
+
+/* Runs controllers (per node in the order added, parents before children),
+ * then recomputes local and world transforms and world bounds, then rebuilds
+ * the snapshot. dt in seconds, finite and >= 0. Errors: OB_ERR_INVALID_ARGUMENT
+ * (bad dt), OB_ERR_WRONG_STATE (called from a controller),
+ * OB_ERR_OUT_OF_HOST_MEMORY (nothing changed). Bad transforms are not errors
+ * of the update: they are logged and those nodes skipped. */
+ob_result ob_scene_update(ob_scene *s, double dt);
+
+/* The frame's snapshot: renderable nodes (ob_node_is_renderable) in ascending
+ * id order, and visible light nodes (has a light, not hidden, transform valid)
+ * in ascending id order. Rebuilt by ob_scene_update; destroying a node removes
+ * it (and its subtree) at once. Never NULL; *out_count may be 0. */
+ob_node *const *ob_scene_renderables(const ob_scene *s, uint32_t *out_count);
+ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count);
+
+/* ------------------------------------------------------------------- nodes */
+
+/* New node under parent (NULL → root) with identity transform, named `name`
+ * (copied; NULL → ""). Its id is unique, increasing in creation order and
+ * never reused, so it breaks draw-order ties deterministically. NULL with
+ * *out_result set on failure. */
+ob_node *ob_node_create(ob_scene *s, ob_node *parent, const char *name, ob_result *out_result);
+/* Destroys n and its whole subtree (iteratively). The root cannot be
+ * destroyed (logged, ignored); NULL is a no-op. */
+void ob_node_destroy(ob_scene *s, ob_node *n);
+/* Moves n (with its subtree) under parent (NULL → root), keeping its local
+ * transform. Refuses cycles, the root and nodes of another scene
+ * (OB_ERR_INVALID_ARGUMENT, logged). */
+ob_result ob_node_set_parent(ob_scene *s, ob_node *n, ob_node *parent);
+
+uint32_t ob_node_id(const ob_node *n);
+const char *ob_node_name(const ob_node *n);
+ob_node *ob_node_parent(const ob_node *n);          /* NULL for the root */
+ob_node *ob_node_first_child(const ob_node *n);     /* children in the order attached */
+ob_node *ob_node_next_sibling(const ob_node *n);
+
+/* Local transform (relative to the parent): T * R * S. Values are taken as
+ * given; non-finite ones are caught by the next update. The rotation need not
+ * be unit (it is normalized); a zero quaternion is rejected like a NaN. */
+void ob_node_set_position(ob_node *n, const double p[3]);
+void ob_node_set_rotation(ob_node *n, const float q[4]);   /* x, y, z, w */
+void ob_node_set_rotation_d(ob_node *n, const double q[4]);  /* full precision */
+void ob_node_set_scale(ob_node *n, const float s[3]);
+/* Rotation from Euler angles in radians: yaw about Y, then pitch about X,
+ * then roll about Z, all in the node's local frame (q = yaw * pitch * roll). */
+void ob_node_set_euler(ob_node *n, float pitch, float yaw, float roll);
+void ob_node_get_position(const ob_node *n, double dest[3]);
+/* The stored rotation is double (controllers integrate in double). */
+void ob_node_get_rotation(const ob_node *n, double dest[4]);
+void ob_node_get_scale(const ob_node *n, float dest[3]);
+/* Turns n so its forward (-Z) points from its current world position (walked
+ * from its ancestors now, no update needed) to target, +Y as close to up as
+ * possible. A degenerate up (parallel to the direction, zero) is replaced by
+ * another axis and logged as a warning naming the node (OB_OK). A target at
+ * the node's own position or non-finite input leaves the rotation unchanged
+ * and returns OB_ERR_INVALID_ARGUMENT (logged). */
+ob_result ob_node_look_at(ob_node *n, const double target[3], const double up[3]);
+
+/* Hides n and its subtree from the snapshot (transforms are still updated). */
+void ob_node_set_hidden(ob_node *n, bool hidden);
+bool ob_node_is_hidden(const ob_node *n);   /* n's own flag */
+/* Copies r (NULL clears). A negative or non-finite bound is refused
+ * (OB_ERR_INVALID_ARGUMENT, logged, nothing changed). */
+ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r);
+const ob_renderable *ob_node_renderable(const ob_node *n);   /* NULL if none */
+
+void ob_node_set_user(ob_node *n, void *user);
+void *ob_node_user(const ob_node *n);
+
+/* ------------------------------------------- world queries (after update) */
+
+/* As of the last ob_scene_update; a node that was never updated, or whose
+ * transform is invalid, reports its last valid world (identity at first). */
+void ob_node_world_position(const ob_node *n, double dest[3]);
+/* Full double world transform. */
+void ob_node_world_affine(const ob_node *n, ob_daffine *dest);
+/* World matrix for the GPU, relative to origin (usually the camera position). */
+void ob_node_world_relative(const ob_node *n, const double origin[3], float dest[16]);
+/* Orthonormal right-handed world axes; forward = the node's -Z. Scale and
+ * shear are removed; under zero scale the axes come from the rotations alone. */
+void ob_node_world_axes(const ob_node *n, float right[3], float up[3], float forward[3]);
+/* View matrix of n used as a camera, relative to origin (pass the camera's
+ * own world position for camera-relative rendering: then it is a rotation). */
+void ob_node_view_relative(const ob_node *n, const double origin[3], float dest[16]);
+/* World bounding sphere of the renderable (center (0,0,0), radius 0 without one). */
+void ob_node_world_sphere(const ob_node *n, double center[3], float *radius);
+/* Has a renderable, neither it nor an ancestor is hidden, transform valid. */
+bool ob_node_is_renderable(const ob_node *n);
+/* Its world transform (and its ancestors') was finite at the last update. */
+bool ob_node_transform_is_valid(const ob_node *n);
+
+/* ----------------------------------------------------------- controllers */
+
+/* Runs during ob_scene_update, before world transforms are computed. */
+typedef void (*ob_controller_fn)(ob_node *n, double dt, void *user);
+
+typedef struct ob_controller_desc {
+    ob_controller_fn fn;            /* required */
+    void *user;
+    /* Optional. The node owns user from the call on: release(user) runs once
+     * when the node is destroyed, and at once if adding fails. */
+    void (*release)(void *user);
+} ob_controller_desc;
+
+/* General form of the three below. Controllers of a node run in the order
+ * added. Errors: OB_ERR_INVALID_ARGUMENT (NULL fn), OB_ERR_OUT_OF_HOST_MEMORY. */
+ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d);
+
+/* Spins the node about its local axis: q = q * dq(axis, rate * dt) each update,
+ * renormalized every time (double), so it stays unit indefinitely. */
+ob_result ob_node_add_rotation_controller(ob_node *n, const float axis[3], float radians_per_second);
+/* Sets the node's position on the circle of `radius` about center (parent
+ * space) in the plane normal to axis, at angle phase + rate * t, rotating
+ * right-handedly about axis. Angle 0 is the world axis least aligned with
+ * axis (preferring X, then Y, then Z) projected onto the plane. */
+ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const float axis[3],
+                                       double radius, float radians_per_second, float phase);
+ob_result ob_node_add_script_controller(ob_node *n, ob_controller_fn fn, void *user);
+/* Errors of the three: OB_ERR_INVALID_ARGUMENT (zero/non-finite axis, rate,
+ * radius, NULL fn; logged with the node's name), OB_ERR_OUT_OF_HOST_MEMORY. */
+
+/* ----------------------------------------------------- cameras and lights */
+
+typedef struct ob_camera_desc {
+    float fovy;     /* vertical field of view in radians, 0 → 60 degrees */
+    float znear;    /* 0 → 0.1 */
+    float aspect;   /* 0 → from the view's target */
+} ob_camera_desc;
+
+/* Copies d with defaults filled in (NULL removes the camera). Refuses fovy
+ * outside (0, pi), negative or non-finite values (OB_ERR_INVALID_ARGUMENT). */
+ob_result ob_node_set_camera(ob_node *n, const ob_camera_desc *d);
+const ob_camera_desc *ob_node_camera(const ob_node *n);   /* NULL if none */
+
+typedef enum ob_light_type { OB_LIGHT_DIRECTIONAL, OB_LIGHT_POINT } ob_light_type;
+
+/* The direction of a directional light is its node's forward (-Z). */
+typedef struct ob_light_desc {
+    ob_light_type type;
+    float color[3];       /* linear RGB, (0,0,0) → white */
+    float intensity;      /* 0 → 1 (hide the node to switch a light off) */
+    float range;          /* point lights; 0 → no cut-off */
+    bool casts_shadows;
+} ob_light_desc;
+
+/* Copies d with defaults filled in (NULL removes the light). Refuses unknown
+ * types, negative or non-finite values (OB_ERR_INVALID_ARGUMENT). */
+ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d);
+const ob_light_desc *ob_node_light(const ob_node *n);     /* NULL if none */
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_SCENE_H */

@@ -1,0 +1,111 @@
+#include "ob_views_internal.h"
+
+#include <stdio.h>
+#include <string.h>
+
+/* Dual-paraboloid environment map of one entity: layer 0 holds the +Z
+ * hemisphere around the owner's centre, layer 1 the -Z one. The map's frame
+ * is the world's (ViewMatrix and EnvMapMatrix are identity), so reflective
+ * lookups only need the reflection vector. */
+struct ob_paraboloid_view {
+    ob_view base;
+    ob_views *ctx;
+    ob_node *owner;
+    ob_param direction, env_map, env_matrix;
+};
+
+#define PARABOLOID_NEAR 0.05f
+
+static void paraboloid_pre_draw(ob_view *v, ob_renderer *r)
+{
+    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
+    if (!ob_renderer_queue_view(r, v)) return;
+    float radius;
+    ob_node_world_sphere(pv->owner, v->origin, &radius);
+    ob_mat4_identity(v->view_proj);
+    ob_view_cull(v, r, ob_renderer_scene(r), pv->owner);
+    ob_view_pre_render_items(v, r);
+    ob_material_library_prepare_view(pv->ctx->materials, r, v);
+}
+
+static void paraboloid_render_params(ob_view *v, ob_renderer *r, ob_params *params)
+{
+    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
+    (void)r;
+    float identity[16];
+    ob_mat4_identity(identity);
+    ob_views_set_common_params(pv->ctx, v, params, identity, identity);
+}
+
+static void paraboloid_usage_params(ob_view *v, ob_renderer *r, ob_params *params,
+                                    const ob_view *consumer)
+{
+    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
+    (void)r;
+    (void)consumer;
+    float identity[16];
+    ob_mat4_identity(identity);
+    ob_params_set_texture(params, pv->env_map, v->color);
+    ob_params_set_mat4(params, pv->env_matrix, identity);
+}
+
+static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                              uint32_t layer, uint32_t first, uint32_t count)
+{
+    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
+    float dir[4] = {layer == 0 ? 1.0f : -1.0f, PARABOLOID_NEAR, 0.0f, 0.0f};
+    ob_params_set_vec4(ob_pm_params(pm), pv->direction, dir);
+    ob_view_record_items(v, r, pm, first, count);
+}
+
+static const ob_view_vtbl paraboloid_vtbl = {
+    .type_name = "paraboloid",
+    .pre_draw = paraboloid_pre_draw,
+    .set_render_params = paraboloid_render_params,
+    .set_usage_params = paraboloid_usage_params,
+    .record = paraboloid_record,
+};
+
+ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    ob_paraboloid_view *pv = ob_calloc(1, sizeof *pv);
+    if (!pv) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto done;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "envmap:%s", ob_node_name(owner));
+    ob_view_init(&pv->base, &paraboloid_vtbl, OB_VIEW_PARABOLOID, name);
+    pv->ctx = ctx;
+    pv->owner = owner;
+    pv->base.no_frustum = true;
+    pv->base.clear_depth = 0.0f;
+    static const float sky[4] = {0.35f, 0.45f, 0.6f, 1.0f};
+    memcpy(pv->base.clear_color, sky, sizeof sky);
+    ob_param_registry *reg = ob_renderer_registry(ctx->r);
+    pv->direction = ob_param_find(reg, "ParaboloidDirection");
+    pv->env_map = ob_param_find(reg, "EnvMap");
+    pv->env_matrix = ob_param_find(reg, "EnvMapMatrix");
+    if (!pv->env_matrix.id) pv->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
+    if (r == OB_OK)
+        r = ob_views_make_target(ctx, &pv->base, ctx->env_map_size, ctx->env_map_size, 2,
+                                 OB_VIEWS_COLOR_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+    if (r != OB_OK) {
+        ob_free(pv);
+        pv = NULL;
+    }
+done:
+    if (out_result) *out_result = r;
+    return pv;
+}
+
+void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v)
+{
+    if (!v) return;
+    ob_views_release_target(ctx, &v->base);
+    ob_view_release(&v->base);
+    ob_free(v);
+}
+
+ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v) { return &v->base; }

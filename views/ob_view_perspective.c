@@ -1,0 +1,110 @@
+#include "ob_views_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+struct ob_perspective_view {
+    ob_view base;
+    ob_views *ctx;
+    ob_node *camera;
+    float view[16], proj[16];
+    bool warned_degenerate;
+};
+
+static void perspective_pre_draw(ob_view *v, ob_renderer *r)
+{
+    ob_perspective_view *pv = (ob_perspective_view *)v;
+    if (!ob_renderer_queue_view(r, v)) return;
+    ob_scene *scene = ob_renderer_scene(r);
+    const ob_camera_desc *cam = pv->camera ? ob_node_camera(pv->camera) : NULL;
+    if (!scene || !cam || !ob_node_transform_is_valid(pv->camera)) {
+        /* Nothing sensible to render: the view still clears its target. */
+        if (!pv->warned_degenerate)
+            OB_LOG_E("views", "view '%s': camera %s%s%s is missing or has an invalid transform; "
+                     "rendering the clear colour only", v->name, pv->camera ? "'" : "",
+                     pv->camera ? ob_node_name(pv->camera) : "(none)", pv->camera ? "'" : "");
+        pv->warned_degenerate = true;
+        v->item_count = 0;
+        return;
+    }
+    ob_node_world_position(pv->camera, v->origin);
+    ob_node_view_relative(pv->camera, v->origin, pv->view);
+    float aspect = cam->aspect > 0.0f ? cam->aspect
+                                      : (v->height ? (float)v->width / (float)v->height : 1.0f);
+    float fovy = cam->fovy > 0.0f && cam->fovy < 3.1f ? cam->fovy : 1.0471976f;
+    float znear = cam->znear > 0.0f ? cam->znear : 0.1f;
+    ob_math_perspective_reverse_z(fovy, aspect, znear, pv->proj);
+    ob_mat4_mul(pv->proj, pv->view, v->view_proj);
+    ob_view_cull(v, r, scene, NULL);
+    ob_views_queue_shadows(pv->ctx, r, v);
+    ob_views_queue_simulations(pv->ctx, r, v);
+    ob_view_pre_render_items(v, r);
+    ob_material_library_prepare_view(pv->ctx->materials, r, v);
+}
+
+static void perspective_render_params(ob_view *v, ob_renderer *r, ob_params *params)
+{
+    ob_perspective_view *pv = (ob_perspective_view *)v;
+    (void)r;
+    ob_views_set_common_params(pv->ctx, v, params, pv->view, pv->proj);
+}
+
+static void perspective_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                               uint32_t layer, uint32_t first, uint32_t count)
+{
+    (void)layer;
+    ob_view_record_items(v, r, pm, first, count);
+}
+
+static const ob_view_vtbl perspective_vtbl = {
+    .type_name = "perspective",
+    .pre_draw = perspective_pre_draw,
+    .set_render_params = perspective_render_params,
+    .record = perspective_record,
+};
+
+ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspective_desc *desc,
+                                                ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    ob_perspective_view *pv = NULL;
+    if (!ctx || !desc || desc->width == 0 || desc->height == 0) {
+        OB_LOG_E("views", "perspective view '%s': needs a width and height (got %ux%u)",
+                 desc && desc->name ? desc->name : "?", desc ? desc->width : 0,
+                 desc ? desc->height : 0);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto done;
+    }
+    pv = ob_calloc(1, sizeof *pv);
+    if (!pv) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto done;
+    }
+    ob_view_init(&pv->base, &perspective_vtbl, OB_VIEW_PERSPECTIVE,
+                 desc->name ? desc->name : "camera");
+    pv->ctx = ctx;
+    pv->camera = desc->camera;
+    memcpy(pv->base.clear_color, desc->clear_color, sizeof pv->base.clear_color);
+    pv->base.clear_depth = 0.0f;
+    r = ob_views_make_target(ctx, &pv->base, desc->width, desc->height, 1,
+                             desc->color_format ? desc->color_format : OB_VIEWS_COLOR_FORMAT,
+                             OB_VIEWS_DEPTH_FORMAT);
+    if (r != OB_OK) {
+        ob_free(pv);
+        pv = NULL;
+    }
+done:
+    if (out_result) *out_result = r;
+    return pv;
+}
+
+void ob_perspective_view_destroy(ob_views *ctx, ob_perspective_view *v)
+{
+    if (!v) return;
+    ob_views_release_target(ctx, &v->base);
+    ob_view_release(&v->base);
+    ob_free(v);
+}
+
+ob_view *ob_perspective_view_base(ob_perspective_view *v) { return &v->base; }
+ob_image ob_perspective_view_color(const ob_perspective_view *v) { return v->base.color; }

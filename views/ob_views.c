@@ -1,0 +1,398 @@
+#include "ob_views_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* ------------------------------------------------------------ parameters */
+
+typedef struct view_params {
+    ob_param screen, ambient, light_dir, light_color;
+    ob_param point_pos[4], point_color[4];
+} view_params;
+
+static view_params params_of(ob_param_registry *reg)
+{
+    view_params p;
+    char name[32];
+    p.screen = ob_param_find(reg, "ScreenSize");
+    p.ambient = ob_param_find(reg, "AmbientColor");
+    p.light_dir = ob_param_find(reg, "LightDirection");
+    p.light_color = ob_param_find(reg, "LightColor");
+    for (int i = 0; i < 4; i++) {
+        snprintf(name, sizeof name, "PointLight%dPosition", i);
+        p.point_pos[i] = ob_param_find(reg, name);
+        snprintf(name, sizeof name, "PointLight%dColor", i);
+        p.point_color[i] = ob_param_find(reg, name);
+    }
+    return p;
+}
+
+static ob_result register_params(ob_param_registry *reg)
+{
+    static const char *const vec4s[] = {
+        "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "PointLight0Position",
+        "PointLight1Position", "PointLight2Position", "PointLight3Position", "PointLight0Color",
+        "PointLight1Color", "PointLight2Color", "PointLight3Color", "ParaboloidDirection",
+        "SimStep", "SimEmitter", "SimForce", "DiffuseColor",
+    };
+    ob_result r = OB_OK;
+    for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
+        ob_param_register(reg, vec4s[i], OB_PARAM_VEC4, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "ShadowMatrix", OB_PARAM_MAT4, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "ShadowMap", OB_PARAM_TEXTURE, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "ShadowMapSampler", OB_PARAM_SAMPLER, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "EnvMap", OB_PARAM_TEXTURE, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "EnvMapSampler", OB_PARAM_SAMPLER, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "SourceImage", OB_PARAM_TEXTURE, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "SourceImageSampler", OB_PARAM_SAMPLER, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "Particles", OB_PARAM_STORAGE_BUFFER, 1, &r);
+    return r;
+}
+
+void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *params,
+                                const float view[16], const float proj[16])
+{
+    const ob_param_builtins *b = ob_param_registry_builtins(params->reg);
+    view_params p = params_of(params->reg);
+    ob_params_set_mat4(params, b->view, view);
+    ob_params_set_mat4(params, b->proj, proj);
+    float screen[4] = {(float)v->width, (float)v->height, v->width ? 1.0f / (float)v->width : 0.0f,
+                       v->height ? 1.0f / (float)v->height : 0.0f};
+    ob_params_set_vec4(params, p.screen, screen);
+    ob_params_set_vec4(params, p.ambient, ctx->ambient);
+
+    /* Lights, relative to the view's origin like everything else. */
+    float zero[4] = {0, 0, 0, 0};
+    float dir[4] = {0, 1, 0, 0}, dcolor[4] = {0, 0, 0, 0};
+    float ppos[4][4] = {{0}}, pcolor[4][4] = {{0}};
+    uint32_t points = 0;
+    bool have_dir = false;
+    uint32_t count = 0;
+    ob_scene *scene = ob_renderer_scene(ctx->r);
+    ob_node *const *lights = scene ? ob_scene_lights(scene, &count) : NULL;
+    for (uint32_t i = 0; i < count; i++) {
+        const ob_light_desc *l = ob_node_light(lights[i]);
+        if (l->type == OB_LIGHT_DIRECTIONAL && !have_dir) {
+            float right[3], up[3], fwd[3];
+            ob_node_world_axes(lights[i], right, up, fwd);
+            dir[0] = -fwd[0];
+            dir[1] = -fwd[1];
+            dir[2] = -fwd[2];
+            dcolor[0] = l->color[0];
+            dcolor[1] = l->color[1];
+            dcolor[2] = l->color[2];
+            dcolor[3] = l->intensity;
+            have_dir = true;
+        } else if (l->type == OB_LIGHT_POINT && points < 4) {
+            double pos[3];
+            ob_node_world_position(lights[i], pos);
+            ppos[points][0] = (float)(pos[0] - v->origin[0]);
+            ppos[points][1] = (float)(pos[1] - v->origin[1]);
+            ppos[points][2] = (float)(pos[2] - v->origin[2]);
+            ppos[points][3] = l->range;
+            memcpy(pcolor[points], l->color, sizeof l->color);
+            pcolor[points][3] = l->intensity;
+            points++;
+        }
+    }
+    ob_params_set_vec4(params, p.light_dir, dir);
+    ob_params_set_vec4(params, p.light_color, have_dir ? dcolor : zero);
+    for (uint32_t i = 0; i < 4; i++) {
+        ob_params_set_vec4(params, p.point_pos[i], ppos[i]);
+        ob_params_set_vec4(params, p.point_color[i], pcolor[i]);
+    }
+}
+
+/* ------------------------------------------------------------ targets */
+
+ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height,
+                               uint32_t layers, VkFormat color, VkFormat depth)
+{
+    ob_result r = OB_OK;
+    char name[64];
+    if (color != VK_FORMAT_UNDEFINED) {
+        snprintf(name, sizeof name, "%s.color", v->name);
+        ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = color,
+                           .usage = OB_IMAGE_COLOR_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC |
+                                    OB_IMAGE_TRANSFER_DST,
+                           .name = name};
+        v->color = ob_image_create(ctx->dev, &d, &r);
+        if (!v->color.id) return r;
+    }
+    if (depth != VK_FORMAT_UNDEFINED) {
+        snprintf(name, sizeof name, "%s.depth", v->name);
+        ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = depth,
+                           .usage = OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
+                           .name = name};
+        v->depth = ob_image_create(ctx->dev, &d, &r);
+        if (!v->depth.id) {
+            ob_image_destroy(ctx->dev, v->color);
+            v->color = (ob_image){0};
+            return r;
+        }
+    }
+    v->width = width;
+    v->height = height;
+    v->layer_count = layers;
+    return OB_OK;
+}
+
+void ob_views_release_target(ob_views *ctx, ob_view *v)
+{
+    ob_image_destroy(ctx->dev, v->color);
+    ob_image_destroy(ctx->dev, v->depth);
+    v->color = v->depth = (ob_image){0};
+}
+
+void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, VkFormat *depth)
+{
+    ob_image_info info;
+    *color = *depth = VK_FORMAT_UNDEFINED;
+    if (v->color.id && ob_image_get_info(ctx->dev, v->color, &info) == OB_OK) *color = info.format;
+    if (v->depth.id && ob_image_get_info(ctx->dev, v->depth, &info) == OB_OK) *depth = info.format;
+}
+
+bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)
+{
+    if (!e) return false;
+    VkFormat color, depth;
+    ob_views_target_formats(ctx, v, &color, &depth);
+    uint32_t id = 0;
+    VkPipeline p = ob_effect_pipeline(e, color, depth, &id);
+    if (!p) return false;
+    ob_pm_set_pipeline(pm, p, id, ob_effect_program(e));
+    return true;
+}
+
+/* ------------------------------------------------------------ entity views */
+
+static ob_views_entry *find_entry(ob_views_entry *list, uint32_t count, uint32_t node_id)
+{
+    for (uint32_t i = 0; i < count; i++)
+        if (list[i].node_id == node_id) return &list[i];
+    return NULL;
+}
+
+static ob_result add_entry(ob_views_entry **list, uint32_t *count, uint32_t *cap,
+                           ob_views_entry e)
+{
+    ob_result r = ob_array_reserve((void **)list, cap, *count + 1, sizeof **list);
+    if (r == OB_OK) (*list)[(*count)++] = e;
+    return r;
+}
+
+/* The material library asks for the views an entity needs (its env map, its
+ * simulation). Each is created on first need and pre-drawn with the current
+ * view as its consumer. */
+static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *requesting,
+                       ob_view_type needed)
+{
+    ob_views *ctx = user;
+    (void)requesting;
+    uint32_t id = ob_node_id(entity);
+    if (needed == OB_VIEW_PARABOLOID) {
+        ob_views_entry *e = find_entry(ctx->envs, ctx->env_count, id);
+        if (!e) {
+            ob_result res;
+            ob_paraboloid_view *pv = ob_paraboloid_view_create(ctx, entity, &res);
+            if (!pv) {
+                OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
+                         ob_node_name(entity), id, ob_result_name(res));
+                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+                return;
+            }
+            if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
+                          (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
+                ob_paraboloid_view_destroy(ctx, pv);
+                return;
+            }
+            e = &ctx->envs[ctx->env_count - 1];
+        }
+        ob_renderer_attach_view(r, entity, e->view);
+        ob_renderer_pre_draw(r, e->view);
+    }
+}
+
+void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
+{
+    uint32_t count = 0;
+    ob_node *const *lights = ob_scene_lights(ob_renderer_scene(r), &count);
+    for (uint32_t i = 0; i < count; i++) {
+        const ob_light_desc *l = ob_node_light(lights[i]);
+        if (l->type != OB_LIGHT_DIRECTIONAL || !l->casts_shadows) continue;
+        char name[64];
+        snprintf(name, sizeof name, "shadow:%s", ob_node_name(lights[i]));
+        if (!(l->intensity > 0.0f)) {
+            ob_renderer_note_skipped(r, name, OB_SKIP_NOT_NEEDED);
+            continue;
+        }
+        uint32_t id = ob_node_id(lights[i]);
+        ob_views_entry *e = find_entry(ctx->shadows, ctx->shadow_count, id);
+        if (!e) {
+            ob_result res;
+            ob_shadow_view *sv = ob_shadow_view_create(ctx, lights[i], &res);
+            if (!sv) {
+                OB_LOG_E("views", "light '%s': cannot create its shadow map: %s",
+                         ob_node_name(lights[i]), ob_result_name(res));
+                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
+                continue;
+            }
+            if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
+                          (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
+                ob_shadow_view_destroy(ctx, sv);
+                continue;
+            }
+            e = &ctx->shadows[ctx->shadow_count - 1];
+        }
+        ob_shadow_view_set_consumer(e->owner_object, consumer);
+        ob_renderer_pre_draw(r, e->view);
+    }
+}
+
+ob_result ob_views_add_system(ob_views *ctx, ob_node *emitter, ob_view *sim, ob_particle_system *ps)
+{
+    return add_entry(&ctx->systems, &ctx->system_count, &ctx->system_cap,
+                     (ob_views_entry){ob_node_id(emitter), sim, ps});
+}
+
+void ob_views_remove_system(ob_views *ctx, ob_particle_system *ps)
+{
+    for (uint32_t i = 0; i < ctx->system_count; i++) {
+        if (ctx->systems[i].owner_object == ps) {
+            ctx->systems[i] = ctx->systems[--ctx->system_count];
+            return;
+        }
+    }
+}
+
+void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer)
+{
+    for (uint32_t i = 0; i < consumer->item_count; i++) {
+        ob_views_entry *e = find_entry(ctx->systems, ctx->system_count,
+                                       ob_node_id(consumer->items[i].node));
+        if (e) ob_renderer_pre_draw(r, e->view);
+    }
+}
+
+/* ------------------------------------------------------------ geometry glue */
+
+static ob_result geometry_draw(const struct ob_geometry *g, ob_pipeline_manager *pm)
+{
+    if (ob_geometry_index_count(g) > 0) {
+        ob_pm_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
+        ob_pm_set_index_buffer(pm, ob_geometry_index_buffer(g), 0, VK_INDEX_TYPE_UINT32);
+        return ob_pm_draw_indexed(pm, ob_geometry_index_count(g), 1, 0, 0, 0);
+    }
+    /* Procedural geometry (no index buffer): vertex pulling, instanced. */
+    ob_pm_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
+    return ob_pm_draw(pm, ob_geometry_vertex_count(g), ob_geometry_instance_count(g), 0, 0);
+}
+
+static uint32_t geometry_id(const struct ob_geometry *g) { return ob_geometry_id(g); }
+
+const ob_effect_vertex_input *ob_views_standard_input(void)
+{
+    static ob_effect_vertex_input input;
+    static bool init;
+    if (!init) {
+        const ob_vertex_layout *l = ob_vertex_layout_standard();
+        input.stride = l->stride;
+        input.attribute_count = l->attribute_count;
+        for (uint32_t i = 0; i < l->attribute_count; i++) {
+            input.attributes[i].location = l->attributes[i].location;
+            input.attributes[i].format = l->attributes[i].format;
+            input.attributes[i].offset = l->attributes[i].offset;
+        }
+        init = true;
+    }
+    return &input;
+}
+
+/* ------------------------------------------------------------ context */
+
+ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    ob_views *ctx = NULL;
+    if (!desc || !desc->renderer || !desc->materials || !desc->effects) {
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto done;
+    }
+    ctx = ob_calloc(1, sizeof *ctx);
+    if (!ctx) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto done;
+    }
+    ctx->r = desc->renderer;
+    ctx->dev = ob_renderer_device(desc->renderer);
+    ctx->materials = desc->materials;
+    ctx->effects = desc->effects;
+    ctx->env_map_size = desc->env_map_size ? desc->env_map_size : 256;
+    ctx->shadow_map_size = desc->shadow_map_size ? desc->shadow_map_size : 1024;
+    static const float default_ambient[4] = {1.0f, 1.0f, 1.0f, 0.15f};
+    memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
+    ctx->dt = 1.0 / 60.0;
+    r = register_params(ob_renderer_registry(ctx->r));
+    if (r != OB_OK) goto fail;
+    ctx->linear_clamp = ob_sampler_create(ctx->dev, &(ob_sampler_desc){
+        .filter = VK_FILTER_LINEAR, .address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .name = "linear-clamp"}, &r);
+    if (!ctx->linear_clamp.id) goto fail;
+    /* Reversed-Z: a fragment is lit when its depth is at least the stored one. */
+    ctx->shadow_compare = ob_sampler_create(ctx->dev, &(ob_sampler_desc){
+        .filter = VK_FILTER_LINEAR, .address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .compare = true, .compare_op = VK_COMPARE_OP_GREATER_OR_EQUAL, .name = "shadow-compare"}, &r);
+    if (!ctx->shadow_compare.id) goto fail;
+    ob_param_registry *reg = ob_renderer_registry(ctx->r);
+    ob_params_init_sampler(reg, ob_param_find(reg, "ShadowMapSampler"), ctx->shadow_compare);
+    ob_params_init_sampler(reg, ob_param_find(reg, "EnvMapSampler"), ctx->linear_clamp);
+    ob_params_init_sampler(reg, ob_param_find(reg, "SourceImageSampler"), ctx->linear_clamp);
+
+    ob_renderer_set_material_iface(ctx->r, ob_material_iface_get());
+    ob_renderer_set_geometry_iface(ctx->r, &(ob_geometry_iface){geometry_draw, geometry_id});
+    ob_material_library_set_queue_hook(ctx->materials, queue_hook, ctx);
+    goto done;
+
+fail:
+    ob_views_destroy(ctx);
+    ctx = NULL;
+done:
+    if (out_result) *out_result = r;
+    return ctx;
+}
+
+void ob_views_destroy(ob_views *ctx)
+{
+    if (!ctx) return;
+    for (uint32_t i = 0; i < ctx->shadow_count; i++)
+        ob_shadow_view_destroy(ctx, ctx->shadows[i].owner_object);
+    for (uint32_t i = 0; i < ctx->env_count; i++)
+        ob_paraboloid_view_destroy(ctx, ctx->envs[i].owner_object);
+    ob_free(ctx->shadows);
+    ob_free(ctx->envs);
+    ob_free(ctx->systems);
+    ob_effect_destroy(ctx->text_effect);
+    ob_effect_destroy(ctx->composite_effect);
+    ob_effect_destroy(ctx->particle_sim_effect);
+    ob_sampler_destroy(ctx->dev, ctx->linear_clamp);
+    ob_sampler_destroy(ctx->dev, ctx->shadow_compare);
+    if (ctx->materials) ob_material_library_set_queue_hook(ctx->materials, NULL, NULL);
+    ob_free(ctx);
+}
+
+ob_renderer *ob_views_renderer(ob_views *ctx) { return ctx->r; }
+
+void ob_views_set_time(ob_views *ctx, double time, double dt)
+{
+    ctx->time = time;
+    ctx->dt = dt;
+}
+
+void ob_views_set_env_map_size(ob_views *ctx, uint32_t size) { ctx->env_map_size = size ? size : 256; }
+void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
+{
+    ctx->shadow_map_size = size ? size : 1024;
+}
+
+void ob_views_render(ob_views *ctx, ob_view *final_view) { ob_renderer_pre_draw(ctx->r, final_view); }
