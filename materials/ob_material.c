@@ -1,0 +1,679 @@
+#include "ob_material.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <string.h>
+
+#define VARIANT_COUNT 8u   /* every combination of the ob_std_variant bits */
+
+typedef struct std_slot {
+    _Atomic(ob_effect *) effect;   /* published once created; read while recording */
+    ob_result failure;             /* OB_OK until a creation failed (not retried) */
+} std_slot;
+
+enum { SAMPLER_SHADOW, SAMPLER_ENV, SAMPLER_SOURCE, SAMPLER_COUNT };
+
+struct ob_material_library {
+    ob_effect_context *ctx;
+    ob_device *dev;
+    ob_param_registry *reg;
+    ob_effect_vertex_input standard_layout, text_layout;
+    float bias_constant, bias_slope;
+    std_slot slots[OB_STD_EFFECT_COUNT][VARIANT_COUNT];
+    ob_material_queue_fn queue_fn;
+    void *queue_user;
+    ob_param diffuse, specular, emissive, reflectivity;
+    ob_sampler samplers[SAMPLER_COUNT];
+    ob_material **materials;
+    uint32_t material_count, material_cap;
+};
+
+struct ob_material {
+    ob_material_library *lib;
+    char name[48];
+    ob_material_kind kind;
+    float diffuse[4], specular[4], emissive[4], reflectivity[4];
+    bool casts_shadows, blended;
+    uint32_t priority;
+    bool render[OB_VIEW_TYPE_COUNT];
+    ob_effect *custom[OB_VIEW_TYPE_COUNT];
+    atomic_bool warned;            /* a skipped draw is logged once */
+};
+
+/* What a material draws with in one view: a standard variant or a custom effect. */
+typedef struct effect_choice {
+    ob_effect *custom;
+    ob_std_effect kind;
+    uint32_t variant;
+    bool standard;
+} effect_choice;
+
+/* ------------------------------------------------------- standard effects */
+
+static const uint32_t allowed_variants[OB_STD_EFFECT_COUNT] = {
+    [OB_STD_LIT] = OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP | OB_VARIANT_BLENDED,
+    [OB_STD_PARABOLOID] = OB_VARIANT_BLENDED,
+    [OB_STD_UNLIT] = OB_VARIANT_BLENDED,
+};
+
+static const char *const std_names[OB_STD_EFFECT_COUNT] = {
+    "lit", "depth", "paraboloid", "unlit", "overlay", "fullscreen", "particles-sim",
+    "particles-draw",
+};
+
+static void variant_name(ob_std_effect kind, uint32_t variant, char *out, size_t cap)
+{
+    snprintf(out, cap, "%s%s%s%s", std_names[kind],
+             variant & OB_VARIANT_SHADOWS ? "+SHADOWS" : "",
+             variant & OB_VARIANT_ENVMAP ? "+ENVMAP" : "",
+             variant & OB_VARIANT_BLENDED ? "+BLENDED" : "");
+}
+
+/* Fills desc (and its defines) for a standard variant. */
+static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_t variant,
+                     ob_effect_desc *desc, ob_shader_define defines[3])
+{
+    bool blended = variant & OB_VARIANT_BLENDED;
+    uint32_t n = 0;
+    *desc = (ob_effect_desc){
+        .layout = &lib->standard_layout,
+        .depth_test = true,
+        .depth_write = !blended,
+        .cull = VK_CULL_MODE_BACK_BIT,
+        .blend = blended,
+    };
+    switch (kind) {
+    case OB_STD_LIT:
+        desc->vertex = "lit.vert";
+        desc->fragment = "lit.frag";
+        if (variant & OB_VARIANT_SHADOWS) defines[n++] = (ob_shader_define){"SHADOWS", "1"};
+        if (variant & OB_VARIANT_ENVMAP) defines[n++] = (ob_shader_define){"ENVMAP", "1"};
+        break;
+    case OB_STD_DEPTH:
+        desc->vertex = "depth.vert";
+        desc->depth_bias_constant = lib->bias_constant;
+        desc->depth_bias_slope = lib->bias_slope;
+        break;
+    case OB_STD_PARABOLOID:
+        /* The paraboloid mirrors the back hemisphere: winding means nothing. */
+        desc->vertex = "paraboloid.vert";
+        desc->fragment = "lit.frag";
+        desc->cull = 0;
+        defines[n++] = (ob_shader_define){"PARABOLOID", "1"};
+        break;
+    case OB_STD_UNLIT:
+        desc->vertex = "unlit.vert";
+        desc->fragment = "unlit.frag";
+        break;
+    case OB_STD_OVERLAY:
+        desc->vertex = "unlit.vert";
+        desc->fragment = "unlit.frag";
+        desc->layout = &lib->text_layout;
+        desc->depth_test = desc->depth_write = false;
+        desc->cull = 0;
+        desc->blend = true;
+        defines[n++] = (ob_shader_define){"SCREEN_SPACE", "1"};
+        defines[n++] = (ob_shader_define){"VERTEX_COLOR", "1"};
+        break;
+    case OB_STD_FULLSCREEN:
+        desc->vertex = "fullscreen.vert";
+        desc->fragment = "fullscreen.frag";
+        desc->layout = NULL;
+        desc->depth_test = desc->depth_write = false;
+        desc->cull = 0;
+        break;
+    case OB_STD_PARTICLES_SIM:
+        *desc = (ob_effect_desc){.compute = "particles.comp"};
+        break;
+    case OB_STD_PARTICLES_DRAW:
+        desc->vertex = "particles.vert";
+        desc->fragment = "particles.frag";
+        desc->layout = NULL;
+        desc->depth_write = false;
+        desc->cull = 0;
+        desc->blend = true;
+        break;
+    case OB_STD_EFFECT_COUNT:
+        break;
+    }
+    desc->define_count = n;
+    desc->defines = n ? defines : NULL;
+}
+
+ob_effect *ob_material_library_find_effect(const ob_material_library *lib, ob_std_effect kind,
+                                           uint32_t variant)
+{
+    if (!lib || (unsigned)kind >= OB_STD_EFFECT_COUNT) return NULL;
+    variant &= allowed_variants[kind];
+    return atomic_load_explicit(&lib->slots[kind][variant].effect, memory_order_acquire);
+}
+
+ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect kind,
+                                      uint32_t variant, ob_result *out_result)
+{
+    if (!lib || (unsigned)kind >= OB_STD_EFFECT_COUNT) {
+        OB_LOG_E("material", "no standard effect %d", (int)kind);
+        if (out_result) *out_result = OB_ERR_INVALID_ARGUMENT;
+        return NULL;
+    }
+    variant &= allowed_variants[kind];
+    std_slot *slot = &lib->slots[kind][variant];
+    ob_effect *e = atomic_load_explicit(&slot->effect, memory_order_acquire);
+    ob_result r = slot->failure;
+    if (!e && r == OB_OK) {
+        char name[64];
+        ob_effect_desc desc;
+        ob_shader_define defines[3];
+        variant_name(kind, variant, name, sizeof name);
+        std_desc(lib, kind, variant, &desc, defines);
+        desc.name = name;
+        e = ob_effect_create(lib->ctx, &desc, &r);
+        if (e) atomic_store_explicit(&slot->effect, e, memory_order_release);
+        /* Host memory may come back; a broken shader or device limit will not. */
+        else if (r != OB_ERR_OUT_OF_HOST_MEMORY) slot->failure = r;
+    }
+    if (out_result) *out_result = e ? OB_OK : r;
+    return e;
+}
+
+/* ---------------------------------------------------------------- library */
+
+static const ob_effect_vertex_input builtin_standard_layout = {
+    .stride = 32,
+    .attribute_count = 3,
+    .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, VK_FORMAT_R32G32_SFLOAT, 24}},
+};
+
+static const ob_effect_vertex_input builtin_text_layout = {
+    .stride = 16,
+    .attribute_count = 2,
+    .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {3, VK_FORMAT_R8G8B8A8_UNORM, 12}},
+};
+
+static ob_param register_param(ob_param_registry *reg, const char *name, ob_param_type type,
+                               ob_result *out_result)
+{
+    ob_param p = ob_param_register(reg, name, type, 1, out_result);
+    if (!p.id)
+        OB_LOG_E("material", "parameter '%s' (%s) not registered: %s", name,
+                 ob_param_type_name(type), ob_result_text(*out_result));
+    return p;
+}
+
+/* Default samplers of the standard shaders, in every slot: a view or the
+ * application may set its own. */
+static ob_result create_samplers(ob_material_library *lib)
+{
+    static const struct {
+        const char *param;
+        bool compare;
+    } specs[SAMPLER_COUNT] = {
+        [SAMPLER_SHADOW] = {"ShadowMapSampler", true},
+        [SAMPLER_ENV] = {"EnvMapSampler", false},
+        [SAMPLER_SOURCE] = {"SourceImageSampler", false},
+    };
+    for (uint32_t i = 0; i < SAMPLER_COUNT; i++) {
+        ob_result r;
+        ob_sampler_desc sd = {
+            .filter = VK_FILTER_LINEAR,
+            .address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            .compare = specs[i].compare,
+            .compare_op = VK_COMPARE_OP_GREATER_OR_EQUAL,   /* reversed-Z: nearer is greater */
+            .name = specs[i].param,
+        };
+        lib->samplers[i] = ob_sampler_create(lib->dev, &sd, &r);
+        if (!lib->samplers[i].id) {
+            OB_LOG_E("material", "default sampler '%s' not created: %s", specs[i].param,
+                     ob_result_text(r));
+            return r;
+        }
+        ob_param p = register_param(lib->reg, specs[i].param, OB_PARAM_SAMPLER, &r);
+        if (!p.id) return r;
+        r = ob_params_init_sampler(lib->reg, p, lib->samplers[i]);
+        if (r != OB_OK) return r;
+    }
+    return OB_OK;
+}
+
+ob_material_library *ob_material_library_create(ob_effect_context *ctx,
+                                                const ob_material_library_desc *desc,
+                                                ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    ob_material_library_desc d = desc ? *desc : (ob_material_library_desc){0};
+    ob_material_library *lib = NULL;
+    if (!ctx) {
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail;
+    }
+    if ((d.standard_layout && d.standard_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES) ||
+        (d.text_layout && d.text_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES)) {
+        OB_LOG_E("material", "material library: a vertex layout has more than %u attributes",
+                 OB_EFFECT_MAX_ATTRIBUTES);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail;
+    }
+    lib = ob_calloc(1, sizeof *lib);
+    if (!lib) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail;
+    }
+    lib->ctx = ctx;
+    lib->dev = ob_effect_context_device(ctx);
+    lib->reg = ob_effect_context_registry(ctx);
+    lib->standard_layout = d.standard_layout ? *d.standard_layout : builtin_standard_layout;
+    lib->text_layout = d.text_layout ? *d.text_layout : builtin_text_layout;
+    lib->bias_constant = d.shadow_bias_constant != 0.0f ? d.shadow_bias_constant : -1.0f;
+    lib->bias_slope = d.shadow_bias_slope != 0.0f ? d.shadow_bias_slope : -1.75f;
+
+    lib->diffuse = register_param(lib->reg, "DiffuseColor", OB_PARAM_VEC4, &r);
+    if (lib->diffuse.id) lib->specular = register_param(lib->reg, "SpecularColor", OB_PARAM_VEC4, &r);
+    if (lib->specular.id) lib->emissive = register_param(lib->reg, "EmissiveColor", OB_PARAM_VEC4, &r);
+    if (lib->emissive.id)
+        lib->reflectivity = register_param(lib->reg, "Reflectivity", OB_PARAM_VEC4, &r);
+    if (!lib->reflectivity.id) goto fail_destroy;
+    r = create_samplers(lib);
+    if (r != OB_OK) goto fail_destroy;
+    if (out_result) *out_result = OB_OK;
+    return lib;
+
+fail_destroy:
+    ob_material_library_destroy(lib);
+fail:
+    OB_LOG_E("material", "material library not created: %s", ob_result_name(r));
+    if (out_result) *out_result = r;
+    return NULL;
+}
+
+void ob_material_library_destroy(ob_material_library *lib)
+{
+    if (!lib) return;
+    while (lib->material_count) ob_material_destroy(lib->materials[lib->material_count - 1]);
+    ob_free(lib->materials);
+    for (uint32_t k = 0; k < OB_STD_EFFECT_COUNT; k++)
+        for (uint32_t v = 0; v < VARIANT_COUNT; v++) ob_effect_destroy(lib->slots[k][v].effect);
+    for (uint32_t i = 0; i < SAMPLER_COUNT; i++)
+        if (lib->samplers[i].id) ob_sampler_destroy(lib->dev, lib->samplers[i]);
+    ob_free(lib);
+}
+
+void ob_material_library_set_queue_hook(ob_material_library *lib, ob_material_queue_fn fn,
+                                        void *user)
+{
+    lib->queue_fn = fn;
+    lib->queue_user = user;
+}
+
+ob_effect_context *ob_material_library_context(const ob_material_library *lib)
+{
+    return lib ? lib->ctx : NULL;
+}
+
+/* --------------------------------------------------------------- materials */
+
+static bool all_zero(const float v[4]) { return !v[0] && !v[1] && !v[2] && !v[3]; }
+
+static bool all_finite(const float *v, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
+static void set_render_flags(ob_material *m)
+{
+    memset(m->render, 0, sizeof m->render);
+    switch (m->kind) {
+    case OB_MATERIAL_LIT:
+    case OB_MATERIAL_REFLECTIVE:
+        m->render[OB_VIEW_PERSPECTIVE] = true;
+        m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_SHADOW] = m->casts_shadows;
+        break;
+    case OB_MATERIAL_UNLIT:
+        m->render[OB_VIEW_PERSPECTIVE] = true;
+        m->render[OB_VIEW_OVERLAY] = true;
+        m->render[OB_VIEW_SHADOW] = m->casts_shadows;
+        break;
+    case OB_MATERIAL_CUSTOM:
+    case OB_MATERIAL_KIND_COUNT:
+        break;
+    }
+}
+
+ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc *desc,
+                                ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    const char *name = desc && desc->name ? desc->name : "material";
+    ob_material *m = NULL;
+    if (!lib || !desc || (unsigned)desc->kind >= OB_MATERIAL_KIND_COUNT) {
+        OB_LOG_E("material", "material '%s': bad library, desc or kind", name);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail;
+    }
+    if (!all_finite(desc->diffuse, 4) || !all_finite(desc->specular, 4) ||
+        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity)) {
+        OB_LOG_E("material", "material '%s': non-finite colour or reflectivity", name);
+        r = OB_ERR_NON_FINITE;
+        goto fail;
+    }
+    r = ob_array_reserve((void **)&lib->materials, &lib->material_cap, lib->material_count + 1,
+                         sizeof *lib->materials);
+    if (r != OB_OK) goto fail;
+    m = ob_calloc(1, sizeof *m);
+    if (!m) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail;
+    }
+    m->lib = lib;
+    snprintf(m->name, sizeof m->name, "%s", name);
+    m->kind = desc->kind;
+    static const float white[4] = {1, 1, 1, 1}, soft_highlight[4] = {0.25f, 0.25f, 0.25f, 32};
+    memcpy(m->diffuse, all_zero(desc->diffuse) ? white : desc->diffuse, sizeof m->diffuse);
+    memcpy(m->specular, all_zero(desc->specular) ? soft_highlight : desc->specular,
+           sizeof m->specular);
+    memcpy(m->emissive, desc->emissive, sizeof m->emissive);
+    m->reflectivity[0] = desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
+                         : desc->reflectivity != 0.0f          ? desc->reflectivity
+                                                               : 0.6f;
+    m->casts_shadows = desc->casts_shadows;
+    m->blended = desc->blended;
+    m->priority = desc->priority;
+    set_render_flags(m);
+    lib->materials[lib->material_count++] = m;
+    if (out_result) *out_result = OB_OK;
+    return m;
+
+fail:
+    OB_LOG_E("material", "material '%s' not created: %s", name, ob_result_name(r));
+    if (out_result) *out_result = r;
+    return NULL;
+}
+
+void ob_material_destroy(ob_material *m)
+{
+    if (!m) return;
+    ob_material_library *lib = m->lib;
+    for (uint32_t i = 0; i < lib->material_count; i++) {
+        if (lib->materials[i] != m) continue;
+        lib->materials[i] = lib->materials[--lib->material_count];
+        break;
+    }
+    ob_free(m);
+}
+
+const char *ob_material_name(const ob_material *m) { return m ? m->name : ""; }
+ob_material_kind ob_material_get_kind(const ob_material *m) { return m->kind; }
+
+static bool renders(const ob_material *m, ob_view_type type)
+{
+    return m && (unsigned)type < OB_VIEW_TYPE_COUNT && m->render[type];
+}
+
+ob_result ob_material_set_view_effect(ob_material *m, ob_view_type type, ob_effect *effect)
+{
+    if (!m || (unsigned)type >= OB_VIEW_TYPE_COUNT) return OB_ERR_INVALID_ARGUMENT;
+    m->custom[type] = effect;
+    if (effect) m->render[type] = true;
+    else if (m->kind == OB_MATERIAL_CUSTOM) m->render[type] = false;
+    else {
+        /* Back to the kind's standard behaviour for every type, then the
+         * other overrides again. */
+        set_render_flags(m);
+        for (uint32_t t = 0; t < OB_VIEW_TYPE_COUNT; t++)
+            if (m->custom[t]) m->render[t] = true;
+    }
+    return OB_OK;
+}
+
+static ob_result set_color(ob_material *m, float dest[4], const float v[4])
+{
+    if (!m || !v) return OB_ERR_INVALID_ARGUMENT;
+    if (!all_finite(v, 4)) {
+        OB_LOG_E("material", "material '%s': non-finite colour refused", m->name);
+        return OB_ERR_NON_FINITE;
+    }
+    memcpy(dest, v, 4 * sizeof *v);
+    return OB_OK;
+}
+
+ob_result ob_material_set_diffuse(ob_material *m, const float rgba[4])
+{
+    return set_color(m, m ? m->diffuse : NULL, rgba);
+}
+ob_result ob_material_set_specular(ob_material *m, const float rgb_power[4])
+{
+    return set_color(m, m ? m->specular : NULL, rgb_power);
+}
+ob_result ob_material_set_emissive(ob_material *m, const float rgb[4])
+{
+    return set_color(m, m ? m->emissive : NULL, rgb);
+}
+ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity)
+{
+    float v[4] = {reflectivity, 0, 0, 0};
+    return set_color(m, m ? m->reflectivity : NULL, v);
+}
+
+/* ---------------------------------------------------------- view effects */
+
+static bool view_depends_on(const ob_view *v, ob_view_type type)
+{
+    for (uint32_t i = 0; i < v->dep_count; i++)
+        if (v->deps[i] && v->deps[i]->type == type) return true;
+    return false;
+}
+
+static ob_view *attached_env_map(const ob_renderer *r, const ob_node *entity)
+{
+    return r && entity ? ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID) : NULL;
+}
+
+/* The effect a material wants in view v; false when it is not drawn there. */
+static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *entity,
+                   const ob_view *v, effect_choice *out)
+{
+    *out = (effect_choice){0};
+    if (!renders(m, v->type)) return false;
+    if (m->custom[v->type]) {
+        out->custom = m->custom[v->type];
+        return true;
+    }
+    uint32_t blended = m->blended ? OB_VARIANT_BLENDED : 0u;
+    out->standard = true;
+    switch (v->type) {
+    case OB_VIEW_PERSPECTIVE:
+        if (m->kind == OB_MATERIAL_UNLIT) {
+            out->kind = OB_STD_UNLIT;
+            out->variant = blended;
+            return true;
+        }
+        out->kind = OB_STD_LIT;
+        out->variant = blended;
+        if (view_depends_on(v, OB_VIEW_SHADOW)) out->variant |= OB_VARIANT_SHADOWS;
+        if (m->kind == OB_MATERIAL_REFLECTIVE && attached_env_map(r, entity))
+            out->variant |= OB_VARIANT_ENVMAP;
+        return true;
+    case OB_VIEW_SHADOW:
+        out->kind = OB_STD_DEPTH;
+        return true;
+    case OB_VIEW_PARABOLOID:
+        out->kind = OB_STD_PARABOLOID;
+        out->variant = blended;
+        return true;
+    case OB_VIEW_OVERLAY:
+        out->kind = OB_STD_OVERLAY;
+        return true;
+    default:
+        return false;
+    }
+}
+
+/* Without creating: the wanted variant, else the closest existing one that
+ * needs fewer inputs (no shadow map, no env map). *io_variant is updated. */
+static ob_effect *find_with_fallback(const ob_material_library *lib, ob_std_effect kind,
+                                     uint32_t *io_variant)
+{
+    static const uint32_t drop[] = {0u, OB_VARIANT_SHADOWS, OB_VARIANT_ENVMAP,
+                                    OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP};
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(drop); i++) {
+        if (i && !(*io_variant & drop[i])) continue;
+        uint32_t variant = *io_variant & ~drop[i];
+        ob_effect *e = ob_material_library_find_effect(lib, kind, variant);
+        if (e) {
+            *io_variant = variant;
+            return e;
+        }
+    }
+    return NULL;
+}
+
+static ob_effect *resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
+                          const ob_view *v, bool create, uint32_t *out_variant,
+                          ob_result *out_result)
+{
+    effect_choice c;
+    *out_variant = 0;
+    if (out_result) *out_result = OB_OK;
+    if (!v || !choose(m, r, entity, v, &c)) {
+        if (out_result) *out_result = OB_ERR_NOT_FOUND;
+        return NULL;
+    }
+    if (c.custom) return c.custom;
+    ob_effect *e = NULL;
+    if (create) {
+        e = ob_material_library_effect(m->lib, c.kind, c.variant, out_result);
+        /* A broken variant must not hide the surface: fall back like apply. */
+        if (!e) e = find_with_fallback(m->lib, c.kind, &c.variant);
+    } else {
+        e = find_with_fallback(m->lib, c.kind, &c.variant);
+        if (!e && out_result) *out_result = OB_ERR_NOT_FOUND;
+    }
+    *out_variant = c.variant;
+    return e;
+}
+
+ob_effect *ob_material_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
+                                   const ob_view *v, bool create, ob_result *out_result)
+{
+    uint32_t variant;
+    return m ? resolve(m, r, entity, v, create, &variant, out_result) : NULL;
+}
+
+ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_view_type type)
+{
+    ob_material_view_params p = {0};
+    if (!renders(m, type)) return p;
+    p.render = true;
+    ob_view probe;
+    memset(&probe, 0, sizeof probe);
+    probe.type = type;
+    effect_choice c;
+    if (choose(m, NULL, NULL, &probe, &c))
+        p.effect = c.custom ? c.custom : ob_material_library_find_effect(m->lib, c.kind, c.variant);
+    return p;
+}
+
+static void view_formats(ob_device *dev, const ob_view *v, VkFormat *out_color,
+                         VkFormat *out_depth)
+{
+    ob_image_info info;
+    *out_color = *out_depth = VK_FORMAT_UNDEFINED;
+    if (v->color.id && ob_image_get_info(dev, v->color, &info) == OB_OK) *out_color = info.format;
+    if (v->depth.id && ob_image_get_info(dev, v->depth, &info) == OB_OK) *out_depth = info.format;
+}
+
+static void prepare(ob_material *m, ob_renderer *r, ob_node *entity, const ob_view *v,
+                    VkFormat color, VkFormat depth)
+{
+    uint32_t variant;
+    ob_effect *e = resolve(m, r, entity, v, true, &variant, NULL);
+    if (e) ob_effect_pipeline(e, color, depth, NULL);
+}
+
+void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v)
+{
+    if (!lib || !v) return;
+    VkFormat color, depth;
+    view_formats(lib->dev, v, &color, &depth);
+    for (uint32_t i = 0; i < v->item_count; i++) {
+        ob_node *n = v->items[i].node;
+        const ob_renderable *rd = n ? ob_node_renderable(n) : NULL;
+        if (!rd || !rd->material || rd->material->lib != lib) continue;
+        prepare(rd->material, r, n, v, color, depth);
+    }
+}
+
+/* ------------------------------------------------------ engine interface */
+
+static bool iface_renders(const struct ob_material *m, ob_view_type type)
+{
+    return renders(m, type);
+}
+
+static void iface_sort_info(const struct ob_material *m, ob_view_type type,
+                            uint32_t *out_class, uint32_t *out_priority)
+{
+    /* Overlay elements blend over each other: back to front, then priority. */
+    *out_class = m->blended || type == OB_VIEW_OVERLAY ? 1u : 0u;
+    *out_priority = m->priority;
+}
+
+static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v)
+{
+    if (!renders(m, v->type)) return;
+    ob_material_library *lib = m->lib;
+    if (m->kind == OB_MATERIAL_REFLECTIVE && !m->custom[v->type] &&
+        v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
+        lib->queue_fn(lib->queue_user, entity, r, v, OB_VIEW_PARABOLOID);
+    VkFormat color, depth;
+    view_formats(lib->dev, v, &color, &depth);
+    prepare(m, r, entity, v, color, depth);
+}
+
+static bool iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
+                        ob_pipeline_manager *pm, const ob_view *v)
+{
+    uint32_t variant;
+    ob_effect *e = resolve(m, r, entity, v, false, &variant, NULL);
+    if (!e) {
+        if (renders(m, v->type) && !atomic_exchange(&m->warned, true))
+            OB_LOG_W("material", "material '%s': no effect prepared for %s view '%s'; its "
+                     "draws are skipped (was PreRender run for this view?)", m->name,
+                     ob_view_type_name(v->type), v->name);
+        return false;
+    }
+    VkFormat color, depth;
+    view_formats(m->lib->dev, v, &color, &depth);
+    uint32_t pipeline_id;
+    VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
+    if (!pipeline) return false;
+    ob_pm_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
+
+    ob_params *params = ob_pm_params(pm);
+    const ob_material_library *lib = m->lib;
+    ob_params_set_vec4(params, lib->diffuse, m->diffuse);
+    ob_params_set_vec4(params, lib->specular, m->specular);
+    ob_params_set_vec4(params, lib->emissive, m->emissive);
+    ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
+    if (variant & OB_VARIANT_ENVMAP) {
+        /* Each reflective entity samples its own map: bind it per draw. */
+        ob_view *env = attached_env_map(r, entity);
+        if (env && env->vtbl && env->vtbl->set_usage_params)
+            env->vtbl->set_usage_params(env, r, params, v);
+    }
+    return true;
+}
+
+static const ob_material_iface material_iface = {
+    .renders = iface_renders,
+    .sort_info = iface_sort_info,
+    .pre_render = iface_pre_render,
+    .apply = iface_apply,
+};
+
+const ob_material_iface *ob_material_iface_get(void) { return &material_iface; }

@@ -1,0 +1,196 @@
+/* ob_material.h — materials and the library of standard effects
+ * (Hieroglyph 3's MaterialDX11 with Params[VT_NUM_VIEW_TYPES]).
+ *
+ * A material says, per view type, whether an entity using it is drawn there
+ * and with which effect, plus its own parameters (DiffuseColor,
+ * SpecularColor, EmissiveColor, Reflectivity), which it writes into the
+ * recording manager's slot when applied. The engine reaches materials only
+ * through ob_material_iface (engine/ob_renderer.h), which
+ * ob_material_iface_get() implements.
+ *
+ * Standard kinds and the effect used per view type:
+ *   LIT         perspective: lit (+SHADOWS when the view depends on a shadow
+ *               view this frame); shadow: depth-only when casts_shadows;
+ *               paraboloid: paraboloid generation (lit shading).
+ *   REFLECTIVE  perspective: lit + ENVMAP (paraboloid lookup) when the entity
+ *               has an environment-map view attached this frame
+ *               (ob_renderer_attached_view), plain lit otherwise;
+ *               paraboloid: generation (the view excludes the owner);
+ *               shadow: depth-only when casts_shadows. Its pre_render asks the
+ *               queue hook for the entity's PARABOLOID view.
+ *   UNLIT       perspective: unlit (DiffuseColor); overlay: screen-space
+ *               unlit with vertex colours, alpha blended, no depth (text);
+ *               shadow: depth-only when casts_shadows.
+ *   CUSTOM      only the effects given with ob_material_set_view_effect.
+ * A view type with no effect is not drawn (renders() is false, so culling
+ * counts the entity as culled).
+ *
+ * Lazy creation: an effect variant is compiled the first time a material
+ * needs it for a view (pre_render or ob_material_library_prepare_view on the
+ * render thread), and its pipeline for the view's target formats is created
+ * then too, so recording normally finds both cached. If recording needs a
+ * variant that does not exist yet (a shadow view queued after the entity's
+ * PreRender), it falls back to the variant without SHADOWS / ENVMAP when that
+ * one exists; otherwise the draw is skipped and logged once per material.
+ *
+ * Standard shader parameters the library sets up: it registers the material
+ * parameters and gives "ShadowMapSampler" (depth compare GREATER_OR_EQUAL,
+ * linear, clamp), "EnvMapSampler" and "SourceImageSampler" (linear, clamp) a
+ * default in every slot. Views provide the rest: per-view matrices and
+ * lights (materials/shaders/common.glsl), "ShadowMap" + "ShadowMatrix" from
+ * shadow views, "EnvMap" + "EnvMapMatrix" (world → owner-frame rotation, the
+ * env-map view's ViewMatrix) + "ParaboloidDirection" from env-map views.
+ *
+ * Lifecycle: library_create → material_create* → frames → library_destroy
+ * (destroys its materials and effects; the device must be idle or the
+ * library's effects otherwise unused). Materials may be destroyed earlier
+ * when no pending frame uses them.
+ * Thread rule: creation, destruction, setters, pre_render and
+ * prepare_view are [render thread, not while recording]; renders,
+ * sort_info and apply are [any thread] (apply writes only the given
+ * manager's slot).
+ */
+#ifndef OB_MATERIAL_H
+#define OB_MATERIAL_H
+
+#include "ob_effect.h"
+#include "ob_renderer.h"
+#include "ob_view.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ob_material_library ob_material_library;
+struct ob_material;  /* the engine forward-declares it */
+typedef struct ob_material ob_material;
+
+typedef enum ob_material_kind {
+    OB_MATERIAL_LIT = 0,
+    OB_MATERIAL_REFLECTIVE,
+    OB_MATERIAL_UNLIT,
+    OB_MATERIAL_CUSTOM,
+    OB_MATERIAL_KIND_COUNT
+} ob_material_kind;
+
+/* Standard effects of the library; variants are flags. */
+typedef enum ob_std_effect {
+    OB_STD_LIT = 0,           /* lit.vert + lit.frag */
+    OB_STD_DEPTH,             /* depth.vert, no fragment stage, depth bias */
+    OB_STD_PARABOLOID,        /* paraboloid.vert + lit.frag PARABOLOID, no culling */
+    OB_STD_UNLIT,             /* unlit.vert + unlit.frag, standard layout */
+    OB_STD_OVERLAY,           /* unlit SCREEN_SPACE + VERTEX_COLOR, text layout, blended */
+    OB_STD_FULLSCREEN,        /* fullscreen.vert + .frag, no vertex input, no depth */
+    OB_STD_PARTICLES_SIM,     /* particles.comp */
+    OB_STD_PARTICLES_DRAW,    /* particles.vert + .frag, pulled quads, blended */
+    OB_STD_EFFECT_COUNT
+} ob_std_effect;
+
+typedef enum ob_std_variant {
+    OB_VARIANT_SHADOWS = 1u << 0,  /* lit: shadowed directional light */
+    OB_VARIANT_ENVMAP = 1u << 1,   /* lit: paraboloid environment lookup */
+    OB_VARIANT_BLENDED = 1u << 2,  /* lit/paraboloid/unlit: alpha blended, no depth write */
+} ob_std_variant;
+
+/* A view type of a material: render flag and the base effect (NULL until the
+ * library first needs it, for standard kinds). */
+typedef struct ob_material_view_params {
+    bool render;
+    ob_effect *effect;
+} ob_material_view_params;
+
+typedef struct ob_material_desc {
+    const char *name;          /* copied; NULL → "material" */
+    ob_material_kind kind;
+    /* Zero means default: diffuse (1,1,1,1); specular (0.25,0.25,0.25, power
+     * 32) — use {0,0,0,1} for no highlight; emissive none; reflectivity 0.6
+     * for REFLECTIVE (ignored otherwise). */
+    float diffuse[4], specular[4], emissive[4];
+    float reflectivity;
+    bool casts_shadows;
+    bool blended;              /* sorted back to front, drawn with the BLENDED variant */
+    uint32_t priority;         /* orders materials within a sort class */
+} ob_material_desc;
+
+/* Called from pre_render for each view type a material needs for an entity
+ * (PARABOLOID for reflective materials in perspective views). The views
+ * layer queues (or finds) the entity's view and attaches it with
+ * ob_renderer_attach_view. [render thread] */
+typedef void (*ob_material_queue_fn)(void *user, ob_node *entity, ob_renderer *r,
+                                     ob_view *requesting_view, ob_view_type needed);
+
+typedef struct ob_material_library_desc {
+    /* The standard vertex layout (position vec3 @0, normal vec3 @12, uv
+     * vec2 @24, stride 32; locations 0, 1, 2). NULL → that built-in copy of
+     * geometry's ob_vertex_layout_standard(). Copied. */
+    const ob_effect_vertex_input *standard_layout;
+    /* Overlay text vertices. NULL → stb_easy_font's 16 bytes: position vec3
+     * at location 0, colour R8G8B8A8_UNORM at location 3, offset 12. Copied. */
+    const ob_effect_vertex_input *text_layout;
+    /* Shadow depth bias (reversed-Z: negative pushes away from the light).
+     * 0 → -1.0 constant, -1.75 slope. */
+    float shadow_bias_constant, shadow_bias_slope;
+} ob_material_library_desc;
+
+/* desc may be NULL. Registers the material parameters and the default
+ * samplers. Compiles nothing. Failure: NULL, *out_result, logged.
+ * [render thread, not while recording] */
+ob_material_library *ob_material_library_create(ob_effect_context *ctx,
+                                                const ob_material_library_desc *desc,
+                                                ob_result *out_result);
+/* Destroys every material and effect of the library and its samplers. NULL ok. */
+void ob_material_library_destroy(ob_material_library *lib);
+void ob_material_library_set_queue_hook(ob_material_library *lib, ob_material_queue_fn fn,
+                                        void *user);
+ob_effect_context *ob_material_library_context(const ob_material_library *lib);
+
+/* The standard effect variant, compiled and built on first request.
+ * Failure: NULL, *out_result, logged (and not retried: later calls return
+ * NULL with the same result quietly). [render thread, not while recording] */
+ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect kind,
+                                      uint32_t variant, ob_result *out_result);
+/* The variant if it exists already, else NULL; never compiles. [any thread] */
+ob_effect *ob_material_library_find_effect(const ob_material_library *lib, ob_std_effect kind,
+                                           uint32_t variant);
+
+/* Make sure every effect variant and pipeline the materials of v's draw list
+ * need exists (for entities whose PreRender ran before v's shadow views were
+ * queued, say). The views layer calls it at the end of a view's pre_draw.
+ * [render thread, not while recording] */
+void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v);
+
+/* The library owns the material. Failure: NULL, *out_result, logged.
+ * [render thread] */
+ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc *desc,
+                                ob_result *out_result);
+/* Now: no pending frame may use it. NULL ok. [render thread] */
+void ob_material_destroy(ob_material *m);
+
+const char *ob_material_name(const ob_material *m);
+ob_material_kind ob_material_get_kind(const ob_material *m);
+ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_view_type type);
+/* CUSTOM materials (any kind may override): draw with `effect` in views of
+ * `type`; NULL stops drawing there. The caller owns the effect and keeps it
+ * alive as long as the material. [render thread, not while recording] */
+ob_result ob_material_set_view_effect(ob_material *m, ob_view_type type, ob_effect *effect);
+/* Parameters; non-finite values are refused (OB_ERR_NON_FINITE). [render thread] */
+ob_result ob_material_set_diffuse(ob_material *m, const float rgba[4]);
+ob_result ob_material_set_specular(ob_material *m, const float rgb_power[4]);
+ob_result ob_material_set_emissive(ob_material *m, const float rgb[4]);
+ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity);
+
+/* The effect (and variant) the material draws with in view v for entity
+ * (r and entity may be NULL: no env-map attachment known). With create, a
+ * missing variant is compiled [render thread]; without, falls back as apply
+ * does [any thread]. NULL when the material does not render in v->type or
+ * the effect failed (logged). */
+ob_effect *ob_material_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
+                                   const ob_view *v, bool create, ob_result *out_result);
+
+/* The engine interface: renders, sort_info, pre_render, apply. Static data. */
+const ob_material_iface *ob_material_iface_get(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_MATERIAL_H */

@@ -1,0 +1,64 @@
+// common.glsl — declarations shared by Obelisk's standard shaders.
+//
+// Binding plan (engine/ob_program.h): uniform blocks live in set 0 and are
+// packed from parameters whose names equal the member names; images, samplers
+// and storage buffers live in set 1 (push descriptors); per-draw data is the
+// one push-constant block. Every member is a vec4 or a mat4 because those are
+// the parameter types the registry stores.
+//
+// Space: rendering is camera-relative. WorldMatrix maps model space to world
+// space minus the view's origin, ViewMatrix is rotation only, CameraPosition
+// is therefore always zero. ProjMatrix is reversed-Z with an infinite far
+// plane (depth 1 at the near plane, 0 at infinity) in Vulkan clip space (y
+// already flipped).
+//
+// Lights: one directional light plus four point lights, as separate vec4
+// parameters PointLight<i>Position / PointLight<i>Color (i = 0..3) rather than
+// a packed mat4 array, so that an application sets a light with two named
+// vec4 writes and an unused light costs nothing but intensity 0.
+#ifndef OB_COMMON_GLSL
+#define OB_COMMON_GLSL
+
+layout(set = 0, binding = 0, std140) uniform PerView {
+    mat4 ViewMatrix;           // rotation only
+    mat4 ProjMatrix;           // reversed-Z, infinite far plane
+    mat4 ViewProjMatrix;       // ProjMatrix * ViewMatrix
+    mat4 ShadowMatrix;         // camera-relative world -> shadow clip space
+    vec4 CameraPosition;       // always 0 (camera-relative); kept for shaders
+    vec4 ScreenSize;           // width, height, 1/width, 1/height in pixels
+    vec4 AmbientColor;         // rgb, w = intensity
+    vec4 LightDirection;       // xyz toward the light (need not be unit length)
+    vec4 LightColor;           // rgb, w = intensity (0 = no directional light)
+    vec4 PointLight0Position;  // xyz camera-relative, w = range (0 = unbounded)
+    vec4 PointLight1Position;
+    vec4 PointLight2Position;
+    vec4 PointLight3Position;
+    vec4 PointLight0Color;     // rgb, w = intensity (0 = light off)
+    vec4 PointLight1Color;
+    vec4 PointLight2Color;
+    vec4 PointLight3Color;
+    vec4 ParaboloidDirection;  // x: +1 front layer (0), -1 back layer (1); y: near distance
+};
+
+layout(set = 0, binding = 1, std140) uniform PerMaterial {
+    vec4 DiffuseColor;         // rgba (alpha used when blended)
+    vec4 SpecularColor;        // rgb, w = Blinn-Phong power
+    vec4 EmissiveColor;        // rgb added unlit
+    vec4 Reflectivity;         // x = mix factor of the environment map
+};
+
+// 128 bytes: exactly the smallest push-constant limit (lavapipe's).
+layout(push_constant, std430) uniform PerDraw {
+    mat4 WorldMatrix;          // model -> camera-relative world
+    mat4 NormalMatrix;         // inverse transpose of WorldMatrix's upper 3x3
+};
+
+// normalize() of a zero vector is NaN; a zero scale produces zero normals,
+// and a NaN would poison the whole pixel (and blending around it).
+vec3 ob_safe_normalize(vec3 v)
+{
+    float len2 = dot(v, v);
+    return len2 > 1e-24 ? v * inversesqrt(len2) : vec3(0.0);
+}
+
+#endif

@@ -1,0 +1,89 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// lit.frag — Blinn-Phong with one directional and four point lights.
+//
+// Variants (each compiled only when a material needs it):
+//   SHADOWS     the directional light is shadowed by "ShadowMap" (depth,
+//               reversed-Z: larger is nearer the light), sampled with a
+//               compare sampler "ShadowMapSampler" whose op is
+//               GREATER_OR_EQUAL, 2x2 PCF. ShadowMatrix maps camera-relative
+//               world positions to the light's clip space.
+//   ENVMAP      reflective surfaces: the reflected view vector samples the
+//               dual-paraboloid "EnvMap" (2D array, layer 0 = +Z of the owner)
+//               rotated by EnvMapMatrix; mixed over the lit colour by
+//               Reflectivity.x.
+//   PARABOLOID  paired with paraboloid.vert: discards the other hemisphere.
+// Output is premultiplied alpha (the blend state is ONE, ONE_MINUS_SRC_ALPHA).
+#include "common.glsl"
+#include "lighting.glsl"
+#if defined(ENVMAP)
+#include "paraboloid.glsl"
+#endif
+
+layout(location = 0) in vec3 vPosition;
+layout(location = 1) in vec3 vNormal;
+layout(location = 2) in vec2 vUV;
+#if defined(PARABOLOID)
+layout(location = 3) in float vHemisphere;
+#endif
+
+layout(location = 0) out vec4 outColor;
+
+#if defined(SHADOWS)
+layout(set = 1, binding = 0) uniform sampler2DShadow ShadowMap;
+
+float ob_shadow_visibility(vec3 p)
+{
+    vec4 clip = ShadowMatrix * vec4(p, 1.0);
+    if (clip.w <= 0.0) return 1.0;
+    vec3 s = clip.xyz / clip.w;
+    vec2 uv = s.xy * 0.5 + 0.5;
+    // Outside the shadow volume nothing was rendered: treat as lit.
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) ||
+        s.z < 0.0 || s.z > 1.0)
+        return 1.0;
+    vec2 texel = 1.0 / vec2(textureSize(ShadowMap, 0));
+    float lit = texture(ShadowMap, vec3(uv + vec2(-0.5, -0.5) * texel, s.z))
+              + texture(ShadowMap, vec3(uv + vec2( 0.5, -0.5) * texel, s.z))
+              + texture(ShadowMap, vec3(uv + vec2(-0.5,  0.5) * texel, s.z))
+              + texture(ShadowMap, vec3(uv + vec2( 0.5,  0.5) * texel, s.z));
+    return lit * 0.25;
+}
+#endif
+
+#if defined(ENVMAP)
+layout(set = 0, binding = 2, std140) uniform PerEnvMap {
+    mat4 EnvMapMatrix;         // world -> env-map owner frame (rotation)
+};
+layout(set = 1, binding = 1) uniform sampler2DArray EnvMap;
+#endif
+
+void main()
+{
+#if defined(PARABOLOID)
+    if (vHemisphere < 0.0) discard;
+#endif
+    vec3 n = ob_safe_normalize(vNormal);
+    vec3 v = ob_safe_normalize(CameraPosition.xyz - vPosition);
+#if !defined(PARABOLOID)
+    // Two-sided lighting for open meshes seen from behind. (The paraboloid
+    // projection mirrors the back hemisphere, so facing means nothing there.)
+    if (!gl_FrontFacing) n = -n;
+#endif
+
+    float visibility = 1.0;
+#if defined(SHADOWS)
+    visibility = ob_shadow_visibility(vPosition);
+#endif
+    vec3 diffuse = DiffuseColor.rgb;
+    vec3 color = AmbientColor.rgb * AmbientColor.w * diffuse + EmissiveColor.rgb
+               + ob_directional_light(n, v, diffuse, SpecularColor, visibility)
+               + ob_point_lights(vPosition, n, v, diffuse, SpecularColor);
+#if defined(ENVMAP)
+    vec3 r = reflect(-v, n);
+    vec3 env = texture(EnvMap, ob_paraboloid_lookup(mat3(EnvMapMatrix) * r)).rgb;
+    color = mix(color, env, clamp(Reflectivity.x, 0.0, 1.0));
+#endif
+    float alpha = DiffuseColor.a;
+    outColor = vec4(color * alpha, alpha);
+}

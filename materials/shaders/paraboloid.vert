@@ -1,0 +1,38 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// paraboloid.vert — renders one hemisphere of a dual-paraboloid environment map.
+//
+// The view's origin is the map owner's centre, so WorldMatrix already yields
+// positions relative to it; ViewMatrix rotates them into the owner's frame.
+// ParaboloidDirection.x picks the hemisphere (+1 layer 0, -1 layer 1) and
+// ParaboloidDirection.y is the near distance (0 -> 0.05): depth is near/dist,
+// reversed-Z like every other view, so anything closer than near is clipped.
+// Fragments of the other hemisphere are discarded in lit.frag (PARABOLOID)
+// through vHemisphere, which avoids needing the shaderClipDistance feature.
+#include "common.glsl"
+#include "paraboloid.glsl"
+
+layout(location = 0) in vec3 inPosition;
+layout(location = 1) in vec3 inNormal;
+layout(location = 2) in vec2 inUV;
+
+layout(location = 0) out vec3 vPosition;
+layout(location = 1) out vec3 vNormal;
+layout(location = 2) out vec2 vUV;
+layout(location = 3) out float vHemisphere;
+
+void main()
+{
+    vec4 world = WorldMatrix * vec4(inPosition, 1.0);
+    vPosition = world.xyz;
+    vNormal = mat3(NormalMatrix) * inNormal;
+    vUV = inUV;
+
+    vec3 q = mat3(ViewMatrix) * world.xyz;
+    float dist = length(q);
+    vec3 d = dist > 1e-12 ? q / dist : vec3(0.0, 0.0, 1.0);
+    float side = ParaboloidDirection.x >= 0.0 ? 1.0 : -1.0;
+    float near_dist = ParaboloidDirection.y > 0.0 ? ParaboloidDirection.y : 0.05;
+    vHemisphere = d.z * side;
+    gl_Position = vec4(ob_paraboloid_uv(d, side), near_dist / max(dist, 1e-12), 1.0);
+}

@@ -1,0 +1,528 @@
+/* test_material.c — materials per view type: render flags, sort info, lazy
+ * variants, the env-map queue hook, apply, and drawing many entities that
+ * share an effect through one pipeline manager. */
+#define _XOPEN_SOURCE 700
+#include "ob_test.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "ob_material.h"
+#include "ob_params.h"
+#include "ob_pipeline_manager.h"
+#include "ob_resources.h"
+#include "ob_scene.h"
+#include "ob_view.h"
+
+#define SIZE 64
+
+typedef struct fixture {
+    ob_device *dev;
+    ob_param_registry *reg;
+    ob_effect_context *ctx;
+    ob_image color, depth, shadow_depth;
+} fixture;
+
+static ob_image make_image(ob_device *dev, VkFormat format, uint32_t usage, const char *name)
+{
+    ob_result r;
+    ob_image img = ob_image_create(dev, &(ob_image_desc){
+        .width = SIZE, .height = SIZE, .format = format, .usage = usage, .name = name}, &r);
+    assert_int_not_equal(img.id, 0);
+    return img;
+}
+
+static int setup(void **state)
+{
+    static fixture f;
+    f.dev = ob_test_device_create();
+    ob_result r;
+    f.reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 2}, &r);
+    assert_non_null(f.reg);
+    f.color = make_image(f.dev, VK_FORMAT_R8G8B8A8_UNORM,
+                         OB_IMAGE_COLOR_TARGET | OB_IMAGE_TRANSFER_SRC, "color");
+    f.depth = make_image(f.dev, VK_FORMAT_D32_SFLOAT, OB_IMAGE_DEPTH_TARGET, "depth");
+    f.shadow_depth = make_image(f.dev, VK_FORMAT_D32_SFLOAT,
+                                OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED, "shadow");
+    *state = &f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    ob_test_assert_no_validation(f->dev);
+    ob_image_destroy(f->dev, f->color);
+    ob_image_destroy(f->dev, f->depth);
+    ob_image_destroy(f->dev, f->shadow_depth);
+    ob_param_registry_destroy(f->reg);
+    ob_device_destroy(f->dev);
+    return 0;
+}
+
+/* Each test gets a fresh context (so variant counters start at zero). */
+static ob_material_library *make_library(fixture *f)
+{
+    ob_result r;
+    f->ctx = ob_effect_context_create(f->dev, f->reg, NULL, &r);
+    assert_non_null(f->ctx);
+    ob_material_library *lib = ob_material_library_create(f->ctx, NULL, &r);
+    assert_non_null(lib);
+    return lib;
+}
+
+static void destroy_library(fixture *f, ob_material_library *lib)
+{
+    ob_material_library_destroy(lib);
+    ob_effect_context_destroy(f->ctx);
+    f->ctx = NULL;
+}
+
+static const ob_view_vtbl test_vtbl = {.type_name = "test"};
+
+static void make_view(fixture *f, ob_view *v, ob_view_type type, const char *name)
+{
+    ob_view_init(v, &test_vtbl, type, name);
+    v->width = v->height = SIZE;
+    switch (type) {
+    case OB_VIEW_SHADOW:
+        v->depth = f->shadow_depth;
+        break;
+    case OB_VIEW_OVERLAY:
+    case OB_VIEW_COMPOSITE:
+        v->color = f->color;
+        break;
+    case OB_VIEW_SIMULATION:
+        v->layer_count = 0;
+        break;
+    default:
+        v->color = f->color;
+        v->depth = f->depth;
+        break;
+    }
+}
+
+static ob_material *make_material(ob_material_library *lib, ob_material_kind kind, bool shadows,
+                                  bool blended, uint32_t priority)
+{
+    ob_result r;
+    ob_material *m = ob_material_create(lib, &(ob_material_desc){
+        .name = "m", .kind = kind, .casts_shadows = shadows, .blended = blended,
+        .priority = priority}, &r);
+    assert_non_null(m);
+    return m;
+}
+
+/* Hieroglyph's Params[type].bRender for the standard kinds. */
+static void test_render_flags_per_view_type(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    static const struct {
+        ob_material_kind kind;
+        bool shadows;
+        bool expect[OB_VIEW_TYPE_COUNT]; /* perspective, shadow, paraboloid, simulation,
+                                            overlay, composite */
+    } cases[] = {
+        {OB_MATERIAL_LIT, false, {true, false, true, false, false, false}},
+        {OB_MATERIAL_LIT, true, {true, true, true, false, false, false}},
+        {OB_MATERIAL_REFLECTIVE, false, {true, false, true, false, false, false}},
+        {OB_MATERIAL_REFLECTIVE, true, {true, true, true, false, false, false}},
+        {OB_MATERIAL_UNLIT, false, {true, false, false, false, true, false}},
+        {OB_MATERIAL_CUSTOM, true, {false, false, false, false, false, false}},
+    };
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(cases); i++) {
+        ob_material *m = make_material(lib, cases[i].kind, cases[i].shadows, false, 0);
+        for (uint32_t t = 0; t < OB_VIEW_TYPE_COUNT; t++) {
+            if (mi->renders(m, (ob_view_type)t) != cases[i].expect[t])
+                fail_msg("kind %d (shadows %d): renders(%s) should be %d", cases[i].kind,
+                         cases[i].shadows, ob_view_type_name((ob_view_type)t), cases[i].expect[t]);
+            assert_int_equal(ob_material_get_view_params(m, (ob_view_type)t).render,
+                             cases[i].expect[t]);
+        }
+        ob_material_destroy(m);
+    }
+    /* Nothing was compiled to answer these questions. */
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 0);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+/* A view type with no effect is not drawn: renders() false, apply() false,
+ * no pipeline set; a custom effect makes it drawn. */
+static void test_no_effect_not_drawn(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_result r;
+    ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
+        .device = f->dev, .registry = f->reg, .name = "test"}, &r);
+    assert_non_null(pm);
+
+    ob_view overlay;
+    make_view(f, &overlay, OB_VIEW_OVERLAY, "overlay");
+    ob_material *lit = make_material(lib, OB_MATERIAL_LIT, false, false, 0);
+    assert_false(mi->renders(lit, OB_VIEW_OVERLAY));
+    mi->pre_render(lit, NULL, NULL, &overlay);
+    assert_false(mi->apply(lit, NULL, NULL, pm, &overlay));
+    assert_null(ob_material_view_effect(lit, NULL, NULL, &overlay, true, &r));
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 0);
+
+    ob_material *custom = make_material(lib, OB_MATERIAL_CUSTOM, false, false, 0);
+    for (uint32_t t = 0; t < OB_VIEW_TYPE_COUNT; t++) assert_false(mi->renders(custom, t));
+    ob_effect *text = ob_material_library_effect(lib, OB_STD_OVERLAY, 0, &r);
+    assert_non_null(text);
+    assert_int_equal(ob_material_set_view_effect(custom, OB_VIEW_OVERLAY, text), OB_OK);
+    assert_true(mi->renders(custom, OB_VIEW_OVERLAY));
+    assert_false(mi->renders(custom, OB_VIEW_PERSPECTIVE));
+    assert_ptr_equal(ob_material_get_view_params(custom, OB_VIEW_OVERLAY).effect, text);
+    mi->pre_render(custom, NULL, NULL, &overlay);
+    assert_true(mi->apply(custom, NULL, NULL, pm, &overlay));
+    assert_int_equal(ob_material_set_view_effect(custom, OB_VIEW_OVERLAY, NULL), OB_OK);
+    assert_false(mi->renders(custom, OB_VIEW_OVERLAY));
+
+    ob_pipeline_manager_destroy(pm);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+/* Opaque before blended; priority passed through; overlay items blend. */
+static void test_sort_info(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_material *opaque = make_material(lib, OB_MATERIAL_LIT, false, false, 3);
+    ob_material *glass = make_material(lib, OB_MATERIAL_LIT, false, true, 7);
+    ob_material *hud = make_material(lib, OB_MATERIAL_UNLIT, false, false, 9);
+    uint32_t cls, prio;
+    mi->sort_info(opaque, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    assert_int_equal(cls, 0);
+    assert_int_equal(prio, 3);
+    mi->sort_info(glass, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    assert_int_equal(cls, 1);
+    assert_int_equal(prio, 7);
+    mi->sort_info(hud, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    assert_int_equal(cls, 0);
+    mi->sort_info(hud, OB_VIEW_OVERLAY, &cls, &prio);
+    assert_int_equal(cls, 1);
+    assert_int_equal(prio, 9);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+/* Variants are compiled the first time a view needs them, once. */
+static void test_variants_compiled_only_when_used(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_view persp, shadow, env;
+    make_view(f, &persp, OB_VIEW_PERSPECTIVE, "camera");
+    make_view(f, &shadow, OB_VIEW_SHADOW, "sun-shadow");
+    make_view(f, &env, OB_VIEW_PARABOLOID, "env");
+
+    ob_material *lit = make_material(lib, OB_MATERIAL_LIT, false, false, 0);
+    ob_material *caster = make_material(lib, OB_MATERIAL_LIT, true, false, 0);
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 0);
+
+    mi->pre_render(lit, NULL, NULL, &persp);
+    ob_effect_counters c = ob_effect_context_counters(f->ctx);
+    assert_int_equal(c.variants_compiled, 1);           /* lit */
+    assert_int_equal(c.pipelines_created, 1);           /* ...for the camera's formats */
+    mi->pre_render(caster, NULL, NULL, &persp);
+    mi->pre_render(lit, NULL, NULL, &persp);
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 1);
+
+    /* A non-caster is not in the shadow view; a caster needs depth-only. */
+    assert_false(mi->renders(lit, OB_VIEW_SHADOW));
+    mi->pre_render(caster, NULL, NULL, &shadow);
+    c = ob_effect_context_counters(f->ctx);
+    assert_int_equal(c.variants_compiled, 2);
+    assert_non_null(ob_material_library_find_effect(lib, OB_STD_DEPTH, 0));
+    assert_null(ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_SHADOWS));
+
+    /* Once the camera depends on a shadow view this frame: SHADOWS variant. */
+    ob_view_add_dependency(&persp, &shadow);
+    mi->pre_render(lit, NULL, NULL, &persp);
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 3);
+    assert_ptr_equal(ob_material_view_effect(lit, NULL, NULL, &persp, false, NULL),
+                     ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_SHADOWS));
+
+    /* Environment map views use the paraboloid generation effect. */
+    mi->pre_render(lit, NULL, NULL, &env);
+    assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 4);
+    assert_non_null(ob_material_library_find_effect(lib, OB_STD_PARABOLOID, 0));
+
+    /* Nothing here asked for an env-map lookup, unlit or particles. */
+    assert_null(ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_ENVMAP));
+    assert_null(ob_material_library_find_effect(lib, OB_STD_UNLIT, 0));
+    assert_null(ob_material_library_find_effect(lib, OB_STD_PARTICLES_SIM, 0));
+    ob_view_release(&persp);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+typedef struct hook_log {
+    uint32_t calls;
+    ob_node *entity;
+    ob_view *requester;
+    ob_view_type needed;
+} hook_log;
+
+static void record_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *requesting,
+                        ob_view_type needed)
+{
+    (void)r;
+    hook_log *log = user;
+    log->calls++;
+    log->entity = entity;
+    log->requester = requesting;
+    log->needed = needed;
+}
+
+/* Reflective materials ask for their entity's environment map from
+ * perspective views only; nothing else asks for anything. */
+static void test_reflective_queues_env_map(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    hook_log log = {0};
+    ob_material_library_set_queue_hook(lib, record_hook, &log);
+    ob_view persp, env;
+    make_view(f, &persp, OB_VIEW_PERSPECTIVE, "camera");
+    make_view(f, &env, OB_VIEW_PARABOLOID, "env");
+    ob_result r;
+    ob_scene *scene = ob_scene_create(&r);
+    assert_non_null(scene);
+    ob_node *ball = ob_node_create(scene, NULL, "mirror-ball", &r);
+    assert_non_null(ball);
+
+    ob_material *mirror = make_material(lib, OB_MATERIAL_REFLECTIVE, false, false, 0);
+    ob_material *plain = make_material(lib, OB_MATERIAL_LIT, false, false, 0);
+    mi->pre_render(plain, ball, NULL, &persp);
+    assert_int_equal(log.calls, 0);
+    mi->pre_render(mirror, ball, NULL, &persp);
+    assert_int_equal(log.calls, 1);
+    assert_ptr_equal(log.entity, ball);
+    assert_ptr_equal(log.requester, &persp);
+    assert_int_equal(log.needed, OB_VIEW_PARABOLOID);
+    mi->pre_render(mirror, ball, NULL, &env);   /* drawn in others' maps, asks nothing */
+    assert_int_equal(log.calls, 1);
+    /* With no map attached the mirror falls back to plain lit shading. */
+    assert_ptr_equal(ob_material_view_effect(mirror, NULL, ball, &persp, false, NULL),
+                     ob_material_library_find_effect(lib, OB_STD_LIT, 0));
+    ob_scene_destroy(scene);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+/* apply() sets the pipeline for the view's formats and the material's own
+ * parameters in the manager's slot; a variant that appears only after
+ * PreRender falls back to an existing one until prepare_view builds it. */
+static void test_apply_and_prepare_view(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_result r;
+    ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
+        .device = f->dev, .registry = f->reg, .slot = 1, .name = "worker"}, &r);
+    assert_non_null(pm);
+    ob_view persp, shadow;
+    make_view(f, &persp, OB_VIEW_PERSPECTIVE, "camera");
+    make_view(f, &shadow, OB_VIEW_SHADOW, "shadow");
+
+    ob_material *red = ob_material_create(lib, &(ob_material_desc){
+        .name = "red", .diffuse = {1, 0, 0, 1}, .emissive = {0.1f, 0, 0, 0}}, &r);
+    ob_material *blue = ob_material_create(lib, &(ob_material_desc){
+        .name = "blue", .diffuse = {0, 0, 1, 1}}, &r);
+    assert_non_null(red);
+    assert_non_null(blue);
+
+    /* Recording without PreRender: skipped, with one warning. */
+    ob_test_log_clear();
+    assert_false(mi->apply(red, NULL, NULL, pm, &persp));
+    assert_false(mi->apply(red, NULL, NULL, pm, &persp));
+    assert_true(ob_test_log_has("material 'red'", "camera", NULL));
+    assert_int_equal(ob_test_log_count(OB_LOG_WARN), 1);
+
+    mi->pre_render(red, NULL, NULL, &persp);
+    assert_true(mi->apply(red, NULL, NULL, pm, &persp));
+    ob_params *params = ob_pm_params(pm);
+    float got[4];
+    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "DiffuseColor"), got), OB_OK);
+    assert_true(got[0] == 1 && got[1] == 0 && got[2] == 0 && got[3] == 1);
+    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "EmissiveColor"), got), OB_OK);
+    assert_true(got[0] == 0.1f);
+    assert_true(mi->apply(blue, NULL, NULL, pm, &persp));   /* same effect, other colours */
+    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "DiffuseColor"), got), OB_OK);
+    assert_true(got[2] == 1 && got[0] == 0);
+    /* Only slot 1 was written: the immediate slot does not hold blue. */
+    ob_params immediate;
+    assert_int_equal(ob_params_manager(f->reg, 0, &immediate), OB_OK);
+    ob_params_get_vec4(&immediate, ob_param_find(f->reg, "DiffuseColor"), got);
+    assert_false(got[0] == 0 && got[1] == 0 && got[2] == 1);
+
+    /* A shadow view queued after the entities' PreRender: the camera now
+     * wants lit+SHADOWS, which does not exist yet, so apply uses lit. */
+    ob_view_add_dependency(&persp, &shadow);
+    assert_true(mi->apply(red, NULL, NULL, pm, &persp));
+    assert_ptr_equal(ob_material_view_effect(red, NULL, NULL, &persp, false, NULL),
+                     ob_material_library_find_effect(lib, OB_STD_LIT, 0));
+    /* prepare_view builds what the draw list needs. */
+    ob_scene *scene = ob_scene_create(&r);
+    ob_node *n = ob_node_create(scene, NULL, "box", &r);
+    assert_int_equal(ob_node_set_renderable(n, &(ob_renderable){.material = red,
+                                                                 .local_radius = 1}), OB_OK);
+    ob_draw_item item = {0, n};
+    persp.items = &item;
+    persp.item_count = 1;
+    ob_material_library_prepare_view(lib, NULL, &persp);
+    persp.items = NULL;
+    persp.item_count = 0;
+    ob_effect *shadowed = ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_SHADOWS);
+    assert_non_null(shadowed);
+    assert_int_equal(ob_effect_pipeline_count(shadowed), 1);
+    assert_ptr_equal(ob_material_view_effect(red, NULL, NULL, &persp, false, NULL), shadowed);
+
+    ob_scene_destroy(scene);
+    ob_pipeline_manager_destroy(pm);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+static void barrier_to(fixture *f, VkCommandBuffer cmd, ob_image img, VkImageLayout layout,
+                       VkPipelineStageFlags2 stages, VkAccessFlags2 access)
+{
+    VkImageMemoryBarrier2 b;
+    ob_image_state next = {layout, stages, access};
+    if (!ob_image_transition(f->dev, img, &next, &b)) return;
+    VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                            .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
+    vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+/* 100 entities sharing one material draw through one pipeline manager with
+ * a single pipeline bind, and the emissive colour reaches the image. */
+static void test_hundred_entities_one_pipeline(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_result r;
+    ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
+        .device = f->dev, .registry = f->reg, .slot = 0, .name = "immediate"}, &r);
+    assert_non_null(pm);
+    ob_view persp;
+    make_view(f, &persp, OB_VIEW_PERSPECTIVE, "camera");
+    ob_material *green = ob_material_create(lib, &(ob_material_desc){
+        .name = "green", .diffuse = {0, 0, 0, 1}, .specular = {0, 0, 0, 1},
+        .emissive = {0, 1, 0, 0}}, &r);
+    assert_non_null(green);
+    mi->pre_render(green, NULL, NULL, &persp);
+
+    /* One small triangle (standard layout) in clip space: ViewProj is identity.
+     * Counter-clockwise as seen on screen (clip y points down). */
+    const float tri[3][8] = {{-0.05f, -0.05f, 0.5f, 0, 0, 1, 0, 0},
+                             {0.0f, 0.05f, 0.5f, 0, 0, 1, 0.5f, 1},
+                             {0.05f, -0.05f, 0.5f, 0, 0, 1, 1, 0}};
+    ob_buffer vb = ob_buffer_create(f->dev, &(ob_buffer_desc){
+        .size = sizeof tri, .usage = OB_BUFFER_VERTEX, .data = tri, .name = "triangle"}, &r);
+    assert_int_not_equal(vb.id, 0);
+
+    VkCommandBuffer cmd;
+    assert_int_equal(ob_device_oneshot_begin(f->dev, &cmd), OB_OK);
+    barrier_to(f, cmd, f->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    barrier_to(f, cmd, f->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo color_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->color),
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue.color.float32 = {0, 0, 0, 1},
+    };
+    VkRenderingAttachmentInfo depth_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->depth),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue.depthStencil = {0.0f, 0},
+    };
+    VkRenderingInfo ri = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .renderArea = {{0, 0}, {SIZE, SIZE}},
+        .layerCount = 1,
+        .colorAttachmentCount = 1,
+        .pColorAttachments = &color_att,
+        .pDepthAttachment = &depth_att,
+    };
+    vkCmdBeginRendering(cmd, &ri);
+    ob_pm_begin_frame(pm, 0, 1);
+    ob_pm_begin(pm, cmd);
+    ob_pm_set_viewport(pm, 0, 0, SIZE, SIZE);
+    ob_pm_set_scissor(pm, 0, 0, SIZE, SIZE);
+    ob_params *params = ob_pm_params(pm);
+    ob_param world = ob_param_registry_builtins(f->reg)->world;
+    for (int i = 0; i < 100; i++) {
+        /* A 10 x 10 grid of triangles across the target. */
+        float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,
+                       -0.9f + 0.2f * (float)(i % 10), -0.9f + 0.2f * (float)(i / 10), 0, 1};
+        assert_int_equal(ob_params_set_mat4(params, world, m), OB_OK);
+        assert_true(mi->apply(green, NULL, NULL, pm, &persp));
+        ob_pm_set_vertex_buffer(pm, vb, 0);
+        assert_int_equal(ob_pm_draw(pm, 3, 1, 0, 0), OB_OK);
+    }
+    ob_cmd_hash h = ob_pm_end(pm);
+    vkCmdEndRendering(cmd);
+    assert_int_equal(ob_device_oneshot_submit(f->dev, cmd), OB_OK);
+
+    ob_pm_stats s = ob_pm_stats_take(pm);
+    assert_int_equal(h.draws, 100);
+    assert_int_equal(s.draws, 100);
+    assert_int_equal(s.pipeline_binds_requested, 100);
+    assert_int_equal(s.pipeline_binds_issued, 1);
+    assert_int_equal(ob_effect_context_counters(f->ctx).pipelines_created, 1);
+
+    uint8_t pixels[SIZE * SIZE * 4];
+    assert_int_equal(ob_image_read_rgba8(f->dev, f->color, pixels), OB_OK);
+    /* Triangle 0 sits around clip (-0.9, -0.9): pixel (3, 3) at 64 x 64. */
+    const uint8_t *p = &pixels[(3 * SIZE + 3) * 4];
+    assert_int_equal(p[0], 0);
+    assert_int_equal(p[1], 255);
+    assert_int_equal(p[2], 0);
+    /* Between triangles: the clear colour. */
+    p = &pixels[(6 * SIZE + 6) * 4];
+    assert_int_equal(p[1], 0);
+
+    ob_buffer_destroy(f->dev, vb);
+    ob_pipeline_manager_destroy(pm);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_render_flags_per_view_type),
+        cmocka_unit_test(test_no_effect_not_drawn),
+        cmocka_unit_test(test_sort_info),
+        cmocka_unit_test(test_variants_compiled_only_when_used),
+        cmocka_unit_test(test_reflective_queues_env_map),
+        cmocka_unit_test(test_apply_and_prepare_view),
+        cmocka_unit_test(test_hundred_entities_one_pipeline),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
