@@ -107,7 +107,7 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     snprintf(debug_name, sizeof debug_name, "%s/vertices", name);
     ob_buffer_desc vb = {
         .size = (uint64_t)mesh->vertex_count * sizeof(ob_vertex),
-        .usage = OB_BUFFER_VERTEX | OB_BUFFER_TRANSFER_DST,
+        .usage = OB_BUFFER_VERTEX | OB_BUFFER_TRANSFER_DST | OB_BUFFER_TRANSFER_SRC,
         .data = mesh->vertices,
         .name = debug_name,
     };
@@ -121,7 +121,7 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     snprintf(debug_name, sizeof debug_name, "%s/indices", name);
     ob_buffer_desc ib = {
         .size = (uint64_t)mesh->index_count * sizeof(uint32_t),
-        .usage = OB_BUFFER_INDEX | OB_BUFFER_TRANSFER_DST,
+        .usage = OB_BUFFER_INDEX | OB_BUFFER_TRANSFER_DST | OB_BUFFER_TRANSFER_SRC,
         .data = mesh->indices,
         .name = debug_name,
     };

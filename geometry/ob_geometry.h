@@ -59,7 +59,8 @@ typedef struct ob_geometry_desc {
 /* Validates the mesh for the topology first (ob_mesh_validate_primitives:
  * indices in range, finite attributes; logged under the name) and uploads
  * nothing if it fails. Then uploads the vertices and indices into
- * device-local buffers (staged, waits for the copy) and computes the bounds
+ * device-local buffers (staged, waits for the copy; TRANSFER_SRC too, so
+ * tools and tests can read them back) and computes the bounds
  * from the vertices (mesh->bounds is not trusted).
  * Returns NULL and sets *out_result (may be NULL) on failure:
  * OB_ERR_INVALID_ARGUMENT (no device, desc or mesh; bad mesh),
