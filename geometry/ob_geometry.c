@@ -59,6 +59,28 @@ static void set_result(ob_result *out_result, ob_result r)
     if (out_result) *out_result = r;
 }
 
+/* A device-local buffer holding `size` bytes of data, named "<name>/<what>".
+ * TRANSFER_SRC lets tools and tests read it back. */
+static ob_buffer upload(ob_device *dev, const char *name, const char *what, uint32_t usage,
+                        const void *data, uint64_t size, ob_result *out_result)
+{
+    char debug_name[160];
+    snprintf(debug_name, sizeof debug_name, "%s/%s", name, what);
+    ob_buffer_desc desc = {
+        .size = size,
+        .usage = usage | OB_BUFFER_TRANSFER_DST | OB_BUFFER_TRANSFER_SRC,
+        .data = data,
+        .name = debug_name,
+    };
+    ob_buffer buf = ob_buffer_create(dev, &desc, out_result);
+    if (!buf.id) {
+        if (*out_result == OB_OK) *out_result = OB_ERR_VULKAN;
+        OB_LOG_E(OB_GEOMETRY_LOG, "%s: %s buffer (%llu bytes) not created: %s", name, what,
+                 (unsigned long long)size, ob_result_name(*out_result));
+    }
+    return buf;
+}
+
 ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob_result *out_result)
 {
     set_result(out_result, OB_OK);
@@ -103,35 +125,12 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     g->topology = topology;
     g->id = desc->id ? desc->id : derive_id(name, mesh);
 
-    char debug_name[160];
-    snprintf(debug_name, sizeof debug_name, "%s/vertices", name);
-    ob_buffer_desc vb = {
-        .size = (uint64_t)mesh->vertex_count * sizeof(ob_vertex),
-        .usage = OB_BUFFER_VERTEX | OB_BUFFER_TRANSFER_DST | OB_BUFFER_TRANSFER_SRC,
-        .data = mesh->vertices,
-        .name = debug_name,
-    };
-    g->vertex_buffer = ob_buffer_create(dev, &vb, &r);
-    if (!g->vertex_buffer.id) {
-        OB_LOG_E(OB_GEOMETRY_LOG, "%s: vertex buffer (%llu bytes) not created: %s", name,
-                 (unsigned long long)vb.size, ob_result_name(r));
-        if (r == OB_OK) r = OB_ERR_VULKAN;
-        goto fail_free_geometry;
-    }
-    snprintf(debug_name, sizeof debug_name, "%s/indices", name);
-    ob_buffer_desc ib = {
-        .size = (uint64_t)mesh->index_count * sizeof(uint32_t),
-        .usage = OB_BUFFER_INDEX | OB_BUFFER_TRANSFER_DST | OB_BUFFER_TRANSFER_SRC,
-        .data = mesh->indices,
-        .name = debug_name,
-    };
-    g->index_buffer = ob_buffer_create(dev, &ib, &r);
-    if (!g->index_buffer.id) {
-        OB_LOG_E(OB_GEOMETRY_LOG, "%s: index buffer (%llu bytes) not created: %s", name,
-                 (unsigned long long)ib.size, ob_result_name(r));
-        if (r == OB_OK) r = OB_ERR_VULKAN;
-        goto fail_destroy_vertex_buffer;
-    }
+    g->vertex_buffer = upload(dev, name, "vertices", OB_BUFFER_VERTEX, mesh->vertices,
+                              (uint64_t)mesh->vertex_count * sizeof(ob_vertex), &r);
+    if (!g->vertex_buffer.id) goto fail_free_geometry;
+    g->index_buffer = upload(dev, name, "indices", OB_BUFFER_INDEX, mesh->indices,
+                             (uint64_t)mesh->index_count * sizeof(uint32_t), &r);
+    if (!g->index_buffer.id) goto fail_destroy_vertex_buffer;
     return g;
 
 fail_destroy_vertex_buffer:
