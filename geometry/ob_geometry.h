@@ -73,8 +73,8 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
  * no-op. [render thread] */
 void ob_geometry_destroy(ob_device *dev, ob_geometry *geo);
 
-/* Accessors [any thread]. On NULL they return zero values (a zero handle,
- * 0, NULL). */
+/* Accessors [any thread]. On NULL they return a zero handle, 0 or NULL
+ * (the topology accessor: TRIANGLE_LIST). */
 ob_buffer ob_geometry_vertex_buffer(const ob_geometry *g);
 ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UINT32 */
 uint32_t ob_geometry_index_count(const ob_geometry *g);
