@@ -11,6 +11,7 @@ struct ob_geometry {
     ob_buffer index_buffer;
     uint32_t vertex_count;
     uint32_t index_count;
+    uint32_t instance_count;
     VkPrimitiveTopology topology;
     ob_bounds bounds;
     uint32_t id;
@@ -81,9 +82,30 @@ static ob_buffer upload(ob_device *dev, const char *name, const char *what, uint
     return buf;
 }
 
+static ob_geometry *create_procedural(const ob_geometry_desc *desc, ob_result *out_result)
+{
+    const char *name = desc->name && desc->name[0] ? desc->name : "geometry";
+    ob_geometry *g = ob_calloc(1, sizeof *g);
+    if (g) g->name = ob_strdup(name);
+    if (!g || !g->name) {
+        ob_free(g);
+        OB_LOG_E(OB_GEOMETRY_LOG, "%s: out of host memory for the geometry object", name);
+        set_result(out_result, OB_ERR_OUT_OF_HOST_MEMORY);
+        return NULL;
+    }
+    g->vertex_count = desc->vertex_count;
+    g->instance_count = desc->instance_count ? desc->instance_count : 1;
+    g->topology = desc->topology ? desc->topology : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    g->id = desc->id ? desc->id
+                     : (uint32_t)ob_hash_u64(ob_hash_str(OB_HASH_SEED, name),
+                                             ((uint64_t)g->vertex_count << 32) | g->instance_count);
+    return g;
+}
+
 ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob_result *out_result)
 {
     set_result(out_result, OB_OK);
+    if (desc && !desc->mesh && desc->vertex_count > 0) return create_procedural(desc, out_result);
     if (!dev || !desc || !desc->mesh) {
         OB_LOG_E(OB_GEOMETRY_LOG, "ob_geometry_create: NULL %s", !dev ? "device"
                  : !desc ? "desc" : "mesh");
@@ -122,6 +144,7 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     if (r != OB_OK) goto fail_free_geometry;   /* unreachable after validation, kept honest */
     g->vertex_count = mesh->vertex_count;
     g->index_count = mesh->index_count;
+    g->instance_count = 1;
     g->topology = topology;
     g->id = desc->id ? desc->id : derive_id(name, mesh);
 
@@ -168,6 +191,7 @@ ob_buffer ob_geometry_index_buffer(const ob_geometry *g)
 
 uint32_t ob_geometry_index_count(const ob_geometry *g) { return g ? g->index_count : 0; }
 uint32_t ob_geometry_vertex_count(const ob_geometry *g) { return g ? g->vertex_count : 0; }
+uint32_t ob_geometry_instance_count(const ob_geometry *g) { return g ? g->instance_count : 0; }
 
 const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g)
 {

@@ -54,6 +54,11 @@ typedef struct ob_geometry_desc {
      * and index data: equal geometry gets an equal id, which is what a
      * command hash needs. Give explicit ids if you need them unique. */
     uint32_t id;
+    /* Procedural geometry (mesh NULL): no buffers; a draw is vertex_count
+     * vertices × instance_count instances whose shader pulls its own data
+     * (particles). Bounds are then unknown: the entity supplies its own. */
+    uint32_t vertex_count;
+    uint32_t instance_count;   /* 0 → 1 */
 } ob_geometry_desc;
 
 /* Validates the mesh for the topology first (ob_mesh_validate_primitives:
@@ -79,6 +84,7 @@ ob_buffer ob_geometry_vertex_buffer(const ob_geometry *g);
 ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UINT32 */
 uint32_t ob_geometry_index_count(const ob_geometry *g);
 uint32_t ob_geometry_vertex_count(const ob_geometry *g);
+uint32_t ob_geometry_instance_count(const ob_geometry *g);  /* 1 for meshes */
 const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);
 VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g);
 const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
