@@ -33,6 +33,9 @@ struct ob_device {
     PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
     bool validation;
+    const char *const *extra_instance_exts;
+    uint32_t extra_instance_ext_count;
+    bool swapchain;
     /* Info/verbose messages (about 90 loader lines per device) are logged
      * only with OB_LOG=debug; otherwise they would swamp log captures. */
     bool log_infos;
@@ -189,10 +192,20 @@ static ob_result instance_create(ob_device *dev, const char *app_name)
     if (r != OB_OK) return r;
     /* The validation layer provides debug utils itself when the loader does not. */
     bool debug_utils = dev->validation || list_has(exts, ext_count, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    const char *enabled_exts[2 + 16];
+    uint32_t enabled_count = 0;
+    for (uint32_t i = 0; i < dev->extra_instance_ext_count; i++) {
+        const char *name = dev->extra_instance_exts[i];
+        if (!list_has(exts, ext_count, name) || enabled_count >= 16) {
+            OB_LOG_E("device", "instance extension %s is %s", name,
+                     enabled_count >= 16 ? "one too many (at most 16 extra)" : "not available");
+            ob_free(exts);
+            return OB_ERR_UNSUPPORTED;
+        }
+        enabled_exts[enabled_count++] = name;
+    }
     ob_free(exts);
 
-    const char *enabled_exts[2];
-    uint32_t enabled_count = 0;
     if (debug_utils) enabled_exts[enabled_count++] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
     if (sync_validation) enabled_exts[enabled_count++] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
     const char *layers[] = {OB_VALIDATION_LAYER};
@@ -314,13 +327,13 @@ static ob_result logical_create(ob_device *dev)
             .textureCompressionBC = caps->texture_compression_bc,
         },
     };
-    const char *exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    const char *exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME, VK_KHR_SWAPCHAIN_EXTENSION_NAME};
     VkDeviceCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
         .pNext = &f2,
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &queue_info,
-        .enabledExtensionCount = OB_ARRAY_COUNT(exts),
+        .enabledExtensionCount = dev->swapchain ? 2u : 1u,
         .ppEnabledExtensionNames = exts,
     };
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateDevice(dev->physical, &info, NULL, &dev->device));
@@ -547,6 +560,9 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     r = slots_create(dev, desc->frames_in_flight);
     if (r != OB_OK) goto fail_free_dev;
     stage = "instance";
+    dev->extra_instance_exts = desc->instance_extensions;
+    dev->extra_instance_ext_count = desc->instance_extensions ? desc->instance_extension_count : 0;
+    dev->swapchain = desc->swapchain;
     r = instance_create(dev, desc->app_name ? desc->app_name : "obelisk");
     if (r != OB_OK) goto fail_destroy_slots;
 

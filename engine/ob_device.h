@@ -60,6 +60,13 @@ typedef struct ob_device_desc {
     const char *device;       /* NULL → $OB_DEVICE → auto ("lavapipe", "gpu" or an index) */
     int validation;           /* 0 → $OB_VALIDATION; >0 on; <0 off */
     uint32_t frames_in_flight;/* 0 → 2; the number of frame slots for deferred deletion */
+    /* Presentation (windowed demos): extra instance extensions (e.g. what
+     * glfwGetRequiredInstanceExtensions returns; the strings must outlive
+     * creation) and VK_KHR_swapchain on the device. Missing ones fail
+     * creation with OB_ERR_UNSUPPORTED naming the extension. */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    bool swapchain;
 } ob_device_desc;
 
 typedef struct ob_validation_counts {

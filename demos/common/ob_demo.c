@@ -146,8 +146,15 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     memset(d, 0, sizeof *d);
     d->opt = *o;
     ob_result r;
+    const char *const *exts = NULL;
+    uint32_t ext_count = 0;
+    if (o->window) {
+        d->window = ob_window_open(o->width, o->height, "Obelisk", &exts, &ext_count);
+        if (!d->window) return OB_ERR_UNSUPPORTED;
+    }
     ob_renderer_desc rd = {
-        .device = {.app_name = "obelisk-demo"},
+        .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
+                   .instance_extension_count = ext_count, .swapchain = o->window},
         .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
         .threading = o->threads == 0 ? OB_THREADING_SINGLE
                      : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
@@ -155,6 +162,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     d->r = ob_renderer_create(&rd, &r);
     if (!d->r) return r;
     ob_renderer_set_stats_callback(d->r, on_stats, d);
+    if (d->window && (r = ob_window_attach(d->window, ob_renderer_device(d->r))) != OB_OK) return r;
     d->fx = ob_effect_context_create(ob_renderer_device(d->r), ob_renderer_registry(d->r), NULL, &r);
     if (!d->fx) return r;
     d->lib = ob_material_library_create(d->fx, NULL, &r);
@@ -203,6 +211,7 @@ void ob_demo_shutdown(ob_demo *d)
     for (uint32_t i = 0; i < d->geometry_count; i++)
         ob_geometry_destroy(ob_renderer_device(d->r), d->geometries[i]);
     ob_effect_context_destroy(d->fx);
+    ob_window_close(d->window);
     ob_renderer_destroy(d->r);
     if (d->json) {
         fputs("\n]\n", d->json);
@@ -362,12 +371,12 @@ static void print_summary(const ob_demo *d)
 
 /* ------------------------------------------------------------ frames */
 
-static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame)
+static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame, bool flipped)
 {
     ob_threading base = o->threads == 0 ? OB_THREADING_SINGLE
                         : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
-    if (o->toggle && (frame / o->toggle) % 2 == 1)
-        return base == OB_THREADING_SINGLE ? OB_THREADING_MULTI : OB_THREADING_SINGLE;
+    bool flip = flipped != (o->toggle && (frame / o->toggle) % 2 == 1);
+    if (flip) return base == OB_THREADING_SINGLE ? OB_THREADING_MULTI : OB_THREADING_SINGLE;
     return base;
 }
 
@@ -390,8 +399,10 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     const double dt = 1.0 / 60.0;
     ob_view *final = d->overlay ? ob_overlay_view_base(d->overlay)
                                 : ob_composite_view_base(d->composite);
-    for (uint32_t f = 0; f < d->opt.frames; f++) {
-        ob_renderer_set_threading(d->r, frame_mode(&d->opt, f),
+    /* With a window the demo runs until it is closed; F1 flips the mode. */
+    for (uint32_t f = 0; d->window ? ob_window_poll(d->window) : f < d->opt.frames; f++) {
+        if (d->window && ob_window_take_toggle(d->window)) d->flipped = !d->flipped;
+        ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
                                   d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
         uint64_t t0 = ob_time_ns();
         if (update) update(d, f, d->time, user);
@@ -407,6 +418,8 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
         overlay_text(d);
         ob_views_render(d->views, final);
         r = ob_renderer_end_frame(d->r);
+        if (r == OB_OK && d->window)
+            r = ob_window_present(d->window, ob_composite_view_target(d->composite));
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
             return 1;

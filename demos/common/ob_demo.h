@@ -14,6 +14,7 @@
 #include "ob_geometry.h"
 #include "ob_mesh.h"
 #include "ob_views.h"
+#include "ob_window.h"
 
 typedef struct ob_demo_options {
     uint32_t frames;          /* --frames F (default 60) */
@@ -56,6 +57,8 @@ typedef struct ob_demo {
     uint32_t history_count, history_cap;
     FILE *json;
     double time;
+    ob_window *window;        /* --window */
+    bool flipped;             /* F1: the mode is the opposite of what the options say */
 } ob_demo;
 
 /* Renderer (worker count from --threads), effect context, material library,
