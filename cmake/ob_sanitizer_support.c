@@ -1,6 +1,12 @@
-/* ob_asan_support.c — compiled into every executable of an address-sanitizer
- * build (tests and demos; see CMakeLists.txt), nowhere else.
+/* ob_sanitizer_support.c — compiled into every executable of an address- or
+ * thread-sanitizer build (tests and demos; see CMakeLists.txt), nowhere else.
  *
+ * Both: the loader unloads the Vulkan driver and layer with each instance.
+ * Keeping them mapped keeps leak reports attributable (address) and keeps
+ * ThreadSanitizer's called_from_lib suppressions valid (thread: it aborts when
+ * a library it suppresses by name is unloaded); see tests/tsan.supp.
+ *
+ * Address:
  * VK_LAYER_KHRONOS_validation 1.3.239 (Debian 12) leaks the state of every
  * command buffer when synchronization validation is on: shared_ptr cycles
  * inside the layer (KhronosGroup/Vulkan-ValidationLayers #5382, #6033; each
@@ -19,6 +25,8 @@
  * Variables in $ASAN_OPTIONS / $LSAN_OPTIONS still override these. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <dlfcn.h>
+
 #if defined(__SANITIZE_ADDRESS__)
 #define OB_ASAN 1
 #elif defined(__has_feature)
@@ -27,18 +35,14 @@
 #endif
 #endif
 
-#ifdef OB_ASAN
-#include <dlfcn.h>
-
-/* The loader unloads the driver and the layer with each instance, which
- * leaves leak stacks pointing at "<unknown module>"; keeping them mapped
- * (RTLD_NODELETE, never closed by design) keeps the reports attributable. */
+/* RTLD_NODELETE: never closed, by design. */
 __attribute__((constructor)) static void pin_vulkan_modules(void)
 {
     (void)dlopen("libVkLayer_khronos_validation.so", RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     (void)dlopen("libvulkan_lvp.so", RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
 }
 
+#ifdef OB_ASAN
 const char *__lsan_default_suppressions(void);
 const char *__lsan_default_suppressions(void)
 {
