@@ -2,30 +2,34 @@
 # Obelisk set-up, build and run. One entry point for the README and CI.
 #
 #   ./setup.sh demo   install missing packages, build, render the main demo headless
-#   ./setup.sh test   install missing packages, build, run the whole test suite
+#   ./setup.sh test   install missing packages, then build and run the whole test
+#                     suite three times: plain (build/), address+undefined
+#                     sanitizers (build-address/) and thread sanitizer (build-thread/)
 #   ./setup.sh deps | build
 #
-# Options: --sanitize address|thread|undefined  (builds into build-<sanitizer>/)
+# Options: --sanitize none|address|thread|undefined  one build only (none = plain)
 #          --build-dir DIR
+# Anything else is passed on to the demo (demo) or to ctest (test).
 set -euo pipefail
 cd "$(dirname "$0")"
 
 cmd=${1:-demo}
 [ $# -gt 0 ] && shift
 sanitize=""
+sanitize_given=""
 build_dir=""
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --sanitize) sanitize=$2; shift 2 ;;
+    --sanitize) sanitize=$2; sanitize_given=1; [ "$sanitize" = none ] && sanitize=""; shift 2 ;;
     --build-dir) build_dir=$2; shift 2 ;;
     *) extra+=("$1"); shift ;;
   esac
 done
-[ -n "$build_dir" ] || build_dir=build${sanitize:+-$sanitize}
+dir_for() { [ -n "$build_dir" ] && echo "$build_dir" || echo "build${1:+-$1}"; }
 
 packages=(
-  cmake make gcc clang pkg-config
+  cmake make gcc clang libclang-rt-14-dev pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev spirv-tools libspirv-cross-c-shared-dev
   libcglm-dev libstb-dev libassimp-dev assimp-testmodels libcjson-dev
@@ -45,11 +49,21 @@ deps() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 }
 
+# build SANITIZER: configure and build into its directory.
 build() {
-  local cfg=(-S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo)
-  [ -n "$sanitize" ] && cfg+=(-DOB_SANITIZE="$sanitize" -DCMAKE_C_COMPILER=clang)
+  local dir; dir=$(dir_for "$1")
+  local cfg=(-S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo)
+  [ -n "$1" ] && cfg+=(-DOB_SANITIZE="$1" -DCMAKE_C_COMPILER=clang)
   cmake "${cfg[@]}" >/dev/null
-  cmake --build "$build_dir" -j"$(nproc)"
+  cmake --build "$dir" -j"$(nproc)"
+}
+
+# suite SANITIZER: build, then run every test of that build.
+suite() {
+  local dir; dir=$(dir_for "$1")
+  echo "== test suite: ${1:-plain} build ($dir)"
+  build "$1"
+  ctest --test-dir "$dir" --output-on-failure -j"$(nproc)" "${extra[@]}"
 }
 
 # lavapipe and the loader warn about a missing XDG_RUNTIME_DIR on bare machines.
@@ -57,12 +71,17 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
 
 case "$cmd" in
   deps) deps ;;
-  build) deps; build ;;
+  build) deps; build "$sanitize" ;;
   demo)
-    deps; build
-    "$build_dir"/bin/obelisk-mirror --frames 60 --out "$build_dir"/obelisk-mirror.png "${extra[@]}" ;;
+    deps; build "$sanitize"
+    dir=$(dir_for "$sanitize")
+    "$dir"/bin/obelisk-mirror --frames 60 --out "$dir"/obelisk-mirror.png "${extra[@]}" ;;
   test)
-    deps; build
-    ctest --test-dir "$build_dir" --output-on-failure -j"$(nproc)" "${extra[@]}" ;;
-  *) echo "usage: $0 demo|test|deps|build [--sanitize address|thread|undefined]" >&2; exit 2 ;;
+    deps
+    if [ -n "$sanitize_given" ]; then
+      suite "$sanitize"
+    else
+      suite ""; suite address; suite thread
+    fi ;;
+  *) echo "usage: $0 demo|test|deps|build [--sanitize none|address|thread|undefined]" >&2; exit 2 ;;
 esac
