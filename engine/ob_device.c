@@ -289,6 +289,10 @@ static ob_result logical_create(ob_device *dev)
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
         .dynamicRendering = VK_TRUE,
         .synchronization2 = VK_TRUE,
+        /* Required by every Vulkan 1.3 device; SPIR-V 1.6 compute shaders
+         * from glslang declare their local size with LocalSizeId, which
+         * needs it enabled. */
+        .maintenance4 = VK_TRUE,
     };
     VkPhysicalDeviceVulkan12Features f12 = {
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,

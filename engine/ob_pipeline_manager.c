@@ -5,7 +5,7 @@
 
 #define MAX_FRAME_SLOTS 4
 #define MAX_CHUNKS 64
-#define PACK_CACHE_SIZE 64      /* power of two */
+#define PACK_CACHE_SIZE 256     /* power of two */
 #define SET_CACHE_SIZE 64       /* power of two */
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
@@ -275,16 +275,25 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
     }
 }
 
+/* The cache entry of a mapping, or a new one claimed for it (frame_serial 0:
+ * not packed yet). Stale entries of earlier frames are reused; probing goes
+ * on past them so a live entry further along is still found. */
 static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map)
 {
     uint32_t h = (uint32_t)(((uintptr_t)map >> 4) * 2654435761u) & (PACK_CACHE_SIZE - 1);
+    pack_entry *reuse = NULL;
     for (uint32_t i = 0; i < PACK_CACHE_SIZE; i++) {
         pack_entry *e = &pm->pack_cache[(h + i) & (PACK_CACHE_SIZE - 1)];
-        if (e->mapping == map || !e->mapping || e->frame_serial != pm->frame_serial) {
-            return e;
+        if (e->mapping == map) return e;
+        if (!e->mapping) {
+            if (!reuse) reuse = e;
+            break;
         }
+        if (!reuse && e->frame_serial != pm->frame_serial) reuse = e;
     }
-    return &pm->pack_cache[h]; /* full: evict */
+    if (!reuse) return NULL; /* full of this frame's blocks: pack without caching */
+    *reuse = (pack_entry){.mapping = map};
+    return reuse;
 }
 
 static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
@@ -362,11 +371,13 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
 {
     if (prog->ubo_count == 0) return OB_OK;
     pack_entry *entries[OB_PROGRAM_MAX_UBOS];
+    pack_entry uncached[OB_PROGRAM_MAX_UBOS];
     uint32_t chunk = UINT32_MAX;
     bool all_same_chunk = true;
     for (uint32_t i = 0; i < prog->ubo_count; i++) {
         const ob_param_mapping *map = prog->ubos[i].mapping;
         pack_entry *e = pack_slot(pm, map);
+        if (!e) e = &uncached[i];
         bool fresh = e->mapping == map && e->frame_serial == pm->frame_serial;
         if (fresh && ob_params_pack_needed(&pm->params, map)) fresh = false;
         if (!fresh) e->mapping = NULL; /* to pack */
@@ -455,7 +466,7 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
             ob_params_get_sampler(&pm->params, res->sampler, &smp);
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].sampler = ob_sampler_vk(pm->dev, smp);
-            images[i].imageLayout = VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL;
+            images[i].imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
             if (!images[i].imageView || !images[i].sampler) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
             writes[i].pImageInfo = &images[i];
@@ -466,7 +477,7 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].imageLayout = res->kind == OB_BINDING_STORAGE_IMAGE
                                         ? VK_IMAGE_LAYOUT_GENERAL
-                                        : VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL;
+                                        : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
             if (!images[i].imageView) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_IMAGE
                                            ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE

@@ -28,6 +28,19 @@ static void record_memory_barrier(VkCommandBuffer cmd, const VkMemoryBarrier2 *b
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+/* Staging of staging_size bytes (none for 0), an idle device and a begun
+ * one-shot; on failure nothing is left behind. */
+static ob_result readback_begin(ob_device *dev, uint64_t staging_size, const char *name, ob_staging *out_staging,
+                                VkCommandBuffer *out_cmd)
+{
+    memset(out_staging, 0, sizeof *out_staging);
+    ob_result r = staging_size ? ob_staging_create(dev, staging_size, name, out_staging) : OB_OK;
+    if (r == OB_OK) r = ob_device_wait_idle(dev);
+    if (r == OB_OK) r = ob_device_oneshot_begin(dev, out_cmd);
+    if (r != OB_OK) ob_staging_destroy(dev, out_staging);
+    return r;
+}
+
 /* ------------------------------------------------------------------ buffers */
 
 ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_t size, void *out)
@@ -45,17 +58,10 @@ ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_
                  (unsigned long long)size, (unsigned long long)offset, (unsigned long long)rec->size);
         return OB_ERR_OUT_OF_RANGE;
     }
-    ob_staging staging = {0};
-    ob_result r = OB_OK;
-    if (!rec->host_visible) {
-        r = ob_staging_create(dev, size, rec->name, &staging);
-        if (r != OB_OK) return r;
-    }
-    r = ob_device_wait_idle(dev);
-    if (r != OB_OK) goto done;
+    ob_staging staging;
     VkCommandBuffer cmd;
-    r = ob_device_oneshot_begin(dev, &cmd);
-    if (r != OB_OK) goto done;
+    ob_result r = readback_begin(dev, rec->host_visible ? 0 : size, rec->name, &staging, &cmd);
+    if (r != OB_OK) goto fail;
     if (!rec->host_visible) {
         VkMemoryBarrier2 to_copy = {
             .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
@@ -70,12 +76,12 @@ ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_
     }
     record_memory_barrier(cmd, &to_host);
     r = ob_device_oneshot_submit(dev, cmd);
-    if (r != OB_OK) goto done;
-    memcpy(out, rec->host_visible ? (const char *)rec->mapped + offset : staging.mapped, (size_t)size);
-done:
-    if (r != OB_OK)
-        OB_LOG_E("resources", "buffer '%s': read-back failed: %s", rec->name, ob_result_name(r));
+    if (r == OB_OK)
+        memcpy(out, rec->host_visible ? (const char *)rec->mapped + offset : staging.mapped, (size_t)size);
     ob_staging_destroy(dev, &staging);
+    if (r == OB_OK) return OB_OK;
+fail:
+    OB_LOG_E("resources", "buffer '%s': read-back failed: %s", rec->name, ob_result_name(r));
     return r;
 }
 
@@ -154,13 +160,9 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
     if (r != OB_OK) return r;
     size_t pixels = (size_t)rec->info.width * rec->info.height;
     ob_staging staging;
-    r = ob_staging_create(dev, pixels * 4, rec->name, &staging);
-    if (r != OB_OK) return r;
-    r = ob_device_wait_idle(dev);
-    if (r != OB_OK) goto done;
     VkCommandBuffer cmd;
-    r = ob_device_oneshot_begin(dev, &cmd);
-    if (r != OB_OK) goto done;
+    r = readback_begin(dev, pixels * 4, rec->name, &staging, &cmd);
+    if (r != OB_OK) goto fail;
     ob_image_state saved = rec->state;
     record_image_copy(cmd, rec, layer, staging.buffer);
     r = ob_device_oneshot_submit(dev, cmd);
@@ -180,8 +182,10 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
         }
     }
 done:
-    if (r != OB_OK) OB_LOG_E("resources", "image '%s': read-back failed: %s", rec->name, ob_result_name(r));
     ob_staging_destroy(dev, &staging);
+    if (r == OB_OK) return OB_OK;
+fail:
+    OB_LOG_E("resources", "image '%s': read-back failed: %s", rec->name, ob_result_name(r));
     return r;
 }
 

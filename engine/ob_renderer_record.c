@@ -258,7 +258,7 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
         }
     }
     /* Largest predicted cost first; assembly later walks views in order. */
-    qsort(r->jobs, r->job_count, sizeof *r->jobs, compare_jobs_by_cost);
+    if (r->job_count > 1) qsort(r->jobs, r->job_count, sizeof *r->jobs, compare_jobs_by_cost);
     return OB_OK;
 }
 
@@ -312,14 +312,14 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
         if (d->layer_count == 0) continue;
         clear_if_undefined(r, cmd, d->color);
         clear_if_undefined(r, cmd, d->depth);
-        add_image_barrier(r, d->color, VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+        add_image_barrier(r, d->color, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sample_stages,
                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
-        add_image_barrier(r, d->depth, VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+        add_image_barrier(r, d->depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sample_stages,
                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
     }
     for (uint32_t i = 0; i < v->input_count; i++) {
         clear_if_undefined(r, cmd, v->inputs[i]);
-        add_image_barrier(r, v->inputs[i], VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL, sample_stages,
+        add_image_barrier(r, v->inputs[i], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sample_stages,
                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
     }
     if (v->layer_count > 0) {

@@ -99,6 +99,20 @@ fail_destroy:
     return r;
 }
 
+uint32_t ob_res_register(ob_device *dev, ob_pool *pool, void *rec, uint64_t mem_size, ob_result *out_result)
+{
+    uint32_t id = ob_pool_insert(pool, rec, out_result);
+    if (id) ob_device_registry(dev)->device_bytes += mem_size;
+    return id;
+}
+
+void *ob_res_retire(ob_pool *pool, uint32_t id, const char *caller, const char *kind)
+{
+    void *rec = ob_pool_remove(pool, id);
+    if (!rec) OB_LOG_E("resources", "%s: invalid or stale %s handle 0x%08x", caller, kind, id);
+    return rec;
+}
+
 ob_buffer_rec *ob_res_buffer_get(const ob_device *dev, ob_buffer buf, const char *caller)
 {
     ob_buffer_rec *rec = ob_pool_get(&ob_device_registry(dev)->buffers, buf.id);
@@ -279,10 +293,8 @@ ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result
         r = buffer_upload_staged(dev, rec, 0, desc->data, data_size);
         if (r != OB_OK) goto fail_free_rec;
     }
-    ob_resource_registry *reg = ob_device_registry(dev);
-    handle.id = ob_pool_insert(&reg->buffers, rec, &r);
+    handle.id = ob_res_register(dev, &ob_device_registry(dev)->buffers, rec, rec->mem_size, &r);
     if (!handle.id) goto fail_free_rec;
-    reg->device_bytes += rec->mem_size;
     if (out_result) *out_result = OB_OK;
     return handle;
 
@@ -298,11 +310,8 @@ void ob_buffer_destroy(ob_device *dev, ob_buffer buf)
 {
     if (!buf.id) return;
     ob_resource_registry *reg = ob_device_registry(dev);
-    ob_buffer_rec *rec = ob_pool_remove(&reg->buffers, buf.id);
-    if (!rec) {
-        OB_LOG_E("resources", "ob_buffer_destroy: invalid or stale buffer handle 0x%08x", buf.id);
-        return;
-    }
+    ob_buffer_rec *rec = ob_res_retire(&reg->buffers, buf.id, "ob_buffer_destroy", "buffer");
+    if (!rec) return;
     reg->device_bytes -= rec->mem_size;
     ob_device_defer(dev, buffer_free_deferred, rec);
 }
@@ -418,7 +427,7 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
         goto fail_free_rec;
     }
     ob_res_set_name(dev, VK_OBJECT_TYPE_SAMPLER, (uint64_t)(uintptr_t)rec->sampler, name, NULL);
-    handle.id = ob_pool_insert(&ob_device_registry(dev)->samplers, rec, &r);
+    handle.id = ob_res_register(dev, &ob_device_registry(dev)->samplers, rec, 0, &r);
     if (!handle.id) goto fail_free_rec;
     if (out_result) *out_result = OB_OK;
     return handle;
@@ -434,11 +443,8 @@ fail:
 void ob_sampler_destroy(ob_device *dev, ob_sampler s)
 {
     if (!s.id) return;
-    ob_sampler_rec *rec = ob_pool_remove(&ob_device_registry(dev)->samplers, s.id);
-    if (!rec) {
-        OB_LOG_E("resources", "ob_sampler_destroy: invalid or stale sampler handle 0x%08x", s.id);
-        return;
-    }
+    ob_sampler_rec *rec = ob_res_retire(&ob_device_registry(dev)->samplers, s.id, "ob_sampler_destroy", "sampler");
+    if (!rec) return;
     ob_device_defer(dev, sampler_free_deferred, rec);
 }
 

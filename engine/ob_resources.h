@@ -39,7 +39,8 @@ typedef enum ob_buffer_usage {
 typedef struct ob_buffer_desc {
     uint64_t size;          /* bytes; 0 is an error */
     uint32_t usage;         /* ob_buffer_usage bits */
-    bool host_visible;      /* mapped, host-coherent (rings, read-back); else device-local */
+    bool host_visible;      /* mapped, host-coherent (rings, read-back); else device-local
+                               (device-local buffers always allow transfers, for staging) */
     const void *data;       /* optional initial contents (staged when not host visible) */
     uint64_t data_size;     /* bytes of data (≤ size); 0 → size when data is set */
     const char *name;       /* debug name (copied) */
@@ -74,7 +75,9 @@ typedef struct ob_image_desc {
     uint32_t layers;         /* 0 → 1; >1 makes a 2D array (paraboloid maps use 2) */
     VkFormat format;         /* must support the usage on this device, else OB_ERR_UNSUPPORTED */
     uint32_t usage;          /* ob_image_usage bits */
-    const void *data;        /* optional tightly packed texels for every layer */
+    const void *data;        /* optional tightly packed texels for every layer (colour,
+                                D16/D32 or BC formats); staged, leaving the image in
+                                SHADER_READ_ONLY_OPTIMAL (TRANSFER_DST is implied) */
     const char *name;
 } ob_image_desc;
 

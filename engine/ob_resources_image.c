@@ -362,10 +362,8 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
         r = image_upload(dev, rec, desc->data, data_size);
         if (r != OB_OK) goto fail_free_rec;
     }
-    ob_resource_registry *reg = ob_device_registry(dev);
-    handle.id = ob_pool_insert(&reg->images, rec, &r);
+    handle.id = ob_res_register(dev, &ob_device_registry(dev)->images, rec, rec->mem_size, &r);
     if (!handle.id) goto fail_free_rec;
-    reg->device_bytes += rec->mem_size;
     if (out_result) *out_result = OB_OK;
     return handle;
 
@@ -381,11 +379,8 @@ void ob_image_destroy(ob_device *dev, ob_image img)
 {
     if (!img.id) return;
     ob_resource_registry *reg = ob_device_registry(dev);
-    ob_image_rec *rec = ob_pool_remove(&reg->images, img.id);
-    if (!rec) {
-        OB_LOG_E("resources", "ob_image_destroy: invalid or stale image handle 0x%08x", img.id);
-        return;
-    }
+    ob_image_rec *rec = ob_res_retire(&reg->images, img.id, "ob_image_destroy", "image");
+    if (!rec) return;
     reg->device_bytes -= rec->mem_size;
     ob_device_defer(dev, image_free_deferred, rec);
 }

@@ -63,6 +63,14 @@ ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, V
 /* Gives obj the debug name "<name><suffix>". */
 void ob_res_set_name(ob_device *dev, VkObjectType type, uint64_t handle, const char *name, const char *suffix);
 
+/* Puts a finished record into its pool and counts its device memory;
+ * 0 (with *out_result set) when the pool cannot grow. */
+uint32_t ob_res_register(ob_device *dev, ob_pool *pool, void *rec, uint64_t mem_size, ob_result *out_result);
+/* Takes id out of its pool at once (so the handle is dead) and returns the
+ * record for the caller to uncount and defer; NULL, logged as coming from
+ * `caller`, when id is stale. */
+void *ob_res_retire(ob_pool *pool, uint32_t id, const char *caller, const char *kind);
+
 /* Resolve a handle; log "<caller>: invalid or stale <kind> handle" and return
  * NULL when it does not resolve. */
 ob_buffer_rec *ob_res_buffer_get(const ob_device *dev, ob_buffer buf, const char *caller);

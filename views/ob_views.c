@@ -9,6 +9,7 @@
 typedef struct view_params {
     ob_param screen, ambient, light_dir, light_color;
     ob_param point_pos[4], point_color[4];
+    ob_param shadow_matrix, paraboloid;
 } view_params;
 
 static view_params params_of(ob_param_registry *reg)
@@ -19,6 +20,8 @@ static view_params params_of(ob_param_registry *reg)
     p.ambient = ob_param_find(reg, "AmbientColor");
     p.light_dir = ob_param_find(reg, "LightDirection");
     p.light_color = ob_param_find(reg, "LightColor");
+    p.shadow_matrix = ob_param_find(reg, "ShadowMatrix");
+    p.paraboloid = ob_param_find(reg, "ParaboloidDirection");
     for (int i = 0; i < 4; i++) {
         snprintf(name, sizeof name, "PointLight%dPosition", i);
         p.point_pos[i] = ob_param_find(reg, name);
@@ -61,6 +64,15 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
                        v->height ? 1.0f / (float)v->height : 0.0f};
     ob_params_set_vec4(params, p.screen, screen);
     ob_params_set_vec4(params, p.ambient, ctx->ambient);
+    /* Members of the shared PerView block that only some views use get a
+     * defined value here (dependencies and the paraboloid view override
+     * them afterwards), so a slot never carries another view's leftovers:
+     * the packed bytes, and so the command hashes, do not depend on which
+     * views a worker happened to record before. */
+    float identity[16];
+    ob_mat4_identity(identity);
+    ob_params_set_mat4(params, p.shadow_matrix, identity);
+    ob_params_set_vec4(params, p.paraboloid, (const float[4]){0, 0, 0, 0});
 
     /* Lights, relative to the view's origin like everything else. */
     float zero[4] = {0, 0, 0, 0};

@@ -1,0 +1,97 @@
+/* ob_geometry.h — geometry on the GPU: one vertex buffer, one 32-bit index
+ * buffer, the vertex layout, the primitive topology and the bounds
+ * (Hieroglyph's GeometryDX11). The pipeline manager binds it; effects match
+ * their vertex inputs against its layout.
+ *
+ * Lifecycle: ob_geometry_create uploads an ob_mesh (the mesh stays the
+ * caller's; the geometry keeps no pointer to it) → draw in frames →
+ * ob_geometry_destroy, which may follow a draw recorded in the current frame
+ * (the buffers are destroyed deferred, after the frame slot completes).
+ *
+ * Thread rule: create and destroy are [render thread] (they create and
+ * destroy device resources). A geometry is immutable after creation: every
+ * accessor is [any thread], so recording workers read it freely.
+ */
+#ifndef OB_GEOMETRY_H
+#define OB_GEOMETRY_H
+
+#include "ob_mesh.h"
+#include "ob_resources.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ob_vertex_attribute {
+    uint32_t location;
+    VkFormat format;
+    uint32_t offset;        /* bytes from the start of the vertex */
+    const char *semantic;   /* "POSITION", "NORMAL", "TEXCOORD0" */
+} ob_vertex_attribute;
+
+typedef struct ob_vertex_layout {
+    uint32_t stride;
+    uint32_t attribute_count;
+    ob_vertex_attribute attributes[8];
+} ob_vertex_layout;
+
+/* The layout of ob_vertex: location 0 POSITION (R32G32B32_SFLOAT, offset 0),
+ * 1 NORMAL (R32G32B32_SFLOAT, 12), 2 TEXCOORD0 (R32G32_SFLOAT, 24);
+ * stride 32. A static constant, never NULL. [any thread] */
+const ob_vertex_layout *ob_vertex_layout_standard(void);
+
+typedef struct ob_geometry ob_geometry;
+
+typedef struct ob_geometry_desc {
+    const ob_mesh *mesh;
+    const char *name;       /* copied; NULL → "geometry". Used in logs and debug names */
+    /* 0 = TRIANGLE_LIST (so POINT_LIST, whose value is 0, cannot be chosen).
+     * Also LINE_LIST, LINE_STRIP, TRIANGLE_STRIP, TRIANGLE_FAN; the mesh's
+     * indices are then read as that topology. */
+    VkPrimitiveTopology topology;
+    /* Stable id for command hashes (never a pointer, so hashes repeat across
+     * runs). 0 → derived from a hash of the name, the counts and the vertex
+     * and index data: equal geometry gets an equal id, which is what a
+     * command hash needs. Give explicit ids if you need them unique. */
+    uint32_t id;
+    /* Procedural geometry (mesh NULL): no buffers; a draw is vertex_count
+     * vertices × instance_count instances whose shader pulls its own data
+     * (particles). Bounds are then unknown: the entity supplies its own. */
+    uint32_t vertex_count;
+    uint32_t instance_count;   /* 0 → 1 */
+} ob_geometry_desc;
+
+/* Validates the mesh for the topology first (ob_mesh_validate_primitives:
+ * indices in range, finite attributes; logged under the name) and uploads
+ * nothing if it fails. Then uploads the vertices and indices into
+ * device-local buffers (staged, waits for the copy; TRANSFER_SRC too, so
+ * tools and tests can read them back) and computes the bounds
+ * from the vertices (mesh->bounds is not trusted).
+ * Returns NULL and sets *out_result (may be NULL) on failure:
+ * OB_ERR_INVALID_ARGUMENT (no device, desc or mesh; bad mesh),
+ * OB_ERR_OUT_OF_RANGE / OB_ERR_NON_FINITE (mesh contents),
+ * OB_ERR_UNSUPPORTED (topology), or the buffer creation's error. Nothing
+ * stays allocated on failure. [render thread] */
+ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob_result *out_result);
+
+/* Destroys the buffers deferred and frees the object at once. NULL is a
+ * no-op. [render thread] */
+void ob_geometry_destroy(ob_device *dev, ob_geometry *geo);
+
+/* Accessors [any thread]. On NULL they return a zero handle, 0 or NULL
+ * (the topology accessor: TRIANGLE_LIST). */
+ob_buffer ob_geometry_vertex_buffer(const ob_geometry *g);
+ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UINT32 */
+uint32_t ob_geometry_index_count(const ob_geometry *g);
+uint32_t ob_geometry_vertex_count(const ob_geometry *g);
+uint32_t ob_geometry_instance_count(const ob_geometry *g);  /* 1 for meshes */
+const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);
+VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g);
+const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
+uint32_t ob_geometry_id(const ob_geometry *g);              /* never 0 for a live geometry */
+const char *ob_geometry_name(const ob_geometry *g);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_GEOMETRY_H */

@@ -1,0 +1,177 @@
+#include "ob_test_world.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define CHECK(expr, what)                                                                  \
+    do {                                                                                   \
+        ob_result check_r_ = (expr);                                                       \
+        if (check_r_ != OB_OK) fail_msg("%s: %s", what, ob_result_name(check_r_));        \
+    } while (0)
+
+void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
+{
+    ob_test_setup_log();
+    ob_test_world_desc d = desc ? *desc : (ob_test_world_desc){0};
+    memset(w, 0, sizeof *w);
+    w->width = d.width ? d.width : 160;
+    w->height = d.height ? d.height : 120;
+    ob_result r;
+    ob_renderer_desc rd = {.device = {.app_name = "obelisk-test", .validation = 1},
+                           .worker_count = d.workers ? d.workers : 4};
+    w->r = ob_renderer_create(&rd, &r);
+    if (!w->r) fail_msg("renderer: %s", ob_result_name(r));
+    w->dev = ob_renderer_device(w->r);
+    w->fx = ob_effect_context_create(w->dev, ob_renderer_registry(w->r), NULL, &r);
+    if (!w->fx) fail_msg("effect context: %s", ob_result_name(r));
+    w->lib = ob_material_library_create(w->fx, NULL, &r);
+    if (!w->lib) fail_msg("material library: %s", ob_result_name(r));
+    ob_views_desc vd = {.renderer = w->r, .materials = w->lib, .effects = w->fx,
+                        .env_map_size = d.env_map_size ? d.env_map_size : 64,
+                        .shadow_map_size = d.shadow_map_size ? d.shadow_map_size : 256};
+    w->views = ob_views_create(&vd, &r);
+    if (!w->views) fail_msg("views: %s", ob_result_name(r));
+    w->scene = ob_scene_create(&r);
+    if (!w->scene) fail_msg("scene: %s", ob_result_name(r));
+    w->camera = ob_node_create(w->scene, NULL, "camera", &r);
+    if (!w->camera) fail_msg("camera: %s", ob_result_name(r));
+    CHECK(ob_node_set_camera(w->camera, &(ob_camera_desc){.fovy = 1.0f, .znear = 0.1f}), "camera");
+    ob_perspective_desc pd = {.name = "main", .camera = w->camera, .width = w->width,
+                              .height = w->height, .clear_color = {0.1f, 0.2f, 0.3f, 1.0f}};
+    if (d.clear_color[3] > 0.0f) memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
+    w->main = ob_perspective_view_create(w->views, &pd, &r);
+    if (!w->main) fail_msg("main view: %s", ob_result_name(r));
+    w->composite = ob_composite_view_create(w->views, ob_perspective_view_base(w->main), &r);
+    if (!w->composite) fail_msg("composite: %s", ob_result_name(r));
+    w->pixels = malloc((size_t)w->width * w->height * 4);
+    assert_non_null(w->pixels);
+
+    ob_mesh m = {0};
+    CHECK(ob_mesh_box((const float[3]){0.5f, 0.5f, 0.5f}, &m), "box");
+    w->box = ob_test_world_geometry(w, &m, "box");
+    ob_mesh_release(&m);
+    CHECK(ob_mesh_sphere(0.5f, 24, 16, &m), "sphere");
+    w->sphere = ob_test_world_geometry(w, &m, "sphere");
+    ob_mesh_release(&m);
+    CHECK(ob_mesh_plane(20.0f, 20.0f, 2, &m), "plane");
+    w->plane = ob_test_world_geometry(w, &m, "plane");
+    ob_mesh_release(&m);
+    ob_test_world_look(w, 0.0, 2.0, 5.0, 0.0, 0.0, 0.0);
+}
+
+void ob_test_world_destroy(ob_test_world *w)
+{
+    if (!w->r) return;
+    ob_renderer_wait_idle(w->r);
+    ob_validation_counts vc = ob_device_validation_counts(w->dev);
+    ob_composite_view_destroy(w->views, w->composite);
+    ob_perspective_view_destroy(w->views, w->main);
+    ob_scene_destroy(w->scene);
+    ob_views_destroy(w->views);
+    ob_material_library_destroy(w->lib);
+    for (uint32_t i = 0; i < w->geometry_count; i++) ob_geometry_destroy(w->dev, w->geometry[i]);
+    ob_effect_context_destroy(w->fx);
+    ob_renderer_destroy(w->r);
+    free(w->pixels);
+    memset(w, 0, sizeof *w);
+    if (vc.errors || vc.warnings)
+        fail_msg("validation layer reported %u errors and %u warnings", vc.errors, vc.warnings);
+}
+
+ob_geometry *ob_test_world_geometry(ob_test_world *w, const ob_mesh *mesh, const char *name)
+{
+    assert_true(w->geometry_count < OB_TEST_WORLD_MAX_GEOMETRY);
+    ob_result r;
+    ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = w->geometry_count + 1};
+    ob_geometry *g = ob_geometry_create(w->dev, &gd, &r);
+    if (!g) fail_msg("geometry '%s': %s", name, ob_result_name(r));
+    w->geometry[w->geometry_count++] = g;
+    return g;
+}
+
+ob_material *ob_test_world_material(ob_test_world *w, ob_material_kind kind, float r, float g,
+                                    float b, bool casts_shadows)
+{
+    ob_result res;
+    ob_material_desc md = {.name = "test", .kind = kind, .diffuse = {r, g, b, 1.0f},
+                           .specular = {0.0f, 0.0f, 0.0f, 1.0f}, .casts_shadows = casts_shadows};
+    ob_material *m = ob_material_create(w->lib, &md, &res);
+    if (!m) fail_msg("material: %s", ob_result_name(res));
+    return m;
+}
+
+ob_node *ob_test_world_entity(ob_test_world *w, ob_node *parent, const char *name, ob_geometry *g,
+                              ob_material *m, double x, double y, double z)
+{
+    ob_result r;
+    ob_node *n = ob_node_create(w->scene, parent, name, &r);
+    if (!n) fail_msg("entity '%s': %s", name, ob_result_name(r));
+    const ob_bounds *b = ob_geometry_bounds(g);
+    ob_renderable rd = {.material = m, .geometry = g, .local_radius = b->radius};
+    memcpy(rd.local_center, b->center, sizeof rd.local_center);
+    CHECK(ob_node_set_renderable(n, &rd), name);
+    ob_node_set_position(n, (const double[3]){x, y, z});
+    return n;
+}
+
+ob_node *ob_test_world_light(ob_test_world *w, ob_light_type type, bool shadows, float intensity,
+                             double x, double y, double z)
+{
+    ob_result r;
+    ob_node *n = ob_node_create(w->scene, NULL, type == OB_LIGHT_DIRECTIONAL ? "sun" : "lamp", &r);
+    if (!n) fail_msg("light: %s", ob_result_name(r));
+    ob_light_desc ld = {.type = type, .color = {1.0f, 1.0f, 1.0f}, .intensity = intensity,
+                        .range = 0.0f, .casts_shadows = shadows};
+    CHECK(ob_node_set_light(n, &ld), "light");
+    ob_node_set_position(n, (const double[3]){x, y, z});
+    if (type == OB_LIGHT_DIRECTIONAL)
+        CHECK(ob_node_look_at(n, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0}), "light aim");
+    return n;
+}
+
+void ob_test_world_look(ob_test_world *w, double ex, double ey, double ez, double tx, double ty,
+                        double tz)
+{
+    ob_node_set_position(w->camera, (const double[3]){ex, ey, ez});
+    CHECK(ob_node_look_at(w->camera, (const double[3]){tx, ty, tz}, (const double[3]){0, 1, 0}),
+          "camera aim");
+}
+
+const ob_frame_stats *ob_test_world_frame(ob_test_world *w, ob_threading mode, uint32_t workers)
+{
+    const double dt = 1.0 / 60.0;
+    ob_renderer_set_threading(w->r, mode, workers);
+    CHECK(ob_scene_update(w->scene, w->time > 0.0 ? dt : 0.0), "scene update");
+    ob_views_set_time(w->views, w->time, dt);
+    CHECK(ob_renderer_begin_frame(w->r, w->scene), "begin frame");
+    ob_views_render(w->views, ob_composite_view_base(w->composite));
+    CHECK(ob_renderer_end_frame(w->r), "end frame");
+    CHECK(ob_renderer_wait_idle(w->r), "wait idle");
+    w->time += dt;
+    return ob_renderer_last_stats(w->r);
+}
+
+const uint8_t *ob_test_world_read(ob_test_world *w)
+{
+    CHECK(ob_image_read_rgba8(w->dev, ob_composite_view_target(w->composite), w->pixels), "read back");
+    return w->pixels;
+}
+
+const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t y)
+{
+    return w->pixels + ((size_t)y * w->width + x) * 4;
+}
+
+const ob_view_stats *ob_test_view_stats(const ob_frame_stats *st, const char *name)
+{
+    for (uint32_t i = 0; i < st->view_count; i++)
+        if (strcmp(st->views[i].name, name) == 0) return &st->views[i];
+    return NULL;
+}
+
+ob_skip_reason ob_test_skip_reason(const ob_frame_stats *st, const char *name)
+{
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        if (strcmp(st->skipped[i].name, name) == 0) return st->skipped[i].reason;
+    return OB_SKIP_NONE;
+}

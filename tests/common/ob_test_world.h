@@ -1,0 +1,71 @@
+/* ob_test_world.h — a whole engine stack for gpu tests: renderer (validation
+ * on), effects, materials, views, a scene with a camera, the main perspective
+ * view and the composite final target; helpers to add entities and lights,
+ * run frames in a given threading mode and read the image back.
+ *
+ * Every helper fails the running cmocka test on error, so tests read as the
+ * scenario they check. ob_test_world_destroy asserts the validation layer
+ * stayed silent.
+ */
+#ifndef OB_TEST_WORLD_H
+#define OB_TEST_WORLD_H
+
+#include "ob_test.h"
+#include "ob_views.h"
+
+#define OB_TEST_WORLD_MAX_GEOMETRY 32
+
+typedef struct ob_test_world_desc {
+    uint32_t workers;          /* 0 → 4 */
+    uint32_t width, height;    /* 0 → 160 x 120 */
+    uint32_t env_map_size;     /* 0 → 64 */
+    uint32_t shadow_map_size;  /* 0 → 256 */
+    float clear_color[4];      /* zero → opaque dark blue (0.1, 0.2, 0.3, 1) */
+} ob_test_world_desc;
+
+typedef struct ob_test_world {
+    ob_renderer *r;
+    ob_device *dev;
+    ob_effect_context *fx;
+    ob_material_library *lib;
+    ob_views *views;
+    ob_scene *scene;
+    ob_node *camera;
+    ob_perspective_view *main;
+    ob_composite_view *composite;
+    ob_geometry *geometry[OB_TEST_WORLD_MAX_GEOMETRY];
+    uint32_t geometry_count;
+    ob_geometry *box, *sphere, *plane;
+    uint32_t width, height;
+    uint8_t *pixels;           /* width * height * 4, filled by ob_test_world_read */
+    double time;
+    char cache_dir[256];
+} ob_test_world;
+
+void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc);
+void ob_test_world_destroy(ob_test_world *w);
+
+/* Geometry from a mesh (the world owns it). */
+ob_geometry *ob_test_world_geometry(ob_test_world *w, const ob_mesh *mesh, const char *name);
+ob_material *ob_test_world_material(ob_test_world *w, ob_material_kind kind, float r, float g,
+                                    float b, bool casts_shadows);
+ob_node *ob_test_world_entity(ob_test_world *w, ob_node *parent, const char *name, ob_geometry *g,
+                              ob_material *m, double x, double y, double z);
+ob_node *ob_test_world_light(ob_test_world *w, ob_light_type type, bool shadows, float intensity,
+                             double x, double y, double z);
+void ob_test_world_look(ob_test_world *w, double ex, double ey, double ez, double tx, double ty,
+                        double tz);
+
+/* One frame (dt = 1/60 after the first) in `mode` with `workers` active
+ * (0 = all), waited for; returns its final stats (GPU times included). */
+const ob_frame_stats *ob_test_world_frame(ob_test_world *w, ob_threading mode, uint32_t workers);
+/* Read the final image into w->pixels; returns it. */
+const uint8_t *ob_test_world_read(ob_test_world *w);
+/* Pixel (x, y) of the last read, RGBA. */
+const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t y);
+/* The stats of the view called name in st (NULL if it did not run). */
+const ob_view_stats *ob_test_view_stats(const ob_frame_stats *st, const char *name);
+/* The skip reason recorded for name, OB_SKIP_NONE if none. */
+ob_skip_reason ob_test_skip_reason(const ob_frame_stats *st, const char *name);
+
+#endif

@@ -1,0 +1,102 @@
+/* What a user sees first: the clear colour, a lit cube, the same pixels in
+ * single- and multi-threaded recording. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ob_test_world.h"
+
+static const ob_test_world_desc small = {.width = 160, .height = 120,
+                                         .clear_color = {0.2f, 0.4f, 0.6f, 1.0f}};
+
+static void empty_scene_is_the_clear_colour(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &small);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    for (uint32_t y = 0; y < w.height; y++) {
+        for (uint32_t x = 0; x < w.width; x++) {
+            const uint8_t *p = ob_test_world_pixel(&w, x, y);
+            if (p[0] != 51 || p[1] != 102 || p[2] != 153 || p[3] != 255)
+                fail_msg("pixel (%u,%u) = %u,%u,%u,%u, expected the clear colour 51,102,153,255", x,
+                         y, p[0], p[1], p[2], p[3]);
+        }
+    }
+    /* The empty main view records nothing and says so. */
+    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    assert_non_null(main);
+    assert_int_equal(main->draws, 0);
+    assert_int_equal(main->skipped, OB_SKIP_EMPTY);
+    ob_test_world_destroy(&w);
+}
+
+/* A cube face-on to the camera and to a white directional light: the centre
+ * is (ambient 0.15 + N.L 1.0) * diffuse, written as UNORM8. */
+static void lit_cube_centre_has_the_expected_shade(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &small);
+    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
+    ob_test_world_entity(&w, NULL, "cube", w.box, m, 0, 0, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
+    ob_test_world_look(&w, 0, 0, 5, 0, 0, 0);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(st->draws, 2); /* the cube and the composite's full-screen triangle */
+    ob_test_world_read(&w);
+    const uint8_t *c = ob_test_world_pixel(&w, w.width / 2, w.height / 2);
+    const float expected[3] = {1.15f * 0.8f, 1.15f * 0.4f, 1.15f * 0.2f};
+    for (int i = 0; i < 3; i++) assert_near(c[i], expected[i] * 255.0f, 2.0);
+    assert_int_equal(c[3], 255);
+    /* Depth test and framing: a corner still shows the clear colour. */
+    const uint8_t *corner = ob_test_world_pixel(&w, 2, 2);
+    assert_int_equal(corner[0], 51);
+    assert_int_equal(corner[2], 153);
+    ob_test_world_destroy(&w);
+}
+
+/* Rotation changes the image over frames (the cube is animated), and every
+ * frame is the same whichever mode recorded it. */
+static void rotating_cube_same_in_every_mode(void **state)
+{
+    (void)state;
+    uint8_t *frames[2][3];
+    for (int run = 0; run < 2; run++) {
+        ob_test_world w;
+        ob_test_world_create(&w, &small);
+        ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.3f, 0.7f, 0.9f, true);
+        ob_node *cube = ob_test_world_entity(&w, NULL, "cube", w.box, m, 0, 0.6, 0);
+        ob_node_add_rotation_controller(cube, (const float[3]){0.3f, 1.0f, 0.1f}, 2.0f);
+        ob_material *g = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+        ob_test_world_entity(&w, NULL, "ground", w.plane, g, 0, 0, 0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
+        ob_test_world_look(&w, 0, 2.5, 4, 0, 0.3, 0);
+        for (int f = 0; f < 3; f++) {
+            ob_threading mode = run == 0 ? OB_THREADING_SINGLE : OB_THREADING_MULTI;
+            ob_test_world_frame(&w, mode, run == 0 ? 0 : 3);
+            ob_test_world_read(&w);
+            frames[run][f] = malloc((size_t)w.width * w.height * 4);
+            memcpy(frames[run][f], w.pixels, (size_t)w.width * w.height * 4);
+        }
+        ob_test_world_destroy(&w);
+    }
+    assert_true(memcmp(frames[0][0], frames[0][2], 160 * 120 * 4) != 0);
+    for (int f = 0; f < 3; f++) {
+        assert_int_equal(ob_test_image_max_diff(frames[0][f], frames[1][f], 160, 120), 0);
+        free(frames[0][f]);
+        free(frames[1][f]);
+    }
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(empty_scene_is_the_clear_colour),
+        cmocka_unit_test(lit_cube_centre_has_the_expected_shade),
+        cmocka_unit_test(rotating_cube_same_in_every_mode),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
