@@ -203,6 +203,39 @@ static ob_param register_param(ob_param_registry *reg, const char *name, ob_para
     return p;
 }
 
+/* The standard shaders' whole parameter interface (materials/shaders),
+ * registered up front so views and applications can look every name up
+ * before the first variant is compiled. Programs map members to these. */
+static ob_result register_standard_params(ob_material_library *lib)
+{
+    static const struct {
+        const char *name;
+        ob_param_type type;
+    } params[] = {
+        {"CameraPosition", OB_PARAM_VEC4},      {"ScreenSize", OB_PARAM_VEC4},
+        {"AmbientColor", OB_PARAM_VEC4},        {"LightDirection", OB_PARAM_VEC4},
+        {"LightColor", OB_PARAM_VEC4},          {"PointLight0Position", OB_PARAM_VEC4},
+        {"PointLight1Position", OB_PARAM_VEC4}, {"PointLight2Position", OB_PARAM_VEC4},
+        {"PointLight3Position", OB_PARAM_VEC4}, {"PointLight0Color", OB_PARAM_VEC4},
+        {"PointLight1Color", OB_PARAM_VEC4},    {"PointLight2Color", OB_PARAM_VEC4},
+        {"PointLight3Color", OB_PARAM_VEC4},    {"ParaboloidDirection", OB_PARAM_VEC4},
+        {"SimStep", OB_PARAM_VEC4},             {"SimEmitter", OB_PARAM_VEC4},
+        {"SimForce", OB_PARAM_VEC4},            {"ShadowMatrix", OB_PARAM_MAT4},
+        {"EnvMapMatrix", OB_PARAM_MAT4},        {"ShadowMap", OB_PARAM_TEXTURE},
+        {"EnvMap", OB_PARAM_TEXTURE},           {"SourceImage", OB_PARAM_TEXTURE},
+        {"Particles", OB_PARAM_STORAGE_BUFFER},
+    };
+    ob_result r = OB_OK;
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(params); i++)
+        if (!register_param(lib->reg, params[i].name, params[i].type, &r).id) return r;
+    lib->diffuse = register_param(lib->reg, "DiffuseColor", OB_PARAM_VEC4, &r);
+    if (lib->diffuse.id) lib->specular = register_param(lib->reg, "SpecularColor", OB_PARAM_VEC4, &r);
+    if (lib->specular.id) lib->emissive = register_param(lib->reg, "EmissiveColor", OB_PARAM_VEC4, &r);
+    if (lib->emissive.id)
+        lib->reflectivity = register_param(lib->reg, "Reflectivity", OB_PARAM_VEC4, &r);
+    return lib->reflectivity.id ? OB_OK : r;
+}
+
 /* Default samplers of the standard shaders, in every slot: a view or the
  * application may set its own. */
 static ob_result create_samplers(ob_material_library *lib)
@@ -269,13 +302,8 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     lib->bias_constant = d.shadow_bias_constant != 0.0f ? d.shadow_bias_constant : -1.0f;
     lib->bias_slope = d.shadow_bias_slope != 0.0f ? d.shadow_bias_slope : -1.75f;
 
-    lib->diffuse = register_param(lib->reg, "DiffuseColor", OB_PARAM_VEC4, &r);
-    if (lib->diffuse.id) lib->specular = register_param(lib->reg, "SpecularColor", OB_PARAM_VEC4, &r);
-    if (lib->specular.id) lib->emissive = register_param(lib->reg, "EmissiveColor", OB_PARAM_VEC4, &r);
-    if (lib->emissive.id)
-        lib->reflectivity = register_param(lib->reg, "Reflectivity", OB_PARAM_VEC4, &r);
-    if (!lib->reflectivity.id) goto fail_destroy;
-    r = create_samplers(lib);
+    r = register_standard_params(lib);
+    if (r == OB_OK) r = create_samplers(lib);
     if (r != OB_OK) goto fail_destroy;
     if (out_result) *out_result = OB_OK;
     return lib;

@@ -10,6 +10,7 @@
 #include "ob_material.h"
 #include "ob_params.h"
 #include "ob_pipeline_manager.h"
+#include "ob_renderer.h"
 #include "ob_resources.h"
 #include "ob_scene.h"
 #include "ob_view.h"
@@ -512,6 +513,123 @@ static void test_hundred_entities_one_pipeline(void **state)
     ob_test_assert_no_validation(f->dev);
 }
 
+typedef struct usage_log {
+    ob_view base;                 /* first: the renderer sees an ob_view */
+    uint32_t calls;
+    const ob_view *consumer;
+} usage_log;
+
+static void record_usage(ob_view *v, ob_renderer *r, ob_params *params, const ob_view *consumer)
+{
+    (void)r, (void)params;
+    usage_log *u = (usage_log *)v;
+    u->calls++;
+    u->consumer = consumer;
+}
+
+static const ob_view_vtbl env_vtbl = {.type_name = "test-env", .set_usage_params = record_usage};
+
+/* With an environment map attached to its entity (as the views layer does in
+ * the queue hook), a reflective material draws with the ENVMAP lookup
+ * variant and binds that entity's map per draw; other materials do not. */
+static void test_reflective_uses_attached_env_map(void **state)
+{
+    fixture *f = *state;
+    ob_result r;
+    ob_renderer *rd = ob_renderer_create(&(ob_renderer_desc){
+        .device = {.app_name = "test-material", .validation = 1}, .worker_count = 1}, &r);
+    assert_non_null(rd);
+    ob_device *dev = ob_renderer_device(rd);
+    ob_effect_context *ctx = ob_effect_context_create(dev, ob_renderer_registry(rd), NULL, &r);
+    assert_non_null(ctx);
+    ob_material_library *lib = ob_material_library_create(ctx, NULL, &r);
+    assert_non_null(lib);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
+        .device = dev, .registry = ob_renderer_registry(rd), .name = "test"}, &r);
+    assert_non_null(pm);
+
+    ob_view persp;
+    ob_view_init(&persp, &test_vtbl, OB_VIEW_PERSPECTIVE, "camera");
+    persp.color = make_image(dev, VK_FORMAT_R8G8B8A8_UNORM, OB_IMAGE_COLOR_TARGET, "color");
+    persp.depth = make_image(dev, VK_FORMAT_D32_SFLOAT, OB_IMAGE_DEPTH_TARGET, "depth");
+    usage_log env = {0};
+    ob_view_init(&env.base, &env_vtbl, OB_VIEW_PARABOLOID, "envmap:mirror");
+
+    ob_scene *scene = ob_scene_create(&r);
+    ob_node *ball = ob_node_create(scene, NULL, "mirror", &r);
+    ob_node *cube = ob_node_create(scene, NULL, "cube", &r);
+    ob_material *mirror = make_material(lib, OB_MATERIAL_REFLECTIVE, false, false, 0);
+    ob_material *plain = make_material(lib, OB_MATERIAL_LIT, false, false, 0);
+
+    mi->pre_render(mirror, ball, rd, &persp);   /* nothing attached: plain lit */
+    assert_ptr_equal(ob_material_view_effect(mirror, rd, ball, &persp, false, NULL),
+                     ob_material_library_find_effect(lib, OB_STD_LIT, 0));
+    assert_null(ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_ENVMAP));
+
+    assert_int_equal(ob_renderer_attach_view(rd, ball, &env.base), OB_OK);
+    mi->pre_render(mirror, ball, rd, &persp);
+    ob_effect *lookup = ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_ENVMAP);
+    assert_non_null(lookup);
+    assert_ptr_equal(ob_material_view_effect(mirror, rd, ball, &persp, false, NULL), lookup);
+    assert_true(mi->apply(mirror, ball, rd, pm, &persp));
+    assert_int_equal(env.calls, 1);
+    assert_ptr_equal(env.consumer, &persp);
+    float got[4];
+    ob_params_get_vec4(ob_pm_params(pm), ob_param_find(ob_renderer_registry(rd), "Reflectivity"), got);
+    assert_true(got[0] == 0.6f);   /* the REFLECTIVE default */
+
+    /* Another entity with the same reflective material has no map: plain lit. */
+    assert_true(mi->apply(mirror, cube, rd, pm, &persp));
+    assert_int_equal(env.calls, 1);
+    /* A lit material on the entity that owns the map ignores it. */
+    mi->pre_render(plain, ball, rd, &persp);
+    assert_true(mi->apply(plain, ball, rd, pm, &persp));
+    assert_int_equal(env.calls, 1);
+
+    ob_scene_destroy(scene);
+    ob_pipeline_manager_destroy(pm);
+    ob_material_library_destroy(lib);
+    ob_effect_context_destroy(ctx);
+    ob_image_destroy(dev, persp.color);
+    ob_image_destroy(dev, persp.depth);
+    ob_test_assert_no_validation(dev);
+    ob_renderer_destroy(rd);
+    ob_test_assert_no_validation(f->dev);
+}
+
+/* Every name of the standard shaders' interface can be looked up as soon as
+ * the library exists, with the type the shaders declare. */
+static void test_library_registers_standard_interface(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    static const struct {
+        const char *name;
+        ob_param_type type;
+    } expect[] = {
+        {"DiffuseColor", OB_PARAM_VEC4},  {"Reflectivity", OB_PARAM_VEC4},
+        {"PointLight3Color", OB_PARAM_VEC4}, {"ParaboloidDirection", OB_PARAM_VEC4},
+        {"ShadowMatrix", OB_PARAM_MAT4},  {"EnvMapMatrix", OB_PARAM_MAT4},
+        {"ShadowMap", OB_PARAM_TEXTURE},  {"EnvMapSampler", OB_PARAM_SAMPLER},
+        {"Particles", OB_PARAM_STORAGE_BUFFER}, {"SimStep", OB_PARAM_VEC4},
+    };
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(expect); i++) {
+        ob_param p = ob_param_find(f->reg, expect[i].name);
+        if (!p.id) fail_msg("parameter '%s' not registered", expect[i].name);
+        assert_int_equal(ob_param_get_type(f->reg, p), expect[i].type);
+    }
+    /* The shadow sampler default compares (reversed-Z) in every slot. */
+    ob_params worker;
+    assert_int_equal(ob_params_manager(f->reg, 1, &worker), OB_OK);
+    ob_sampler s = {0};
+    assert_int_equal(ob_params_get_sampler(&worker, ob_param_find(f->reg, "ShadowMapSampler"), &s),
+                     OB_OK);
+    assert_int_not_equal(s.id, 0);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -523,6 +641,8 @@ int main(void)
         cmocka_unit_test(test_reflective_queues_env_map),
         cmocka_unit_test(test_apply_and_prepare_view),
         cmocka_unit_test(test_hundred_entities_one_pipeline),
+        cmocka_unit_test(test_reflective_uses_attached_env_map),
+        cmocka_unit_test(test_library_registers_standard_interface),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
