@@ -44,11 +44,8 @@ static ob_result register_params(ob_param_registry *reg)
         ob_param_register(reg, vec4s[i], OB_PARAM_VEC4, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "ShadowMatrix", OB_PARAM_MAT4, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "ShadowMap", OB_PARAM_TEXTURE, 1, &r);
-    if (r == OB_OK) ob_param_register(reg, "ShadowMapSampler", OB_PARAM_SAMPLER, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "EnvMap", OB_PARAM_TEXTURE, 1, &r);
-    if (r == OB_OK) ob_param_register(reg, "EnvMapSampler", OB_PARAM_SAMPLER, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "SourceImage", OB_PARAM_TEXTURE, 1, &r);
-    if (r == OB_OK) ob_param_register(reg, "SourceImageSampler", OB_PARAM_SAMPLER, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "Particles", OB_PARAM_STORAGE_BUFFER, 1, &r);
     return r;
 }
@@ -347,20 +344,8 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ctx->dt = 1.0 / 60.0;
     r = register_params(ob_renderer_registry(ctx->r));
     if (r != OB_OK) goto fail;
-    ctx->linear_clamp = ob_sampler_create(ctx->dev, &(ob_sampler_desc){
-        .filter = VK_FILTER_LINEAR, .address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .name = "linear-clamp"}, &r);
-    if (!ctx->linear_clamp.id) goto fail;
-    /* Reversed-Z: a fragment is lit when its depth is at least the stored one. */
-    ctx->shadow_compare = ob_sampler_create(ctx->dev, &(ob_sampler_desc){
-        .filter = VK_FILTER_LINEAR, .address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .compare = true, .compare_op = VK_COMPARE_OP_GREATER_OR_EQUAL, .name = "shadow-compare"}, &r);
-    if (!ctx->shadow_compare.id) goto fail;
-    ob_param_registry *reg = ob_renderer_registry(ctx->r);
-    ob_params_init_sampler(reg, ob_param_find(reg, "ShadowMapSampler"), ctx->shadow_compare);
-    ob_params_init_sampler(reg, ob_param_find(reg, "EnvMapSampler"), ctx->linear_clamp);
-    ob_params_init_sampler(reg, ob_param_find(reg, "SourceImageSampler"), ctx->linear_clamp);
-
+    /* Samplers (ShadowMapSampler, EnvMapSampler, SourceImageSampler) are
+     * the material library's defaults. */
     ob_renderer_set_material_iface(ctx->r, ob_material_iface_get());
     ob_renderer_set_geometry_iface(ctx->r, &(ob_geometry_iface){geometry_draw, geometry_id});
     ob_material_library_set_queue_hook(ctx->materials, queue_hook, ctx);
@@ -387,8 +372,6 @@ void ob_views_destroy(ob_views *ctx)
     ob_effect_destroy(ctx->text_effect);
     ob_effect_destroy(ctx->composite_effect);
     ob_effect_destroy(ctx->particle_sim_effect);
-    ob_sampler_destroy(ctx->dev, ctx->linear_clamp);
-    ob_sampler_destroy(ctx->dev, ctx->shadow_compare);
     if (ctx->materials) ob_material_library_set_queue_hook(ctx->materials, NULL, NULL);
     ob_free(ctx);
 }

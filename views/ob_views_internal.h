@@ -31,7 +31,6 @@ struct ob_views {
     ob_views_entry *systems;     /* particle systems by emitter node */
     uint32_t system_count, system_cap;
 
-    ob_sampler linear_clamp, shadow_compare;
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };
 
