@@ -210,6 +210,12 @@ static bool unknown_key(ob_json_reader *rd, const char *key, const char *const *
         uint32_t d = edit_distance(key, keys[i]);
         if (d < best && d < strlen(keys[i])) best = d, close = keys[i];
     }
+    /* "speed" for "speed_degrees", "fov" for "fov_degrees": a shortened name. */
+    size_t kl = strlen(key);
+    for (uint32_t i = 0; i < n && !close && kl >= 3; i++) {
+        size_t nl = strlen(keys[i]);
+        if (strncmp(key, keys[i], OB_MIN(kl, nl)) == 0) close = keys[i];
+    }
     if (close) return ob_json_fail(rd, "unknown key (did you mean '%s'? expected one of: %s)", close, list);
     return ob_json_fail(rd, "unknown key (expected one of: %s)", list);
 }
