@@ -117,16 +117,19 @@ static ob_result add_light(ob_demo *d, const char *name, const ob_light_desc *de
     ob_node *n = ob_node_create(d->scene, NULL, name, &r);
     if (!n) return r;
     if ((r = ob_node_set_light(n, desc)) != OB_OK) return r;
-    ob_node_set_position(n, position);
     /* The engine reads a zero colour or intensity as "default": hide instead. */
     bool off = desc->intensity == 0.0f || (desc->color[0] == 0.0f && desc->color[1] == 0.0f &&
                                            desc->color[2] == 0.0f);
     ob_node_set_hidden(n, off);
-    if (desc->type != OB_LIGHT_DIRECTIONAL) return OB_OK;
-    double target[3] = {position[0] + direction[0], position[1] + direction[1], position[2] + direction[2]};
-    double up[3] = {0, 1, 0};
-    if (fabs(direction[1]) > 0.99) up[1] = 0, up[2] = -1;
-    return ob_node_look_at(n, target, up);
+    if (desc->type == OB_LIGHT_DIRECTIONAL) {
+        /* Aimed from the origin: position + direction could round back to a
+         * far-away position, and a directional light's position is unused. */
+        double up[3] = {0, 1, 0};
+        if (fabs(direction[1]) > 0.99) up[1] = 0, up[2] = -1;
+        if ((r = ob_node_look_at(n, direction, up)) != OB_OK) return r;
+    }
+    ob_node_set_position(n, position);
+    return OB_OK;
 }
 
 static ob_result add_entity(scene_builder *b, const ob_scene_file_entity *e)
@@ -224,8 +227,11 @@ static void builder_release(scene_builder *b)
 
 /* Points the camera at a bounding sphere from a 3/4 view above it, at the
  * distance where the sphere fills the narrower field of view. */
-static ob_result frame_sphere(ob_demo *d, const double center[3], double radius)
+static ob_result frame_sphere(ob_demo *d, const double sphere_center[3], double radius)
 {
+    double center[3] = {0, 0, 0};
+    if (isfinite(sphere_center[0] + sphere_center[1] + sphere_center[2]))
+        memcpy(center, sphere_center, sizeof center);
     if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
     const double fovy = 45.0 * DEG;
     double aspect = (double)d->opt.width / (double)d->opt.height;

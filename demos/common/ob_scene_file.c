@@ -192,7 +192,7 @@ static bool parse_camera(sf_ctx *c, const cJSON *j, ob_scene_file_camera *cam)
                                   .fov_degrees = 60.0f, .znear = 0.1f};
     if (!ob_json_opt_vec3d(&c->rd, j, "position", OB_JSON_ANY, cam->position) || !ob_json_opt_vec3d(&c->rd, j, "target", OB_JSON_ANY, cam->target) ||
         !opt_direction(c, j, "up", cam->up) ||
-        !ob_json_opt_float(&c->rd, j, "fov_degrees", OB_JSON_RANGE(1, 179), &cam->fov_degrees) ||
+        !ob_json_opt_float(&c->rd, j, "fov_degrees", OB_JSON_RANGE(1, 170), &cam->fov_degrees) ||
         !ob_json_opt_float(&c->rd, j, "near", OB_JSON_POSITIVE, &cam->znear))
         return false;
     double dir[3] = {cam->target[0] - cam->position[0], cam->target[1] - cam->position[1],

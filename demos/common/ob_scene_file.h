@@ -59,7 +59,7 @@ typedef struct ob_scene_file_settings {
 typedef struct ob_scene_file_camera {
     bool present;
     double position[3], target[3], up[3];
-    float fov_degrees;            /* vertical, (0, 180) */
+    float fov_degrees;            /* vertical, 1..170 */
     float znear;                  /* > 0 */
 } ob_scene_file_camera;
 

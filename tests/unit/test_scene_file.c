@@ -336,7 +336,7 @@ static const bad_case bad_cases[] = {
      "within single precision"},
     {"{" E "[{\"geometry\": {\"generator\": \"sphere\", \"radius\": 1e-300}}]}", "entities[0].geometry.radius",
      "too small for single precision"},
-    {"{\"camera\": {\"fov_degrees\": 180}, " E "[]}", "camera.fov_degrees", "expected a number from 1 to 179"},
+    {"{\"camera\": {\"fov_degrees\": 180}, " E "[]}", "camera.fov_degrees", "expected a number from 1 to 170"},
     {"{\"materials\": {\"m\": {\"diffuse\": [1, 1, 1, 2]}}, " E "[]}", "materials.m.diffuse[3]",
      "expected an alpha from 0 to 1"},
     {"{\"materials\": {\"m\": {\"diffuse\": [-0.5, 1, 1]}}, " E "[]}", "materials.m.diffuse[0]",
@@ -509,6 +509,33 @@ static void bad_files_fail_as_their_sidecars_say(void **state)
     assert_true(count >= 10);
 }
 
+/* The complete example of docs/scene-format.md is a valid scene. */
+static void documented_example_parses(void **state)
+{
+    (void)state;
+    ob_result r;
+    size_t size;
+    char *doc = ob_file_read(OB_SOURCE_DIR "/docs/scene-format.md", &size, &r);
+    assert_non_null(doc);
+    char *start = strstr(doc, "## Complete example");
+    assert_non_null(start);
+    start = strstr(start, "```json\n");
+    assert_non_null(start);
+    start += 8;
+    char *end = strstr(start, "```");
+    assert_non_null(end);
+    ob_scene_file sf;
+    ob_scene_file_error err;
+    r = ob_scene_file_parse(start, (size_t)(end - start), "scene-format.md", &sf, &err);
+    if (r != OB_OK) print_error("%s\n", err.message);
+    assert_int_equal(r, OB_OK);
+    assert_int_equal(sf.entity_count, 7);
+    assert_int_equal(sf.light_count, 2);
+    assert_int_equal(sf.particle_count, 1);
+    ob_scene_file_release(&sf);
+    ob_free(doc);
+}
+
 static void unreadable_file_is_an_io_error_naming_it(void **state)
 {
     (void)state;
@@ -565,6 +592,7 @@ int main(void)
         cmocka_unit_test(only_the_first_error_is_reported),
         cmocka_unit_test(shipped_scenes_parse),
         cmocka_unit_test(bad_files_fail_as_their_sidecars_say),
+        cmocka_unit_test(documented_example_parses),
         cmocka_unit_test(unreadable_file_is_an_io_error_naming_it),
         cmocka_unit_test(every_allocation_failure_is_clean),
     };
