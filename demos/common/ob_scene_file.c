@@ -758,7 +758,7 @@ static char *directory_of(const char *path)
     size_t n = slash ? (size_t)(slash - path) + 1 : 0;
     char *dir = ob_malloc(n + 1);
     if (!dir) return NULL;
-    memcpy(dir, path, n);
+    if (n) memcpy(dir, path, n);
     dir[n] = '\0';
     return dir;
 }
