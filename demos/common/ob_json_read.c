@@ -445,3 +445,71 @@ bool ob_json_opt_number_or_vec3(ob_json_reader *rd, const cJSON *obj, const char
     ob_json_pop(rd, mark);
     return true;
 }
+
+/* ------------------------------------------------------------ vectors and names */
+
+bool ob_json_normalize(double *v, int n)
+{
+    double m = 0.0;
+    for (int i = 0; i < n; i++) m = fmax(m, fabs(v[i]));
+    if (!(m > 0.0) || !isfinite(m)) return false;
+    double len2 = 0.0;
+    for (int i = 0; i < n; i++) len2 += (v[i] / m) * (v[i] / m);
+    double len = m * sqrt(len2);
+    for (int i = 0; i < n; i++) v[i] /= len;
+    return true;
+}
+
+bool ob_json_opt_direction(ob_json_reader *rd, const cJSON *obj, const char *key, double out[3])
+{
+    const cJSON *j = ob_json_member(obj, key);
+    if (!j) return true;
+    size_t mark = ob_json_push_key(rd, key);
+    double v[3];
+    if (!ob_json_vector(rd, j, 3, 3, OB_JSON_ANY, true, v, NULL)) return false;
+    if (!ob_json_normalize(v, 3)) return ob_json_fail(rd, "expected a non-zero vector");
+    memcpy(out, v, sizeof v);
+    ob_json_pop(rd, mark);
+    return true;
+}
+
+bool ob_json_names_init(ob_json_reader *rd, ob_json_names *m, uint32_t n)
+{
+    uint64_t cap = 8;
+    while (cap < 2ull * n + 1) cap *= 2;
+    if (cap > UINT32_MAX) return ob_json_out_of_memory(rd);
+    m->keys = ob_calloc((size_t)cap, sizeof *m->keys);
+    m->values = ob_calloc((size_t)cap, sizeof *m->values);
+    m->cap = (uint32_t)cap;
+    if (!m->keys || !m->values) return ob_json_out_of_memory(rd);
+    return true;
+}
+
+void ob_json_names_release(ob_json_names *m)
+{
+    ob_free(m->keys);
+    ob_free(m->values);
+    memset(m, 0, sizeof *m);
+}
+
+/* The slot of key: where it is, or the empty slot where it would go. */
+static uint32_t names_slot(const ob_json_names *m, const char *key)
+{
+    uint32_t i = (uint32_t)ob_hash_str(OB_HASH_SEED, key) & (m->cap - 1);
+    while (m->keys[i] && strcmp(m->keys[i], key) != 0) i = (i + 1) & (m->cap - 1);
+    return i;
+}
+
+uint32_t ob_json_names_find(const ob_json_names *m, const char *key)
+{
+    if (!m->cap) return UINT32_MAX;
+    uint32_t i = names_slot(m, key);
+    return m->keys[i] ? m->values[i] : UINT32_MAX;
+}
+
+void ob_json_names_put(ob_json_names *m, const char *key, uint32_t value)
+{
+    uint32_t i = names_slot(m, key);
+    m->keys[i] = key;
+    m->values[i] = value;
+}

@@ -119,4 +119,28 @@ bool ob_json_opt_number_or_vec3(ob_json_reader *rd, const cJSON *obj, const char
 /* 3 or 4 numbers >= 0; a missing fourth is `w`. */
 bool ob_json_opt_color(ob_json_reader *rd, const cJSON *obj, const char *key, float w, float out[4]);
 
+/* Scales a vector of n doubles to unit length without overflowing; false
+ * (v unchanged) if it is zero or not finite. */
+bool ob_json_normalize(double *v, int n);
+/* 3 numbers, not all zero, stored at unit length. */
+bool ob_json_opt_direction(ob_json_reader *rd, const cJSON *obj, const char *key, double out[3]);
+
+/* Names → indices, for values that refer to others by name (hashed, so a
+ * document with many names stays linear). Keys are not copied: they must
+ * outlive the map (strings of the parsed document do). */
+typedef struct ob_json_names {
+    const char **keys;
+    uint32_t *values;
+    uint32_t cap;   /* power of two; 0 before init */
+} ob_json_names;
+
+/* Room for n names; false (out of memory recorded in rd) on failure. Release
+ * even after a failed init. */
+bool ob_json_names_init(ob_json_reader *rd, ob_json_names *m, uint32_t n);
+void ob_json_names_release(ob_json_names *m);
+/* The value of key, or UINT32_MAX if absent (also before init). */
+uint32_t ob_json_names_find(const ob_json_names *m, const char *key);
+/* Adds key (not present yet; at most the n given to init). */
+void ob_json_names_put(ob_json_names *m, const char *key, uint32_t value);
+
 #endif /* OB_JSON_READ_H */

@@ -8,53 +8,18 @@
 
 #include "ob_json_read.h"
 
-/* String → index for names referenced elsewhere (materials, parents):
- * hashed, so files with many entities stay linear. Keys are not owned. */
-typedef struct name_map {
-    const char **keys;
-    uint32_t *values;
-    uint32_t cap;   /* power of two */
-} name_map;
-
 typedef struct sf_ctx {
     ob_json_reader rd;
     ob_scene_file *sf;
     uint32_t material_cap;
-    name_map materials, entities;
+    ob_json_names materials, entities;
     char *dir;   /* base for relative model paths; "" = the working directory */
 } sf_ctx;
-
-/* Scales a non-zero vector to unit length without overflowing; false if zero. */
-static bool normalize(double *v, int n)
-{
-    double m = 0.0;
-    for (int i = 0; i < n; i++) m = fmax(m, fabs(v[i]));
-    if (!(m > 0.0)) return false;
-    double len2 = 0.0;
-    for (int i = 0; i < n; i++) len2 += (v[i] / m) * (v[i] / m);
-    double len = m * sqrt(len2);
-    for (int i = 0; i < n; i++) v[i] /= len;
-    return true;
-}
-
-/* A non-zero direction (3 numbers), stored at unit length. */
-static bool opt_direction(sf_ctx *c, const cJSON *obj, const char *key, double out[3])
-{
-    const cJSON *j = ob_json_member(obj, key);
-    if (!j) return true;
-    size_t mark = ob_json_push_key(&c->rd, key);
-    double v[3];
-    if (!ob_json_vector(&c->rd, j, 3, 3, OB_JSON_ANY, true, v, NULL)) return false;
-    if (!normalize(v, 3)) return ob_json_fail(&c->rd, "expected a non-zero vector");
-    memcpy(out, v, sizeof v);
-    ob_json_pop(&c->rd, mark);
-    return true;
-}
 
 static bool opt_axis(sf_ctx *c, const cJSON *obj, const char *key, float out[3])
 {
     double v[3] = {out[0], out[1], out[2]};
-    if (!opt_direction(c, obj, key, v)) return false;
+    if (!ob_json_opt_direction(&c->rd, obj, key, v)) return false;
     for (int i = 0; i < 3; i++) out[i] = (float)v[i];
     return true;
 }
@@ -80,49 +45,6 @@ static char *name_or_default(sf_ctx *c, const cJSON *obj, const char *section, u
     char buf[48];
     snprintf(buf, sizeof buf, "%s[%u]", section, i);
     return dup_or_oom(c, buf);
-}
-
-/* ------------------------------------------------------------ name maps */
-
-static bool map_init(sf_ctx *c, name_map *m, uint32_t n)
-{
-    uint64_t cap = 8;
-    while (cap < 2ull * n + 1) cap *= 2;
-    if (cap > UINT32_MAX) return ob_json_out_of_memory(&c->rd);
-    m->keys = ob_calloc((size_t)cap, sizeof *m->keys);
-    m->values = ob_calloc((size_t)cap, sizeof *m->values);
-    m->cap = (uint32_t)cap;
-    if (!m->keys || !m->values) return ob_json_out_of_memory(&c->rd);
-    return true;
-}
-
-static void map_release(name_map *m)
-{
-    ob_free(m->keys);
-    ob_free(m->values);
-    memset(m, 0, sizeof *m);
-}
-
-/* The slot of key: where it is, or the empty slot where it would go. */
-static uint32_t map_slot(const name_map *m, const char *key)
-{
-    uint32_t i = (uint32_t)ob_hash_str(OB_HASH_SEED, key) & (m->cap - 1);
-    while (m->keys[i] && strcmp(m->keys[i], key) != 0) i = (i + 1) & (m->cap - 1);
-    return i;
-}
-
-static uint32_t map_find(const name_map *m, const char *key)
-{
-    if (!m->cap) return OB_SCENE_FILE_NONE;
-    uint32_t i = map_slot(m, key);
-    return m->keys[i] ? m->values[i] : OB_SCENE_FILE_NONE;
-}
-
-static void map_put(name_map *m, const char *key, uint32_t value)
-{
-    uint32_t i = map_slot(m, key);
-    m->keys[i] = key;
-    m->values[i] = value;
 }
 
 /* ------------------------------------------------------------ settings & camera */
@@ -191,13 +113,13 @@ static bool parse_camera(sf_ctx *c, const cJSON *j, ob_scene_file_camera *cam)
     *cam = (ob_scene_file_camera){.present = true, .position = {0, 2, 8}, .up = {0, 1, 0},
                                   .fov_degrees = 60.0f, .znear = 0.1f};
     if (!ob_json_opt_vec3d(&c->rd, j, "position", OB_JSON_ANY, cam->position) || !ob_json_opt_vec3d(&c->rd, j, "target", OB_JSON_ANY, cam->target) ||
-        !opt_direction(c, j, "up", cam->up) ||
+        !ob_json_opt_direction(&c->rd, j, "up", cam->up) ||
         !ob_json_opt_float(&c->rd, j, "fov_degrees", OB_JSON_RANGE(1, 170), &cam->fov_degrees) ||
         !ob_json_opt_float(&c->rd, j, "near", OB_JSON_POSITIVE, &cam->znear))
         return false;
     double dir[3] = {cam->target[0] - cam->position[0], cam->target[1] - cam->position[1],
                      cam->target[2] - cam->position[2]};
-    if (!normalize(dir, 3) || !isfinite(dir[0] + dir[1] + dir[2])) {
+    if (!ob_json_normalize(dir, 3) || !isfinite(dir[0] + dir[1] + dir[2])) {
         ob_json_push_key(&c->rd, "target");
         return ob_json_fail(&c->rd, "must differ from camera.position (the camera looks from position to target)");
     }
@@ -233,7 +155,7 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
     float color[4] = {1, 1, 1, 1};
     l->desc.intensity = 1.0f;
     l->direction[0] = -1.0, l->direction[1] = -2.0, l->direction[2] = -1.0;
-    normalize(l->direction, 3);
+    ob_json_normalize(l->direction, 3);
     if (!ob_json_opt_vec3d(&c->rd, j, "position", OB_JSON_ANY, l->position) || !ob_json_opt_color(&c->rd, j, "color", 1.0f, color) ||
         !ob_json_opt_float(&c->rd, j, "intensity", OB_JSON_NON_NEGATIVE, &l->desc.intensity) ||
         !ob_json_opt_float(&c->rd, j, "range", OB_JSON_NON_NEGATIVE, &l->desc.range) ||
@@ -258,12 +180,12 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
         ob_json_push_key(&c->rd, "direction");
         return ob_json_fail(&c->rd, "give either target or direction, not both");
     }
-    if (!opt_direction(c, j, "direction", l->direction)) return false;
+    if (!ob_json_opt_direction(&c->rd, j, "direction", l->direction)) return false;
     if (ob_json_member(j, "target")) {
         double t[3];
         if (!ob_json_opt_vec3d(&c->rd, j, "target", OB_JSON_ANY, t)) return false;
         for (int k = 0; k < 3; k++) l->direction[k] = t[k] - l->position[k];
-        if (!normalize(l->direction, 3) || !isfinite(l->direction[0] + l->direction[1] + l->direction[2])) {
+        if (!ob_json_normalize(l->direction, 3) || !isfinite(l->direction[0] + l->direction[1] + l->direction[2])) {
             ob_json_push_key(&c->rd, "target");
             return ob_json_fail(&c->rd, "must differ from position (the light points from position to target)");
         }
@@ -357,14 +279,14 @@ static bool parse_materials(sf_ctx *c, const cJSON *j)
     if (!cJSON_IsObject(j))
         return ob_json_fail(&c->rd, "expected an object of named materials, got %s", ob_json_type_name(j));
     uint32_t n = (uint32_t)cJSON_GetArraySize(j);
-    if (!map_init(c, &c->materials, n)) return false;
+    if (!ob_json_names_init(&c->rd, &c->materials, n)) return false;
     for (const cJSON *it = j->child; it; it = it->next) {
         size_t mark = ob_json_push_key(&c->rd, it->string);
         if (!it->string[0]) return ob_json_fail(&c->rd, "a material needs a non-empty name");
-        if (map_find(&c->materials, it->string) != OB_SCENE_FILE_NONE) return ob_json_fail(&c->rd, "duplicate material name");
+        if (ob_json_names_find(&c->materials, it->string) != OB_SCENE_FILE_NONE) return ob_json_fail(&c->rd, "duplicate material name");
         ob_scene_file_material *m = add_material(c, it->string, false);
         if (!m || !parse_material(c, it, m)) return false;
-        map_put(&c->materials, it->string, c->sf->material_count - 1);
+        ob_json_names_put(&c->materials, it->string, c->sf->material_count - 1);
         ob_json_pop(&c->rd, mark);
     }
     return true;
@@ -499,7 +421,7 @@ static bool parse_transform(sf_ctx *c, const cJSON *j, ob_scene_file_entity *e)
         e->rotation_kind = OB_SCENE_ROTATION_EULER;
     } else {
         if (!ob_json_vector(&c->rd, quat, 4, 4, OB_JSON_ANY, false, e->rotation, NULL)) return false;
-        if (!normalize(e->rotation, 4)) return ob_json_fail(&c->rd, "expected a non-zero quaternion");
+        if (!ob_json_normalize(e->rotation, 4)) return ob_json_fail(&c->rd, "expected a non-zero quaternion");
         e->rotation_kind = OB_SCENE_ROTATION_QUATERNION;
     }
     ob_json_pop(&c->rd, inner);
@@ -546,7 +468,7 @@ static uint32_t find_entity_json(const cJSON *entities, const char *name)
 static bool parse_entity_material(sf_ctx *c, const cJSON *j, ob_scene_file_entity *e)
 {
     if (cJSON_IsString(j)) {
-        e->material = map_find(&c->materials, j->valuestring);
+        e->material = ob_json_names_find(&c->materials, j->valuestring);
         if (e->material == OB_SCENE_FILE_NONE)
             return ob_json_fail(&c->rd, "unknown material '%.60s' (not among \"materials\")", j->valuestring);
         return true;
@@ -569,12 +491,12 @@ static bool parse_entity(sf_ctx *c, const cJSON *all, const cJSON *j, uint32_t i
     e->scale[0] = e->scale[1] = e->scale[2] = 1.0f;
     if (!(e->name = name_or_default(c, j, "entities", i))) return false;
     if (ob_json_member(j, "name")) {
-        uint32_t other = map_find(&c->entities, e->name);
+        uint32_t other = ob_json_names_find(&c->entities, e->name);
         if (other != OB_SCENE_FILE_NONE) {
             ob_json_push_key(&c->rd, "name");
             return ob_json_fail(&c->rd, "'%.60s' is already the name of entities[%u]", e->name, other);
         }
-        map_put(&c->entities, e->name, i);
+        ob_json_names_put(&c->entities, e->name, i);
     }
     const cJSON *g = ob_json_member(j, "geometry"), *t = ob_json_member(j, "transform"), *m = ob_json_member(j, "material");
     const cJSON *p = ob_json_member(j, "parent"), *ctl = ob_json_member(j, "controllers");
@@ -599,7 +521,7 @@ static bool parse_entity(sf_ctx *c, const cJSON *all, const cJSON *j, uint32_t i
         mark = ob_json_push_key(&c->rd, "parent");
         const char *name = ob_json_string(&c->rd, p, "the name of an earlier entity");
         if (!name) return false;
-        e->parent = map_find(&c->entities, name);
+        e->parent = ob_json_names_find(&c->entities, name);
         if (e->parent == i) return ob_json_fail(&c->rd, "an entity cannot be its own parent");
         if (e->parent == OB_SCENE_FILE_NONE) {
             uint32_t later = find_entity_json(all, name);
@@ -632,7 +554,7 @@ static bool parse_entities(sf_ctx *c, const cJSON *j)
     if (!cJSON_IsArray(j)) return ob_json_fail(&c->rd, "expected an array of entities, got %s", ob_json_type_name(j));
     ob_scene_file *sf = c->sf;
     uint32_t n = (uint32_t)cJSON_GetArraySize(j), i = 0;
-    if (!map_init(c, &c->entities, n)) return false;
+    if (!ob_json_names_init(&c->rd, &c->entities, n)) return false;
     if (n && !(sf->entities = ob_calloc(n, sizeof *sf->entities))) return ob_json_out_of_memory(&c->rd);
     for (const cJSON *it = j->child; it; it = it->next, i++) {
         size_t mark = ob_json_push_index(&c->rd, i);
@@ -661,7 +583,7 @@ static bool parse_particle_system(sf_ctx *c, const cJSON *j, uint32_t i, ob_scen
         size_t mark = ob_json_push_key(&c->rd, "parent");
         const char *name = ob_json_string(&c->rd, parent, "the name of an entity");
         if (!name) return false;
-        if ((p->parent = map_find(&c->entities, name)) == OB_SCENE_FILE_NONE)
+        if ((p->parent = ob_json_names_find(&c->entities, name)) == OB_SCENE_FILE_NONE)
             return ob_json_fail(&c->rd, "no entity is named '%.60s'", name);
         ob_json_pop(&c->rd, mark);
     }
@@ -777,8 +699,8 @@ ob_result ob_scene_file_parse(const char *text, size_t size, const char *path,
         parse_document(&c, root);
     cJSON_Delete(root);
     ob_free(c.dir);
-    map_release(&c.materials);
-    map_release(&c.entities);
+    ob_json_names_release(&c.materials);
+    ob_json_names_release(&c.entities);
     if (c.rd.result != OB_OK) ob_scene_file_release(out);
     return c.rd.result;
 }
