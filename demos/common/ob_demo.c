@@ -72,6 +72,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             if (!strcmp(v, "auto")) o->threads = -1;
             else if ((ok = parse_u32(v, &t) && t <= OB_MAX_WORKERS)) o->threads = (int)t;
             i++;
+            o->threads_given = true;
         } else if (!strcmp(a, "--toggle")) {
             ok = parse_u32(v, &o->toggle);
             i++;
@@ -79,6 +80,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             ok = sscanf(v, "%ux%u", &o->width, &o->height) == 2 && o->width > 0 && o->height > 0 &&
                  o->width <= 8192 && o->height <= 8192;
             i++;
+            o->size_given = true;
         } else if (!strcmp(a, "--out")) {
             o->out = v;
             i++;
@@ -169,6 +171,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     if (!d->lib) return r;
     ob_views_desc vd = {.renderer = d->r, .materials = d->lib, .effects = d->fx,
                         .env_map_size = o->env_size, .shadow_map_size = o->shadow_size};
+    memcpy(vd.ambient, o->ambient, sizeof vd.ambient);
     d->views = ob_views_create(&vd, &r);
     if (!d->views) return r;
     d->scene = ob_scene_create(&r);
@@ -179,6 +182,9 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     if ((r = ob_node_set_camera(d->camera, &cam)) != OB_OK) return r;
     ob_perspective_desc pd = {.name = "main", .camera = d->camera, .width = o->width,
                               .height = o->height, .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
+    static const float zero[4] = {0, 0, 0, 0};
+    if (memcmp(o->clear_color, zero, sizeof zero) != 0)
+        memcpy(pd.clear_color, o->clear_color, sizeof pd.clear_color);
     d->main = ob_perspective_view_create(d->views, &pd, &r);
     if (!d->main) return r;
     d->composite = ob_composite_view_create(d->views, ob_perspective_view_base(d->main), &r);

@@ -31,6 +31,11 @@ typedef struct ob_demo_options {
     bool window;              /* --window */
     bool quiet;               /* --quiet: no per-frame lines */
     const char *input;        /* positional argument (obelisk-view FILE) */
+    /* Set by the parser when --size / --threads were given, so that settings
+     * from a scene file do not override the command line. */
+    bool size_given, threads_given;
+    float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
+    float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
 } ob_demo_options;
 
 /* Parses argv into *o (defaults first). Prints usage and returns false on

@@ -1,0 +1,191 @@
+/* ob_scene_file.h — scene description files (JSON, docs/scene-format.md):
+ * parsing and validation into a plain description, with no device involved.
+ *
+ * The parser reads the whole document, checks every key, type, array length,
+ * range and reference, fills in the documented defaults and resolves model
+ * paths against the scene file's directory. Anything wrong stops it with one
+ * error naming the file and the JSON path of the offending value, e.g.
+ *   scene.json: entities[3].transform.scale: expected a number or 3 numbers
+ * and, for a JSON syntax error, the line and column:
+ *   scene.json:12:7: invalid JSON near '}, "camera"...'
+ * Unknown keys are errors (with a suggestion when one is close), so a typo is
+ * never silently ignored. Nothing here touches the GPU: turning the
+ * description into a scene (materials, geometry, nodes) is the program's job
+ * (obelisk-view), which can then report a model that fails to load and go on
+ * with the rest.
+ *
+ * Lifecycle: ob_scene_file_parse / ob_scene_file_load fill a caller-provided
+ * ob_scene_file → read it → ob_scene_file_release. A zeroed ob_scene_file is
+ * empty and may be released.
+ * Thread rule: [any thread]; a description is plain data, written by one
+ * thread at a time. Parses may run concurrently (cJSON's global error pointer
+ * is never used; its allocation hooks are installed once, to ob_malloc).
+ */
+#ifndef OB_SCENE_FILE_H
+#define OB_SCENE_FILE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ob_core.h"
+#include "ob_json_read.h"
+#include "ob_material.h"
+#include "ob_scene.h"
+#include "ob_views.h"
+
+#define OB_SCENE_FILE_NONE UINT32_MAX   /* "no index": no parent, default material */
+#define OB_SCENE_FILE_MAX_PARTICLES (1u << 20)
+
+/* The error of a failed parse: message, JSON path, syntax line/column. */
+typedef ob_json_error ob_scene_file_error;
+
+/* "settings": each value overrides the program's default; a command-line
+ * option overrides the file. */
+typedef struct ob_scene_file_settings {
+    bool has_size;
+    uint32_t width, height;       /* 1..8192 */
+    uint32_t env_map_size;        /* 0 = not given; else 8..4096 */
+    uint32_t shadow_map_size;     /* 0 = not given; else 16..8192 */
+    bool has_threads;
+    int threads;                  /* 0 = single-threaded, N workers, -1 = "auto" */
+    bool has_clear_color;
+    float clear_color[4];         /* rgba (alpha 1 when 3 numbers were given) */
+    bool has_ambient;
+    float ambient[4];             /* rgb, w = intensity > 0 (0 0 0 1 for "none") */
+} ob_scene_file_settings;
+
+/* "camera": without one the program frames the whole scene. */
+typedef struct ob_scene_file_camera {
+    bool present;
+    double position[3], target[3], up[3];
+    float fov_degrees;            /* vertical, 1..170 */
+    float znear;                  /* > 0 */
+} ob_scene_file_camera;
+
+typedef struct ob_scene_file_light {
+    ob_light_desc desc;           /* type, color, intensity (>= 0), range, casts_shadows */
+    char *name;                   /* "lights[i]" when not given */
+    double position[3];
+    /* Where the light points (directional: its direction; point: unused).
+     * From "direction", or target - position. Never zero. */
+    double direction[3];
+} ob_scene_file_light;
+
+typedef struct ob_scene_file_material {
+    char *name;                   /* the key in "materials", or "entities[i].material" */
+    bool inline_material;         /* written inside an entity */
+    /* Every field explicit (no zero-means-default left): reflectivity is
+     * meaningful only for OB_MATERIAL_REFLECTIVE and may be 0. desc.name
+     * points at name. */
+    ob_material_desc desc;
+} ob_scene_file_material;
+
+typedef enum ob_scene_file_geometry_kind {
+    OB_SCENE_GEOMETRY_NONE = 0,   /* a transform-only entity (a pivot, a parent) */
+    OB_SCENE_GEOMETRY_BOX,
+    OB_SCENE_GEOMETRY_SPHERE,
+    OB_SCENE_GEOMETRY_PLANE,
+    OB_SCENE_GEOMETRY_CONE,
+    OB_SCENE_GEOMETRY_TORUS,
+    OB_SCENE_GEOMETRY_MODEL,
+} ob_scene_file_geometry_kind;
+
+/* A generator's parameters (defaults filled in) or a resolved model path.
+ * Two entities whose geometry descriptions compare equal
+ * (ob_scene_file_geometry_equal) can share one uploaded geometry. */
+typedef struct ob_scene_file_geometry {
+    ob_scene_file_geometry_kind kind;
+    float size[3];                /* box: full extents */
+    float radius;                 /* sphere, cone */
+    float height;                 /* cone */
+    float width, depth;           /* plane */
+    float major_radius, minor_radius;  /* torus */
+    uint32_t segments[2];         /* sphere: slices, stacks; cone: slices, 0;
+                                     plane: subdivisions, 0; torus: major, minor */
+    char *model;                  /* MODEL: the path as the loader gets it */
+} ob_scene_file_geometry;
+
+typedef enum ob_scene_file_rotation_kind {
+    OB_SCENE_ROTATION_NONE = 0,
+    OB_SCENE_ROTATION_EULER,      /* value = pitch, yaw, roll in degrees */
+    OB_SCENE_ROTATION_QUATERNION, /* value = x, y, z, w (non-zero; not normalized) */
+} ob_scene_file_rotation_kind;
+
+typedef enum ob_scene_file_controller_kind {
+    OB_SCENE_CONTROLLER_ROTATE = 0,
+    OB_SCENE_CONTROLLER_ORBIT,
+} ob_scene_file_controller_kind;
+
+typedef struct ob_scene_file_controller {
+    ob_scene_file_controller_kind kind;
+    float axis[3];                /* non-zero */
+    float speed_degrees;          /* degrees per second, may be negative */
+    double center[3];             /* orbit: in the parent's space */
+    double radius;                /* orbit: >= 0 */
+    float phase_degrees;          /* orbit */
+} ob_scene_file_controller;
+
+typedef struct ob_scene_file_entity {
+    char *name;                   /* "entities[i]" when not given; names are unique */
+    uint32_t index;               /* position in "entities" */
+    ob_scene_file_geometry geometry;
+    double position[3];
+    ob_scene_file_rotation_kind rotation_kind;
+    double rotation[4];
+    float scale[3];
+    uint32_t material;            /* index into materials, or OB_SCENE_FILE_NONE (default) */
+    uint32_t parent;              /* index of an earlier entity, or OB_SCENE_FILE_NONE */
+    bool hidden;
+    ob_scene_file_controller *controllers;
+    uint32_t controller_count;
+} ob_scene_file_entity;
+
+typedef struct ob_scene_file_particles {
+    /* desc.name points at name; desc.seed is 0 (the program picks one). */
+    ob_particle_desc desc;
+    char *name;                   /* "particles[i]" when not given */
+    uint32_t parent;              /* entity index or OB_SCENE_FILE_NONE (the root) */
+} ob_scene_file_particles;
+
+typedef struct ob_scene_file {
+    char *path;                   /* the file as named to the parser */
+    char *description;            /* "description", or NULL */
+    bool has_lights;              /* "lights" was given (an empty list means none) */
+    ob_scene_file_settings settings;
+    ob_scene_file_camera camera;
+    ob_scene_file_light *lights;
+    uint32_t light_count;
+    ob_scene_file_material *materials;
+    uint32_t material_count;
+    ob_scene_file_entity *entities;
+    uint32_t entity_count;
+    ob_scene_file_particles *particles;
+    uint32_t particle_count;
+} ob_scene_file;
+
+/* Parses `size` bytes of JSON text (need not be NUL-terminated; a NUL byte
+ * inside is an error). `path` names the file in messages and is the base for
+ * relative model paths (NULL → "scene", relative to the working directory).
+ * On success *out holds the description (release it) and *out_error is
+ * cleared. On failure *out is left empty and *out_error (may be NULL) says
+ * what and where: OB_ERR_PARSE (JSON syntax, wrong type, length, unknown key,
+ * bad reference, out-of-range or non-finite value), OB_ERR_OUT_OF_HOST_MEMORY.
+ * Nothing is logged: the caller shows out_error->message. */
+ob_result ob_scene_file_parse(const char *text, size_t size, const char *path,
+                              ob_scene_file *out, ob_scene_file_error *out_error);
+
+/* Reads the file at `path` and parses it. Also OB_ERR_IO (message names the
+ * file and the OS error). */
+ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file_error *out_error);
+
+/* Frees everything the description owns and zeroes it. NULL is a no-op. */
+void ob_scene_file_release(ob_scene_file *sf);
+
+/* Same generator and parameters, or the same model path. */
+bool ob_scene_file_geometry_equal(const ob_scene_file_geometry *a, const ob_scene_file_geometry *b);
+
+/* Stable lower-case names: "none", "box", ..., "model". */
+const char *ob_scene_file_geometry_kind_name(ob_scene_file_geometry_kind kind);
+
+#endif /* OB_SCENE_FILE_H */
