@@ -1,5 +1,7 @@
 #include "ob_pipeline_manager.h"
 
+#include "ob_resources_internal.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -440,9 +442,18 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     return OB_OK;
 }
 
+static bool sampler_is_valid(const ob_device *dev, ob_sampler s)
+{
+    return ob_pool_get(&ob_device_registry(dev)->samplers, s.id) != NULL;
+}
+
 /* Resolve the program's images, samplers and buffers from parameters and push
- * them when any differs from what is bound. */
-static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+ * them when any differs from what is bound. A zero or stale handle fails with
+ * OB_ERR_INVALID_HANDLE and *out_bad naming the parameter; handles are checked
+ * before they are resolved so that the caller logs one line, not one per
+ * lookup. */
+static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h,
+                                 ob_param *out_bad)
 {
     if (prog->resource_count == 0) return OB_OK;
     uint32_t ids[OB_PROGRAM_MAX_RESOURCES * 2];
@@ -464,21 +475,25 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
         case OB_BINDING_COMBINED_IMAGE_SAMPLER:
             ob_params_get_texture(&pm->params, res->param, &img);
             ob_params_get_sampler(&pm->params, res->sampler, &smp);
+            if (!ob_image_is_valid(pm->dev, img)) goto bad_param;
+            if (!sampler_is_valid(pm->dev, smp)) {
+                *out_bad = res->sampler;
+                return OB_ERR_INVALID_HANDLE;
+            }
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].sampler = ob_sampler_vk(pm->dev, smp);
             images[i].imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            if (!images[i].imageView || !images[i].sampler) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
             writes[i].pImageInfo = &images[i];
             break;
         case OB_BINDING_SAMPLED_IMAGE:
         case OB_BINDING_STORAGE_IMAGE:
             ob_params_get_texture(&pm->params, res->param, &img);
+            if (!ob_image_is_valid(pm->dev, img)) goto bad_param;
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].imageLayout = res->kind == OB_BINDING_STORAGE_IMAGE
                                         ? VK_IMAGE_LAYOUT_GENERAL
                                         : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            if (!images[i].imageView) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_IMAGE
                                            ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE
                                            : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
@@ -486,16 +501,16 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
             break;
         case OB_BINDING_SAMPLER:
             ob_params_get_sampler(&pm->params, res->param, &smp);
+            if (!sampler_is_valid(pm->dev, smp)) goto bad_param;
             images[i].sampler = ob_sampler_vk(pm->dev, smp);
-            if (!images[i].sampler) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_SAMPLER;
             writes[i].pImageInfo = &images[i];
             break;
         case OB_BINDING_STORAGE_BUFFER:
         case OB_BINDING_UNIFORM_BUFFER:
             ob_params_get_buffer(&pm->params, res->param, &buf);
+            if (!ob_buffer_is_valid(pm->dev, buf)) goto bad_param;
             buffers[i] = (VkDescriptorBufferInfo){ob_buffer_vk(pm->dev, buf), 0, VK_WHOLE_SIZE};
-            if (!buffers[i].buffer) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_BUFFER
                                            ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
                                            : VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
@@ -505,6 +520,10 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
         ids[2 * i] = img.id ? img.id : buf.id;
         ids[2 * i + 1] = smp.id;
         *h = ob_hash_u64(*h, ((uint64_t)ids[2 * i] << 32) | ids[2 * i + 1]);
+        continue;
+    bad_param:
+        *out_bad = res->param;
+        return OB_ERR_INVALID_HANDLE;
     }
     pm->stats.push_descriptor_requested++;
     size_t n = sizeof ids[0] * 2 * prog->resource_count;
@@ -559,13 +578,19 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->cur.resources_valid = false;
         pm->cur.push_valid = false;
     }
+    ob_param bad = {0};
     ob_result r = apply_uniforms(pm, prog, h);
-    if (r == OB_OK) r = apply_resources(pm, prog, h);
+    if (r == OB_OK) r = apply_resources(pm, prog, h, &bad);
     if (r != OB_OK) {
         pm->stats.skipped_draws++;
-        log_once(pm, r == OB_ERR_INVALID_HANDLE ? "a texture, sampler or buffer parameter holds "
-                                                  "an invalid handle"
-                                                : ob_result_text(r));
+        if (r == OB_ERR_INVALID_HANDLE) {
+            char what[160];
+            snprintf(what, sizeof what, "parameter '%s' of program '%s' holds an invalid or "
+                     "stale handle", ob_param_name(pm->params.reg, bad), prog->name);
+            log_once(pm, what);
+        } else {
+            log_once(pm, ob_result_text(r));
+        }
         return r;
     }
     apply_push_constants(pm, prog, h);
