@@ -8,7 +8,7 @@
 #define MAX_FRAME_SLOTS 4
 #define MAX_CHUNKS 64
 #define PACK_CACHE_SIZE 256     /* power of two */
-#define SET_CACHE_SIZE 64       /* power of two */
+#define SET_CACHE_MIN 64        /* power of two; the set cache doubles when half full */
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
 
@@ -41,7 +41,8 @@ typedef struct frame_ring {
     uint32_t chunk_count, current;
     VkDescriptorPool pools[MAX_POOLS];
     uint32_t pool_count, sets_in_last_pool;
-    set_entry sets[SET_CACHE_SIZE];
+    set_entry *sets;            /* open addressing, set_cap entries (power of two) */
+    uint32_t set_cap, set_count;
 } frame_ring;
 
 typedef struct bound_state {
@@ -168,6 +169,7 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
         for (uint32_t i = 0; i < fr->chunk_count; i++) ob_buffer_destroy(pm->dev, fr->chunks[i].buffer);
         for (uint32_t i = 0; i < fr->pool_count; i++)
             vkDestroyDescriptorPool(pm->vk, fr->pools[i], NULL);
+        ob_free(fr->sets);
     }
     ob_free(pm);
 }
@@ -316,24 +318,45 @@ static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
     return OB_OK;
 }
 
+static set_entry *set_probe(set_entry *sets, uint32_t cap, VkDescriptorSetLayout layout,
+                            uint32_t chunk)
+{
+    uint32_t h = (uint32_t)((((uintptr_t)layout >> 4) ^ chunk) * 2654435761u);
+    for (uint32_t i = 0;; i++) {
+        set_entry *e = &sets[(h + i) & (cap - 1)];
+        if (!e->set || (e->layout == layout && e->chunk == chunk)) return e;
+    }
+}
+
+/* Keeps the set cache at most half full (a frame may use any number of
+ * programs). The old table is kept when growing fails. */
+static ob_result set_cache_reserve(frame_ring *fr)
+{
+    if (fr->set_cap && (fr->set_count + 1) * 2 <= fr->set_cap) return OB_OK;
+    uint32_t cap = fr->set_cap ? fr->set_cap * 2 : SET_CACHE_MIN;
+    set_entry *sets = ob_calloc(cap, sizeof *sets);
+    if (!sets) return OB_ERR_OUT_OF_HOST_MEMORY;
+    for (uint32_t i = 0; i < fr->set_cap; i++) {
+        const set_entry *e = &fr->sets[i];
+        if (e->set) *set_probe(sets, cap, e->layout, e->chunk) = *e;
+    }
+    ob_free(fr->sets);
+    fr->sets = sets;
+    fr->set_cap = cap;
+    return OB_OK;
+}
+
 static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, uint32_t chunk,
                              VkDescriptorSet *out_set)
 {
     frame_ring *fr = pm->ring;
-    uint32_t h = (uint32_t)((((uintptr_t)prog->set_layouts[0] >> 4) ^ chunk) * 2654435761u);
-    set_entry *slot = NULL;
-    for (uint32_t i = 0; i < SET_CACHE_SIZE; i++) {
-        set_entry *e = &fr->sets[(h + i) & (SET_CACHE_SIZE - 1)];
-        if (e->set && e->layout == prog->set_layouts[0] && e->chunk == chunk) {
-            *out_set = e->set;
-            return OB_OK;
-        }
-        if (!e->set) {
-            slot = e;
-            break;
-        }
+    ob_result res = set_cache_reserve(fr);
+    if (res != OB_OK) return res;
+    set_entry *slot = set_probe(fr->sets, fr->set_cap, prog->set_layouts[0], chunk);
+    if (slot->set) {
+        *out_set = slot->set;
+        return OB_OK;
     }
-    if (!slot) return OB_ERR_LIMIT;
     if (fr->pool_count == 0 || fr->sets_in_last_pool >= SETS_PER_POOL) {
         ob_result r = new_pool(pm, fr);
         if (r != OB_OK) return r;
@@ -363,6 +386,7 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
     }
     vkUpdateDescriptorSets(pm->vk, prog->ubo_count, writes, 0, NULL);
     *slot = (set_entry){prog->set_layouts[0], chunk, set};
+    fr->set_count++;
     *out_set = set;
     return OB_OK;
 }
