@@ -19,10 +19,13 @@ typedef struct ring_chunk {
     uint64_t size, used;
 } ring_chunk;
 
-/* Where a block was last packed in this frame, and what it contained. */
+/* Where a block was last packed in this frame, and what it contained. An
+ * entry belongs to the frame it was last claimed in; `packed` says it holds
+ * a block packed in that frame (a claimed entry is packed in the same draw). */
 typedef struct pack_entry {
     const ob_param_mapping *mapping;
     uint64_t frame_serial;
+    bool packed;
     uint32_t chunk;
     uint32_t offset;
     uint64_t content_hash;
@@ -279,24 +282,30 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
     }
 }
 
-/* The cache entry of a mapping, or a new one claimed for it (frame_serial 0:
- * not packed yet). Stale entries of earlier frames are reused; probing goes
- * on past them so a live entry further along is still found. */
+/* The cache entry of a mapping, claimed for this frame: its own entry, or a
+ * stale one of an earlier frame, or an empty one. An entry claimed in this
+ * frame is never handed to another mapping, so the blocks of one draw get
+ * distinct entries. Entries never become empty again, so probing may stop at
+ * the first empty one. NULL when the cache is full of this frame's blocks. */
 static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map)
 {
     uint32_t h = (uint32_t)(((uintptr_t)map >> 4) * 2654435761u) & (PACK_CACHE_SIZE - 1);
     pack_entry *reuse = NULL;
     for (uint32_t i = 0; i < PACK_CACHE_SIZE; i++) {
         pack_entry *e = &pm->pack_cache[(h + i) & (PACK_CACHE_SIZE - 1)];
-        if (e->mapping == map) return e;
+        if (e->mapping == map) {
+            if (e->frame_serial != pm->frame_serial)
+                *e = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
+            return e;
+        }
         if (!e->mapping) {
             if (!reuse) reuse = e;
             break;
         }
         if (!reuse && e->frame_serial != pm->frame_serial) reuse = e;
     }
-    if (!reuse) return NULL; /* full of this frame's blocks: pack without caching */
-    *reuse = (pack_entry){.mapping = map};
+    if (!reuse) return NULL;
+    *reuse = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
     return reuse;
 }
 
@@ -398,16 +407,18 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     if (prog->ubo_count == 0) return OB_OK;
     pack_entry *entries[OB_PROGRAM_MAX_UBOS];
     pack_entry uncached[OB_PROGRAM_MAX_UBOS];
+    bool pack[OB_PROGRAM_MAX_UBOS];
     uint32_t chunk = UINT32_MAX;
     bool all_same_chunk = true;
     for (uint32_t i = 0; i < prog->ubo_count; i++) {
         const ob_param_mapping *map = prog->ubos[i].mapping;
         pack_entry *e = pack_slot(pm, map);
-        if (!e) e = &uncached[i];
-        bool fresh = e->mapping == map && e->frame_serial == pm->frame_serial;
-        if (fresh && ob_params_pack_needed(&pm->params, map)) fresh = false;
-        if (!fresh) e->mapping = NULL; /* to pack */
-        else pm->stats.blocks_reused++;
+        if (!e) {
+            uncached[i] = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
+            e = &uncached[i];
+        }
+        bool fresh = e->packed && !ob_params_pack_needed(&pm->params, map);
+        pack[i] = !fresh;
         entries[i] = e;
         if (fresh) {
             if (chunk == UINT32_MAX) chunk = e->chunk;
@@ -417,20 +428,25 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     /* Blocks of one draw share one set, so they must sit in one chunk:
      * repack everything when the fresh ones are spread or stale. */
     if (!all_same_chunk || (chunk != UINT32_MAX && chunk != pm->ring->current)) {
-        for (uint32_t i = 0; i < prog->ubo_count; i++) entries[i]->mapping = NULL;
+        for (uint32_t i = 0; i < prog->ubo_count; i++) pack[i] = true;
         chunk = UINT32_MAX;
     }
+    for (uint32_t i = 0; i < prog->ubo_count; i++)
+        if (!pack[i]) pm->stats.blocks_reused++;
     for (int attempt = 0; attempt < 2; attempt++) {
         bool moved = false;
         for (uint32_t i = 0; i < prog->ubo_count; i++) {
-            pack_entry *e = entries[i];
-            if (e->mapping) continue;
+            if (!pack[i]) continue;
             uint32_t c = 0, off = 0;
             ob_result r = ring_alloc(pm, prog->ubos[i].size, &c, &off);
-            if (r != OB_OK) return r;
+            if (r != OB_OK) {
+                for (uint32_t j = 0; j < prog->ubo_count; j++)
+                    if (pack[j]) entries[j]->packed = false;
+                return r;
+            }
             if (chunk != UINT32_MAX && c != chunk) {
                 /* Ring moved to a new chunk mid-draw: repack all there. */
-                for (uint32_t j = 0; j < prog->ubo_count; j++) entries[j]->mapping = NULL;
+                for (uint32_t j = 0; j < prog->ubo_count; j++) pack[j] = true;
                 chunk = UINT32_MAX;
                 moved = true;
                 break;
@@ -438,8 +454,9 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
             chunk = c;
             uint8_t *dst = pm->ring->chunks[c].mapped + off;
             ob_params_pack(&pm->params, prog->ubos[i].mapping, dst, true);
-            *e = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, c, off,
-                              hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            *entries[i] = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, true, c, off,
+                                       hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            pack[i] = false;
             pm->stats.blocks_packed++;
             pm->stats.uniform_bytes += prog->ubos[i].size;
         }
