@@ -7,6 +7,7 @@
  * the main view's share of the summed manager stats is the frame's stats
  * minus those of a frame in which the main view is empty. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -205,6 +206,66 @@ static void uniforms_packed_only_after_a_change(void **state)
     assert_int_equal(got[DISTINCT].uniform_bytes, per_view + 100 * per_material);
     /* One effect for all of them: still one pipeline bind. */
     assert_int_equal(got[DISTINCT].pipeline_binds_issued, 1);
+}
+
+/* Many programs, each with its own PerView and PerMaterial mappings, drawn
+ * once each: every draw must read its own material block (the per-manager
+ * cache of packed blocks must never hand one entry to two blocks of a
+ * draw). Unlit colours land in the image exactly. */
+static void many_programs_each_read_their_own_uniforms(void **state)
+{
+    (void)state;
+    enum { N = 100, SIDE = 10 };
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_test_world_look(&w, 0, 0, 20, 0, 0, 0);
+    ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 0.6f, .znear = 0.1f});
+    ob_effect *effects[N];
+    float colors[N][3];
+    for (uint32_t i = 0; i < N; i++) {
+        char name[32], value[16];
+        snprintf(name, sizeof name, "unlit-%u", i);
+        snprintf(value, sizeof value, "%u", i);
+        ob_shader_define def = {"TEST_VARIANT", value};
+        ob_effect_desc ed = {.name = name, .vertex = "unlit.vert", .fragment = "unlit.frag",
+                             .define_count = 1, .defines = &def,
+                             .layout = ob_views_standard_input(), .depth_test = true,
+                             .depth_write = true, .cull = VK_CULL_MODE_BACK_BIT};
+        ob_result r;
+        effects[i] = ob_effect_create(w.fx, &ed, &r);
+        if (!effects[i]) fail_msg("effect %u: %s", i, ob_result_name(r));
+        colors[i][0] = (float)(i % 5) / 5.0f + 0.1f;
+        colors[i][1] = (float)((i / 5) % 5) / 5.0f + 0.1f;
+        colors[i][2] = (float)(i / 25) / 5.0f + 0.1f;
+        ob_material_desc md = {.name = name, .kind = OB_MATERIAL_CUSTOM,
+                               .diffuse = {colors[i][0], colors[i][1], colors[i][2], 1.0f}};
+        ob_material *m = ob_material_create(w.lib, &md, &r);
+        assert_non_null(m);
+        assert_int_equal(ob_material_set_view_effect(m, OB_VIEW_PERSPECTIVE, effects[i]), OB_OK);
+        double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
+        ob_test_world_entity(&w, NULL, name, w.box, m, x, y, 0);
+    }
+    const double half_h = 19.5 * tan(0.3), half_w = half_h * 160.0 / 120.0;
+    for (int f = 0; f < 4; f++) {
+        const ob_frame_stats *st =
+            ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+        assert_int_equal(ob_test_view_stats(st, "main")->draws, N);
+        ob_test_world_read(&w);
+        for (uint32_t i = 0; i < N; i++) {
+            double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
+            uint32_t px = (uint32_t)((x / half_w + 1.0) * 0.5 * w.width);
+            uint32_t py = (uint32_t)((1.0 - y / half_h) * 0.5 * w.height);
+            const uint8_t *p = ob_test_world_pixel(&w, px, py);
+            for (int c = 0; c < 3; c++)
+                if (fabs(p[c] - colors[i][c] * 255.0f) > 1.0)
+                    fail_msg("frame %d, box %u at (%u,%u): %u,%u,%u, expected %.0f,%.0f,%.0f", f,
+                             i, px, py, p[0], p[1], p[2], colors[i][0] * 255.0f,
+                             colors[i][1] * 255.0f, colors[i][2] * 255.0f);
+        }
+    }
+    assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+    for (uint32_t i = 0; i < N; i++) ob_effect_destroy(effects[i]);
+    ob_test_world_destroy(&w);
 }
 
 /* Build the scene used for the ST/MT comparison: shared and distinct
@@ -425,6 +486,7 @@ int main(void)
         cmocka_unit_test(shared_state_bound_once_single_threaded),
         cmocka_unit_test(shared_state_bound_once_per_secondary),
         cmocka_unit_test(uniforms_packed_only_after_a_change),
+        cmocka_unit_test(many_programs_each_read_their_own_uniforms),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),
