@@ -320,8 +320,8 @@ static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
         .poolSizeCount = 1,
         .pPoolSizes = &size,
     };
-    VkResult vr = OB_VK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     fr->pool_count++;
     fr->sets_in_last_pool = 0;
     return OB_OK;
@@ -377,8 +377,8 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
         .pSetLayouts = &prog->set_layouts[0],
     };
     VkDescriptorSet set;
-    VkResult vr = OB_VK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     fr->sets_in_last_pool++;
     VkDescriptorBufferInfo infos[OB_PROGRAM_MAX_UBOS];
     VkWriteDescriptorSet writes[OB_PROGRAM_MAX_UBOS];

@@ -29,23 +29,23 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
         .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
         .queueFamilyIndex = ob_device_queue_family(r->dev),
     };
-    VkResult vr = OB_VK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
         .commandPool = fs->pool,
         .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
         .commandBufferCount = 1,
     };
-    vr = OB_VK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->primary));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->primary));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     char name[32];
     snprintf(name, sizeof name, "primary[%u]", index);
     ob_device_set_name(r->dev, VK_OBJECT_TYPE_COMMAND_BUFFER, (uint64_t)(uintptr_t)fs->primary, name);
     VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
                              .flags = VK_FENCE_CREATE_SIGNALED_BIT};
-    vr = OB_VK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     if (ob_device_timestamp_period_ns(r->dev) > 0) {
         fs->query_capacity = 2 * OB_MAX_FRAME_VIEWS + 2;
         VkQueryPoolCreateInfo qci = {
@@ -53,8 +53,8 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
             .queryType = VK_QUERY_TYPE_TIMESTAMP,
             .queryCount = fs->query_capacity,
         };
-        vr = OB_VK_CREATE(vkCreateQueryPool(vk, &qci, NULL, &fs->queries));
-        if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+        vr = OB_VK_CHECK_CREATE(vkCreateQueryPool(vk, &qci, NULL, &fs->queries));
+        if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     }
     return OB_OK;
 }
