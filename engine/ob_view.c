@@ -99,7 +99,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         float d2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
         v->items[v->item_count++] = (ob_draw_item){sort_key(cls, priority, d2), n};
     }
-    qsort(v->items, v->item_count, sizeof *v->items, compare_items);
+    if (v->item_count > 1) qsort(v->items, v->item_count, sizeof *v->items, compare_items);
     v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
 }
