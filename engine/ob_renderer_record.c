@@ -231,8 +231,10 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
         uint32_t chunks = 1;
         if (!compute && !v->custom_record) {
             chunks = (v->item_count + r->chunk_draws - 1) / r->chunk_draws;
-            uint64_t by_cost = v->cost_ns / (250u * 1000u * layers);
-            if (by_cost > chunks) chunks = (uint32_t)OB_MIN(by_cost, (uint64_t)active * 2);
+            /* Slow views get up to two chunks per worker, never fewer than
+             * the draw count asks for. */
+            uint64_t by_cost = OB_MIN(v->cost_ns / (250u * 1000u * layers), (uint64_t)active * 2);
+            if (by_cost > chunks) chunks = (uint32_t)by_cost;
             if (chunks > v->item_count) chunks = v->item_count;
             if (chunks == 0) chunks = 1;
         }
