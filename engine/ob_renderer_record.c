@@ -260,7 +260,7 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
         }
     }
     /* Largest predicted cost first; assembly later walks views in order. */
-    qsort(r->jobs, r->job_count, sizeof *r->jobs, compare_jobs_by_cost);
+    if (r->job_count > 1) qsort(r->jobs, r->job_count, sizeof *r->jobs, compare_jobs_by_cost);
     return OB_OK;
 }
 
