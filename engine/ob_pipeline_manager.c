@@ -12,8 +12,11 @@
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
 
+/* Ring chunks are raw Vulkan objects, not ob_buffer handles: a worker may
+ * grow its ring while recording, and the handle pool belongs to the render
+ * thread (creating one here raced with other workers' handle lookups). */
 typedef struct ring_chunk {
-    ob_buffer buffer;
+    VkDeviceMemory memory;
     VkBuffer vk;
     uint8_t *mapped;
     uint64_t size, used;
@@ -164,12 +167,67 @@ done:
     return pm;
 }
 
+static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
+{
+    if (c->memory) vkUnmapMemory(pm->vk, c->memory);
+    if (c->vk) vkDestroyBuffer(pm->vk, c->vk, NULL);
+    if (c->memory) vkFreeMemory(pm->vk, c->memory, NULL);
+    memset(c, 0, sizeof *c);
+}
+
+/* A host-visible, coherent, persistently mapped uniform buffer. [own thread] */
+static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
+{
+    VkBufferCreateInfo bi = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = pm->chunk_size,
+        .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    VkResult vr = OB_VK_CREATE(vkCreateBuffer(pm->vk, &bi, NULL, &c->vk));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail;
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(pm->vk, c->vk, &req);
+    uint32_t type = ob_device_memory_type(pm->dev, req.memoryTypeBits,
+                                          VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    if (type == UINT32_MAX) {
+        vr = VK_ERROR_FEATURE_NOT_PRESENT;
+        OB_LOG_E("pm", "pipeline manager '%s': no host-visible coherent memory for its uniform ring",
+                 pm->name);
+        goto fail;
+    }
+    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+                               .allocationSize = req.size,
+                               .memoryTypeIndex = type};
+    vr = OB_VK_CREATE(vkAllocateMemory(pm->vk, &ai, NULL, &c->memory));
+    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail;
+    vr = OB_VK_CHECK(vkBindBufferMemory(pm->vk, c->vk, c->memory, 0));
+    if (vr != VK_SUCCESS) goto fail;
+    void *mapped = NULL;
+    vr = OB_VK_CHECK(vkMapMemory(pm->vk, c->memory, 0, VK_WHOLE_SIZE, 0, &mapped));
+    if (vr != VK_SUCCESS) goto fail;
+    c->mapped = mapped;
+    c->size = pm->chunk_size;
+    c->used = 0;
+    ob_device_set_name(pm->dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)c->vk, pm->name);
+    return OB_OK;
+fail:
+    if (c->memory) {
+        vkFreeMemory(pm->vk, c->memory, NULL);
+        c->memory = VK_NULL_HANDLE;
+    }
+    if (c->vk) vkDestroyBuffer(pm->vk, c->vk, NULL);
+    memset(c, 0, sizeof *c);
+    return vr == VK_ERROR_FEATURE_NOT_PRESENT ? OB_ERR_UNSUPPORTED : ob_result_from_vk(vr);
+}
+
 void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
 {
     if (!pm) return;
     for (uint32_t s = 0; s < MAX_FRAME_SLOTS; s++) {
         frame_ring *fr = &pm->rings[s];
-        for (uint32_t i = 0; i < fr->chunk_count; i++) ob_buffer_destroy(pm->dev, fr->chunks[i].buffer);
+        for (uint32_t i = 0; i < fr->chunk_count; i++) chunk_destroy(pm, &fr->chunks[i]);
         for (uint32_t i = 0; i < fr->pool_count; i++)
             vkDestroyDescriptorPool(pm->vk, fr->pools[i], NULL);
         ob_free(fr->sets);
@@ -264,20 +322,8 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
             continue;
         }
         if (fr->chunk_count >= MAX_CHUNKS) return OB_ERR_LIMIT;
-        ob_result r;
-        ob_buffer_desc bd = {
-            .size = pm->chunk_size,
-            .usage = OB_BUFFER_UNIFORM,
-            .host_visible = true,
-            .name = pm->name,
-        };
-        ring_chunk *c = &fr->chunks[fr->chunk_count];
-        c->buffer = ob_buffer_create(pm->dev, &bd, &r);
-        if (!c->buffer.id) return r;
-        c->vk = ob_buffer_vk(pm->dev, c->buffer);
-        c->mapped = ob_buffer_mapped(pm->dev, c->buffer);
-        c->size = pm->chunk_size;
-        c->used = 0;
+        ob_result r = chunk_create(pm, &fr->chunks[fr->chunk_count]);
+        if (r != OB_OK) return r;
         fr->chunk_count++;
     }
 }
