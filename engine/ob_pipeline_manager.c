@@ -1,12 +1,14 @@
 #include "ob_pipeline_manager.h"
 
+#include "ob_resources_internal.h"
+
 #include <stdio.h>
 #include <string.h>
 
 #define MAX_FRAME_SLOTS 4
 #define MAX_CHUNKS 64
 #define PACK_CACHE_SIZE 256     /* power of two */
-#define SET_CACHE_SIZE 64       /* power of two */
+#define SET_CACHE_MIN 64        /* power of two; the set cache doubles when half full */
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
 
@@ -20,10 +22,13 @@ typedef struct ring_chunk {
     uint64_t size, used;
 } ring_chunk;
 
-/* Where a block was last packed in this frame, and what it contained. */
+/* Where a block was last packed in this frame, and what it contained. An
+ * entry belongs to the frame it was last claimed in; `packed` says it holds
+ * a block packed in that frame (a claimed entry is packed in the same draw). */
 typedef struct pack_entry {
     const ob_param_mapping *mapping;
     uint64_t frame_serial;
+    bool packed;
     uint32_t chunk;
     uint32_t offset;
     uint64_t content_hash;
@@ -42,7 +47,8 @@ typedef struct frame_ring {
     uint32_t chunk_count, current;
     VkDescriptorPool pools[MAX_POOLS];
     uint32_t pool_count, sets_in_last_pool;
-    set_entry sets[SET_CACHE_SIZE];
+    set_entry *sets;            /* open addressing, set_cap entries (power of two) */
+    uint32_t set_cap, set_count;
 } frame_ring;
 
 typedef struct bound_state {
@@ -224,6 +230,7 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
         for (uint32_t i = 0; i < fr->chunk_count; i++) chunk_destroy(pm, &fr->chunks[i]);
         for (uint32_t i = 0; i < fr->pool_count; i++)
             vkDestroyDescriptorPool(pm->vk, fr->pools[i], NULL);
+        ob_free(fr->sets);
     }
     ob_free(pm);
 }
@@ -321,24 +328,30 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
     }
 }
 
-/* The cache entry of a mapping, or a new one claimed for it (frame_serial 0:
- * not packed yet). Stale entries of earlier frames are reused; probing goes
- * on past them so a live entry further along is still found. */
+/* The cache entry of a mapping, claimed for this frame: its own entry, or a
+ * stale one of an earlier frame, or an empty one. An entry claimed in this
+ * frame is never handed to another mapping, so the blocks of one draw get
+ * distinct entries. Entries never become empty again, so probing may stop at
+ * the first empty one. NULL when the cache is full of this frame's blocks. */
 static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map)
 {
     uint32_t h = (uint32_t)(((uintptr_t)map >> 4) * 2654435761u) & (PACK_CACHE_SIZE - 1);
     pack_entry *reuse = NULL;
     for (uint32_t i = 0; i < PACK_CACHE_SIZE; i++) {
         pack_entry *e = &pm->pack_cache[(h + i) & (PACK_CACHE_SIZE - 1)];
-        if (e->mapping == map) return e;
+        if (e->mapping == map) {
+            if (e->frame_serial != pm->frame_serial)
+                *e = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
+            return e;
+        }
         if (!e->mapping) {
             if (!reuse) reuse = e;
             break;
         }
         if (!reuse && e->frame_serial != pm->frame_serial) reuse = e;
     }
-    if (!reuse) return NULL; /* full of this frame's blocks: pack without caching */
-    *reuse = (pack_entry){.mapping = map};
+    if (!reuse) return NULL;
+    *reuse = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
     return reuse;
 }
 
@@ -353,10 +366,38 @@ static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
         .poolSizeCount = 1,
         .pPoolSizes = &size,
     };
-    VkResult vr = OB_VK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     fr->pool_count++;
     fr->sets_in_last_pool = 0;
+    return OB_OK;
+}
+
+static set_entry *set_probe(set_entry *sets, uint32_t cap, VkDescriptorSetLayout layout,
+                            uint32_t chunk)
+{
+    uint32_t h = (uint32_t)((((uintptr_t)layout >> 4) ^ chunk) * 2654435761u);
+    for (uint32_t i = 0;; i++) {
+        set_entry *e = &sets[(h + i) & (cap - 1)];
+        if (!e->set || (e->layout == layout && e->chunk == chunk)) return e;
+    }
+}
+
+/* Keeps the set cache at most half full (a frame may use any number of
+ * programs). The old table is kept when growing fails. */
+static ob_result set_cache_reserve(frame_ring *fr)
+{
+    if (fr->set_cap && (fr->set_count + 1) * 2 <= fr->set_cap) return OB_OK;
+    uint32_t cap = fr->set_cap ? fr->set_cap * 2 : SET_CACHE_MIN;
+    set_entry *sets = ob_calloc(cap, sizeof *sets);
+    if (!sets) return OB_ERR_OUT_OF_HOST_MEMORY;
+    for (uint32_t i = 0; i < fr->set_cap; i++) {
+        const set_entry *e = &fr->sets[i];
+        if (e->set) *set_probe(sets, cap, e->layout, e->chunk) = *e;
+    }
+    ob_free(fr->sets);
+    fr->sets = sets;
+    fr->set_cap = cap;
     return OB_OK;
 }
 
@@ -364,20 +405,13 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
                              VkDescriptorSet *out_set)
 {
     frame_ring *fr = pm->ring;
-    uint32_t h = (uint32_t)((((uintptr_t)prog->set_layouts[0] >> 4) ^ chunk) * 2654435761u);
-    set_entry *slot = NULL;
-    for (uint32_t i = 0; i < SET_CACHE_SIZE; i++) {
-        set_entry *e = &fr->sets[(h + i) & (SET_CACHE_SIZE - 1)];
-        if (e->set && e->layout == prog->set_layouts[0] && e->chunk == chunk) {
-            *out_set = e->set;
-            return OB_OK;
-        }
-        if (!e->set) {
-            slot = e;
-            break;
-        }
+    ob_result res = set_cache_reserve(fr);
+    if (res != OB_OK) return res;
+    set_entry *slot = set_probe(fr->sets, fr->set_cap, prog->set_layouts[0], chunk);
+    if (slot->set) {
+        *out_set = slot->set;
+        return OB_OK;
     }
-    if (!slot) return OB_ERR_LIMIT;
     if (fr->pool_count == 0 || fr->sets_in_last_pool >= SETS_PER_POOL) {
         ob_result r = new_pool(pm, fr);
         if (r != OB_OK) return r;
@@ -389,8 +423,8 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
         .pSetLayouts = &prog->set_layouts[0],
     };
     VkDescriptorSet set;
-    VkResult vr = OB_VK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     fr->sets_in_last_pool++;
     VkDescriptorBufferInfo infos[OB_PROGRAM_MAX_UBOS];
     VkWriteDescriptorSet writes[OB_PROGRAM_MAX_UBOS];
@@ -407,6 +441,7 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
     }
     vkUpdateDescriptorSets(pm->vk, prog->ubo_count, writes, 0, NULL);
     *slot = (set_entry){prog->set_layouts[0], chunk, set};
+    fr->set_count++;
     *out_set = set;
     return OB_OK;
 }
@@ -418,16 +453,18 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     if (prog->ubo_count == 0) return OB_OK;
     pack_entry *entries[OB_PROGRAM_MAX_UBOS];
     pack_entry uncached[OB_PROGRAM_MAX_UBOS];
+    bool pack[OB_PROGRAM_MAX_UBOS];
     uint32_t chunk = UINT32_MAX;
     bool all_same_chunk = true;
     for (uint32_t i = 0; i < prog->ubo_count; i++) {
         const ob_param_mapping *map = prog->ubos[i].mapping;
         pack_entry *e = pack_slot(pm, map);
-        if (!e) e = &uncached[i];
-        bool fresh = e->mapping == map && e->frame_serial == pm->frame_serial;
-        if (fresh && ob_params_pack_needed(&pm->params, map)) fresh = false;
-        if (!fresh) e->mapping = NULL; /* to pack */
-        else pm->stats.blocks_reused++;
+        if (!e) {
+            uncached[i] = (pack_entry){.mapping = map, .frame_serial = pm->frame_serial};
+            e = &uncached[i];
+        }
+        bool fresh = e->packed && !ob_params_pack_needed(&pm->params, map);
+        pack[i] = !fresh;
         entries[i] = e;
         if (fresh) {
             if (chunk == UINT32_MAX) chunk = e->chunk;
@@ -437,20 +474,25 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     /* Blocks of one draw share one set, so they must sit in one chunk:
      * repack everything when the fresh ones are spread or stale. */
     if (!all_same_chunk || (chunk != UINT32_MAX && chunk != pm->ring->current)) {
-        for (uint32_t i = 0; i < prog->ubo_count; i++) entries[i]->mapping = NULL;
+        for (uint32_t i = 0; i < prog->ubo_count; i++) pack[i] = true;
         chunk = UINT32_MAX;
     }
+    for (uint32_t i = 0; i < prog->ubo_count; i++)
+        if (!pack[i]) pm->stats.blocks_reused++;
     for (int attempt = 0; attempt < 2; attempt++) {
         bool moved = false;
         for (uint32_t i = 0; i < prog->ubo_count; i++) {
-            pack_entry *e = entries[i];
-            if (e->mapping) continue;
+            if (!pack[i]) continue;
             uint32_t c = 0, off = 0;
             ob_result r = ring_alloc(pm, prog->ubos[i].size, &c, &off);
-            if (r != OB_OK) return r;
+            if (r != OB_OK) {
+                for (uint32_t j = 0; j < prog->ubo_count; j++)
+                    if (pack[j]) entries[j]->packed = false;
+                return r;
+            }
             if (chunk != UINT32_MAX && c != chunk) {
                 /* Ring moved to a new chunk mid-draw: repack all there. */
-                for (uint32_t j = 0; j < prog->ubo_count; j++) entries[j]->mapping = NULL;
+                for (uint32_t j = 0; j < prog->ubo_count; j++) pack[j] = true;
                 chunk = UINT32_MAX;
                 moved = true;
                 break;
@@ -458,8 +500,9 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
             chunk = c;
             uint8_t *dst = pm->ring->chunks[c].mapped + off;
             ob_params_pack(&pm->params, prog->ubos[i].mapping, dst, true);
-            *e = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, c, off,
-                              hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            *entries[i] = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, true, c, off,
+                                       hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            pack[i] = false;
             pm->stats.blocks_packed++;
             pm->stats.uniform_bytes += prog->ubos[i].size;
         }
@@ -486,9 +529,18 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     return OB_OK;
 }
 
+static bool sampler_is_valid(const ob_device *dev, ob_sampler s)
+{
+    return ob_pool_get(&ob_device_registry(dev)->samplers, s.id) != NULL;
+}
+
 /* Resolve the program's images, samplers and buffers from parameters and push
- * them when any differs from what is bound. */
-static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+ * them when any differs from what is bound. A zero or stale handle fails with
+ * OB_ERR_INVALID_HANDLE and *out_bad naming the parameter; handles are checked
+ * before they are resolved so that the caller logs one line, not one per
+ * lookup. */
+static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h,
+                                 ob_param *out_bad)
 {
     if (prog->resource_count == 0) return OB_OK;
     uint32_t ids[OB_PROGRAM_MAX_RESOURCES * 2];
@@ -510,21 +562,25 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
         case OB_BINDING_COMBINED_IMAGE_SAMPLER:
             ob_params_get_texture(&pm->params, res->param, &img);
             ob_params_get_sampler(&pm->params, res->sampler, &smp);
+            if (!ob_image_is_valid(pm->dev, img)) goto bad_param;
+            if (!sampler_is_valid(pm->dev, smp)) {
+                *out_bad = res->sampler;
+                return OB_ERR_INVALID_HANDLE;
+            }
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].sampler = ob_sampler_vk(pm->dev, smp);
             images[i].imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            if (!images[i].imageView || !images[i].sampler) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
             writes[i].pImageInfo = &images[i];
             break;
         case OB_BINDING_SAMPLED_IMAGE:
         case OB_BINDING_STORAGE_IMAGE:
             ob_params_get_texture(&pm->params, res->param, &img);
+            if (!ob_image_is_valid(pm->dev, img)) goto bad_param;
             images[i].imageView = ob_image_view(pm->dev, img);
             images[i].imageLayout = res->kind == OB_BINDING_STORAGE_IMAGE
                                         ? VK_IMAGE_LAYOUT_GENERAL
                                         : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            if (!images[i].imageView) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_IMAGE
                                            ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE
                                            : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
@@ -532,16 +588,16 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
             break;
         case OB_BINDING_SAMPLER:
             ob_params_get_sampler(&pm->params, res->param, &smp);
+            if (!sampler_is_valid(pm->dev, smp)) goto bad_param;
             images[i].sampler = ob_sampler_vk(pm->dev, smp);
-            if (!images[i].sampler) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = VK_DESCRIPTOR_TYPE_SAMPLER;
             writes[i].pImageInfo = &images[i];
             break;
         case OB_BINDING_STORAGE_BUFFER:
         case OB_BINDING_UNIFORM_BUFFER:
             ob_params_get_buffer(&pm->params, res->param, &buf);
+            if (!ob_buffer_is_valid(pm->dev, buf)) goto bad_param;
             buffers[i] = (VkDescriptorBufferInfo){ob_buffer_vk(pm->dev, buf), 0, VK_WHOLE_SIZE};
-            if (!buffers[i].buffer) return OB_ERR_INVALID_HANDLE;
             writes[i].descriptorType = res->kind == OB_BINDING_STORAGE_BUFFER
                                            ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
                                            : VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
@@ -551,6 +607,10 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
         ids[2 * i] = img.id ? img.id : buf.id;
         ids[2 * i + 1] = smp.id;
         *h = ob_hash_u64(*h, ((uint64_t)ids[2 * i] << 32) | ids[2 * i + 1]);
+        continue;
+    bad_param:
+        *out_bad = res->param;
+        return OB_ERR_INVALID_HANDLE;
     }
     pm->stats.push_descriptor_requested++;
     size_t n = sizeof ids[0] * 2 * prog->resource_count;
@@ -605,13 +665,19 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->cur.resources_valid = false;
         pm->cur.push_valid = false;
     }
+    ob_param bad = {0};
     ob_result r = apply_uniforms(pm, prog, h);
-    if (r == OB_OK) r = apply_resources(pm, prog, h);
+    if (r == OB_OK) r = apply_resources(pm, prog, h, &bad);
     if (r != OB_OK) {
         pm->stats.skipped_draws++;
-        log_once(pm, r == OB_ERR_INVALID_HANDLE ? "a texture, sampler or buffer parameter holds "
-                                                  "an invalid handle"
-                                                : ob_result_text(r));
+        if (r == OB_ERR_INVALID_HANDLE) {
+            char what[160];
+            snprintf(what, sizeof what, "parameter '%s' of program '%s' holds an invalid or "
+                     "stale handle", ob_param_name(pm->params.reg, bad), prog->name);
+            log_once(pm, what);
+        } else {
+            log_once(pm, ob_result_text(r));
+        }
         return r;
     }
     apply_push_constants(pm, prog, h);

@@ -185,16 +185,16 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         .bindingCount = prog->ubo_count,
         .pBindings = ubo_bindings,
     };
-    VkResult vr = OB_VK_CREATE(vkCreateDescriptorSetLayout(vk, &set0, NULL, &prog->set_layouts[0]));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail_vk;
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateDescriptorSetLayout(vk, &set0, NULL, &prog->set_layouts[0]));
+    if (vr != VK_SUCCESS) goto fail_vk;
     VkDescriptorSetLayoutCreateInfo set1 = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
         .flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR,
         .bindingCount = prog->resource_count,
         .pBindings = res_bindings,
     };
-    vr = OB_VK_CREATE(vkCreateDescriptorSetLayout(vk, &set1, NULL, &prog->set_layouts[1]));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail_vk;
+    vr = OB_VK_CHECK_CREATE(vkCreateDescriptorSetLayout(vk, &set1, NULL, &prog->set_layouts[1]));
+    if (vr != VK_SUCCESS) goto fail_vk;
     VkPushConstantRange push = {.stageFlags = prog->push_stages, .size = prog->push_size};
     VkPipelineLayoutCreateInfo pl = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
@@ -203,8 +203,8 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         .pushConstantRangeCount = prog->push_size ? 1u : 0u,
         .pPushConstantRanges = &push,
     };
-    vr = OB_VK_CREATE(vkCreatePipelineLayout(vk, &pl, NULL, &prog->layout));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail_vk;
+    vr = OB_VK_CHECK_CREATE(vkCreatePipelineLayout(vk, &pl, NULL, &prog->layout));
+    if (vr != VK_SUCCESS) goto fail_vk;
     ob_device_set_name(dev, VK_OBJECT_TYPE_PIPELINE_LAYOUT, (uint64_t)prog->layout, prog->name);
     if (out_result) *out_result = OB_OK;
     return prog;

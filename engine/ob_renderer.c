@@ -29,23 +29,23 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
         .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
         .queueFamilyIndex = ob_device_queue_family(r->dev),
     };
-    VkResult vr = OB_VK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
         .commandPool = fs->pool,
         .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
         .commandBufferCount = 1,
     };
-    vr = OB_VK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->primary));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->primary));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     char name[32];
     snprintf(name, sizeof name, "primary[%u]", index);
     ob_device_set_name(r->dev, VK_OBJECT_TYPE_COMMAND_BUFFER, (uint64_t)(uintptr_t)fs->primary, name);
     VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
                              .flags = VK_FENCE_CREATE_SIGNALED_BIT};
-    vr = OB_VK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     if (ob_device_timestamp_period_ns(r->dev) > 0) {
         fs->query_capacity = 2 * OB_MAX_FRAME_VIEWS + 2;
         VkQueryPoolCreateInfo qci = {
@@ -53,8 +53,8 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
             .queryType = VK_QUERY_TYPE_TIMESTAMP,
             .queryCount = fs->query_capacity,
         };
-        vr = OB_VK_CREATE(vkCreateQueryPool(vk, &qci, NULL, &fs->queries));
-        if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+        vr = OB_VK_CHECK_CREATE(vkCreateQueryPool(vk, &qci, NULL, &fs->queries));
+        if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     }
     return OB_OK;
 }
@@ -303,6 +303,13 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 
 /* ------------------------------------------------------------ view queue */
 
+static int32_t queue_index(const ob_renderer *r, const ob_view *v)
+{
+    for (uint32_t i = 0; i < r->queue_count; i++)
+        if (r->queue[i] == v) return (int32_t)i;
+    return -1;
+}
+
 bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
 {
     if (!r->in_frame || !v) return false;
@@ -338,6 +345,7 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     v->dep_count = 0;
     v->item_count = 0;
     v->culled = 0;
+    r->queued_by[r->queue_count] = consumer ? queue_index(r, consumer) : -1;
     r->queue[r->queue_count++] = v;
     if (consumer) ob_view_add_dependency(consumer, v);
     return true;
@@ -395,19 +403,50 @@ ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, 
 
 /* ------------------------------------------------------------ processing */
 
+/* Was queue entry `ancestor` on the PreRender chain that queued entry i? */
+static bool queued_under(const ob_renderer *r, uint32_t i, uint32_t ancestor)
+{
+    for (int32_t p = r->queued_by[i]; p >= 0; p = r->queued_by[p])
+        if ((uint32_t)p == ancestor) return true;
+    return false;
+}
+
+/* Post-order walk: a view's dependencies are placed before it. Dependencies
+ * are visited in reverse order of addition, so a PreRender tree comes out in
+ * exactly the reverse of queue order. An edge to a view on the chain that
+ * queued this one closes a cycle and is not followed: that consumer reads
+ * the previous frame's contents. */
+static void order_visit(const ob_renderer *r, uint32_t i, uint8_t *mark, ob_view **order,
+                        uint32_t *n)
+{
+    mark[i] = 1;
+    const ob_view *v = r->queue[i];
+    for (uint32_t k = v->dep_count; k-- > 0;) {
+        int32_t d = queue_index(r, v->deps[k]);
+        if (d < 0 || mark[d] || queued_under(r, i, (uint32_t)d)) continue;
+        order_visit(r, (uint32_t)d, mark, order, n);
+    }
+    mark[i] = 2;
+    order[(*n)++] = r->queue[i];
+}
+
 ob_result ob_renderer_process_views(ob_renderer *r)
 {
     if (!r->in_frame || r->submitted) {
         OB_LOG_E("renderer", "process_views outside a frame or called twice");
         return OB_ERR_WRONG_STATE;
     }
-    /* Dependencies were queued after their consumers: reverse queue order
-     * runs them first (Hieroglyph's LIFO rule). The dependency lists make the
-     * rule checkable: an edge that points forward is a cycle (env maps seeing
-     * each other), resolved by reading the previous frame's contents. */
+    /* Dependencies were queued after their consumers, so reverse queue order
+     * runs them first (Hieroglyph's LIFO rule) — as long as every dependency
+     * was queued by its consumer. A view another consumer queued earlier (an
+     * env map two cameras see) would come after the later consumer, so the
+     * order is the dependency order, walked from the last queued view back:
+     * identical to LIFO for a tree, correct for shared dependencies. */
     ob_view *order[OB_MAX_FRAME_VIEWS];
-    uint32_t n = r->queue_count;
-    for (uint32_t i = 0; i < n; i++) order[i] = r->queue[n - 1 - i];
+    uint8_t mark[OB_MAX_FRAME_VIEWS] = {0};
+    uint32_t n = 0;
+    for (uint32_t i = r->queue_count; i-- > 0;)
+        if (!mark[i]) order_visit(r, i, mark, order, &n);
     ob_result res = ob_renderer_record_frame(r, order, n);
     r->submitted = true;
     return res;

@@ -79,6 +79,8 @@ struct ob_renderer {
     ob_scene *scene;
 
     ob_view *queue[OB_MAX_FRAME_VIEWS];
+    int32_t queued_by[OB_MAX_FRAME_VIEWS]; /* queue index of the view whose PreRender
+                                              queued each one; -1 for a root */
     uint32_t queue_count;
     ob_view *stack[OB_MAX_VIEW_STACK];
     uint32_t stack_depth, max_recursion;

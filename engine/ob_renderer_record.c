@@ -29,8 +29,8 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
             .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
             .queueFamilyIndex = ob_device_queue_family(r->dev),
         };
-        VkResult vr = OB_VK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci, NULL, &w->pools[f]));
-        if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+        VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci, NULL, &w->pools[f]));
+        if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     }
     return OB_OK;
 }
@@ -61,8 +61,8 @@ static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
             .commandBufferCount = 1,
         };
         VkCommandBuffer cmd;
-        VkResult vr = OB_VK_CREATE(vkAllocateCommandBuffers(ob_device_vk(r->dev), &ai, &cmd));
-        if (OB_VK_CHECK(vr) != VK_SUCCESS) return VK_NULL_HANDLE;
+        VkResult vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(ob_device_vk(r->dev), &ai, &cmd));
+        if (vr != VK_SUCCESS) return VK_NULL_HANDLE;
         w->cmds[f][w->cmd_count[f]++] = cmd;
     }
     return w->cmds[f][w->cmd_used++];
@@ -231,8 +231,10 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
         uint32_t chunks = 1;
         if (!compute && !v->custom_record) {
             chunks = (v->item_count + r->chunk_draws - 1) / r->chunk_draws;
-            uint64_t by_cost = v->cost_ns / (250u * 1000u * layers);
-            if (by_cost > chunks) chunks = (uint32_t)OB_MIN(by_cost, (uint64_t)active * 2);
+            /* Slow views get up to two chunks per worker, never fewer than
+             * the draw count asks for. */
+            uint64_t by_cost = OB_MIN(v->cost_ns / (250u * 1000u * layers), (uint64_t)active * 2);
+            if (by_cost > chunks) chunks = (uint32_t)by_cost;
             if (chunks > v->item_count) chunks = v->item_count;
             if (chunks == 0) chunks = 1;
         }

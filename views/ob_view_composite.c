@@ -68,6 +68,11 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
     cv->ctx = ctx;
     cv->source = source;
     cv->base.custom_record = true;
+    /* The source's colour is sampled whether or not the source ran this
+     * frame (it may be left out, e.g. past the recursion bound): as an input
+     * it gets its barrier, and is cleared if it was never written. */
+    cv->base.inputs[0] = source->color;
+    cv->base.input_count = 1;
     cv->source_image = ob_param_find(ob_renderer_registry(ctx->r), "SourceImage");
     ob_image_info info;
     r = ob_image_get_info(ctx->dev, source->color, &info);

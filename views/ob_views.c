@@ -218,8 +218,12 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             }
             e = &ctx->envs[ctx->env_count - 1];
         }
-        ob_renderer_attach_view(r, entity, e->view);
         ob_renderer_pre_draw(r, e->view);
+        /* Only a map that renders this frame is sampled: one left out (past
+         * the recursion bound, say) was never written, so the entity is
+         * drawn without its reflection instead. */
+        if (e->view->queued_frame == ob_renderer_frame_serial(r))
+            ob_renderer_attach_view(r, entity, e->view);
     }
 }
 

@@ -18,7 +18,8 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     w->height = d.height ? d.height : 120;
     ob_result r;
     ob_renderer_desc rd = {.device = {.app_name = "obelisk-test", .validation = 1},
-                           .worker_count = d.workers ? d.workers : 4};
+                           .worker_count = d.workers ? d.workers : 4,
+                           .chunk_draws = d.chunk_draws};
     w->r = ob_renderer_create(&rd, &r);
     if (!w->r) fail_msg("renderer: %s", ob_result_name(r));
     w->dev = ob_renderer_device(w->r);
@@ -174,4 +175,35 @@ ob_skip_reason ob_test_skip_reason(const ob_frame_stats *st, const char *name)
     for (uint32_t i = 0; i < st->skipped_count; i++)
         if (strcmp(st->skipped[i].name, name) == 0) return st->skipped[i].reason;
     return OB_SKIP_NONE;
+}
+
+uint8_t *ob_test_world_snapshot(ob_test_world *w)
+{
+    ob_test_world_read(w);
+    size_t n = (size_t)w->width * w->height * 4;
+    uint8_t *copy = malloc(n); /* test-side bookkeeping: not an engine allocation */
+    assert_non_null(copy);
+    memcpy(copy, w->pixels, n);
+    return copy;
+}
+
+int ob_test_view_index(const ob_frame_stats *st, const char *name)
+{
+    for (uint32_t i = 0; i < st->view_count; i++)
+        if (strcmp(st->views[i].name, name) == 0) return (int)i;
+    return -1;
+}
+
+uint32_t ob_test_count_views(const ob_frame_stats *st, ob_view_type type)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < st->view_count; i++) n += st->views[i].type == type;
+    return n;
+}
+
+uint32_t ob_test_count_skipped(const ob_frame_stats *st, ob_skip_reason reason)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < st->skipped_count; i++) n += st->skipped[i].reason == reason;
+    return n;
 }

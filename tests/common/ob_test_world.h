@@ -21,6 +21,7 @@ typedef struct ob_test_world_desc {
     uint32_t env_map_size;     /* 0 → 64 */
     uint32_t shadow_map_size;  /* 0 → 256 */
     float clear_color[4];      /* zero → opaque dark blue (0.1, 0.2, 0.3, 1) */
+    uint32_t chunk_draws;      /* renderer's draws per job; 0 → the renderer's default */
 } ob_test_world_desc;
 
 typedef struct ob_test_world {
@@ -67,5 +68,14 @@ const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t 
 const ob_view_stats *ob_test_view_stats(const ob_frame_stats *st, const char *name);
 /* The skip reason recorded for name, OB_SKIP_NONE if none. */
 ob_skip_reason ob_test_skip_reason(const ob_frame_stats *st, const char *name);
+
+/* Read the final image and return a copy (free() it). */
+uint8_t *ob_test_world_snapshot(ob_test_world *w);
+/* Position of the view called name in st->views (execution order), -1 if absent. */
+int ob_test_view_index(const ob_frame_stats *st, const char *name);
+/* Views of a type that ran in st. */
+uint32_t ob_test_count_views(const ob_frame_stats *st, ob_view_type type);
+/* Skip entries of st with that reason. */
+uint32_t ob_test_count_skipped(const ob_frame_stats *st, ob_skip_reason reason);
 
 #endif

@@ -1,0 +1,228 @@
+/* Issue 5: determinism. One animated scene — a shadow-casting sun, three
+ * mirror spheres with environment maps, a particle simulation and 500
+ * moving entities — rendered for five frames single-threaded, with 1, 2, 3,
+ * 4 and 8 workers, switching mode every frame, and in AUTO mode: every frame
+ * has the same pixels (byte for byte) and the same command hash per view.
+ *
+ * Each run builds the scene afresh (controllers and the particle buffer
+ * carry state from frame to frame). The renderer always has 8 workers;
+ * ob_renderer_set_threading picks how many record. Views are cut into
+ * chunks of 64 draws so that the main, shadow and env-map views are spread
+ * over several workers. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ob_test_world.h"
+
+#define FRAMES 5
+#define ENTITIES 500
+#define WIDTH 160
+#define HEIGHT 120
+
+typedef struct run_result {
+    uint8_t *images[FRAMES];
+    ob_frame_stats stats[FRAMES];
+} run_result;
+
+/* How a run picks the mode of frame f. */
+typedef struct run_plan {
+    const char *name;
+    ob_threading modes[FRAMES];
+    uint32_t workers[FRAMES];
+} run_plan;
+
+static uint32_t next_random(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+static float random01(uint32_t *s) { return (float)next_random(s) / (float)(1u << 24); }
+
+static void build_scene(ob_test_world *w, ob_particle_system **out_ps)
+{
+    ob_test_world_look(w, 0, 7, 14, 0, 0.5, 0);
+    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 6, 12, 4);
+    ob_test_world_light(w, OB_LIGHT_POINT, false, 2.0f, -3, 2, 2);
+    ob_result r;
+    ob_material *palette[8];
+    for (int i = 0; i < 6; i++)
+        palette[i] = ob_test_world_material(w, OB_MATERIAL_LIT, 0.2f + 0.13f * (float)i,
+                                            0.9f - 0.12f * (float)i, 0.3f + 0.1f * (float)(i % 3),
+                                            i != 5);
+    palette[6] = ob_test_world_material(w, OB_MATERIAL_UNLIT, 0.95f, 0.85f, 0.2f, true);
+    palette[7] = ob_material_create(w->lib, &(ob_material_desc){.name = "glass",
+        .kind = OB_MATERIAL_LIT, .diffuse = {0.4f, 0.6f, 0.9f, 0.5f}, .blended = true}, &r);
+    assert_non_null(palette[7]);
+    ob_material *ground = ob_test_world_material(w, OB_MATERIAL_LIT, 0.55f, 0.55f, 0.5f, false);
+    ob_test_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.6, 0);
+    ob_material *mirror = ob_material_create(w->lib, &(ob_material_desc){.name = "mirror",
+        .kind = OB_MATERIAL_REFLECTIVE, .reflectivity = 0.8f, .casts_shadows = true}, &r);
+    assert_non_null(mirror);
+    static const double mirrors[3][3] = {{-1.6, 0.4, 0}, {1.6, 0.4, 0}, {0, 0.4, -2.2}};
+    for (int i = 0; i < 3; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "mirror%d", i);
+        ob_node *m = ob_test_world_entity(w, NULL, name, w->sphere, mirror, mirrors[i][0],
+                                          mirrors[i][1], mirrors[i][2]);
+        ob_node_set_scale(m, (const float[3]){1.6f, 1.6f, 1.6f});
+    }
+    uint32_t seed = 12345;
+    for (uint32_t i = 0; i < ENTITIES; i++) {
+        char name[24];
+        snprintf(name, sizeof name, "object%u", i);
+        ob_geometry *g = i % 3 == 0 ? w->sphere : w->box;
+        ob_material *m = palette[next_random(&seed) % 8];
+        ob_node *n = ob_test_world_entity(w, NULL, name, g, m, 0, 0, 0);
+        ob_node_set_scale(n, (const float[3]){0.3f, 0.3f, 0.3f});
+        double radius = 3.0 + 5.0 * random01(&seed);
+        double center[3] = {0.0, 0.2 + 2.0 * random01(&seed), 0.0};
+        float speed = (0.2f + 0.6f * random01(&seed)) * (i % 2 ? -1.0f : 1.0f);
+        assert_int_equal(ob_node_add_orbit_controller(n, center, (const float[3]){0, 1, 0}, radius,
+                                                      speed, 6.2831853f * random01(&seed)), OB_OK);
+        float spin[3] = {random01(&seed) - 0.5f, 1.0f, random01(&seed) - 0.5f};
+        assert_int_equal(ob_node_add_rotation_controller(n, spin, 1.0f + 2.0f * random01(&seed)),
+                         OB_OK);
+    }
+    ob_node *fountain = ob_node_create(w->scene, NULL, "fountain", &r);
+    assert_non_null(fountain);
+    ob_node_set_position(fountain, (const double[3]){0.0, 0.0, 1.5});
+    ob_particle_desc pd = {.name = "sparks", .count = 1024, .seed = 3, .lifetime = 1.5f,
+                           .speed = 2.0f, .size = 0.05f, .gravity = {0.0f, -2.0f, 0.0f}};
+    *out_ps = ob_particle_system_create(w->views, w->scene, fountain, &pd, &r);
+    if (!*out_ps) fail_msg("particles: %s", ob_result_name(r));
+}
+
+static void run(const run_plan *plan, run_result *out)
+{
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 8, .width = WIDTH,
+                                                   .height = HEIGHT, .env_map_size = 32,
+                                                   .shadow_map_size = 128, .chunk_draws = 64});
+    assert_int_equal(ob_renderer_worker_count(w.r), 8);
+    ob_particle_system *ps = NULL;
+    build_scene(&w, &ps);
+    for (int f = 0; f < FRAMES; f++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, plan->modes[f], plan->workers[f]);
+        out->stats[f] = *st;
+        out->images[f] = ob_test_world_snapshot(&w);
+        /* The mode asked for is the mode used (AUTO decides for itself). */
+        if (plan->modes[f] == OB_THREADING_SINGLE) assert_int_equal(st->workers, 0);
+        if (plan->modes[f] == OB_THREADING_MULTI)
+            assert_int_equal(st->workers, plan->workers[f] ? plan->workers[f] : 8);
+    }
+    assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+    ob_particle_system_destroy(w.views, ps);
+    ob_test_world_destroy(&w);
+}
+
+static void release(run_result *r)
+{
+    for (int f = 0; f < FRAMES; f++) free(r->images[f]);
+}
+
+/* The scene really is what it claims: every kind of view runs and the
+ * frames differ from each other (it moves). */
+static void check_reference(const run_result *ref)
+{
+    for (int f = 0; f < FRAMES; f++) {
+        const ob_frame_stats *st = &ref->stats[f];
+        assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 3);
+        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_test_count_views(st, OB_VIEW_SIMULATION), 1);
+        assert_true(ob_test_view_stats(st, "main")->draws > 200);
+        assert_int_equal(st->pm.skipped_draws, 0);
+        if (f > 0)
+            assert_true(ob_test_image_max_diff(ref->images[f - 1], ref->images[f], WIDTH, HEIGHT) > 0);
+    }
+}
+
+static void assert_same(const run_result *ref, const run_result *got, const char *name)
+{
+    for (int f = 0; f < FRAMES; f++) {
+        const ob_frame_stats *a = &ref->stats[f], *b = &got->stats[f];
+        if (a->view_count != b->view_count)
+            fail_msg("%s, frame %d: %u views, single-threaded %u", name, f, b->view_count,
+                     a->view_count);
+        for (uint32_t i = 0; i < a->view_count; i++) {
+            if (strcmp(a->views[i].name, b->views[i].name) != 0)
+                fail_msg("%s, frame %d: view %u is '%s', single-threaded '%s'", name, f, i,
+                         b->views[i].name, a->views[i].name);
+            if (a->views[i].hash.hash != b->views[i].hash.hash ||
+                a->views[i].hash.draws != b->views[i].hash.draws)
+                fail_msg("%s, frame %d, view '%s': hash %016llx (%u draws), single-threaded "
+                         "%016llx (%u draws)", name, f, a->views[i].name,
+                         (unsigned long long)b->views[i].hash.hash, b->views[i].hash.draws,
+                         (unsigned long long)a->views[i].hash.hash, a->views[i].hash.draws);
+        }
+        assert_true(a->frame_hash == b->frame_hash);
+        uint32_t diff = ob_test_image_max_diff(ref->images[f], got->images[f], WIDTH, HEIGHT);
+        if (diff) fail_msg("%s, frame %d: pixels differ by up to %u", name, f, diff);
+    }
+}
+
+static run_plan constant_plan(const char *name, ob_threading mode, uint32_t workers)
+{
+    run_plan p = {.name = name};
+    for (int f = 0; f < FRAMES; f++) {
+        p.modes[f] = mode;
+        p.workers[f] = workers;
+    }
+    return p;
+}
+
+static void same_frames_in_every_threading_mode(void **state)
+{
+    (void)state;
+    run_result ref;
+    run_plan st_plan = constant_plan("single-threaded", OB_THREADING_SINGLE, 0);
+    run(&st_plan, &ref);
+    check_reference(&ref);
+
+    static const uint32_t counts[] = {1, 2, 3, 4, 8};
+    for (size_t k = 0; k < OB_ARRAY_COUNT(counts); k++) {
+        char name[32];
+        snprintf(name, sizeof name, "%u workers", counts[k]);
+        run_plan plan = constant_plan(name, OB_THREADING_MULTI, counts[k]);
+        run_result got;
+        run(&plan, &got);
+        /* Chunked: the main view was recorded as several secondaries. */
+        for (int f = 0; f < FRAMES; f++)
+            assert_true(ob_test_view_stats(&got.stats[f], "main")->chunks > 1);
+        assert_same(&ref, &got, name);
+        release(&got);
+    }
+    release(&ref);
+}
+
+static void switching_mode_every_frame_changes_nothing(void **state)
+{
+    (void)state;
+    run_result ref, got;
+    run_plan st_plan = constant_plan("single-threaded", OB_THREADING_SINGLE, 0);
+    run(&st_plan, &ref);
+    run_plan mixed = {.name = "switching every frame",
+                      .modes = {OB_THREADING_MULTI, OB_THREADING_SINGLE, OB_THREADING_MULTI,
+                                OB_THREADING_SINGLE, OB_THREADING_MULTI},
+                      .workers = {3, 0, 8, 0, 1}};
+    run(&mixed, &got);
+    assert_same(&ref, &got, mixed.name);
+    release(&got);
+    run_plan automatic = constant_plan("auto", OB_THREADING_AUTO, 0);
+    run(&automatic, &got);
+    for (int f = 0; f < FRAMES; f++) assert_int_equal(got.stats[f].mode, OB_THREADING_AUTO);
+    assert_same(&ref, &got, automatic.name);
+    release(&got);
+    release(&ref);
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(same_frames_in_every_threading_mode),
+        cmocka_unit_test(switching_mode_every_frame_changes_nothing),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

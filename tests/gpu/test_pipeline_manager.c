@@ -1,0 +1,495 @@
+/* Issue 4: the pipeline manager binds only what changes, packs uniforms only
+ * after a parameter changed, records the same commands into the primary and
+ * into secondaries, survives a stale texture handle and leaves out materials
+ * that have no effect for a view type.
+ *
+ * The frame always ends with the composite view (one full-screen draw), so
+ * the main view's share of the summed manager stats is the frame's stats
+ * minus those of a frame in which the main view is empty. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "ob_test_world.h"
+
+#define GRID_COLUMNS 10
+
+/* Boxes on a grid in front of the camera, all visible from (0, 12, 8). */
+static void add_grid(ob_test_world *w, uint32_t count, ob_material **materials,
+                     uint32_t material_count)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "box%u", i);
+        double x = ((double)(i % GRID_COLUMNS) - 4.5) * 1.2, z = -(double)(i / GRID_COLUMNS) * 1.2;
+        ob_test_world_entity(w, NULL, name, w->box, materials[i % material_count], x, 0.0, z);
+    }
+}
+
+static void frame_camera(ob_test_world *w) { ob_test_world_look(w, 0, 12, 8, 0, 0, -5); }
+
+/* a - b, field by field (every field of ob_pm_stats is a counter). */
+static ob_pm_stats pm_minus(ob_pm_stats a, const ob_pm_stats *b)
+{
+    a.draws -= b->draws;
+    a.dispatches -= b->dispatches;
+    a.pipeline_binds_requested -= b->pipeline_binds_requested;
+    a.pipeline_binds_issued -= b->pipeline_binds_issued;
+    a.descriptor_binds_requested -= b->descriptor_binds_requested;
+    a.descriptor_binds_issued -= b->descriptor_binds_issued;
+    a.push_descriptor_requested -= b->push_descriptor_requested;
+    a.push_descriptor_issued -= b->push_descriptor_issued;
+    a.push_constant_requested -= b->push_constant_requested;
+    a.push_constant_issued -= b->push_constant_issued;
+    a.vertex_binds_requested -= b->vertex_binds_requested;
+    a.vertex_binds_issued -= b->vertex_binds_issued;
+    a.index_binds_requested -= b->index_binds_requested;
+    a.index_binds_issued -= b->index_binds_issued;
+    a.blocks_packed -= b->blocks_packed;
+    a.blocks_reused -= b->blocks_reused;
+    a.uniform_bytes -= b->uniform_bytes;
+    a.skipped_draws -= b->skipped_draws;
+    return a;
+}
+
+/* The manager stats of the composite alone (main view empty). */
+static ob_pm_stats composite_only(ob_test_world *w, ob_threading mode, uint32_t workers)
+{
+    const ob_frame_stats *st = ob_test_world_frame(w, mode, workers);
+    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    assert_non_null(main);
+    assert_int_equal(main->draws, 0);
+    assert_int_equal(st->pm.draws, 1);
+    return st->pm;
+}
+
+/* Sizes of the lit effect's PerView and PerMaterial blocks. */
+static void lit_block_sizes(ob_test_world *w, uint32_t *per_view, uint32_t *per_material)
+{
+    ob_effect *e = ob_material_library_find_effect(w->lib, OB_STD_LIT, 0);
+    assert_non_null(e);
+    const ob_program *p = ob_effect_program(e);
+    assert_int_equal(p->ubo_count, 2);
+    *per_view = *per_material = 0;
+    for (uint32_t i = 0; i < p->ubo_count; i++) {
+        if (p->ubos[i].binding == 0) *per_view = p->ubos[i].size;
+        if (p->ubos[i].binding == 1) *per_material = p->ubos[i].size;
+    }
+    assert_true(*per_view > 0 && *per_material > 0);
+}
+
+/* 100 entities sharing a material and a geometry: one pipeline, vertex,
+ * index and descriptor-set bind, and each uniform block packed once. */
+static void shared_state_bound_once_single_threaded(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    frame_camera(&w);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_pm_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
+
+    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    add_grid(&w, 100, &m, 1);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint32_t per_view, per_material;
+    lit_block_sizes(&w, &per_view, &per_material);
+    ob_pm_stats s = pm_minus(st->pm, &base);
+    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    assert_int_equal(main->draws, 100);
+    assert_int_equal(main->chunks, 1);
+    assert_int_equal(main->worker, -1);
+    assert_int_equal(s.draws, 100);
+    assert_int_equal(s.pipeline_binds_requested, 100);
+    assert_int_equal(s.pipeline_binds_issued, 1);
+    assert_int_equal(s.vertex_binds_requested, 100);
+    assert_int_equal(s.vertex_binds_issued, 1);
+    assert_int_equal(s.index_binds_requested, 100);
+    assert_int_equal(s.index_binds_issued, 1);
+    assert_int_equal(s.descriptor_binds_requested, 100);
+    assert_int_equal(s.descriptor_binds_issued, 1);
+    /* PerView and PerMaterial packed once, reused by the other 99 draws. */
+    assert_int_equal(s.blocks_packed, 2);
+    assert_int_equal(s.blocks_reused, 2 * 99);
+    assert_int_equal(s.uniform_bytes, per_view + per_material);
+    /* Every box has its own world matrix: push constants change per draw. */
+    assert_int_equal(s.push_constant_requested, 100);
+    assert_int_equal(s.push_constant_issued, 100);
+    assert_int_equal(s.skipped_draws, 0);
+    ob_test_world_destroy(&w);
+}
+
+/* Multi-threaded, the main view is split into chunks, each recorded into its
+ * own secondary: state is bound once per secondary. */
+static void shared_state_bound_once_per_secondary(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 25});
+    frame_camera(&w);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_pm_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
+    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    add_grid(&w, 100, &m, 1);
+    uint32_t per_view, per_material;
+    for (int frame = 0; frame < 3; frame++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 4);
+        if (frame == 0) lit_block_sizes(&w, &per_view, &per_material);
+        ob_pm_stats s = pm_minus(st->pm, &base);
+        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        assert_int_equal(st->workers, 4);
+        assert_int_equal(main->draws, 100);
+        assert_true(main->worker >= 1 && main->worker <= 4);
+        uint32_t chunks = main->chunks;
+        assert_true(chunks >= 4); /* 100 draws, 25 per job */
+        assert_true(chunks <= 100);
+        assert_int_equal(s.pipeline_binds_requested, 100);
+        assert_int_equal(s.pipeline_binds_issued, chunks);
+        assert_int_equal(s.vertex_binds_requested, 100);
+        assert_int_equal(s.vertex_binds_issued, chunks);
+        assert_int_equal(s.index_binds_requested, 100);
+        assert_int_equal(s.index_binds_issued, chunks);
+        assert_int_equal(s.descriptor_binds_requested, 100);
+        assert_int_equal(s.descriptor_binds_issued, chunks);
+        /* A worker keeps its packed blocks across the chunks it records. */
+        assert_true(s.blocks_packed >= 2 && s.blocks_packed <= 2 * chunks);
+        assert_int_equal(s.blocks_packed + s.blocks_reused, 200);
+        assert_true(s.uniform_bytes <= (uint64_t)chunks * (per_view + per_material));
+        assert_int_equal(s.skipped_draws, 0);
+    }
+    ob_test_world_destroy(&w);
+}
+
+/* Uniform data follows parameter changes, not draws: more draws with the
+ * same parameters pack nothing more; distinct material objects with equal
+ * values pack like one material; a colour per draw packs per draw. */
+static void uniforms_packed_only_after_a_change(void **state)
+{
+    (void)state;
+    enum { SHARED_50, SHARED_100, SAME_VALUES, DISTINCT, CASES };
+    ob_pm_stats got[CASES];
+    uint32_t per_view = 0, per_material = 0;
+    for (int c = 0; c < CASES; c++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        frame_camera(&w);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+        ob_pm_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
+        ob_material *mats[100];
+        uint32_t nm = c == SHARED_50 || c == SHARED_100 ? 1 : 100;
+        for (uint32_t i = 0; i < nm; i++) {
+            float red = c == DISTINCT ? (float)i / 100.0f : 0.5f;
+            mats[i] = ob_test_world_material(&w, OB_MATERIAL_LIT, red, 0.5f, 0.5f, false);
+        }
+        uint32_t count = c == SHARED_50 ? 50 : 100;
+        add_grid(&w, count, mats, nm);
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        assert_int_equal(ob_test_view_stats(st, "main")->draws, count);
+        got[c] = pm_minus(st->pm, &base);
+        if (c == 0) lit_block_sizes(&w, &per_view, &per_material);
+        /* The next frame packs again (new ring space) but no more than this one. */
+        const ob_frame_stats *again = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        assert_int_equal(pm_minus(again->pm, &base).blocks_packed, got[c].blocks_packed);
+        ob_test_world_destroy(&w);
+    }
+    assert_int_equal(got[SHARED_50].blocks_packed, 2);
+    assert_int_equal(got[SHARED_100].blocks_packed, 2);
+    assert_int_equal(got[SHARED_50].uniform_bytes, got[SHARED_100].uniform_bytes);
+    assert_int_equal(got[SAME_VALUES].blocks_packed, 2);
+    assert_int_equal(got[SAME_VALUES].uniform_bytes, per_view + per_material);
+    assert_int_equal(got[SAME_VALUES].descriptor_binds_issued, 1);
+    assert_int_equal(got[DISTINCT].blocks_packed, 1 + 100);
+    assert_int_equal(got[DISTINCT].blocks_reused, 99);
+    assert_int_equal(got[DISTINCT].uniform_bytes, per_view + 100 * per_material);
+    /* One effect for all of them: still one pipeline bind. */
+    assert_int_equal(got[DISTINCT].pipeline_binds_issued, 1);
+}
+
+/* Many programs, each with its own PerView and PerMaterial mappings, drawn
+ * once each: every draw must read its own material block (the per-manager
+ * cache of packed blocks must never hand one entry to two blocks of a
+ * draw). Unlit colours land in the image exactly. */
+static void many_programs_each_read_their_own_uniforms(void **state)
+{
+    (void)state;
+    enum { N = 100, SIDE = 10 };
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_test_world_look(&w, 0, 0, 20, 0, 0, 0);
+    ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 0.6f, .znear = 0.1f});
+    ob_effect *effects[N];
+    float colors[N][3];
+    for (uint32_t i = 0; i < N; i++) {
+        char name[32], value[16];
+        snprintf(name, sizeof name, "unlit-%u", i);
+        snprintf(value, sizeof value, "%u", i);
+        ob_shader_define def = {"TEST_VARIANT", value};
+        ob_effect_desc ed = {.name = name, .vertex = "unlit.vert", .fragment = "unlit.frag",
+                             .define_count = 1, .defines = &def,
+                             .layout = ob_views_standard_input(), .depth_test = true,
+                             .depth_write = true, .cull = VK_CULL_MODE_BACK_BIT};
+        ob_result r;
+        effects[i] = ob_effect_create(w.fx, &ed, &r);
+        if (!effects[i]) fail_msg("effect %u: %s", i, ob_result_name(r));
+        colors[i][0] = (float)(i % 5) / 5.0f + 0.1f;
+        colors[i][1] = (float)((i / 5) % 5) / 5.0f + 0.1f;
+        colors[i][2] = (float)(i / 25) / 5.0f + 0.1f;
+        ob_material_desc md = {.name = name, .kind = OB_MATERIAL_CUSTOM,
+                               .diffuse = {colors[i][0], colors[i][1], colors[i][2], 1.0f}};
+        ob_material *m = ob_material_create(w.lib, &md, &r);
+        assert_non_null(m);
+        assert_int_equal(ob_material_set_view_effect(m, OB_VIEW_PERSPECTIVE, effects[i]), OB_OK);
+        double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
+        ob_test_world_entity(&w, NULL, name, w.box, m, x, y, 0);
+    }
+    const double half_h = 19.5 * tan(0.3), half_w = half_h * 160.0 / 120.0;
+    for (int f = 0; f < 4; f++) {
+        const ob_frame_stats *st =
+            ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+        assert_int_equal(ob_test_view_stats(st, "main")->draws, N);
+        ob_test_world_read(&w);
+        for (uint32_t i = 0; i < N; i++) {
+            double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
+            uint32_t px = (uint32_t)((x / half_w + 1.0) * 0.5 * w.width);
+            uint32_t py = (uint32_t)((1.0 - y / half_h) * 0.5 * w.height);
+            const uint8_t *p = ob_test_world_pixel(&w, px, py);
+            for (int c = 0; c < 3; c++)
+                if (fabs(p[c] - colors[i][c] * 255.0f) > 1.0)
+                    fail_msg("frame %d, box %u at (%u,%u): %u,%u,%u, expected %.0f,%.0f,%.0f", f,
+                             i, px, py, p[0], p[1], p[2], colors[i][0] * 255.0f,
+                             colors[i][1] * 255.0f, colors[i][2] * 255.0f);
+        }
+    }
+    assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+    for (uint32_t i = 0; i < N; i++) ob_effect_destroy(effects[i]);
+    ob_test_world_destroy(&w);
+}
+
+/* Build the scene used for the ST/MT comparison: shared and distinct
+ * materials, two geometries, a shadow-casting light. */
+static void mixed_scene(ob_test_world *w)
+{
+    frame_camera(w);
+    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 10, 5);
+    ob_material *mats[4] = {
+        ob_test_world_material(w, OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true),
+        ob_test_world_material(w, OB_MATERIAL_LIT, 0.2f, 0.7f, 0.3f, true),
+        ob_test_world_material(w, OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.2f, false),
+        ob_test_world_material(w, OB_MATERIAL_LIT, 0.3f, 0.3f, 0.9f, false),
+    };
+    add_grid(w, 120, mats, 4);
+    ob_material *ground = ob_test_world_material(w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_test_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.5, -5);
+    for (int i = 0; i < 10; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "ball%d", i);
+        ob_test_world_entity(w, NULL, name, w->sphere, mats[i % 2], -5.0 + i, 1.0, -4.0);
+    }
+}
+
+/* The same draws recorded inline into the primary and as chunks into
+ * secondaries on several workers: same pixels, same command hashes. */
+static void primary_and_secondaries_record_the_same(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16});
+    mixed_scene(&w);
+    ob_frame_stats ref = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
+    assert_int_equal(ref.workers, 0);
+    const ob_view_stats *ref_main = ob_test_view_stats(&ref, "main");
+    assert_true(ref_main->draws >= 120);
+    assert_non_null(ob_test_view_stats(&ref, "shadow:sun"));
+    static const uint32_t workers[] = {1, 2, 4};
+    for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, workers[k]);
+        assert_int_equal(st->workers, workers[k]);
+        assert_int_equal(st->view_count, ref.view_count);
+        assert_true(ob_test_view_stats(st, "main")->chunks > 1);
+        for (uint32_t i = 0; i < ref.view_count; i++) {
+            assert_string_equal(st->views[i].name, ref.views[i].name);
+            assert_int_equal(st->views[i].draws, ref.views[i].draws);
+            if (st->views[i].hash.hash != ref.views[i].hash.hash)
+                fail_msg("view '%s': hash %016llx with %u workers, %016llx single-threaded",
+                         ref.views[i].name, (unsigned long long)st->views[i].hash.hash, workers[k],
+                         (unsigned long long)ref.views[i].hash.hash);
+            assert_int_equal(st->views[i].hash.draws, ref.views[i].hash.draws);
+        }
+        assert_true(st->frame_hash == ref.frame_hash);
+        ob_test_world_read(&w);
+        assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+    }
+    free(ref_pixels);
+    ob_test_world_destroy(&w);
+}
+
+/* A fragment shader sampling "TestTexture" (and "TestTextureSampler"). */
+static const char textured_frag[] =
+    "#version 450\n"
+    "layout(set = 1, binding = 0) uniform sampler2D TestTexture;\n"
+    "layout(location = 0) in vec4 vColor;\n"
+    "layout(location = 0) out vec4 outColor;\n"
+    "void main() { outColor = texture(TestTexture, vec2(0.5)); }\n";
+
+/* A texture parameter whose image was destroyed: the draws that sample it
+ * are skipped and counted, one line is logged, nothing crashes and every
+ * other draw still lands. */
+static void stale_texture_skips_the_draw(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ob-test-pm-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[128];
+    snprintf(path, sizeof path, "%s/textured.frag", dir);
+    assert_int_equal(ob_file_write(path, textured_frag, sizeof textured_frag - 1), OB_OK);
+
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_test_world_look(&w, 0, 0, 6, 0, 0, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
+    ob_result r;
+    ob_effect_desc ed = {.name = "textured", .vertex = "unlit.vert", .fragment = path,
+                         .layout = ob_views_standard_input(), .depth_test = true,
+                         .depth_write = true, .cull = VK_CULL_MODE_BACK_BIT};
+    ob_effect *fx = ob_effect_create(w.fx, &ed, &r);
+    if (!fx) fail_msg("textured effect: %s", ob_result_name(r));
+    ob_param_registry *reg = ob_renderer_registry(w.r);
+    ob_param tex = ob_param_find(reg, "TestTexture");
+    ob_param smp = ob_param_find(reg, "TestTextureSampler");
+    assert_true(tex.id && smp.id);
+    const uint8_t green[4 * 4] = {0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255};
+    ob_image img = ob_image_create(w.dev, &(ob_image_desc){.width = 2, .height = 2,
+        .format = VK_FORMAT_R8G8B8A8_UNORM, .usage = OB_IMAGE_SAMPLED, .data = green,
+        .name = "green"}, &r);
+    assert_true(img.id != 0);
+    ob_sampler sampler = ob_sampler_create(w.dev, &(ob_sampler_desc){.name = "test"}, &r);
+    assert_true(sampler.id != 0);
+    assert_int_equal(ob_params_init_texture(reg, tex, img), OB_OK);
+    assert_int_equal(ob_params_init_sampler(reg, smp, sampler), OB_OK);
+
+    ob_material_desc md = {.name = "textured", .kind = OB_MATERIAL_CUSTOM};
+    ob_material *textured = ob_material_create(w.lib, &md, &r);
+    assert_non_null(textured);
+    assert_int_equal(ob_material_set_view_effect(textured, OB_VIEW_PERSPECTIVE, fx), OB_OK);
+    ob_material *red = ob_test_world_material(&w, OB_MATERIAL_UNLIT, 1.0f, 0.0f, 0.0f, false);
+    ob_node *bad[3];
+    for (int i = 0; i < 3; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "textured%d", i);
+        bad[i] = ob_test_world_entity(&w, NULL, name, w.box, textured, -1.5 + 1.5 * i, 1.2, 0);
+    }
+    ob_test_world_entity(&w, NULL, "red", w.box, red, 0, -1.2, 0);
+
+    /* Valid texture: the textured boxes are green. */
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(st->pm.skipped_draws, 0);
+    assert_int_equal(ob_test_view_stats(st, "main")->draws, 4);
+    ob_test_world_read(&w);
+    uint32_t top = (uint32_t)(w.height * 0.3f), bottom = (uint32_t)(w.height * 0.7f);
+    const uint8_t *p = ob_test_world_pixel(&w, w.width / 2, top);
+    assert_true(p[0] == 0 && p[1] == 255 && p[2] == 0);
+
+    /* Reference: the frame without the textured boxes. */
+    for (int i = 0; i < 3; i++) ob_node_set_hidden(bad[i], true);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *without = ob_test_world_snapshot(&w);
+    for (int i = 0; i < 3; i++) ob_node_set_hidden(bad[i], false);
+
+    ob_image_destroy(w.dev, img); /* TestTexture now holds a stale handle */
+    for (int mode = 0; mode < 2; mode++) {
+        ob_test_log_clear();
+        st = ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 1);
+        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        assert_int_equal(st->pm.skipped_draws, 3);
+        assert_int_equal(main->draws, 1); /* the red box */
+        assert_int_equal(ob_test_log_count(OB_LOG_WARN), 1);
+        assert_true(ob_test_log_has("TestTexture", "stale handle", NULL));
+        ob_test_world_read(&w);
+        assert_int_equal(ob_test_image_max_diff(without, w.pixels, w.width, w.height), 0);
+        p = ob_test_world_pixel(&w, w.width / 2, bottom);
+        assert_true(p[0] == 255 && p[1] == 0 && p[2] == 0);
+    }
+    free(without);
+    /* The effect goes before the effect context, once no frame uses it. */
+    assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+    ob_material_set_view_effect(textured, OB_VIEW_PERSPECTIVE, NULL);
+    ob_effect_destroy(fx);
+    ob_sampler_destroy(w.dev, sampler);
+    ob_test_world_destroy(&w);
+    unlink(path);
+    rmdir(dir);
+}
+
+/* A material with no effect for a view type is not drawn there and counts
+ * as culled: a custom material with only a perspective effect, a lit
+ * material that casts no shadow, an unlit one in an environment map. */
+static void material_without_effect_is_culled(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_test_world_look(&w, 0, 3, 6, 0, 0, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *caster = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, true);
+    ob_material *no_shadow = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.8f, false);
+    ob_material *unlit = ob_test_world_material(&w, OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.1f, false);
+    ob_result r;
+    ob_material *custom = ob_material_create(w.lib, &(ob_material_desc){.name = "custom-unlit",
+                                             .kind = OB_MATERIAL_CUSTOM}, &r);
+    assert_non_null(custom);
+    ob_effect *unlit_fx = ob_material_library_effect(w.lib, OB_STD_UNLIT, 0, &r);
+    assert_non_null(unlit_fx);
+    assert_int_equal(ob_material_set_view_effect(custom, OB_VIEW_PERSPECTIVE, unlit_fx), OB_OK);
+    ob_material_desc mirror_desc = {.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE,
+                                    .casts_shadows = true};
+    ob_material *mirror = ob_material_create(w.lib, &mirror_desc, &r);
+    assert_non_null(mirror);
+
+    ob_test_world_entity(&w, NULL, "caster", w.box, caster, -1.5, 0, 0);
+    ob_test_world_entity(&w, NULL, "no-shadow", w.box, no_shadow, 0, 0, -1.5);
+    ob_test_world_entity(&w, NULL, "unlit", w.box, unlit, 1.5, 0, 0);
+    ob_test_world_entity(&w, NULL, "custom", w.box, custom, 0, 0, 1.5);
+    ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror, 0, 0, 0);
+
+    for (int mode = 0; mode < 2; mode++) {
+        const ob_frame_stats *st =
+            ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        const ob_view_stats *shadow = ob_test_view_stats(st, "shadow:sun");
+        const ob_view_stats *env = ob_test_view_stats(st, "envmap:mirror");
+        assert_non_null(main);
+        assert_non_null(shadow);
+        assert_non_null(env);
+        assert_int_equal(main->draws, 5);
+        assert_int_equal(main->culled, 0);
+        /* Shadow: the caster and the mirror; three without a depth effect. */
+        assert_int_equal(shadow->draws, 2);
+        assert_int_equal(shadow->culled, 3);
+        /* Env map (two layers): caster and no-shadow in each; the owner is
+         * excluded, unlit and custom have no paraboloid effect. */
+        assert_int_equal(env->draws, 2 * 2);
+        assert_int_equal(env->culled, 3);
+        assert_int_equal(st->pm.skipped_draws, 0);
+        assert_int_equal(st->culled, main->culled + shadow->culled + env->culled);
+    }
+    ob_test_world_destroy(&w);
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(shared_state_bound_once_single_threaded),
+        cmocka_unit_test(shared_state_bound_once_per_secondary),
+        cmocka_unit_test(uniforms_packed_only_after_a_change),
+        cmocka_unit_test(many_programs_each_read_their_own_uniforms),
+        cmocka_unit_test(primary_and_secondaries_record_the_same),
+        cmocka_unit_test(stale_texture_skips_the_draw),
+        cmocka_unit_test(material_without_effect_is_culled),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,203 @@
+/* Issue 5: the worker pool. It starts and stops with the renderer (threads
+ * joined, nothing leaked — the ASan build checks the memory, the thread
+ * count here checks the joins), also when creation fails half-way; the
+ * threading mode and worker count change at the next frame start, never in
+ * the middle of a frame. */
+#define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ob_test_world.h"
+
+/* Threads of this process. */
+static uint32_t thread_count(void)
+{
+    DIR *d = opendir("/proc/self/task");
+    assert_non_null(d);
+    uint32_t n = 0;
+    for (struct dirent *e; (e = readdir(d));) n += e->d_name[0] != '.';
+    closedir(d);
+    return n;
+}
+
+/* Threads the driver and layers start once per process stay; take the
+ * baseline after one full renderer has come and gone. */
+static uint32_t baseline_threads(void)
+{
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 2});
+    ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
+    ob_test_world_destroy(&w);
+    return thread_count();
+}
+
+static void lit_cube(ob_test_world *w)
+{
+    ob_material *m = ob_test_world_material(w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, true);
+    ob_test_world_entity(w, NULL, "cube", w->box, m, 0, 0, 0);
+    ob_material *g = ob_test_world_material(w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    ob_test_world_entity(w, NULL, "ground", w->plane, g, 0, -0.5, 0);
+    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+}
+
+/* Five renderers with 1 to 8 workers: each starts its threads, records a
+ * frame with all of them active, and takes every thread with it. */
+static void worker_pool_starts_and_stops_with_the_renderer(void **state)
+{
+    (void)state;
+    uint32_t base = baseline_threads();
+    static const uint32_t counts[] = {1, 2, 3, 5, 8};
+    uint8_t *first = NULL;
+    for (size_t k = 0; k < OB_ARRAY_COUNT(counts); k++) {
+        uint32_t n = counts[k];
+        ob_test_world w;
+        ob_test_world_create(&w, &(ob_test_world_desc){.workers = n});
+        assert_int_equal(ob_renderer_worker_count(w.r), n);
+        assert_true(thread_count() >= base + n);
+        lit_cube(&w);
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
+        assert_int_equal(st->mode, OB_THREADING_MULTI);
+        assert_int_equal(st->workers, n);
+        for (uint32_t i = 0; i < st->view_count; i++) {
+            if (st->views[i].chunks == 0) continue;
+            assert_true(st->views[i].worker >= 1 && (uint32_t)st->views[i].worker <= n);
+        }
+        uint8_t *img = ob_test_world_snapshot(&w);
+        if (!first) first = img;
+        else {
+            assert_int_equal(ob_test_image_max_diff(first, img, w.width, w.height), 0);
+            free(img);
+        }
+        ob_test_world_destroy(&w);
+        if (thread_count() != base)
+            fail_msg("%u workers: %u threads after destroy, %u before create", n, thread_count(),
+                     base);
+    }
+    free(first);
+}
+
+/* One frame driven by hand so the mode can be changed in its middle. */
+static const ob_frame_stats *frame_changing_mode(ob_test_world *w, ob_threading mode,
+                                                 uint32_t workers)
+{
+    assert_int_equal(ob_scene_update(w->scene, 1.0 / 60.0), OB_OK);
+    assert_int_equal(ob_renderer_begin_frame(w->r, w->scene), OB_OK);
+    ob_views_render(w->views, ob_composite_view_base(w->composite));
+    ob_renderer_set_threading(w->r, mode, workers); /* mid-frame: for the next one */
+    assert_int_equal(ob_renderer_end_frame(w->r), OB_OK);
+    assert_int_equal(ob_renderer_wait_idle(w->r), OB_OK);
+    return ob_renderer_last_stats(w->r);
+}
+
+/* A change asked for during a frame applies from the next frame start. */
+static void threading_change_takes_effect_at_next_frame(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 8, .chunk_draws = 1});
+    lit_cube(&w);
+    ob_renderer_set_threading(w.r, OB_THREADING_SINGLE, 0);
+    static const struct {
+        ob_threading mode;
+        uint32_t asked, active;
+    } steps[] = {
+        {OB_THREADING_MULTI, 3, 3},  {OB_THREADING_MULTI, 5, 5},  {OB_THREADING_SINGLE, 0, 0},
+        {OB_THREADING_MULTI, 0, 8},  /* 0: all workers */
+        {OB_THREADING_MULTI, 99, 8}, /* more than the pool: all of it */
+        {OB_THREADING_MULTI, 1, 1},  {OB_THREADING_SINGLE, 4, 0},
+    };
+    ob_threading mode = OB_THREADING_SINGLE;
+    uint32_t active = 0;
+    for (size_t i = 0; i < OB_ARRAY_COUNT(steps); i++) {
+        const ob_frame_stats *st = frame_changing_mode(&w, steps[i].mode, steps[i].asked);
+        /* This frame still ran as set before it began. */
+        assert_int_equal(st->mode, mode);
+        assert_int_equal(st->workers, active);
+        assert_int_equal(ob_renderer_threading(w.r), mode);
+        mode = steps[i].mode;
+        active = steps[i].active;
+    }
+    const ob_frame_stats *st = frame_changing_mode(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(st->mode, mode);
+    assert_int_equal(st->workers, active);
+    ob_test_world_destroy(&w);
+}
+
+/* Views are recorded by workers of the active set only. */
+static void only_active_workers_record(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 6, .chunk_draws = 2});
+    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
+    for (int i = 0; i < 60; i++)
+        ob_test_world_entity(&w, NULL, "box", w.box, m, (i % 10) - 4.5, 0, -(i / 10));
+    ob_test_world_look(&w, 0, 8, 8, 0, 0, -3);
+    for (uint32_t n = 1; n <= 6; n++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, n);
+        assert_int_equal(st->workers, n);
+        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        assert_int_equal(main->draws, 60);
+        assert_true(main->chunks >= 30);
+        for (uint32_t i = 0; i < st->view_count; i++)
+            if (st->views[i].chunks)
+                assert_true(st->views[i].worker >= 1 && (uint32_t)st->views[i].worker <= n);
+    }
+    ob_test_world_destroy(&w);
+}
+
+/* Renderer creation failing at each host allocation and each Vulkan object
+ * creation in turn: a NULL renderer and an error, no thread left running, no
+ * memory left (ASan), no validation message from the half-built device. */
+static void failed_creation_leaves_no_worker_behind(void **state)
+{
+    (void)state;
+    uint32_t base = baseline_threads();
+    static const ob_fault_kind kinds[] = {OB_FAULT_HOST_ALLOC, OB_FAULT_VK_OBJECT};
+    for (size_t k = 0; k < OB_ARRAY_COUNT(kinds); k++) {
+        ob_renderer_desc rd = {.device = {.app_name = "obelisk-test", .validation = 1},
+                               .worker_count = 4};
+        ob_result r;
+        ob_fault_arm(kinds[k], 0);
+        ob_renderer *ren = ob_renderer_create(&rd, &r);
+        assert_non_null(ren);
+        uint64_t points = ob_fault_count(kinds[k]);
+        ob_renderer_destroy(ren);
+        assert_true(points > 0);
+        uint32_t failed = 0;
+        for (uint64_t nth = 1; nth <= points; nth++) {
+            ob_fault_arm(kinds[k], nth);
+            ren = ob_renderer_create(&rd, &r);
+            bool hit = ob_fault_hit(kinds[k]);
+            ob_fault_arm(kinds[k], 0);
+            if (ren) {
+                /* A failure the renderer could live with (a debug name, say). */
+                ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(ren));
+                assert_int_equal(vc.errors + vc.warnings, 0);
+                ob_renderer_destroy(ren);
+            } else {
+                assert_true(hit);
+                assert_int_not_equal(r, OB_OK);
+                failed++;
+            }
+            if (thread_count() != base)
+                fail_msg("fault %zu at point %llu: %u threads, %u before", k,
+                         (unsigned long long)nth, thread_count(), base);
+        }
+        assert_true(failed > 0);
+    }
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(worker_pool_starts_and_stops_with_the_renderer),
+        cmocka_unit_test(threading_change_takes_effect_at_next_frame),
+        cmocka_unit_test(only_active_workers_record),
+        cmocka_unit_test(failed_creation_leaves_no_worker_behind),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
