@@ -88,6 +88,14 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         double c[3];
         float radius;
         ob_node_world_sphere(n, c, &radius);
+        /* A bound that is not empty locally but zero in the world: the world
+         * transform has zero scale, every triangle has zero area. Drawing it
+         * yields nothing, but keeping it would still queue its env map and
+         * stretch a shadow map's fit to its position. */
+        if (radius == 0.0f && rd->local_radius > 0.0f) {
+            v->culled++;
+            continue;
+        }
         float rel[3] = {(float)(c[0] - v->origin[0]), (float)(c[1] - v->origin[1]),
                         (float)(c[2] - v->origin[2])};
         if (!v->no_frustum && !ob_frustum_test_sphere(&frustum, rel, radius)) {
