@@ -105,6 +105,8 @@ struct ob_view {
     uint64_t queued_frame;            /* renderer frame serial when last queued */
     uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
     uint64_t cull_ns;                 /* this frame's ob_view_cull time */
+    bool range_reported;              /* an entity beyond float range was logged
+                                         and has not gone away since */
 };
 
 /* Initialise the base part (name copied, id = hash of name). */
@@ -113,8 +115,10 @@ void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const
 void ob_view_release(ob_view *v);
 
 /* Frustum-cull the scene's renderables into v->items for view type v->type,
- * using v->origin and v->view_proj, skipping `exclude` (the owner of an env map)
- * and entities whose material does not render in this view type; then sort
+ * using v->origin and v->view_proj, skipping `exclude` (the owner of an env map),
+ * entities whose material does not render in this view type, entities of
+ * zero world scale, and entities whose bound relative to v->origin does not
+ * fit in a float (logged once, naming the entity, until none is left); then sort
  * the list (opaque front to back, blended back to front, priority, id).
  * [render thread] */
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude);
