@@ -40,7 +40,11 @@ typedef enum ob_view_type {
 
 const char *ob_view_type_name(ob_view_type t);
 
-#define OB_VIEW_MAX_DEPS 8
+/* A view may depend on every other view of its frame (a camera seeing 100
+ * reflective entities samples 100 env maps), so this matches the renderer's
+ * OB_MAX_FRAME_VIEWS (checked there) and an edge is never dropped. */
+#define OB_VIEW_MAX_DEPS 128
+#define OB_VIEW_MAX_INPUTS 8
 #define OB_VIEW_MAX_LAYERS 2
 
 typedef struct ob_view ob_view;
@@ -89,7 +93,7 @@ struct ob_view {
 
     /* Images read by this view's draws besides its dependencies' targets. */
     uint32_t input_count;
-    ob_image inputs[OB_VIEW_MAX_DEPS];
+    ob_image inputs[OB_VIEW_MAX_INPUTS];
     ob_buffer storage_written;        /* compute views: buffer written (consumers
                                          read it in their vertex stage) */
 
