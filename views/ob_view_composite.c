@@ -68,6 +68,11 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
     cv->ctx = ctx;
     cv->source = source;
     cv->base.custom_record = true;
+    /* Declared as an input, not only reached through the dependency: when
+     * the source is left out (recursion bound 0) the composite still samples
+     * it, and an input gets a defined layout (cleared if never written). */
+    cv->base.inputs[0] = source->color;
+    cv->base.input_count = 1;
     cv->source_image = ob_param_find(ob_renderer_registry(ctx->r), "SourceImage");
     ob_image_info info;
     r = ob_image_get_info(ctx->dev, source->color, &info);
