@@ -221,8 +221,12 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             }
             e = &ctx->envs[ctx->env_count - 1];
         }
-        ob_renderer_attach_view(r, entity, e->view);
         ob_renderer_pre_draw(r, e->view);
+        /* Attached only when queued (now or earlier this frame): one left
+         * out at the recursion bound is never rendered, so the entity must
+         * not sample it (it draws without reflections instead). */
+        if (e->view->queued_frame == ob_renderer_frame_serial(r))
+            ob_renderer_attach_view(r, entity, e->view);
     }
 }
 
