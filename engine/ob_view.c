@@ -123,7 +123,8 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         v->items[v->item_count++] = (ob_draw_item){sort_key(cls, priority, d2), n};
     }
     if (!out_of_range) v->range_reported = false;
-    qsort(v->items, v->item_count, sizeof *v->items, compare_items);
+    /* items is NULL for an empty scene, and qsort's pointer must not be. */
+    if (v->item_count > 1) qsort(v->items, v->item_count, sizeof *v->items, compare_items);
     v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
 }
