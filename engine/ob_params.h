@@ -18,7 +18,9 @@
  * derived matrix may also be set directly; it then holds until one of its
  * sources changes in that slot. NormalMatrix's upper 3x3 is the cofactor
  * matrix of World's (det · inverse-transpose): finite even for a zero scale;
- * the shader normalizes.
+ * the shader normalizes. (When World's largest element is outside 2^±60 the
+ * cofactors are taken of World scaled by a power of two, so they neither
+ * overflow nor vanish: same direction, different length.)
  *
  * Lifecycle: ob_param_registry_create → register parameters → per frame
  * begin_recording / (set, get, pack on workers) / end_recording → destroy.

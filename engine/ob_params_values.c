@@ -140,13 +140,28 @@ typedef struct derived {
 
 /* Cofactor matrix of the upper 3x3 (columns c1×c2, c2×c0, c0×c1) = det ·
  * inverse-transpose: correct for non-uniform scale, finite for zero scale,
- * and the shader normalizes anyway. */
+ * and the shader normalizes anyway. It grows as scale²: past a scale of
+ * ~1e19 it would overflow (and the whole World write be refused), below
+ * ~1e-19 it would be denormal (flushed to zero on GPUs). Outside 2^±60 the
+ * columns are first scaled by a power of two — exact, and the direction is
+ * all the shader uses. */
 static void normal_from_world(mat4 w, mat4 dest)
 {
+    float largest = 0.0f;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) largest = fmaxf(largest, fabsf(w[i][k]));
+    vec3 c[3];
+    for (int i = 0; i < 3; i++) glm_vec3_copy(w[i], c[i]);
+    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
+        int exponent;
+        frexpf(largest, &exponent);
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) c[i][k] = ldexpf(c[i][k], -exponent);
+    }
     glm_mat4_zero(dest);
-    glm_vec3_cross(w[1], w[2], dest[0]);
-    glm_vec3_cross(w[2], w[0], dest[1]);
-    glm_vec3_cross(w[0], w[1], dest[2]);
+    glm_vec3_cross(c[1], c[2], dest[0]);
+    glm_vec3_cross(c[2], c[0], dest[1]);
+    glm_vec3_cross(c[0], c[1], dest[2]);
     dest[3][3] = 1.0f;
 }
 

@@ -5,6 +5,9 @@
 #include <string.h>
 #include <unistd.h>
 
+/* A consumer never has more dependencies than there are other views. */
+_Static_assert(OB_VIEW_MAX_DEPS >= OB_MAX_FRAME_VIEWS - 1, "dependency lists can overflow");
+
 const char *ob_skip_reason_name(ob_skip_reason r)
 {
     switch (r) {

@@ -266,11 +266,14 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 
 /* ------------------------------------------------------------ primary */
 
+/* Colour and depth of each dependency, the inputs, the view's own two targets. */
+#define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 2)
+
 static void add_image_barrier(ob_renderer *r, ob_image img, VkImageLayout layout,
                               VkPipelineStageFlags2 stages, VkAccessFlags2 access,
                               VkImageMemoryBarrier2 *barriers, uint32_t *n)
 {
-    if (!img.id || *n >= 2 * OB_VIEW_MAX_DEPS + 4) return;
+    if (!img.id || *n >= VIEW_MAX_BARRIERS) return;
     ob_image_state next = {layout, stages, access};
     if (ob_image_transition(r->dev, img, &next, &barriers[*n])) (*n)++;
 }
@@ -305,7 +308,7 @@ static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img
 
 static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
 {
-    VkImageMemoryBarrier2 barriers[2 * OB_VIEW_MAX_DEPS + 4];
+    VkImageMemoryBarrier2 barriers[VIEW_MAX_BARRIERS];
     uint32_t n = 0;
     const VkPipelineStageFlags2 sample_stages =
         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT;

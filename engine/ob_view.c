@@ -78,6 +78,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     if (res != OB_OK) return res;
     ob_frustum frustum;
     ob_frustum_from_matrix(v->view_proj, &frustum);
+    bool out_of_range = false;
     for (uint32_t i = 0; i < count; i++) {
         ob_node *n = nodes[i];
         const ob_renderable *rd = ob_node_renderable(n);
@@ -88,8 +89,30 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         double c[3];
         float radius;
         ob_node_world_sphere(n, c, &radius);
+        /* A bound that is not empty locally but zero in the world: the world
+         * transform has zero scale, every triangle has zero area. Drawing it
+         * yields nothing, but keeping it would still queue its env map and
+         * stretch a shadow map's fit to its position. */
+        if (radius == 0.0f && rd->local_radius > 0.0f) {
+            v->culled++;
+            continue;
+        }
         float rel[3] = {(float)(c[0] - v->origin[0]), (float)(c[1] - v->origin[1]),
                         (float)(c[2] - v->origin[2])};
+        if (!isfinite(rel[0]) || !isfinite(rel[1]) || !isfinite(rel[2]) || !isfinite(radius)) {
+            /* Finite in double, not in float: no matrix the GPU could take
+             * places it, and as a "visible" shadow caster it would blow up
+             * the light's fit. */
+            if (!v->range_reported)
+                OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
+                         "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
+                         v->name, ob_node_name(n), ob_node_id(n), c[0] - v->origin[0],
+                         c[1] - v->origin[1], c[2] - v->origin[2], (double)radius);
+            out_of_range = true;
+            v->range_reported = true;
+            v->culled++;
+            continue;
+        }
         if (!v->no_frustum && !ob_frustum_test_sphere(&frustum, rel, radius)) {
             v->culled++;
             continue;
@@ -99,6 +122,8 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         float d2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
         v->items[v->item_count++] = (ob_draw_item){sort_key(cls, priority, d2), n};
     }
+    if (!out_of_range) v->range_reported = false;
+    /* items is NULL for an empty scene, and qsort's pointer must not be. */
     if (v->item_count > 1) qsort(v->items, v->item_count, sizeof *v->items, compare_items);
     v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
@@ -127,7 +152,13 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
         ob_node *n = v->items[i].node;
         const ob_renderable *rd = ob_node_renderable(n);
         ob_node_world_relative(n, v->origin, m);
-        ob_params_set_mat4(params, world, m);
+        /* A refused matrix (logged by the parameter) would leave the previous
+         * entity's in the slot: drawing then puts this one in its place. */
+        if (ob_params_set_mat4(params, world, m) != OB_OK) {
+            OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix refused; not drawn",
+                     v->name, ob_node_name(n), ob_node_id(n));
+            continue;
+        }
         if (!mi->apply(rd->material, n, r, pm, v)) continue;
         gi->draw(rd->geometry, pm);
     }

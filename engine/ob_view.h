@@ -40,7 +40,11 @@ typedef enum ob_view_type {
 
 const char *ob_view_type_name(ob_view_type t);
 
-#define OB_VIEW_MAX_DEPS 8
+/* A view may depend on every other view of its frame (a camera seeing 100
+ * reflective entities samples 100 env maps), so this matches the renderer's
+ * OB_MAX_FRAME_VIEWS (checked there) and an edge is never dropped. */
+#define OB_VIEW_MAX_DEPS 128
+#define OB_VIEW_MAX_INPUTS 8
 #define OB_VIEW_MAX_LAYERS 2
 
 typedef struct ob_view ob_view;
@@ -89,7 +93,7 @@ struct ob_view {
 
     /* Images read by this view's draws besides its dependencies' targets. */
     uint32_t input_count;
-    ob_image inputs[OB_VIEW_MAX_DEPS];
+    ob_image inputs[OB_VIEW_MAX_INPUTS];
     ob_buffer storage_written;        /* compute views: buffer written (consumers
                                          read it in their vertex stage) */
 
@@ -105,6 +109,8 @@ struct ob_view {
     uint64_t queued_frame;            /* renderer frame serial when last queued */
     uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
     uint64_t cull_ns;                 /* this frame's ob_view_cull time */
+    bool range_reported;              /* an entity beyond float range was logged
+                                         and has not gone away since */
 };
 
 /* Initialise the base part (name copied, id = hash of name). */
@@ -113,8 +119,10 @@ void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const
 void ob_view_release(ob_view *v);
 
 /* Frustum-cull the scene's renderables into v->items for view type v->type,
- * using v->origin and v->view_proj, skipping `exclude` (the owner of an env map)
- * and entities whose material does not render in this view type; then sort
+ * using v->origin and v->view_proj, skipping `exclude` (the owner of an env map),
+ * entities whose material does not render in this view type, entities of
+ * zero world scale, and entities whose bound relative to v->origin does not
+ * fit in a float (logged once, naming the entity, until none is left); then sort
  * the list (opaque front to back, blended back to front, priority, id).
  * [render thread] */
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude);

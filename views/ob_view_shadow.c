@@ -52,8 +52,12 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
     /* View space looks down -Z: distance along the light is -z. */
     float znear = -hi[2], zfar = -lo[2];
     float extent = fmaxf(zfar - znear, fmaxf(hi[0] - lo[0], hi[1] - lo[1]));
-    znear -= 2.0f * extent + 1.0f;
-    float pad = 1e-3f * extent + 1e-4f;
+    /* Margins relative to the casters' size only: an absolute one (a unit,
+     * 1e-4) would dwarf a millimetre-sized scene and spread its shadow map
+     * over empty space. A single caster without bounds has no size: 1. */
+    float size = extent > 0.0f ? extent : 1.0f;
+    znear -= 2.0f * size;
+    float pad = 1e-3f * size;
     ob_math_ortho_reverse_z(lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad, znear, zfar + pad,
                             sv->proj);
     ob_mat4_mul(sv->proj, sv->view, v->view_proj);

@@ -61,4 +61,14 @@ vec3 ob_safe_normalize(vec3 v)
     return len2 > 1e-24 ? v * inversesqrt(len2) : vec3(0.0);
 }
 
+// NormalMatrix is the cofactor matrix (det * inverse-transpose): its size
+// goes as scale^2, so a 1e-6 scale gives normals of length 1e-12, which
+// ob_safe_normalize takes for zero. Dividing by the largest component first
+// keeps the direction for any finite size; zero stays zero.
+vec3 ob_unit_normal(vec3 n)
+{
+    float m = max(abs(n.x), max(abs(n.y), abs(n.z)));
+    return m > 0.0 ? normalize(n / m) : vec3(0.0);
+}
+
 #endif

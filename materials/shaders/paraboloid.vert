@@ -25,7 +25,7 @@ void main()
 {
     vec4 world = WorldMatrix * vec4(inPosition, 1.0);
     vPosition = world.xyz;
-    vNormal = mat3(NormalMatrix) * inNormal;
+    vNormal = ob_unit_normal(mat3(NormalMatrix) * inNormal);
     vUV = inUV;
 
     vec3 q = mat3(ViewMatrix) * world.xyz;

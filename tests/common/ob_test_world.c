@@ -140,12 +140,20 @@ void ob_test_world_look(ob_test_world *w, double ex, double ey, double ez, doubl
 
 const ob_frame_stats *ob_test_world_frame(ob_test_world *w, ob_threading mode, uint32_t workers)
 {
+    return ob_test_world_frame_with(w, mode, workers, NULL, 0);
+}
+
+const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mode,
+                                               uint32_t workers, ob_view *const *extra,
+                                               uint32_t extra_count)
+{
     const double dt = 1.0 / 60.0;
     ob_renderer_set_threading(w->r, mode, workers);
     CHECK(ob_scene_update(w->scene, w->time > 0.0 ? dt : 0.0), "scene update");
     ob_views_set_time(w->views, w->time, dt);
     CHECK(ob_renderer_begin_frame(w->r, w->scene), "begin frame");
     ob_views_render(w->views, ob_composite_view_base(w->composite));
+    for (uint32_t i = 0; i < extra_count; i++) ob_views_render(w->views, extra[i]);
     CHECK(ob_renderer_end_frame(w->r), "end frame");
     CHECK(ob_renderer_wait_idle(w->r), "wait idle");
     w->time += dt;
@@ -161,6 +169,31 @@ const uint8_t *ob_test_world_read(ob_test_world *w)
 const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t y)
 {
     return w->pixels + ((size_t)y * w->width + x) * 4;
+}
+
+uint8_t *ob_test_world_copy(const ob_test_world *w)
+{
+    size_t n = (size_t)w->width * w->height * 4;
+    uint8_t *copy = malloc(n); /* test-side image: not an engine allocation */
+    assert_non_null(copy);
+    memcpy(copy, w->pixels, n);
+    return copy;
+}
+
+uint32_t ob_test_image_diff_count(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h,
+                                  uint32_t tol)
+{
+    uint32_t count = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        bool differs = false;
+        for (int c = 0; c < 4; c++) {
+            uint32_t d = a[4 * i + c] > b[4 * i + c] ? a[4 * i + c] - b[4 * i + c]
+                                                     : b[4 * i + c] - a[4 * i + c];
+            differs = differs || d > tol;
+        }
+        count += differs;
+    }
+    return count;
 }
 
 const ob_view_stats *ob_test_view_stats(const ob_frame_stats *st, const char *name)

@@ -60,10 +60,20 @@ void ob_test_world_look(ob_test_world *w, double ex, double ey, double ez, doubl
 /* One frame (dt = 1/60 after the first) in `mode` with `workers` active
  * (0 = all), waited for; returns its final stats (GPU times included). */
 const ob_frame_stats *ob_test_world_frame(ob_test_world *w, ob_threading mode, uint32_t workers);
+/* Like ob_test_world_frame, and pre-draws `extra` views in the same frame
+ * after the final one (so they execute before it). */
+const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mode,
+                                               uint32_t workers, ob_view *const *extra,
+                                               uint32_t extra_count);
 /* Read the final image into w->pixels; returns it. */
 const uint8_t *ob_test_world_read(ob_test_world *w);
 /* Pixel (x, y) of the last read, RGBA. */
 const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t y);
+/* A heap copy (free()) of the last read image. */
+uint8_t *ob_test_world_copy(const ob_test_world *w);
+/* Pixels of two RGBA8 images with some channel differing by more than tol. */
+uint32_t ob_test_image_diff_count(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h,
+                                  uint32_t tol);
 /* The stats of the view called name in st (NULL if it did not run). */
 const ob_view_stats *ob_test_view_stats(const ob_frame_stats *st, const char *name);
 /* The skip reason recorded for name, OB_SKIP_NONE if none. */
