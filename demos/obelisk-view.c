@@ -117,10 +117,10 @@ static ob_result add_light(ob_demo *d, const char *name, const ob_light_desc *de
     ob_node *n = ob_node_create(d->scene, NULL, name, &r);
     if (!n) return r;
     if ((r = ob_node_set_light(n, desc)) != OB_OK) return r;
-    /* The engine reads a zero colour or intensity as "default": hide instead. */
-    bool off = desc->intensity == 0.0f || (desc->color[0] == 0.0f && desc->color[1] == 0.0f &&
-                                           desc->color[2] == 0.0f);
-    ob_node_set_hidden(n, off);
+    /* The engine reads a zero colour as white (its default): hide a black
+     * light instead. Intensity 0 is literal and needs nothing here. */
+    bool black = desc->color[0] == 0.0f && desc->color[1] == 0.0f && desc->color[2] == 0.0f;
+    ob_node_set_hidden(n, black);
     if (desc->type == OB_LIGHT_DIRECTIONAL) {
         /* Aimed from the origin: position + direction could round back to a
          * far-away position, and a directional light's position is unused. */

@@ -741,7 +741,6 @@ ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d)
     }
     if (l.color[0] == 0.0f && l.color[1] == 0.0f && l.color[2] == 0.0f)
         l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    if (l.intensity == 0.0f) l.intensity = 1.0f;
     n->light = l;
     n->has_light = true;
     return OB_OK;

@@ -205,7 +205,8 @@ typedef enum ob_light_type { OB_LIGHT_DIRECTIONAL, OB_LIGHT_POINT } ob_light_typ
 typedef struct ob_light_desc {
     ob_light_type type;
     float color[3];       /* linear RGB, (0,0,0) → white */
-    float intensity;      /* 0 → 1 (hide the node to switch a light off) */
+    float intensity;      /* literal: 0 switches the light off (it lights nothing and
+                             its shadow view is left out); set 1 for a plain light */
     float range;          /* point lights; 0 → no cut-off */
     bool casts_shadows;
 } ob_light_desc;

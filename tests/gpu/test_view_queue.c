@@ -399,20 +399,26 @@ static void light_without_shadows_no_shadow_view(void **state)
     ob_test_world_destroy(&w);
 }
 
-/* A light with intensity 0 is a light with the default intensity 1 (zero
- * means default in ob_light_desc); a light is switched off by hiding it, and
- * a switched-off light needs no shadow map. */
+/* A light at intensity 0 is off: its shadow view is left out with the
+ * reason "not needed"; hiding a light leaves it out too. */
 static void switched_off_light_no_shadow_view(void **state)
 {
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_node *sun = ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 0.0f, 2, 8, 3);
-    assert_true(ob_node_light(sun)->intensity == 1.0f);
+    ob_node *sun = ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
     ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
     ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_non_null(ob_test_view_stats(st, "shadow:sun"));
+    ob_light_desc dark = *ob_node_light(sun);
+    dark.intensity = 0.0f;
+    assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);
+    st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
+    assert_int_equal(ob_test_skip_reason(st, "shadow:sun"), OB_SKIP_NOT_NEEDED);
+    dark.intensity = 1.0f;
+    assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);
     ob_node_set_hidden(sun, true);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
