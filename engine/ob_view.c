@@ -163,3 +163,10 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
         gi->draw(rd->geometry, pm);
     }
 }
+
+void ob_view_record_draw_list(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                              uint32_t layer, uint32_t first, uint32_t count)
+{
+    (void)layer;
+    ob_view_record_items(v, r, pm, first, count);
+}

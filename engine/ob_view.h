@@ -133,6 +133,11 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                           uint32_t first, uint32_t count);
 
+/* ob_view_record_items as a view's `record` callback, for views whose
+ * layers all draw the same list (perspective, shadow). */
+void ob_view_record_draw_list(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
+                              uint32_t layer, uint32_t first, uint32_t count);
+
 /* Let the material of every item queue the views it needs. [render thread] */
 void ob_view_pre_render_items(ob_view *v, ob_renderer *r);
 

@@ -90,10 +90,7 @@ done:
 
 void ob_composite_view_destroy(ob_views *ctx, ob_composite_view *v)
 {
-    if (!v) return;
-    ob_views_release_target(ctx, &v->base);
-    ob_view_release(&v->base);
-    ob_free(v);
+    if (v) ob_views_free_view(ctx, &v->base);
 }
 
 ob_view *ob_composite_view_base(ob_composite_view *v) { return &v->base; }

@@ -102,10 +102,7 @@ done:
 
 void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v)
 {
-    if (!v) return;
-    ob_views_release_target(ctx, &v->base);
-    ob_view_release(&v->base);
-    ob_free(v);
+    if (v) ob_views_free_view(ctx, &v->base);
 }
 
 ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v) { return &v->base; }

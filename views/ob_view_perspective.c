@@ -49,18 +49,11 @@ static void perspective_render_params(ob_view *v, ob_renderer *r, ob_params *par
     ob_views_set_common_params(pv->ctx, v, params, pv->view, pv->proj);
 }
 
-static void perspective_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
-                               uint32_t layer, uint32_t first, uint32_t count)
-{
-    (void)layer;
-    ob_view_record_items(v, r, pm, first, count);
-}
-
 static const ob_view_vtbl perspective_vtbl = {
     .type_name = "perspective",
     .pre_draw = perspective_pre_draw,
     .set_render_params = perspective_render_params,
-    .record = perspective_record,
+    .record = ob_view_record_draw_list,
 };
 
 ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspective_desc *desc,
@@ -100,10 +93,7 @@ done:
 
 void ob_perspective_view_destroy(ob_views *ctx, ob_perspective_view *v)
 {
-    if (!v) return;
-    ob_views_release_target(ctx, &v->base);
-    ob_view_release(&v->base);
-    ob_free(v);
+    if (v) ob_views_free_view(ctx, &v->base);
 }
 
 ob_view *ob_perspective_view_base(ob_perspective_view *v) { return &v->base; }

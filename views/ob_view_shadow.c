@@ -103,19 +103,12 @@ static void shadow_usage_params(ob_view *v, ob_renderer *r, ob_params *params,
     ob_params_set_mat4(params, sv->shadow_matrix, m);
 }
 
-static void shadow_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t layer,
-                          uint32_t first, uint32_t count)
-{
-    (void)layer;
-    ob_view_record_items(v, r, pm, first, count);
-}
-
 static const ob_view_vtbl shadow_vtbl = {
     .type_name = "shadow",
     .pre_draw = shadow_pre_draw,
     .set_render_params = shadow_render_params,
     .set_usage_params = shadow_usage_params,
-    .record = shadow_record,
+    .record = ob_view_record_draw_list,
 };
 
 ob_shadow_view *ob_shadow_view_create(ob_views *ctx, ob_node *light, ob_result *out_result)
@@ -148,10 +141,7 @@ done:
 
 void ob_shadow_view_destroy(ob_views *ctx, ob_shadow_view *v)
 {
-    if (!v) return;
-    ob_views_release_target(ctx, &v->base);
-    ob_view_release(&v->base);
-    ob_free(v);
+    if (v) ob_views_free_view(ctx, &v->base);
 }
 
 ob_view *ob_shadow_view_base(ob_shadow_view *v) { return &v->base; }

@@ -154,6 +154,14 @@ void ob_views_release_target(ob_views *ctx, ob_view *v)
     v->color = v->depth = (ob_image){0};
 }
 
+void ob_views_free_view(ob_views *ctx, ob_view *base)
+{
+    if (!base) return;
+    ob_views_release_target(ctx, base);
+    ob_view_release(base);
+    ob_free(base);
+}
+
 void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, VkFormat *depth)
 {
     ob_image_info info;

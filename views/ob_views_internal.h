@@ -66,6 +66,10 @@ ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32
                                uint32_t layers, VkFormat color, VkFormat depth);
 void ob_views_release_target(ob_views *ctx, ob_view *v);
 
+/* Frees a view made by this layer: its targets, its draw list and the
+ * object itself (whose first member is the base). NULL ok. */
+void ob_views_free_view(ob_views *ctx, ob_view *base);
+
 /* Formats of a view's targets (VK_FORMAT_UNDEFINED when absent). */
 void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, VkFormat *depth);
 /* Bind an effect's pipeline for v's targets on pm; false if unavailable. */
