@@ -10,8 +10,12 @@
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
 
+/* Ring chunks are plain Vulkan buffers owned by the manager, not ob_buffer
+ * handles: a worker grows its ring while recording, and the resource
+ * registry's pools are render-thread only (an insert may reallocate them
+ * under other workers' lookups of vertex buffers and images). */
 typedef struct ring_chunk {
-    ob_buffer buffer;
+    VkDeviceMemory memory;
     VkBuffer vk;
     uint8_t *mapped;
     uint64_t size, used;
@@ -119,6 +123,59 @@ static void log_once(ob_pipeline_manager *pm, const char *what)
              "are counted, not logged)", pm->name, what);
 }
 
+/* ------------------------------------------------------------ ring chunks */
+
+/* Safe on the manager's own thread: it touches only Vulkan (whose object
+ * creation is externally synchronized per pool, and these have none) and c. */
+static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
+{
+    *c = (ring_chunk){0};
+    VkBufferCreateInfo bi = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = pm->chunk_size,
+        .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(pm->vk, &bi, NULL, &c->vk));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(pm->vk, c->vk, &req);
+    uint32_t type = ob_device_memory_type(pm->dev, req.memoryTypeBits,
+                                          VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    ob_result r = OB_OK;
+    if (type == UINT32_MAX) {
+        OB_LOG_E("pm", "pipeline manager '%s': no host-visible coherent memory for its uniform "
+                 "ring", pm->name);
+        r = OB_ERR_UNSUPPORTED;
+        goto fail;
+    }
+    VkMemoryAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = type,
+    };
+    vr = OB_VK_CHECK_CREATE(vkAllocateMemory(pm->vk, &ai, NULL, &c->memory));
+    if (vr == VK_SUCCESS) vr = OB_VK_CHECK(vkBindBufferMemory(pm->vk, c->vk, c->memory, 0));
+    if (vr == VK_SUCCESS)
+        vr = OB_VK_CHECK(vkMapMemory(pm->vk, c->memory, 0, VK_WHOLE_SIZE, 0, (void **)&c->mapped));
+    if (vr == VK_SUCCESS) return OB_OK;
+    r = ob_result_from_vk(vr);
+fail:
+    if (c->memory) vkFreeMemory(pm->vk, c->memory, NULL);
+    vkDestroyBuffer(pm->vk, c->vk, NULL);
+    *c = (ring_chunk){0};
+    return r;
+}
+
+/* The device is idle (manager destruction). */
+static void chunk_release(ob_pipeline_manager *pm, ring_chunk *c)
+{
+    if (c->vk) vkDestroyBuffer(pm->vk, c->vk, NULL);
+    if (c->memory) vkFreeMemory(pm->vk, c->memory, NULL);
+    *c = (ring_chunk){0};
+}
+
 /* ------------------------------------------------------------ lifecycle */
 
 ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,
@@ -163,7 +220,7 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
     if (!pm) return;
     for (uint32_t s = 0; s < MAX_FRAME_SLOTS; s++) {
         frame_ring *fr = &pm->rings[s];
-        for (uint32_t i = 0; i < fr->chunk_count; i++) ob_buffer_destroy(pm->dev, fr->chunks[i].buffer);
+        for (uint32_t i = 0; i < fr->chunk_count; i++) chunk_release(pm, &fr->chunks[i]);
         for (uint32_t i = 0; i < fr->pool_count; i++)
             vkDestroyDescriptorPool(pm->vk, fr->pools[i], NULL);
     }
@@ -257,18 +314,9 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
             continue;
         }
         if (fr->chunk_count >= MAX_CHUNKS) return OB_ERR_LIMIT;
-        ob_result r;
-        ob_buffer_desc bd = {
-            .size = pm->chunk_size,
-            .usage = OB_BUFFER_UNIFORM,
-            .host_visible = true,
-            .name = pm->name,
-        };
         ring_chunk *c = &fr->chunks[fr->chunk_count];
-        c->buffer = ob_buffer_create(pm->dev, &bd, &r);
-        if (!c->buffer.id) return r;
-        c->vk = ob_buffer_vk(pm->dev, c->buffer);
-        c->mapped = ob_buffer_mapped(pm->dev, c->buffer);
+        ob_result r = chunk_create(pm, c);
+        if (r != OB_OK) return r;
         c->size = pm->chunk_size;
         c->used = 0;
         fr->chunk_count++;
