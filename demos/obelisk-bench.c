@@ -314,6 +314,18 @@ static void summarize(ob_bench_report *rep)
     s->threading_identical = s->threading_max_abs_diff == 0 && s->hash_mismatches == 0;
 }
 
+/* The 1-minute load average: other work on the machine skews every time. */
+static double load_average(void)
+{
+    double load = NAN;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1) load = NAN;
+        fclose(f);
+    }
+    return load;
+}
+
 static int run(const bench_options *o)
 {
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
@@ -326,6 +338,7 @@ static int run(const bench_options *o)
     rep.big_draws = BIG_FRAME_DRAWS;
     frame_counts(o, 1000, 1000000, &rep.big_warmup, &rep.big_rounds, &rep.big_flight);
     uint64_t t0 = ob_time_ns();
+    rep.load_start = load_average();
     static const uint32_t env_full[] = {64, 128, 256, 512}, shadow_full[] = {256, 512, 1024, 2048};
     static const uint32_t env_quick[] = {128, 512}, shadow_quick[] = {512, 2048};
     ob_bench_quality_desc qd = {
@@ -374,6 +387,7 @@ static int run(const bench_options *o)
     }
     ob_bench_progress_finish(&prog);
     rep.seconds = (double)(ob_time_ns() - t0) * 1e-9;
+    rep.load_end = load_average();
 
     if (r != OB_OK) {
         fprintf(stderr, "obelisk-bench: failed: %s (%s)\n", ob_result_name(r), ob_result_text(r));

@@ -120,10 +120,11 @@ void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
     fprintf(f, "\nsummary:\n  mt_speedup_record_10k_8views %.3f (best MT mode %s)\n"
                "  engine_vs_raw_per_draw       %.3f\n  auto_vs_best_200             %.3f\n"
                "  threading modes identical    %s (max abs diff %u, hash mismatches %u)\n"
-               "  run time                     %.0f s\n",
+               "  run time                     %.0f s (load average %.1f at start, %.1f at end)\n",
             s->mt_speedup_record_10k_8views, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "-",
             s->engine_vs_raw_per_draw, s->auto_vs_best_200, s->threading_identical ? "yes" : "NO",
-            s->threading_max_abs_diff, s->hash_mismatches, rep->seconds);
+            s->threading_max_abs_diff, s->hash_mismatches, rep->seconds, rep->load_start,
+            rep->load_end);
 }
 
 /* ------------------------------------------------------------ JSON */
@@ -217,8 +218,13 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
     if (!f) return OB_ERR_IO;
     fprintf(f, "{\"program\":\"obelisk-bench\",\"quick\":%s,\"seed\":%u,\"seconds\":%.1f,\n",
             rep->quick ? "true" : "false", rep->seed, rep->seconds);
-    fprintf(f, "\"machine\":{\"cores\":%u,\"pool_workers\":%u,\"validation\":%s},\n", rep->cores,
+    fprintf(f, "\"machine\":{\"cores\":%u,\"pool_workers\":%u,\"validation\":%s,", rep->cores,
             rep->pool_workers, rep->validation ? "true" : "false");
+    fputs("\"load_average\":[", f);
+    json_num(f, rep->load_start);
+    fputs(",", f);
+    json_num(f, rep->load_end);
+    fputs("]},\n", f);
     fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"flight\":%u,"
                "\"big_frames\":{\"over_draws\":%u,\"warmup\":%u,\"rounds\":%u,\"flight\":%u},"
                "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u},\n",
@@ -304,7 +310,7 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
         csv_result(f, "scene200", 1, rep->scene200.objects, &rep->scene200.results[m]);
     for (uint32_t i = 0; i < rep->quality_count; i++) {
         const ob_bench_quality_row *q = &rep->quality[i];
-        fprintf(f, "%s,1,%u,%u,%u,%s,%u,,%u,,,,,,", ob_bench_quality_kind_name(q->kind),
+        fprintf(f, "%s,1,%u,%u,%u,%s,%u,,%u,,,,,", ob_bench_quality_kind_name(q->kind),
                 rep->scene200.objects, q->env_size, q->shadow_size, q->mode.name, q->mode.workers,
                 q->draws);
         csv_num(f, q->record_total_ms);
@@ -316,11 +322,12 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
         csv_num(f, q->psnr_db);
         fprintf(f, ",%u\n", q->hash_mismatches);
     }
-    fprintf(f, "raw,%u,%u,,,raw,0,,%u,,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
+    /* Raw: record time in record_ms and record_total_ms, and draws/s. */
+    fprintf(f, "raw,%u,%u,,,raw,0,,%u,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
     csv_num(f, rep->raw.record_ms);
     fputs(",,", f);
     csv_num(f, rep->raw.record_ms);
-    fputs(",,,,", f);
+    fputs(",,,", f);
     csv_num(f, rep->raw.record_ms > 0 ? rep->raw.draws / (rep->raw.record_ms * 1e-3) : NAN);
     fputs(",,,,,,,,,,,,,,,,,\n", f);
     return close_out(f, path);

@@ -45,6 +45,7 @@ typedef struct ob_bench_report {
     uint32_t view_width, view_height;              /* sweep view size */
     uint32_t image_width, image_height, image_frames;
     double seconds;                                /* whole run, wall clock */
+    double load_start, load_end;                   /* 1-minute load average (NAN if unknown) */
 
     ob_bench_sweep_entry *sweep;
     uint32_t sweep_count;

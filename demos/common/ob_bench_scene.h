@@ -6,10 +6,12 @@
  *           spinning over a ground plane, one directional light (no
  *           shadows) and two point lights. The ring of objects grows with
  *           sqrt(N) so the density stays that of obelisk-mirror. V "views"
- *           = V perspective views of the same scene from V cameras spaced
- *           evenly around it, each framing the whole ring (so every view
- *           draws nearly all N objects): the demo's main view (shown by the
- *           composite) plus V-1 extra perspective views queued in the frame.
+ *           = V perspective views of the same scene from V cameras that
+ *           stand a little behind the centre and look outward in V evenly
+ *           spaced directions, each framing a wedge of the ring (a view
+ *           draws about a third of the objects and culls the rest): the
+ *           demo's main view (shown by the composite) plus V-1 extra
+ *           perspective views queued in the frame before it.
  *   mirror  obelisk-mirror's scene: three reflective spheres (dual-paraboloid
  *           environment maps that see each other), N orbiting objects, a
  *           shadow-casting sun, two point lights, a particle fountain; the
