@@ -294,13 +294,19 @@ double ob_demo_median_ms(const ob_demo *d, int mode, size_t phase_offset)
             v[n++] = (double)ns * 1e-6;
         }
     }
-    double m = NAN;
-    if (n) {
-        qsort(v, n, sizeof *v, compare_double);
-        m = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    }
+    double m = ob_demo_median(v, n);
     ob_free(v);
     return m;
+}
+
+double ob_demo_median(double *v, uint32_t n)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (!isnan(v[i])) v[k++] = v[i];
+    if (!k) return NAN;
+    qsort(v, k, sizeof *v, compare_double);
+    return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
 void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st)

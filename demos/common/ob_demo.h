@@ -90,6 +90,9 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user);
 /* Medians of a phase over the recorded frames of one mode (NAN if none). */
 double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase_offset);
 
+/* Median of v[0..n), NaNs left out (v is reordered); NAN if nothing is left. */
+double ob_demo_median(double *v, uint32_t n);
+
 /* Writes one frame's stats as a JSON object. */
 void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st);
 

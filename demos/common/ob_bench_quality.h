@@ -1,0 +1,67 @@
+/* ob_bench_quality.h — image error against run time, and the threading
+ * modes' identity check, on the mirror scene.
+ *
+ * Every configuration is a fresh demo (renderer, views, scene built from the
+ * same seed) that renders the same sequence of `image_frames` frames with a
+ * fixed time step and reads the final image back; then it is timed (idle
+ * rounds for CPU and GPU time, then frames in flight for the frame period).
+ *   reference   highest env-map and shadow-map size, single-threaded
+ *   quality     each env-map size (shadow map at its highest) and each
+ *               shadow-map size (env map at its highest), single-threaded:
+ *               max abs difference and PSNR over RGB against the reference
+ *   threading   every other mode at the reference quality: its image must be
+ *               byte-identical to the reference and the command hash of each
+ *               of its frames equal to the reference's frame of the same index
+ *
+ * Lifecycle: one call; rows are ob_malloc'ed, the caller ob_frees them.
+ * Thread rule: render thread; creates and destroys its own renderers.
+ */
+#ifndef OB_BENCH_QUALITY_H
+#define OB_BENCH_QUALITY_H
+
+#include "ob_bench_run.h"
+
+typedef enum ob_bench_quality_kind {
+    OB_BENCH_QUALITY_REFERENCE = 0,
+    OB_BENCH_QUALITY_ENV,
+    OB_BENCH_QUALITY_SHADOW,
+    OB_BENCH_QUALITY_THREADING,
+} ob_bench_quality_kind;
+
+typedef struct ob_bench_quality_desc {
+    ob_demo_options base;          /* size, seed, objects (200) */
+    uint32_t pool_workers;         /* renderer worker pool (largest mode) */
+    uint32_t image_frames;         /* frames before the image is read (≥ 1) */
+    uint32_t rounds, flight;       /* timing after the image (ob_bench_run_modes) */
+    const uint32_t *env_sizes;     /* ascending; the last is the reference's */
+    uint32_t env_count;
+    const uint32_t *shadow_sizes;  /* ascending; the last is the reference's */
+    uint32_t shadow_count;
+    const ob_bench_mode *modes;    /* modes[0] is the reference mode (single-threaded) */
+    uint32_t mode_count;
+    ob_bench_tick_fn tick;
+    void *tick_user;
+} ob_bench_quality_desc;
+
+typedef struct ob_bench_quality_row {
+    ob_bench_quality_kind kind;
+    uint32_t env_size, shadow_size;
+    ob_bench_mode mode;
+    uint32_t max_abs_diff;         /* over R, G, B of every pixel */
+    double psnr_db;                /* INFINITY when identical */
+    double frame_ms, gpu_ms, record_total_ms, cpu_frame_ms;
+    uint32_t hash_mismatches;      /* threading rows: frames whose hash differs from the
+                                      reference's (0 in other rows) */
+    uint32_t draws;
+} ob_bench_quality_row;
+
+ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quality_row **out_rows,
+                               uint32_t *out_count);
+
+/* Error of b against a, RGBA8 images of w*h pixels (alpha ignored). */
+void ob_bench_image_error(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h,
+                          uint32_t *out_max_abs, double *out_psnr_db);
+
+const char *ob_bench_quality_kind_name(ob_bench_quality_kind k);
+
+#endif /* OB_BENCH_QUALITY_H */

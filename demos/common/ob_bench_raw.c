@@ -1,0 +1,253 @@
+#include "ob_bench_raw.h"
+
+#include <cglm/cglm.h>
+#include <string.h>
+
+#include "ob_bench_run.h"
+
+#define COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
+#define DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define PUSH_SIZE 128u
+
+static const char raw_vert[] =
+    "#version 450\n"
+    "layout(push_constant, std430) uniform PerDraw { mat4 WorldMatrix; mat4 NormalMatrix; };\n"
+    "layout(location = 0) in vec3 inPosition;\n"
+    "layout(location = 0) out vec3 vNormal;\n"
+    "void main() {\n"
+    "    vNormal = mat3(NormalMatrix) * vec3(0.0, 1.0, 0.0);\n"
+    "    gl_Position = WorldMatrix * vec4(inPosition, 1.0);\n"
+    "}\n";
+static const char raw_frag[] =
+    "#version 450\n"
+    "layout(location = 0) in vec3 vNormal;\n"
+    "layout(location = 0) out vec4 outColor;\n"
+    "void main() { outColor = vec4(normalize(vNormal) * 0.5 + 0.5, 1.0); }\n";
+
+/* What one draw needs, gathered before timing. */
+typedef struct raw_draw {
+    VkBuffer vb, ib;
+    uint32_t index_count;
+} raw_draw;
+
+typedef struct raw_state {
+    VkDevice vk;
+    VkShaderModule vert, frag;
+    VkPipelineLayout layout;
+    VkPipeline pipeline;
+    VkCommandPool pool;
+    VkCommandBuffer cmd;
+    raw_draw *draws;
+    float *push;               /* 32 floats per draw, 32-byte aligned */
+    uint32_t count;
+} raw_state;
+
+static ob_result make_module(ob_demo *d, const char *name, const char *source, ob_shader_stage stage,
+                             VkShaderModule *out)
+{
+    ob_result r;
+    ob_shader_desc sd = {.path = name, .source = source, .stage = stage};
+    const ob_shader *sh = ob_shader_get(ob_effect_context_compiler(d->fx), &sd, &r);
+    if (!sh) return r;
+    VkShaderModuleCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+                                   .codeSize = sh->spirv_words * 4, .pCode = sh->spirv};
+    VkResult vr = OB_VK_CHECK(vkCreateShaderModule(ob_device_vk(ob_renderer_device(d->r)), &ci, NULL, out));
+    return ob_result_from_vk(vr);
+}
+
+static ob_result make_pipeline(ob_demo *d, raw_state *s)
+{
+    ob_result r = make_module(d, "bench_raw.vert", raw_vert, OB_SHADER_VERTEX, &s->vert);
+    if (r == OB_OK) r = make_module(d, "bench_raw.frag", raw_frag, OB_SHADER_FRAGMENT, &s->frag);
+    if (r != OB_OK) return r;
+    VkPushConstantRange range = {VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE};
+    VkPipelineLayoutCreateInfo lci = {.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+                                      .pushConstantRangeCount = 1, .pPushConstantRanges = &range};
+    VkResult vr = OB_VK_CHECK(vkCreatePipelineLayout(s->vk, &lci, NULL, &s->layout));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkPipelineShaderStageCreateInfo stages[2] = {
+        {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+         .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = s->vert, .pName = "main"},
+        {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+         .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = s->frag, .pName = "main"},
+    };
+    VkVertexInputBindingDescription binding = {0, sizeof(ob_vertex), VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputAttributeDescription position = {0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
+    VkPipelineVertexInputStateCreateInfo vi = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+        .vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &binding,
+        .vertexAttributeDescriptionCount = 1, .pVertexAttributeDescriptions = &position};
+    VkPipelineInputAssemblyStateCreateInfo ia = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
+    VkPipelineViewportStateCreateInfo vp = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+        .viewportCount = 1, .scissorCount = 1};
+    VkPipelineRasterizationStateCreateInfo rs = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+        .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_BACK_BIT,
+        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE, .lineWidth = 1.0f};
+    VkPipelineMultisampleStateCreateInfo ms = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
+    VkPipelineDepthStencilStateCreateInfo ds = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+        .depthTestEnable = VK_TRUE, .depthWriteEnable = VK_TRUE,
+        .depthCompareOp = VK_COMPARE_OP_GREATER_OR_EQUAL};
+    VkPipelineColorBlendAttachmentState att = {.colorWriteMask = 0xf};
+    VkPipelineColorBlendStateCreateInfo cb = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+        .attachmentCount = 1, .pAttachments = &att};
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dy = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+        .dynamicStateCount = 2, .pDynamicStates = dyn};
+    VkFormat color = COLOR_FORMAT;
+    VkPipelineRenderingCreateInfo rendering = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
+        .colorAttachmentCount = 1, .pColorAttachmentFormats = &color,
+        .depthAttachmentFormat = DEPTH_FORMAT};
+    VkGraphicsPipelineCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, .pNext = &rendering,
+        .stageCount = 2, .pStages = stages, .pVertexInputState = &vi,
+        .pInputAssemblyState = &ia, .pViewportState = &vp, .pRasterizationState = &rs,
+        .pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb,
+        .pDynamicState = &dy, .layout = s->layout};
+    vr = OB_VK_CHECK(vkCreateGraphicsPipelines(s->vk, VK_NULL_HANDLE, 1, &pci, NULL, &s->pipeline));
+    return ob_result_from_vk(vr);
+}
+
+static ob_result make_commands(ob_demo *d, raw_state *s)
+{
+    VkCommandPoolCreateInfo pci = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+                                   .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
+                                   .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->r))};
+    VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, NULL, &s->pool));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+                                      .commandPool = s->pool,
+                                      .level = VK_COMMAND_BUFFER_LEVEL_SECONDARY,
+                                      .commandBufferCount = 1};
+    vr = OB_VK_CHECK(vkAllocateCommandBuffers(s->vk, &ai, &s->cmd));
+    return ob_result_from_vk(vr);
+}
+
+/* World and normal matrices as the engine computes them for v. */
+static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
+{
+    ob_device *dev = ob_renderer_device(d->r);
+    s->draws = ob_calloc(v->item_count, sizeof *s->draws);
+    s->push = ob_aligned_alloc(32, sizeof(float) * 32 * v->item_count);
+    if (!s->draws || !s->push) return OB_ERR_OUT_OF_HOST_MEMORY;
+    for (uint32_t i = 0; i < v->item_count; i++) {
+        const ob_node *n = v->items[i].node;
+        const ob_renderable *rd = ob_node_renderable(n);
+        const ob_geometry *g = rd ? (const ob_geometry *)rd->geometry : NULL;
+        if (!g || ob_geometry_index_count(g) == 0) continue;
+        float *world = &s->push[32 * s->count], *normal = world + 16;
+        ob_node_world_relative(n, v->origin, world);
+        mat4 inv;
+        glm_mat4_inv((vec4 *)world, inv);
+        glm_mat4_transpose_to(inv, (vec4 *)normal);
+        s->draws[s->count++] = (raw_draw){ob_buffer_vk(dev, ob_geometry_vertex_buffer(g)),
+                                          ob_buffer_vk(dev, ob_geometry_index_buffer(g)),
+                                          ob_geometry_index_count(g)};
+    }
+    return s->count ? OB_OK : OB_ERR_INVALID_ARGUMENT;
+}
+
+/* The timed part: one recording of every draw. */
+static ob_result record_once(raw_state *s, const ob_view *v, uint32_t *out_binds, uint64_t *out_ns)
+{
+    VkFormat color = COLOR_FORMAT;
+    VkCommandBufferInheritanceRenderingInfo rendering = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO,
+        .colorAttachmentCount = 1, .pColorAttachmentFormats = &color,
+        .depthAttachmentFormat = DEPTH_FORMAT, .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
+    VkCommandBufferInheritanceInfo inherit = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO, .pNext = &rendering};
+    VkCommandBufferBeginInfo bi = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT |
+                 VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT,
+        .pInheritanceInfo = &inherit};
+    if (OB_VK_CHECK(vkResetCommandPool(s->vk, s->pool, 0)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    uint64_t t0 = ob_time_ns();
+    if (OB_VK_CHECK(vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s->pipeline);
+    VkViewport viewport = {0.0f, 0.0f, (float)v->width, (float)v->height, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {v->width, v->height}};
+    vkCmdSetViewport(s->cmd, 0, 1, &viewport);
+    vkCmdSetScissor(s->cmd, 0, 1, &scissor);
+    VkBuffer vb = VK_NULL_HANDLE, ib = VK_NULL_HANDLE;
+    uint32_t binds = 0;
+    for (uint32_t i = 0; i < s->count; i++) {
+        const raw_draw *dr = &s->draws[i];
+        if (dr->vb != vb) {
+            VkDeviceSize offset = 0;
+            vkCmdBindVertexBuffers(s->cmd, 0, 1, &dr->vb, &offset);
+            vb = dr->vb;
+            binds++;
+        }
+        if (dr->ib != ib) {
+            vkCmdBindIndexBuffer(s->cmd, dr->ib, 0, VK_INDEX_TYPE_UINT32);
+            ib = dr->ib;
+            binds++;
+        }
+        vkCmdPushConstants(s->cmd, s->layout, VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE,
+                           &s->push[32 * i]);
+        vkCmdDrawIndexed(s->cmd, dr->index_count, 1, 0, 0, 0);
+    }
+    if (OB_VK_CHECK(vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    *out_ns = ob_time_ns() - t0;
+    *out_binds = binds;
+    return OB_OK;
+}
+
+static void release(raw_state *s)
+{
+    if (s->pool) vkDestroyCommandPool(s->vk, s->pool, NULL);
+    if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
+    if (s->layout) vkDestroyPipelineLayout(s->vk, s->layout, NULL);
+    if (s->vert) vkDestroyShaderModule(s->vk, s->vert, NULL);
+    if (s->frag) vkDestroyShaderModule(s->vk, s->frag, NULL);
+    ob_free(s->draws);
+    ob_aligned_free(s->push);
+}
+
+ob_result ob_bench_raw_measure(ob_demo *d, const ob_view *v, uint32_t reps,
+                               ob_bench_raw_result *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!v || v->item_count == 0 || reps == 0) {
+        OB_LOG_E("bench", "raw baseline: view '%s' has no draws to record",
+                 v ? v->name : "(none)");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    raw_state s = {.vk = ob_device_vk(ob_renderer_device(d->r))};
+    double *times = ob_calloc(reps, sizeof *times);
+    ob_result r = times ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
+    if (r == OB_OK) r = gather(d, v, &s);
+    if (r == OB_OK) r = make_pipeline(d, &s);
+    if (r == OB_OK) r = make_commands(d, &s);
+    /* One unmeasured pass warms the driver's allocator and the caches. */
+    uint64_t ns = 0;
+    uint32_t binds = 0;
+    if (r == OB_OK) r = record_once(&s, v, &binds, &ns);
+    for (uint32_t i = 0; i < reps && r == OB_OK; i++) {
+        r = record_once(&s, v, &binds, &ns);
+        times[i] = (double)ns * 1e-6;
+    }
+    if (r == OB_OK) {
+        out->draws = s.count;
+        out->reps = reps;
+        out->buffer_binds = binds;
+        out->record_ms = ob_demo_median(times, reps);
+        out->ns_per_draw = out->record_ms * 1e6 / s.count;
+    } else {
+        OB_LOG_E("bench", "raw baseline on view '%s' failed: %s", v->name, ob_result_name(r));
+    }
+    release(&s);
+    ob_free(times);
+    return r;
+}

@@ -1,0 +1,458 @@
+#define _POSIX_C_SOURCE 200809L
+#include "ob_bench_report.h"
+
+#include <errno.h>
+#include <math.h>
+#include <spawn.h>
+#include <string.h>
+#include <sys/wait.h>
+
+extern char **environ;
+
+/* ------------------------------------------------------------ helpers */
+
+static const char *threading_name(ob_threading t)
+{
+    return t == OB_THREADING_SINGLE ? "single" : t == OB_THREADING_MULTI ? "multi" : "auto";
+}
+
+/* JSON has no NaN or infinity: those become null. */
+static void json_num(FILE *f, double v)
+{
+    if (isfinite(v)) fprintf(f, "%.6g", v);
+    else fputs("null", f);
+}
+
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; s && *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c < 0x20) fprintf(f, "\\u%04x", c);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void csv_num(FILE *f, double v)
+{
+    if (isnan(v)) fputs(",", f);
+    else if (isinf(v)) fputs(",inf", f);
+    else fprintf(f, ",%.6g", v);
+}
+
+static FILE *open_out(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) OB_LOG_E("bench", "cannot write '%s': %s", path, strerror(errno));
+    return f;
+}
+
+static ob_result close_out(FILE *f, const char *path)
+{
+    bool bad = ferror(f) != 0;
+    if (fclose(f) != 0) bad = true;
+    if (bad) {
+        OB_LOG_E("bench", "writing '%s' failed: %s", path, strerror(errno));
+        return OB_ERR_IO;
+    }
+    return OB_OK;
+}
+
+/* ------------------------------------------------------------ text */
+
+static void print_entry(FILE *f, const ob_bench_sweep_entry *e)
+{
+    for (uint32_t m = 0; m < e->mode_count; m++) {
+        const ob_bench_result *r = &e->results[m];
+        fprintf(f,
+                "  %5u %6u %-5s %4.1f %7u %8.2f %8.2f %8.2f %8.2f %7.2f %8.2f %8.2f %8.2f %6.2f "
+                "%9.0f %6u/%-6u %s\n",
+                e->views, e->objects, r->mode.name, r->workers_used, r->draws, r->update_ms,
+                r->pre_render_ms, r->record_ms, r->assemble_ms, r->submit_ms, r->record_total_ms,
+                r->gpu_ms, r->frame_ms, r->speedup_record, r->draws_per_s,
+                r->pm.descriptor_binds_issued, r->pm.descriptor_binds_requested,
+                r->hash_mismatches ? "HASH MISMATCH" : "");
+    }
+}
+
+static void print_header(FILE *f)
+{
+    fprintf(f, "  %5s %6s %-5s %4s %7s %8s %8s %8s %8s %7s %8s %8s %8s %6s %9s %13s\n", "views",
+            "objs", "mode", "wrk", "draws", "update", "pre-rend", "record", "assemble", "submit",
+            "rec+asm", "gpu", "frame", "spdup", "draws/s", "desc binds");
+}
+
+void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
+{
+    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s\n",
+            rep->quick ? " --quick" : "", rep->device_name, rep->driver_info, rep->cores,
+            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "");
+    fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up; frame = "
+               "in-flight period over %u frames (%u, %u, %u for frames over ~%u draws); "
+               "spdup = ST rec+asm / this\n",
+            rep->rounds, rep->warmup, rep->flight, rep->big_rounds, rep->big_warmup,
+            rep->big_flight, rep->big_draws);
+    print_header(f);
+    for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
+    fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
+    print_header(f);
+    print_entry(f, &rep->scene200);
+    fprintf(f, "\nraw Vulkan baseline (%u views, %u objects): %u draws, raw %.1f ns/draw, "
+               "engine (ST) %.1f ns/draw, ratio %.2f\n",
+            rep->raw_views, rep->raw_objects, rep->raw.draws, rep->raw.ns_per_draw,
+            rep->engine_ns_per_draw, rep->summary.engine_vs_raw_per_draw);
+    fprintf(f, "\nimage error against the reference (ST, highest quality), mirror scene %ux%u, "
+               "frame %u:\n  %-10s %5s %6s %-5s %8s %9s %9s %9s %9s %s\n",
+            rep->image_width, rep->image_height, rep->image_frames, "kind", "env", "shadow",
+            "mode", "max_abs", "psnr_dB", "frame_ms", "gpu_ms", "rec+asm", "hashes");
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        const ob_bench_quality_row *q = &rep->quality[i];
+        fprintf(f, "  %-10s %5u %6u %-5s %8u %9.2f %9.2f %9.2f %9.2f %s\n",
+                ob_bench_quality_kind_name(q->kind), q->env_size, q->shadow_size, q->mode.name,
+                q->max_abs_diff, q->psnr_db, q->frame_ms, q->gpu_ms, q->record_total_ms,
+                q->kind != OB_BENCH_QUALITY_THREADING ? "-"
+                : q->hash_mismatches                  ? "MISMATCH"
+                                                      : "equal");
+    }
+    const ob_bench_summary *s = &rep->summary;
+    fprintf(f, "\nsummary:\n  mt_speedup_record_10k_8views %.3f (best MT mode %s)\n"
+               "  engine_vs_raw_per_draw       %.3f\n  auto_vs_best_200             %.3f\n"
+               "  threading modes identical    %s (max abs diff %u, hash mismatches %u)\n"
+               "  run time                     %.0f s (load average %.1f at start, %.1f at end)\n",
+            s->mt_speedup_record_10k_8views, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "-",
+            s->engine_vs_raw_per_draw, s->auto_vs_best_200, s->threading_identical ? "yes" : "NO",
+            s->threading_max_abs_diff, s->hash_mismatches, rep->seconds, rep->load_start,
+            rep->load_end);
+}
+
+/* ------------------------------------------------------------ JSON */
+
+static void json_pair(FILE *f, const char *name, uint32_t req, uint32_t iss, bool last)
+{
+    fprintf(f, "\"%s\":[%u,%u]%s", name, req, iss, last ? "" : ",");
+}
+
+static void json_result(FILE *f, const ob_bench_result *r)
+{
+    fputs("{\"mode\":", f);
+    json_str(f, r->mode.name);
+    fprintf(f, ",\"threading\":\"%s\",\"workers\":%u,\"workers_used\":",
+            threading_name(r->mode.threading), r->mode.workers);
+    json_num(f, r->workers_used);
+    fprintf(f, ",\"frames\":%u,\"views\":%u,\"draws\":%u", r->frames, r->views, r->draws);
+    static const char *const names[] = {"update_ms", "pre_render_ms", "record_ms", "assemble_ms",
+                                        "submit_ms", "record_total_ms", "cpu_frame_ms", "gpu_ms",
+                                        "frame_ms", "draws_per_s", "speedup_record",
+                                        "speedup_frame"};
+    const double values[] = {r->update_ms, r->pre_render_ms, r->record_ms, r->assemble_ms,
+                             r->submit_ms, r->record_total_ms, r->cpu_frame_ms, r->gpu_ms,
+                             r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(names); i++) {
+        fprintf(f, ",\"%s\":", names[i]);
+        json_num(f, values[i]);
+    }
+    const ob_pm_stats *p = &r->pm;
+    fputs(",\"binds\":{", f);
+    json_pair(f, "pipeline", p->pipeline_binds_requested, p->pipeline_binds_issued, false);
+    json_pair(f, "descriptor", p->descriptor_binds_requested, p->descriptor_binds_issued, false);
+    json_pair(f, "push_descriptor", p->push_descriptor_requested, p->push_descriptor_issued, false);
+    json_pair(f, "push_constant", p->push_constant_requested, p->push_constant_issued, false);
+    json_pair(f, "vertex", p->vertex_binds_requested, p->vertex_binds_issued, false);
+    json_pair(f, "index", p->index_binds_requested, p->index_binds_issued, true);
+    fprintf(f, "},\"uniform_bytes\":%llu,\"frame_hash\":\"%016llx\",\"hash_mismatches\":%u}",
+            (unsigned long long)p->uniform_bytes, (unsigned long long)r->frame_hash,
+            r->hash_mismatches);
+}
+
+static void json_entry(FILE *f, const ob_bench_sweep_entry *e)
+{
+    fprintf(f, "{\"views\":%u,\"objects\":%u,\"modes\":[", e->views, e->objects);
+    for (uint32_t m = 0; m < e->mode_count; m++) {
+        fputs(m ? ",\n    " : "\n    ", f);
+        json_result(f, &e->results[m]);
+    }
+    fputs("]}", f);
+}
+
+static void json_quality(FILE *f, const ob_bench_quality_row *q)
+{
+    fprintf(f, "{\"kind\":\"%s\",\"env_size\":%u,\"shadow_size\":%u,\"mode\":",
+            ob_bench_quality_kind_name(q->kind), q->env_size, q->shadow_size);
+    json_str(f, q->mode.name);
+    fprintf(f, ",\"workers\":%u,\"max_abs_diff\":%u,\"psnr_db\":", q->mode.workers, q->max_abs_diff);
+    json_num(f, q->psnr_db);
+    fputs(",\"frame_ms\":", f);
+    json_num(f, q->frame_ms);
+    fputs(",\"gpu_ms\":", f);
+    json_num(f, q->gpu_ms);
+    fputs(",\"record_total_ms\":", f);
+    json_num(f, q->record_total_ms);
+    fprintf(f, ",\"draws\":%u,\"hash_mismatches\":%u}", q->draws, q->hash_mismatches);
+}
+
+static void json_summary(FILE *f, const ob_bench_report *rep)
+{
+    const ob_bench_summary *s = &rep->summary;
+    fputs("\"summary\":{\"mt_speedup_record_10k_8views\":", f);
+    json_num(f, s->mt_speedup_record_10k_8views);
+    fputs(",\"mt_speedup_best_mode\":", f);
+    json_str(f, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "");
+    fputs(",\"engine_vs_raw_per_draw\":", f);
+    json_num(f, s->engine_vs_raw_per_draw);
+    fputs(",\"auto_vs_best_200\":", f);
+    json_num(f, s->auto_vs_best_200);
+    fprintf(f, ",\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",
+            s->threading_max_abs_diff, s->hash_mismatches, s->threading_identical ? "true" : "false");
+    fputs("\"device\":{\"name\":", f);
+    json_str(f, rep->device_name);
+    fputs(",\"driver\":", f);
+    json_str(f, rep->driver_info);
+    fputs("}}", f);
+}
+
+ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
+{
+    FILE *f = open_out(path);
+    if (!f) return OB_ERR_IO;
+    fprintf(f, "{\"program\":\"obelisk-bench\",\"quick\":%s,\"seed\":%u,\"seconds\":%.1f,\n",
+            rep->quick ? "true" : "false", rep->seed, rep->seconds);
+    fprintf(f, "\"machine\":{\"cores\":%u,\"pool_workers\":%u,\"validation\":%s,", rep->cores,
+            rep->pool_workers, rep->validation ? "true" : "false");
+    fputs("\"load_average\":[", f);
+    json_num(f, rep->load_start);
+    fputs(",", f);
+    json_num(f, rep->load_end);
+    fputs("]},\n", f);
+    fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"flight\":%u,"
+               "\"big_frames\":{\"over_draws\":%u,\"warmup\":%u,\"rounds\":%u,\"flight\":%u},"
+               "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u},\n",
+            rep->warmup, rep->rounds, rep->flight, rep->big_draws, rep->big_warmup,
+            rep->big_rounds, rep->big_flight, rep->view_width, rep->view_height,
+            rep->image_width, rep->image_height, rep->image_frames);
+    fputs("\"sweep\":[\n  ", f);
+    for (uint32_t i = 0; i < rep->sweep_count; i++) {
+        if (i) fputs(",\n  ", f);
+        json_entry(f, &rep->sweep[i]);
+    }
+    fputs("],\n\"scene200\":", f);
+    json_entry(f, &rep->scene200);
+    fprintf(f, ",\n\"raw_baseline\":{\"views\":%u,\"objects\":%u,\"draws\":%u,\"reps\":%u,"
+               "\"buffer_binds\":%u,\"raw_record_ms\":",
+            rep->raw_views, rep->raw_objects, rep->raw.draws, rep->raw.reps, rep->raw.buffer_binds);
+    json_num(f, rep->raw.record_ms);
+    fputs(",\"raw_ns_per_draw\":", f);
+    json_num(f, rep->raw.ns_per_draw);
+    fputs(",\"engine_ns_per_draw\":", f);
+    json_num(f, rep->engine_ns_per_draw);
+    fputs("},\n\"quality\":[\n  ", f);
+    uint32_t written = 0;
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        if (rep->quality[i].kind == OB_BENCH_QUALITY_THREADING) continue;
+        if (written++) fputs(",\n  ", f);
+        json_quality(f, &rep->quality[i]);
+    }
+    /* The threading check: the mirror scene's images, plus every sweep
+     * configuration's command hashes (no image there). */
+    fputs("],\n\"threading_check\":[\n  ", f);
+    written = 0;
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        const ob_bench_quality_row *q = &rep->quality[i];
+        if (q->kind != OB_BENCH_QUALITY_THREADING) continue;
+        if (written++) fputs(",\n  ", f);
+        fputs("{\"scene\":\"mirror\",\"mode\":", f);
+        json_str(f, q->mode.name);
+        fprintf(f, ",\"max_abs_diff\":%u,\"hash_mismatches\":%u,\"identical\":%s}",
+                q->max_abs_diff, q->hash_mismatches,
+                q->max_abs_diff == 0 && q->hash_mismatches == 0 ? "true" : "false");
+    }
+    fputs("],\n", f);
+    json_summary(f, rep);
+    fputs("}\n", f);
+    return close_out(f, path);
+}
+
+/* ------------------------------------------------------------ CSV */
+
+static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t objects,
+                       const ob_bench_result *r)
+{
+    const ob_pm_stats *p = &r->pm;
+    fprintf(f, "%s,%u,%u,,,%s,%u", section, views, objects, r->mode.name, r->mode.workers);
+    const double v[] = {r->workers_used, r->draws, r->update_ms, r->pre_render_ms, r->record_ms,
+                        r->assemble_ms, r->submit_ms, r->record_total_ms, r->cpu_frame_ms,
+                        r->gpu_ms, r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(v); i++) csv_num(f, v[i]);
+    fprintf(f, ",%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,,,%u\n", p->pipeline_binds_requested,
+            p->pipeline_binds_issued, p->descriptor_binds_requested, p->descriptor_binds_issued,
+            p->push_descriptor_requested, p->push_descriptor_issued, p->push_constant_requested,
+            p->push_constant_issued, p->vertex_binds_requested, p->vertex_binds_issued,
+            p->index_binds_requested, p->index_binds_issued, r->hash_mismatches);
+}
+
+ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
+{
+    FILE *f = open_out(path);
+    if (!f) return OB_ERR_IO;
+    fputs("section,views,objects,env_size,shadow_size,mode,workers,workers_used,draws,update_ms,"
+          "pre_render_ms,record_ms,assemble_ms,submit_ms,record_total_ms,cpu_frame_ms,gpu_ms,"
+          "frame_ms,draws_per_s,speedup_record,speedup_frame,pipeline_req,pipeline_iss,"
+          "descriptor_req,descriptor_iss,push_descriptor_req,push_descriptor_iss,push_constant_req,"
+          "push_constant_iss,vertex_req,vertex_iss,index_req,index_iss,max_abs_diff,psnr_db,"
+          "hash_mismatches\n",
+          f);
+    for (uint32_t i = 0; i < rep->sweep_count; i++)
+        for (uint32_t m = 0; m < rep->sweep[i].mode_count; m++)
+            csv_result(f, "sweep", rep->sweep[i].views, rep->sweep[i].objects,
+                       &rep->sweep[i].results[m]);
+    for (uint32_t m = 0; m < rep->scene200.mode_count; m++)
+        csv_result(f, "scene200", 1, rep->scene200.objects, &rep->scene200.results[m]);
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        const ob_bench_quality_row *q = &rep->quality[i];
+        fprintf(f, "%s,1,%u,%u,%u,%s,%u,,%u,,,,,", ob_bench_quality_kind_name(q->kind),
+                rep->scene200.objects, q->env_size, q->shadow_size, q->mode.name, q->mode.workers,
+                q->draws);
+        csv_num(f, q->record_total_ms);
+        fputs(",", f);
+        csv_num(f, q->gpu_ms);
+        csv_num(f, q->frame_ms);
+        fputs(",,,,,,,,,,,,,,,", f);
+        fprintf(f, ",%u", q->max_abs_diff);
+        csv_num(f, q->psnr_db);
+        fprintf(f, ",%u\n", q->hash_mismatches);
+    }
+    /* Raw: record time in record_ms and record_total_ms, and draws/s. */
+    fprintf(f, "raw,%u,%u,,,raw,0,,%u,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
+    csv_num(f, rep->raw.record_ms);
+    fputs(",,", f);
+    csv_num(f, rep->raw.record_ms);
+    fputs(",,,", f);
+    csv_num(f, rep->raw.record_ms > 0 ? rep->raw.draws / (rep->raw.record_ms * 1e-3) : NAN);
+    fputs(",,,,,,,,,,,,,,,,,\n", f);
+    return close_out(f, path);
+}
+
+/* ------------------------------------------------------------ charts */
+
+static ob_result run_gnuplot(const char *script)
+{
+    char *argv[] = {"gnuplot", (char *)script, NULL};
+    pid_t pid;
+    int err = posix_spawnp(&pid, "gnuplot", NULL, NULL, argv, environ);
+    if (err != 0) {
+        OB_LOG_E("bench", "cannot run gnuplot for '%s': %s", script, strerror(err));
+        return OB_ERR_UNSUPPORTED;
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) return OB_ERR_UNSUPPORTED;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        OB_LOG_E("bench", "gnuplot failed on '%s' (status %d)", script, status);
+        return OB_ERR_UNSUPPORTED;
+    }
+    return OB_OK;
+}
+
+/* Paths of a chart's data and script (1024 bytes each); opens the data. */
+static FILE *open_chart_data(const char *dir, const char *name, char *dat, char *gp)
+{
+    snprintf(dat, 1024, "%s/%s.dat", dir, name);
+    snprintf(gp, 1024, "%s/%s.gp", dir, name);
+    return open_out(dat);
+}
+
+static ob_result speedup_chart(const ob_bench_report *rep, const char *dir)
+{
+    char dat[1024], gp[1024];
+    FILE *f = open_chart_data(dir, "speedup", dat, gp);
+    if (!f) return OB_ERR_IO;
+    fputs("# views objects workers speedup_record (ST rec+asm / MT rec+asm, device idle)\n", f);
+    uint32_t panels[16], panel_count = 0, sizes[16], size_count = 0;
+    for (uint32_t i = 0; i < rep->sweep_count; i++) {
+        const ob_bench_sweep_entry *e = &rep->sweep[i];
+        bool seen = false;
+        for (uint32_t k = 0; k < panel_count; k++) seen |= panels[k] == e->views;
+        if (!seen && panel_count < 16) panels[panel_count++] = e->views;
+        seen = false;
+        for (uint32_t k = 0; k < size_count; k++) seen |= sizes[k] == e->objects;
+        if (!seen && size_count < 16) sizes[size_count++] = e->objects;
+        fprintf(f, "%u %u 0 1\n", e->views, e->objects);
+        for (uint32_t m = 0; m < e->mode_count; m++) {
+            const ob_bench_result *r = &e->results[m];
+            if (r->mode.threading != OB_THREADING_MULTI) continue;
+            fprintf(f, "%u %u %u %.4f\n", e->views, e->objects, r->mode.workers, r->speedup_record);
+        }
+        fputs("\n", f);
+    }
+    ob_result res = close_out(f, dat);
+    if (res != OB_OK) return res;
+    f = open_out(gp);
+    if (!f) return OB_ERR_IO;
+    uint32_t cols = panel_count > 1 ? 2 : 1, rows = (panel_count + cols - 1) / cols;
+    fprintf(f, "set terminal pngcairo size %u,%u font ',10'\nset output '%s/speedup.png'\n",
+            560 * cols, 400 * (rows ? rows : 1), dir);
+    fprintf(f, "set multiplot layout %u,%u title 'Recording speedup vs workers (device idle; "
+               "%u cores; 0 = single-threaded)'\n", rows ? rows : 1, cols, rep->cores);
+    fputs("set xlabel 'workers'\nset ylabel 'ST / MT record time'\nset key top left\n"
+          "set grid\nset xtics 1\nset yrange [0:*]\nset xrange [-0.2:*]\n", f);
+    for (uint32_t p = 0; p < panel_count; p++) {
+        fprintf(f, "set title '%u view%s'\nplot ", panels[p], panels[p] == 1 ? "" : "s");
+        for (uint32_t s = 0; s < size_count; s++)
+            fprintf(f, "'%s' using 3:(($1==%u && $2==%u) ? $4 : 1/0) with linespoints lw 2 "
+                       "title '%u objects', ", dat, panels[p], sizes[s], sizes[s]);
+        fprintf(f, "%u < x ? %u : x dashtype 2 lc rgb 'gray' title 'cores bound'\n", rep->cores,
+                rep->cores);
+    }
+    fputs("unset multiplot\n", f);
+    res = close_out(f, gp);
+    return res == OB_OK ? run_gnuplot(gp) : res;
+}
+
+static ob_result error_chart(const ob_bench_report *rep, const char *dir)
+{
+    char dat[1024], gp[1024];
+    FILE *f = open_chart_data(dir, "error", dat, gp);
+    if (!f) return OB_ERR_IO;
+    fputs("# series(0 env, 1 shadow) size frame_ms psnr_db max_abs_diff\n", f);
+    double ref_ms = NAN;
+    for (int series = 0; series < 2; series++) {
+        for (uint32_t i = 0; i < rep->quality_count; i++) {
+            const ob_bench_quality_row *q = &rep->quality[i];
+            if (q->kind == OB_BENCH_QUALITY_REFERENCE) ref_ms = q->frame_ms;
+            ob_bench_quality_kind want = series ? OB_BENCH_QUALITY_SHADOW : OB_BENCH_QUALITY_ENV;
+            if (q->kind != want || !isfinite(q->psnr_db)) continue;
+            fprintf(f, "%d %u %.4f %.4f %u\n", series, series ? q->shadow_size : q->env_size,
+                    q->frame_ms, q->psnr_db, q->max_abs_diff);
+        }
+        fputs("\n\n", f);
+    }
+    ob_result res = close_out(f, dat);
+    if (res != OB_OK) return res;
+    f = open_out(gp);
+    if (!f) return OB_ERR_IO;
+    fprintf(f, "set terminal pngcairo size 800,560 font ',10'\nset output '%s/error.png'\n", dir);
+    fprintf(f, "set title 'Image error vs frame time (mirror scene; reference: ST, highest "
+               "quality, %.1f ms)'\n", isfinite(ref_ms) ? ref_ms : 0.0);
+    fputs("set xlabel 'frame time in flight (ms)'\nset ylabel 'PSNR over RGB (dB)'\nset grid\n"
+          "set key bottom right\n", f);
+    fprintf(f, "plot '%s' index 0 using 3:4 with linespoints pt 7 lw 2 title 'env-map size', "
+               "'' index 0 using 3:4:(sprintf('%%d', $2)) with labels offset 1,1 notitle, "
+               "'' index 1 using 3:4 with linespoints pt 5 lw 2 title 'shadow-map size', "
+               "'' index 1 using 3:4:(sprintf('%%d', $2)) with labels offset 1,-1 notitle\n", dat);
+    res = close_out(f, gp);
+    return res == OB_OK ? run_gnuplot(gp) : res;
+}
+
+ob_result ob_bench_report_charts(const ob_bench_report *rep, const char *dir)
+{
+    if (strpbrk(dir, "'\"\n")) {
+        OB_LOG_E("bench", "chart folder '%s': quotes and newlines are not supported", dir);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    ob_result res = ob_dir_make(dir);
+    if (res != OB_OK) return res;
+    res = speedup_chart(rep, dir);
+    ob_result res2 = error_chart(rep, dir);
+    return res != OB_OK ? res : res2;
+}

@@ -1,0 +1,70 @@
+/* ob_bench_report.h — what obelisk-bench measured, and its outputs: a
+ * table on stdout, JSON, CSV, gnuplot charts.
+ *
+ * Lifecycle: the program fills an ob_bench_report, then calls the writers.
+ * Thread rule: any one thread. Writers report I/O failures as OB_ERR_IO
+ * (logged with the path); the charts need gnuplot on PATH
+ * (OB_ERR_UNSUPPORTED, logged, when it is missing or fails).
+ */
+#ifndef OB_BENCH_REPORT_H
+#define OB_BENCH_REPORT_H
+
+#include <stdio.h>
+
+#include "ob_bench_quality.h"
+#include "ob_bench_raw.h"
+#include "ob_bench_run.h"
+
+#define OB_BENCH_MAX_MODES 8
+
+/* One scene (views × objects) measured in every mode of the list. */
+typedef struct ob_bench_sweep_entry {
+    uint32_t views, objects;
+    uint32_t mode_count;
+    ob_bench_result results[OB_BENCH_MAX_MODES];
+} ob_bench_sweep_entry;
+
+typedef struct ob_bench_summary {
+    double mt_speedup_record_10k_8views;   /* ST record / best MT record, 10k objects, 8 views */
+    const char *mt_speedup_best_mode;      /* the MT mode that was best there */
+    double engine_vs_raw_per_draw;         /* engine ST record ns per draw / raw ns per draw */
+    double auto_vs_best_200;               /* auto frame / min(ST, MT) frame, 200-object scene */
+    uint32_t threading_max_abs_diff;       /* largest image difference of any mode vs ST */
+    uint32_t hash_mismatches;              /* frames of any mode whose hash differed from ST's */
+    bool threading_identical;              /* both of the above are 0 */
+} ob_bench_summary;
+
+typedef struct ob_bench_report {
+    bool quick;
+    uint32_t seed, cores, pool_workers;
+    char device_name[256], driver_info[256];   /* ob_device_name / ob_device_driver_info */
+    bool validation;
+    uint32_t warmup, rounds, flight;               /* sweep frame counts per mode */
+    uint32_t big_draws;                            /* frames of more draws (estimated) use */
+    uint32_t big_warmup, big_rounds, big_flight;   /* these counts instead */
+    uint32_t view_width, view_height;              /* sweep view size */
+    uint32_t image_width, image_height, image_frames;
+    double seconds;                                /* whole run, wall clock */
+    double load_start, load_end;                   /* 1-minute load average (NAN if unknown) */
+
+    ob_bench_sweep_entry *sweep;
+    uint32_t sweep_count;
+    ob_bench_raw_result raw;                       /* raw Vulkan baseline */
+    uint32_t raw_views, raw_objects;               /* the sweep entry it is compared with */
+    double engine_ns_per_draw;                     /* that entry's ST record / draws */
+    ob_bench_quality_row *quality;
+    uint32_t quality_count;
+    ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */
+    ob_bench_summary summary;
+} ob_bench_report;
+
+void ob_bench_report_print(const ob_bench_report *rep, FILE *f);
+ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path);
+ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path);
+/* Writes DIR/speedup.png (record-time speedup against workers, one line
+ * per object count, one panel per view count) and DIR/error.png (PSNR
+ * against frame time for the quality settings), with their .dat and .gp
+ * files beside them. Creates DIR. */
+ob_result ob_bench_report_charts(const ob_bench_report *rep, const char *dir);
+
+#endif /* OB_BENCH_REPORT_H */

@@ -1,0 +1,75 @@
+/* ob_bench_run.h — measuring one scene in several threading modes.
+ *
+ * Two loops, both over every mode of the list, in the same process on the
+ * same scene (so ratios between modes come from one run):
+ *   idle     rounds of one frame per mode; before each frame the device is
+ *            waited idle (ob_renderer_wait_idle), so recording never competes
+ *            with lavapipe executing the previous frame on the same cores.
+ *            Within a round the scene is advanced once (by the first mode)
+ *            and re-rendered untouched by the others, so every mode records
+ *            exactly the same commands and their hashes must be equal.
+ *            Gives the CPU phases, GPU time (timestamps), binds.
+ *   flight   per mode, consecutive frames without waiting (frames in
+ *            flight, the normal way to run): gives the frame period.
+ * Warm-up frames (idle, round-robin) come first. Reported values are medians.
+ *
+ * Lifecycle: fill ob_bench_run_desc → ob_bench_run_modes → read results.
+ * Thread rule: render thread; the renderer's stats callback is taken over
+ * for the duration of the call and restored to none afterwards.
+ */
+#ifndef OB_BENCH_RUN_H
+#define OB_BENCH_RUN_H
+
+#include "ob_bench_scene.h"
+
+typedef struct ob_bench_mode {
+    const char *name;          /* "ST", "1", "2", "4", "auto" */
+    ob_threading threading;
+    uint32_t workers;          /* active workers for MULTI/AUTO (0 for ST) */
+} ob_bench_mode;
+
+/* Called once per rendered frame (progress display). */
+typedef void (*ob_bench_tick_fn)(void *user);
+
+typedef struct ob_bench_run_desc {
+    const ob_bench_mode *modes;
+    uint32_t mode_count;       /* the first mode is the reference for hashes and speedups */
+    uint32_t warmup;           /* idle frames per mode before measuring */
+    uint32_t rounds;           /* measured idle frames per mode */
+    uint32_t flight;           /* measured in-flight frames per mode (0 = skip the loop) */
+    double dt;                 /* scene time step, e.g. 1/60 */
+    ob_bench_tick_fn tick;
+    void *tick_user;
+} ob_bench_run_desc;
+
+typedef struct ob_bench_result {
+    ob_bench_mode mode;
+    uint32_t frames;           /* measured idle frames */
+    uint32_t draws;            /* per frame (median) */
+    uint32_t views;            /* views recorded per frame (median) */
+    double workers_used;       /* mean active workers of the measured frames (auto varies) */
+    /* medians, milliseconds, idle loop */
+    double update_ms;          /* from the in-flight frames, which all advance the scene */
+    double pre_render_ms, record_ms, assemble_ms, submit_ms;
+    double record_total_ms;    /* record + assemble: start of recording to primary complete */
+    double cpu_frame_ms;       /* the renderer's frame_ns with the device idle (its update
+                                  replaced by update_ms: see ob_bench_run.c) */
+    double gpu_ms;             /* timestamps (NAN if unavailable) */
+    double draws_per_s;        /* draws / record_total */
+    double frame_ms;           /* in-flight frame period (median), NAN without the loop */
+    double speedup_record;     /* reference mode's record_total / this one's */
+    double speedup_frame;      /* reference mode's frame_ms / this one's */
+    ob_pm_stats pm;            /* bind counters of the last measured frame */
+    uint64_t frame_hash;       /* of the last measured frame */
+    uint32_t hash_mismatches;  /* measured frames whose hash differed from the reference mode's */
+} ob_bench_result;
+
+/* Runs the loops; out has desc->mode_count entries. Failure: the first
+ * frame error (logged); out is then incomplete. */
+ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
+                             ob_bench_result *out);
+
+/* Sets the renderer's threading mode for the next frame. */
+void ob_bench_set_mode(ob_renderer *r, const ob_bench_mode *m);
+
+#endif /* OB_BENCH_RUN_H */

@@ -1,0 +1,424 @@
+/* obelisk-bench — what multithreaded recording buys, what the engine costs
+ * per draw, and what quality costs.
+ *
+ *   sweep      views × objects × threading modes (ST, 1, 2, 4 workers,
+ *              auto) on the sweep scene (demos/common/ob_bench_scene.h: a
+ *              "view" is one more camera's perspective view of the whole
+ *              scene): CPU time per phase and recording time with the device
+ *              idle, frame time with frames in flight, GPU time, draws per
+ *              second, binds requested / issued, command hashes (equal in
+ *              every mode, else the run fails)
+ *   raw        the same draws recorded with bare Vulkan (ob_bench_raw.h):
+ *              engine ns per draw / raw ns per draw
+ *   scene200   obelisk-mirror's 200-object scene in ST, MT and auto
+ *   quality    env-map and shadow-map sizes: image error against the
+ *              highest-quality single-threaded image next to frame time; the
+ *              threading modes must give that image byte for byte
+ *
+ * Medians of repeated frames after warm-up; every ratio comes from one run.
+ * Fixed seeds. A program, not a test: it never judges a time; it fails
+ * (exit 4) only when a threading mode's image or command hashes differ.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "ob_bench_progress.h"
+#include "ob_bench_report.h"
+
+#define MAX_LIST 8
+
+typedef struct bench_options {
+    bool quick, progress;
+    const char *json, *csv, *charts;
+    uint32_t seed;
+    uint32_t views[MAX_LIST], view_count;
+    uint32_t objects[MAX_LIST], object_count;
+    ob_bench_mode modes[OB_BENCH_MAX_MODES];
+    char mode_names[OB_BENCH_MAX_MODES][8];
+    uint32_t mode_count;
+    uint32_t warmup, rounds, flight;
+    uint32_t view_width, view_height, image_width, image_height;
+    uint32_t raw_objects;
+} bench_options;
+
+static const char usage_text[] =
+    "usage: obelisk-bench [options]\n"
+    "  --quick            a reduced run (under a minute on 2 cores)\n"
+    "  --json FILE        write every result and the summary as JSON\n"
+    "  --csv FILE         write every result as CSV (one row per configuration)\n"
+    "  --charts DIR       write speedup.png and error.png (gnuplot)\n"
+    "  --views LIST       perspective views per frame (default 1,4,8,16)\n"
+    "  --objects LIST     objects (default 1000,10000,50000; at most 100000)\n"
+    "  --modes LIST       ST, worker counts, auto (default ST,1,2,4,auto)\n"
+    "  --warmup N --rounds N --flight N   frames per mode: warm-up, idle, in flight\n"
+    "  --view-size WxH    size of each sweep view (default 256x192)\n"
+    "  --size WxH         size of the quality images (default 640x480)\n"
+    "  --seed S           scene seed (default 1)\n"
+    "  --no-progress      no progress bar even on a terminal\n";
+
+static bool parse_list(const char *s, uint32_t *out, uint32_t *count, uint32_t max_value)
+{
+    *count = 0;
+    char *end;
+    while (*s) {
+        unsigned long v = strtoul(s, &end, 10);
+        if (end == s || v == 0 || v > max_value || *count >= MAX_LIST) return false;
+        out[(*count)++] = (uint32_t)v;
+        s = *end == ',' ? end + 1 : end;
+        if (*end && *end != ',') return false;
+    }
+    return *count > 0;
+}
+
+static bool parse_modes(const char *s, bench_options *o)
+{
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s", s);
+    o->mode_count = 0;
+    /* auto hands work to as many workers as there are cores, like a
+     * renderer created with the default pool. */
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t cores = ncpu > 0 ? (uint32_t)OB_MIN(ncpu, (long)OB_MAX_WORKERS) : 1;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (o->mode_count >= OB_BENCH_MAX_MODES) return false;
+        ob_bench_mode *m = &o->modes[o->mode_count];
+        snprintf(o->mode_names[o->mode_count], sizeof o->mode_names[0], "%s", tok);
+        m->name = o->mode_names[o->mode_count];
+        if (!strcmp(tok, "ST")) {
+            *m = (ob_bench_mode){m->name, OB_THREADING_SINGLE, 0};
+        } else if (!strcmp(tok, "auto")) {
+            *m = (ob_bench_mode){m->name, OB_THREADING_AUTO, cores};
+        } else {
+            char *end;
+            unsigned long w = strtoul(tok, &end, 10);
+            if (*end || w == 0 || w > OB_MAX_WORKERS) return false;
+            *m = (ob_bench_mode){m->name, OB_THREADING_MULTI, (uint32_t)w};
+        }
+        o->mode_count++;
+    }
+    return o->mode_count > 0 && o->modes[0].threading == OB_THREADING_SINGLE;
+}
+
+static bool parse_size(const char *s, uint32_t *w, uint32_t *h)
+{
+    return sscanf(s, "%ux%u", w, h) == 2 && *w >= 16 && *h >= 16 && *w <= 4096 && *h <= 4096;
+}
+
+static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit)
+{
+    bool quick = false;
+    for (int i = 1; i < argc; i++) quick |= !strcmp(argv[i], "--quick");
+    *o = (bench_options){.quick = quick, .progress = true, .seed = 1, .view_width = 256,
+                         .view_height = 192, .image_width = 640, .image_height = 480,
+                         .raw_objects = 10000};
+    const char *views = quick ? "1,8" : "1,4,8,16";
+    const char *objects = quick ? "1000,10000" : "1000,10000,50000";
+    const char *modes = quick ? "ST,2,auto" : "ST,1,2,4,auto";
+    o->warmup = quick ? 1 : 2;
+    o->rounds = quick ? 3 : 5;
+    o->flight = quick ? 3 : 5;
+    *out_exit = 2;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        bool ok = true, takes = true;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            fputs(usage_text, stdout);
+            *out_exit = 0;
+            return false;
+        } else if (!strcmp(a, "--quick")) {
+            takes = false;
+        } else if (!strcmp(a, "--no-progress")) {
+            o->progress = takes = false;
+        } else if (!v) {
+            fprintf(stderr, "obelisk-bench: %s needs a value (or is unknown)\n%s", a, usage_text);
+            return false;
+        } else if (!strcmp(a, "--json")) {
+            o->json = v;
+        } else if (!strcmp(a, "--csv")) {
+            o->csv = v;
+        } else if (!strcmp(a, "--charts")) {
+            o->charts = v;
+        } else if (!strcmp(a, "--views")) {
+            views = v;
+        } else if (!strcmp(a, "--objects")) {
+            objects = v;
+        } else if (!strcmp(a, "--modes")) {
+            modes = v;
+        } else if (!strcmp(a, "--warmup") || !strcmp(a, "--rounds") || !strcmp(a, "--flight") ||
+                   !strcmp(a, "--seed")) {
+            char *end;
+            unsigned long n = strtoul(v, &end, 10);
+            ok = *v && !*end && n <= 1000;
+            uint32_t *dst = !strcmp(a, "--warmup") ? &o->warmup : !strcmp(a, "--rounds") ? &o->rounds
+                            : !strcmp(a, "--flight") ? &o->flight : &o->seed;
+            *dst = (uint32_t)n;
+            if (dst == &o->rounds) ok = ok && n > 0;
+        } else if (!strcmp(a, "--view-size")) {
+            ok = parse_size(v, &o->view_width, &o->view_height);
+        } else if (!strcmp(a, "--size")) {
+            ok = parse_size(v, &o->image_width, &o->image_height);
+        } else {
+            fprintf(stderr, "obelisk-bench: unknown option '%s'\n%s", a, usage_text);
+            return false;
+        }
+        if (!ok) {
+            fprintf(stderr, "obelisk-bench: bad value '%s' for %s\n", v, a);
+            return false;
+        }
+        if (takes) i++;
+    }
+    if (!parse_list(views, o->views, &o->view_count, OB_BENCH_MAX_VIEWS) ||
+        !parse_list(objects, o->objects, &o->object_count, 100000) || !parse_modes(modes, o)) {
+        fprintf(stderr, "obelisk-bench: bad --views, --objects or --modes list (modes must start "
+                        "with ST; views 1..%u)\n", OB_BENCH_MAX_VIEWS);
+        return false;
+    }
+    *out_exit = 0;
+    return true;
+}
+
+/* ------------------------------------------------------------ steps */
+
+static uint32_t pool_size(const bench_options *o, uint32_t cores)
+{
+    uint32_t pool = cores;
+    for (uint32_t m = 0; m < o->mode_count; m++) pool = OB_MAX(pool, o->modes[m].workers);
+    return OB_MIN(pool, (uint32_t)OB_MAX_WORKERS);
+}
+
+static ob_demo_options demo_options(const bench_options *o, uint32_t pool, uint32_t w, uint32_t h,
+                                    uint32_t objects)
+{
+    return (ob_demo_options){.frames = 1, .threads = (int)pool, .width = w, .height = h,
+                             .seed = o->seed, .objects = objects, .quiet = true};
+}
+
+/* Lavapipe executes every frame on the same two cores, at some 10-25 us
+ * a draw: big frames get fewer repetitions so the full sweep stays near ten
+ * minutes. A view draws about a third of the objects (ob_bench_scene.h). */
+#define BIG_FRAME_DRAWS 50000u
+
+static bool big_frame(uint32_t views, uint32_t objects)
+{
+    return (uint64_t)views * objects / 3 > BIG_FRAME_DRAWS;
+}
+
+static void frame_counts(const bench_options *o, uint32_t views, uint32_t objects,
+                         uint32_t *warmup, uint32_t *rounds, uint32_t *flight)
+{
+    bool big = big_frame(views, objects);
+    *warmup = big ? OB_MIN(o->warmup, 1u) : o->warmup;
+    *rounds = big ? OB_MIN(o->rounds, 3u) : o->rounds;
+    *flight = big ? OB_MIN(o->flight, 2u) : o->flight;
+}
+
+/* Progress units of one sweep frame: its draws, so the bar follows time
+ * (a mirror-scene frame, about 1500 draws at 640x480, counts as one). */
+static uint64_t frame_weight(uint32_t views, uint32_t objects)
+{
+    return OB_MAX((uint64_t)views * objects / 3 / 1500, (uint64_t)1);
+}
+
+/* One sweep configuration, and the raw baseline when it is the raw one. */
+static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint32_t views,
+                              uint32_t objects, ob_bench_progress *prog, ob_bench_sweep_entry *out)
+{
+    ob_demo_options dopt = demo_options(o, rep->pool_workers, o->view_width, o->view_height, objects);
+    ob_demo d;
+    ob_bench_scene s = {0};
+    ob_result r = ob_demo_init(&d, &dopt);
+    ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_SWEEP, .objects = objects, .views = views,
+                              .seed = o->seed};
+    if (r == OB_OK && !rep->device_name[0]) {
+        ob_device *dev = ob_renderer_device(d.r);
+        snprintf(rep->device_name, sizeof rep->device_name, "%s", ob_device_name(dev));
+        snprintf(rep->driver_info, sizeof rep->driver_info, "%s", ob_device_driver_info(dev));
+        rep->validation = ob_device_validation_enabled(dev);
+    }
+    if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
+    ob_bench_run_desc rd = {.modes = o->modes, .mode_count = o->mode_count, .dt = 1.0 / 60.0,
+                            .tick = ob_bench_progress_tick, .tick_user = prog};
+    frame_counts(o, views, objects, &rd.warmup, &rd.rounds, &rd.flight);
+    *out = (ob_bench_sweep_entry){.views = views, .objects = objects, .mode_count = o->mode_count};
+    if (r == OB_OK) r = ob_bench_run_modes(&s, &rd, out->results);
+    if (r == OB_OK && views == 1 && objects == o->raw_objects) {
+        r = ob_bench_raw_measure(&d, s.views[0], 2 * o->rounds + 1, &rep->raw);
+        rep->raw_views = views;
+        rep->raw_objects = objects;
+        const ob_bench_result *st = &out->results[0];
+        rep->engine_ns_per_draw = st->record_total_ms * 1e6 / st->draws;
+    }
+    if (d.r) ob_renderer_wait_idle(d.r);
+    ob_bench_scene_release(&s);
+    ob_demo_shutdown(&d);
+    return r;
+}
+
+static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench_progress *prog)
+{
+    ob_demo_options dopt = demo_options(o, rep->pool_workers, o->image_width, o->image_height, 200);
+    ob_demo d;
+    ob_bench_scene s = {0};
+    ob_result r = ob_demo_init(&d, &dopt);
+    ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_MIRROR, .objects = 200, .seed = o->seed};
+    if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
+    ob_bench_mode modes[3] = {{"ST", OB_THREADING_SINGLE, 0},
+                              {"MT", OB_THREADING_MULTI, rep->cores},
+                              {"auto", OB_THREADING_AUTO, rep->cores}};
+    ob_bench_run_desc rd = {.modes = modes, .mode_count = 3, .warmup = o->warmup,
+                            .rounds = o->rounds, .flight = 2 * o->flight, .dt = 1.0 / 60.0,
+                            .tick = ob_bench_progress_tick, .tick_user = prog};
+    rep->scene200 = (ob_bench_sweep_entry){.views = 1, .objects = 200, .mode_count = 3};
+    if (r == OB_OK) r = ob_bench_run_modes(&s, &rd, rep->scene200.results);
+    if (d.r) ob_renderer_wait_idle(d.r);
+    ob_bench_scene_release(&s);
+    ob_demo_shutdown(&d);
+    return r;
+}
+
+static void summarize(ob_bench_report *rep)
+{
+    ob_bench_summary *s = &rep->summary;
+    s->mt_speedup_record_10k_8views = NAN;
+    for (uint32_t i = 0; i < rep->sweep_count; i++) {
+        const ob_bench_sweep_entry *e = &rep->sweep[i];
+        for (uint32_t m = 0; m < e->mode_count; m++) s->hash_mismatches += e->results[m].hash_mismatches;
+        if (e->views != 8 || e->objects != 10000) continue;
+        double best = INFINITY;
+        for (uint32_t m = 1; m < e->mode_count; m++) {
+            const ob_bench_result *r = &e->results[m];
+            if (r->mode.threading != OB_THREADING_MULTI || !(r->record_total_ms < best)) continue;
+            best = r->record_total_ms;
+            s->mt_speedup_best_mode = r->mode.name;
+        }
+        if (isfinite(best)) s->mt_speedup_record_10k_8views = e->results[0].record_total_ms / best;
+    }
+    for (uint32_t m = 0; m < rep->scene200.mode_count; m++)
+        s->hash_mismatches += rep->scene200.results[m].hash_mismatches;
+    s->engine_vs_raw_per_draw = rep->raw.ns_per_draw > 0.0
+                                    ? rep->engine_ns_per_draw / rep->raw.ns_per_draw : NAN;
+    const ob_bench_result *r200 = rep->scene200.results;
+    s->auto_vs_best_200 = rep->scene200.mode_count == 3
+                              ? r200[2].frame_ms / fmin(r200[0].frame_ms, r200[1].frame_ms) : NAN;
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        const ob_bench_quality_row *q = &rep->quality[i];
+        if (q->kind != OB_BENCH_QUALITY_THREADING) continue;
+        s->threading_max_abs_diff = OB_MAX(s->threading_max_abs_diff, q->max_abs_diff);
+        s->hash_mismatches += q->hash_mismatches;
+    }
+    s->threading_identical = s->threading_max_abs_diff == 0 && s->hash_mismatches == 0;
+}
+
+/* The 1-minute load average: other work on the machine skews every time. */
+static double load_average(void)
+{
+    double load = NAN;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1) load = NAN;
+        fclose(f);
+    }
+    return load;
+}
+
+static int run(const bench_options *o)
+{
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    ob_bench_report rep = {.quick = o->quick, .seed = o->seed, .cores = ncpu > 0 ? (uint32_t)ncpu : 1,
+                           .warmup = o->warmup, .rounds = o->rounds, .flight = o->flight,
+                           .view_width = o->view_width, .view_height = o->view_height,
+                           .image_width = o->image_width, .image_height = o->image_height,
+                           .image_frames = o->quick ? 3 : 4};
+    rep.pool_workers = pool_size(o, rep.cores);
+    rep.big_draws = BIG_FRAME_DRAWS;
+    frame_counts(o, 1000, 1000000, &rep.big_warmup, &rep.big_rounds, &rep.big_flight);
+    uint64_t t0 = ob_time_ns();
+    rep.load_start = load_average();
+    static const uint32_t env_full[] = {64, 128, 256, 512}, shadow_full[] = {256, 512, 1024, 2048};
+    static const uint32_t env_quick[] = {128, 512}, shadow_quick[] = {512, 2048};
+    ob_bench_quality_desc qd = {
+        .base = demo_options(o, rep.pool_workers, o->image_width, o->image_height, 200),
+        .pool_workers = rep.pool_workers, .image_frames = rep.image_frames,
+        .rounds = o->quick ? 2 : 3, .flight = o->flight,
+        .env_sizes = o->quick ? env_quick : env_full, .env_count = o->quick ? 2 : 4,
+        .shadow_sizes = o->quick ? shadow_quick : shadow_full, .shadow_count = o->quick ? 2 : 4,
+        .modes = o->modes, .mode_count = o->mode_count,
+    };
+    uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1;
+    uint64_t total = 3 * (o->warmup + o->rounds + 2 * o->flight + 1) +
+                     quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1);
+    for (uint32_t n = 0; n < o->object_count; n++) {
+        for (uint32_t v = 0; v < o->view_count; v++) {
+            uint32_t w, r, f;
+            frame_counts(o, o->views[v], o->objects[n], &w, &r, &f);
+            total += (uint64_t)o->mode_count * (w + r + f + 1) * frame_weight(o->views[v], o->objects[n]);
+        }
+    }
+    ob_bench_progress prog;
+    ob_bench_progress_init(&prog, total, o->progress);
+    qd.tick = ob_bench_progress_tick;
+    qd.tick_user = &prog;
+
+    int code = 0;
+    ob_result r = OB_OK;
+    rep.sweep = ob_calloc(o->view_count * o->object_count, sizeof *rep.sweep);
+    if (!rep.sweep) r = OB_ERR_OUT_OF_HOST_MEMORY;
+    for (uint32_t n = 0; n < o->object_count && r == OB_OK; n++) {
+        for (uint32_t v = 0; v < o->view_count && r == OB_OK; v++) {
+            ob_bench_progress_label(&prog, "sweep: %u views, %u objects", o->views[v], o->objects[n]);
+            prog.unit = frame_weight(o->views[v], o->objects[n]);
+            r = sweep_config(o, &rep, o->views[v], o->objects[n], &prog, &rep.sweep[rep.sweep_count]);
+            if (r == OB_OK) rep.sweep_count++;
+        }
+    }
+    prog.unit = 1;
+    if (r == OB_OK) {
+        ob_bench_progress_label(&prog, "mirror scene, 200 objects: ST / MT / auto");
+        r = scene200(o, &rep, &prog);
+    }
+    if (r == OB_OK) {
+        ob_bench_progress_label(&prog, "quality and threading check (mirror scene)");
+        r = ob_bench_quality_run(&qd, &rep.quality, &rep.quality_count);
+    }
+    ob_bench_progress_finish(&prog);
+    rep.seconds = (double)(ob_time_ns() - t0) * 1e-9;
+    rep.load_end = load_average();
+
+    if (r != OB_OK) {
+        fprintf(stderr, "obelisk-bench: failed: %s (%s)\n", ob_result_name(r), ob_result_text(r));
+        code = 1;
+    } else {
+        summarize(&rep);
+        ob_bench_report_print(&rep, stdout);
+        if (o->json && ob_bench_report_json(&rep, o->json) != OB_OK) code = 1;
+        if (o->csv && ob_bench_report_csv(&rep, o->csv) != OB_OK) code = 1;
+        if (o->charts && ob_bench_report_charts(&rep, o->charts) != OB_OK) code = 1;
+        if (!rep.summary.threading_identical) {
+            fprintf(stderr, "obelisk-bench: threading modes differ from single-threaded "
+                            "(max abs diff %u, %u hash mismatches)\n",
+                    rep.summary.threading_max_abs_diff, rep.summary.hash_mismatches);
+            code = 4;
+        }
+        if (ob_log_count(OB_LOG_ERROR) > 0) {
+            fprintf(stderr, "obelisk-bench: %llu errors were logged\n",
+                    (unsigned long long)ob_log_count(OB_LOG_ERROR));
+            if (!code) code = 3;
+        }
+    }
+    ob_free(rep.sweep);
+    ob_free(rep.quality);
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    bench_options o;
+    int code;
+    if (!parse_options(argc, argv, &o, &code)) return code;
+    return run(&o);
+}
