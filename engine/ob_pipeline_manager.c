@@ -277,8 +277,12 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
 
 /* The cache entry of a mapping, or a new one claimed for it (frame_serial 0:
  * not packed yet). Stale entries of earlier frames are reused; probing goes
- * on past them so a live entry further along is still found. */
-static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map)
+ * on past them so a live entry further along is still found. The `claimed`
+ * entries (other blocks of the same draw, not packed yet, so they look
+ * stale too) are never taken over: two blocks sharing one entry would both
+ * be bound at the first one's offset. */
+static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *map,
+                             pack_entry *const *claimed, uint32_t claimed_count)
 {
     uint32_t h = (uint32_t)(((uintptr_t)map >> 4) * 2654435761u) & (PACK_CACHE_SIZE - 1);
     pack_entry *reuse = NULL;
@@ -289,7 +293,11 @@ static pack_entry *pack_slot(ob_pipeline_manager *pm, const ob_param_mapping *ma
             if (!reuse) reuse = e;
             break;
         }
-        if (!reuse && e->frame_serial != pm->frame_serial) reuse = e;
+        if (!reuse && e->frame_serial != pm->frame_serial) {
+            bool taken = false;
+            for (uint32_t k = 0; k < claimed_count; k++) taken |= claimed[k] == e;
+            if (!taken) reuse = e;
+        }
     }
     if (!reuse) return NULL; /* full of this frame's blocks: pack without caching */
     *reuse = (pack_entry){.mapping = map};
@@ -371,17 +379,21 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
 {
     if (prog->ubo_count == 0) return OB_OK;
     pack_entry *entries[OB_PROGRAM_MAX_UBOS];
-    pack_entry uncached[OB_PROGRAM_MAX_UBOS];
+    pack_entry uncached[OB_PROGRAM_MAX_UBOS] = {{0}};
+    /* Which blocks to pack, kept apart from the entries: clearing an
+     * entry's mapping instead would make it look free to the next block's
+     * lookup (which then took it over) and cut the probe chains of others. */
+    bool to_pack[OB_PROGRAM_MAX_UBOS];
     uint32_t chunk = UINT32_MAX;
     bool all_same_chunk = true;
     for (uint32_t i = 0; i < prog->ubo_count; i++) {
         const ob_param_mapping *map = prog->ubos[i].mapping;
-        pack_entry *e = pack_slot(pm, map);
+        pack_entry *e = pack_slot(pm, map, entries, i);
         if (!e) e = &uncached[i];
         bool fresh = e->mapping == map && e->frame_serial == pm->frame_serial;
         if (fresh && ob_params_pack_needed(&pm->params, map)) fresh = false;
-        if (!fresh) e->mapping = NULL; /* to pack */
-        else pm->stats.blocks_reused++;
+        to_pack[i] = !fresh;
+        if (fresh) pm->stats.blocks_reused++;
         entries[i] = e;
         if (fresh) {
             if (chunk == UINT32_MAX) chunk = e->chunk;
@@ -391,20 +403,20 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
     /* Blocks of one draw share one set, so they must sit in one chunk:
      * repack everything when the fresh ones are spread or stale. */
     if (!all_same_chunk || (chunk != UINT32_MAX && chunk != pm->ring->current)) {
-        for (uint32_t i = 0; i < prog->ubo_count; i++) entries[i]->mapping = NULL;
+        for (uint32_t i = 0; i < prog->ubo_count; i++) to_pack[i] = true;
         chunk = UINT32_MAX;
     }
     for (int attempt = 0; attempt < 2; attempt++) {
         bool moved = false;
         for (uint32_t i = 0; i < prog->ubo_count; i++) {
             pack_entry *e = entries[i];
-            if (e->mapping) continue;
+            if (!to_pack[i]) continue;
             uint32_t c = 0, off = 0;
             ob_result r = ring_alloc(pm, prog->ubos[i].size, &c, &off);
             if (r != OB_OK) return r;
             if (chunk != UINT32_MAX && c != chunk) {
                 /* Ring moved to a new chunk mid-draw: repack all there. */
-                for (uint32_t j = 0; j < prog->ubo_count; j++) entries[j]->mapping = NULL;
+                for (uint32_t j = 0; j < prog->ubo_count; j++) to_pack[j] = true;
                 chunk = UINT32_MAX;
                 moved = true;
                 break;
@@ -414,6 +426,7 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
             ob_params_pack(&pm->params, prog->ubos[i].mapping, dst, true);
             *e = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, c, off,
                               hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+            to_pack[i] = false;
             pm->stats.blocks_packed++;
             pm->stats.uniform_bytes += prog->ubos[i].size;
         }
