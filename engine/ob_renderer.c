@@ -130,6 +130,7 @@ fail_free:
     ob_free(r);
     r = NULL;
 fail:
+    OB_LOG_E("renderer", "renderer not created: %s", ob_result_name(res));
     if (out_result) *out_result = res;
     return NULL;
 }

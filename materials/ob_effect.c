@@ -177,7 +177,11 @@ ob_result ob_effect_context_save_cache(ob_effect_context *ctx)
         return OB_ERR_VULKAN;
     if (size == 0) return OB_OK;
     void *data = ob_malloc(size);
-    if (!data) return OB_ERR_OUT_OF_HOST_MEMORY;
+    if (!data) {
+        OB_LOG_W("effect", "pipeline cache not saved to '%s': no memory for %zu bytes",
+                 ctx->cache_path, size);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
     VkResult vr = vkGetPipelineCacheData(vk, ctx->cache, &size, data);
     ob_result r = OB_OK;
     if (vr != VK_SUCCESS && vr != VK_INCOMPLETE) {

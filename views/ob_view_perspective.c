@@ -97,6 +97,9 @@ ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspect
         pv = NULL;
     }
 done:
+    if (r != OB_OK && r != OB_ERR_INVALID_ARGUMENT)
+        OB_LOG_E("views", "perspective view '%s' not created: %s",
+                 desc->name ? desc->name : "camera", ob_result_name(r));
     if (out_result) *out_result = r;
     return pv;
 }

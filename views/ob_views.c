@@ -216,12 +216,22 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             }
             if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
                           (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
+                OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
+                         "skipped this frame", ob_node_name(entity), id);
+                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
                 ob_paraboloid_view_destroy(ctx, pv);
                 return;
             }
             e = &ctx->envs[ctx->env_count - 1];
         }
-        ob_renderer_attach_view(r, entity, e->view);
+        ob_result res = ob_renderer_attach_view(r, entity, e->view);
+        if (res != OB_OK) {
+            /* Unattached, the material could not find the map: do not render it. */
+            OB_LOG_E("views", "entity '%s' (id %u): environment map not attached (%s); skipped "
+                     "this frame", ob_node_name(entity), id, ob_result_name(res));
+            ob_renderer_note_skipped(r, e->view->name, OB_SKIP_ERROR);
+            return;
+        }
         ob_renderer_pre_draw(r, e->view);
     }
 }
@@ -252,6 +262,9 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             }
             if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
                           (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
+                OB_LOG_E("views", "light '%s': no memory to keep its shadow map; skipped this frame",
+                         ob_node_name(lights[i]));
+                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
                 ob_shadow_view_destroy(ctx, sv);
                 continue;
             }
@@ -370,6 +383,7 @@ fail:
     ob_views_destroy(ctx);
     ctx = NULL;
 done:
+    if (r != OB_OK) OB_LOG_E("views", "views context not created: %s", ob_result_name(r));
     if (out_result) *out_result = r;
     return ctx;
 }
