@@ -46,14 +46,20 @@ static void worker_release(ob_renderer *r, ob_worker *w)
 }
 
 /* Next secondary command buffer of this worker for the current frame slot
- * (allocated once, reused every time the slot comes round). */
-static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
+ * (allocated once, reused every time the slot comes round). On failure
+ * returns VK_NULL_HANDLE with *out_result set and logged. */
+static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *out_result)
 {
     uint32_t f = r->slot;
+    *out_result = OB_OK;
     if (w->cmd_used >= w->cmd_count[f]) {
-        if (ob_array_reserve((void **)&w->cmds[f], &w->cmd_cap[f], w->cmd_count[f] + 1,
-                             sizeof(VkCommandBuffer)) != OB_OK)
+        *out_result = ob_array_reserve((void **)&w->cmds[f], &w->cmd_cap[f], w->cmd_count[f] + 1,
+                                       sizeof(VkCommandBuffer));
+        if (*out_result != OB_OK) {
+            OB_LOG_E("renderer", "worker %u: its list of secondary command buffers cannot grow "
+                     "past %u: %s", w->index, w->cmd_count[f], ob_result_name(*out_result));
             return VK_NULL_HANDLE;
+        }
         VkCommandBufferAllocateInfo ai = {
             .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
             .commandPool = w->pools[f],
@@ -62,7 +68,11 @@ static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
         };
         VkCommandBuffer cmd;
         VkResult vr = OB_VK_CREATE(vkAllocateCommandBuffers(ob_device_vk(r->dev), &ai, &cmd));
-        if (OB_VK_CHECK(vr) != VK_SUCCESS) return VK_NULL_HANDLE;
+        if (OB_VK_CHECK(vr) != VK_SUCCESS) {
+            ob_device_note_result(r->dev, vr);
+            *out_result = ob_result_from_vk(vr);
+            return VK_NULL_HANDLE;
+        }
         w->cmds[f][w->cmd_count[f]++] = cmd;
     }
     return w->cmds[f][w->cmd_used++];
@@ -95,9 +105,13 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
     ob_view *v = job->view;
     uint64_t t0 = ob_time_ns();
     job->worker = (int32_t)w->index;
-    job->cmd = worker_next_cmd(r, w);
+    ob_result res;
+    job->cmd = worker_next_cmd(r, w, &res);
     if (!job->cmd) {
-        w->error = OB_ERR_OUT_OF_DEVICE_MEMORY;
+        OB_LOG_E("renderer", "view '%s' (layer %u, items %u..%u) not recorded by worker %u: %s",
+                 v->name, job->layer, job->first, job->first + job->count, w->index,
+                 ob_result_name(res));
+        w->error = res;
         return;
     }
     VkFormat color = image_format(r->dev, v->color);
@@ -433,6 +447,12 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_result res = OB_OK;
     if (multi) {
         res = build_jobs(r, order, count, active);
+        if (res != OB_OK) {
+            OB_LOG_E("renderer", "frame %llu: the job list for %u views cannot grow (%s); the "
+                     "frame is submitted without their draws", (unsigned long long)r->serial,
+                     count, ob_result_name(res));
+            r->job_count = 0;
+        }
         if (res == OB_OK && r->job_count > 0) run_jobs(r);
         for (uint32_t i = 0; i < r->worker_count; i++) {
             if (r->workers[i].error != OB_OK && res == OB_OK) res = r->workers[i].error;
@@ -461,7 +481,11 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     uint32_t job_total = multi ? r->job_count : 0;
     if (job_total) {
         by_view = ob_malloc(sizeof *by_view * job_total);
-        if (!by_view) res = OB_ERR_OUT_OF_HOST_MEMORY;
+        if (!by_view) {
+            res = OB_ERR_OUT_OF_HOST_MEMORY;
+            OB_LOG_E("renderer", "frame %llu: no memory to order %u recorded jobs; the frame is "
+                     "submitted without their draws", (unsigned long long)r->serial, job_total);
+        }
         for (uint32_t j = 0; by_view && j < job_total; j++) {
             ob_job *job = &r->jobs[j];
             /* insertion into (view_index, layer, first) order */
