@@ -278,12 +278,44 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 
 /* ------------------------------------------------------------ primary */
 
+/* Keep img's tracked state from before this frame's first barrier on it. */
+static void remember_state(ob_renderer *r, ob_image img)
+{
+    for (uint32_t i = 0; i < r->undo_count; i++)
+        if (r->undo[i].img.id == img.id) return;
+    if (r->undo_count >= OB_MAX_FRAME_IMAGES) {
+        r->undo_overflow = true;
+        return;
+    }
+    ob_image_undo *u = &r->undo[r->undo_count];
+    if (ob_image_get_state(r->dev, img, &u->before) == OB_OK) {
+        u->img = img;
+        r->undo_count++;
+    }
+}
+
+/* The primary will not run: put the layout tracking back to what the GPU
+ * last saw, or the next frame's barriers would start from layouts the
+ * images never reached (and say so to the validation layer). */
+static void undo_states(ob_renderer *r)
+{
+    for (uint32_t i = 0; i < r->undo_count; i++)
+        ob_image_set_state(r->dev, r->undo[i].img, &r->undo[i].before);
+    if (r->undo_overflow)
+        OB_LOG_E("renderer", "frame %llu touched more than %u images: the layout tracking of the "
+                 "others may not match the device after this failed frame",
+                 (unsigned long long)r->serial, OB_MAX_FRAME_IMAGES);
+    r->undo_count = 0;
+    r->undo_overflow = false;
+}
+
 static void add_image_barrier(ob_renderer *r, ob_image img, VkImageLayout layout,
                               VkPipelineStageFlags2 stages, VkAccessFlags2 access,
                               VkImageMemoryBarrier2 *barriers, uint32_t *n)
 {
     if (!img.id || *n >= 2 * OB_VIEW_MAX_DEPS + 4) return;
     ob_image_state next = {layout, stages, access};
+    remember_state(r, img);
     if (ob_image_transition(r->dev, img, &next, &barriers[*n])) (*n)++;
 }
 
@@ -299,6 +331,7 @@ static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img
     VkImageMemoryBarrier2 b;
     ob_image_state dst = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
                           VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    remember_state(r, img);
     if (!ob_image_transition(r->dev, img, &dst, &b)) return;
     VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
                             .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
@@ -436,6 +469,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_frame_slot *fs = &r->frames[r->slot];
     ob_frame_stats *st = &r->cur;
     VkDevice vk = ob_device_vk(r->dev);
+    VkResult vr;
     bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
     uint32_t active = multi ? r->active : 0;
     st->workers = active;
@@ -443,6 +477,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     for (uint32_t i = 0; i < count; i++) stat_view(st, i, order[i]);
 
     ob_param_registry_begin_recording(r->reg);
+    r->undo_count = 0;
+    r->undo_overflow = false;
     uint64_t t_record = ob_time_ns();
     ob_result res = OB_OK;
     if (multi) {
@@ -465,9 +501,13 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkCommandBuffer cmd = fs->primary;
     VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                    .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-    if (OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi)) != VK_SUCCESS) {
+    vr = OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    if (vr != VK_SUCCESS) {
         ob_param_registry_end_recording(r->reg);
-        return OB_ERR_VULKAN;
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not recorded: its primary command buffer could not begin",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
     }
     bool timestamps = fs->queries && 2 * count + 2 <= fs->query_capacity;
     if (timestamps) {
@@ -558,26 +598,39 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
 
-    if (OB_VK_CHECK(vkEndCommandBuffer(cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
+    if (vr != VK_SUCCESS) {
+        undo_states(r);
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not submitted: its command buffer could not be ended",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
+    }
     uint64_t t_submit = ob_time_ns();
-    VkResult vr = OB_VK_CHECK(vkResetFences(vk, 1, &fs->fence));
-    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK(vkResetFences(vk, 1, &fs->fence));
+    if (vr != VK_SUCCESS) {
+        undo_states(r);
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not submitted: its fence could not be reset",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
+    }
     VkCommandBufferSubmitInfo cbi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
                                      .commandBuffer = cmd};
     VkSubmitInfo2 si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
                         .commandBufferInfoCount = 1,
                         .pCommandBufferInfos = &cbi};
-    vr = OB_VK_CHECK(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence));
+    vr = OB_VK_CHECK(OB_VK_SUBMIT(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence)));
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
-        /* Nothing was submitted: leave the fence signalled so the slot can be reused. */
-        VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
-                                 .flags = VK_FENCE_CREATE_SIGNALED_BIT};
-        VkFence f;
-        if (vkCreateFence(vk, &fci, NULL, &f) == VK_SUCCESS) {
-            vkDestroyFence(vk, fs->fence, NULL);
-            fs->fence = f;
-        }
+        /* Nothing was submitted: the reset fence will not signal, so the
+         * slot's next begin_frame must not wait for it (creating a signalled
+         * replacement could fail too and leave that wait hanging). */
+        fs->unsubmitted = true;
+        undo_states(r);
+        OB_LOG_E("renderer", "frame %llu not submitted (%s): nothing of it was drawn%s",
+                 (unsigned long long)r->serial, ob_vk_result_name(vr),
+                 vr == VK_ERROR_DEVICE_LOST ? "" : "; the next frame starts afresh");
         return ob_result_from_vk(vr);
     }
     st->submit_ns = ob_time_ns() - t_submit;
