@@ -113,6 +113,8 @@ ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t el
 typedef enum ob_fault_kind {
     OB_FAULT_HOST_ALLOC = 0,   /* ob_malloc & co. return NULL */
     OB_FAULT_VK_OBJECT = 1,    /* a Vulkan allocation or object creation fails */
+    OB_FAULT_DEVICE_LOST = 2,  /* a queue submission or a wait reports VK_ERROR_DEVICE_LOST */
+    OB_FAULT_SUBMIT_OOM = 3,   /* a queue submission reports VK_ERROR_OUT_OF_DEVICE_MEMORY */
     OB_FAULT_KIND_COUNT
 } ob_fault_kind;
 

@@ -445,9 +445,10 @@ ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd)
             .commandBufferInfoCount = 1,
             .pCommandBufferInfos = &cmd_info,
         };
-        vr = OB_VK_CHECK(vkQueueSubmit2(dev->queue, 1, &submit, dev->oneshot_fence));
+        vr = OB_VK_CHECK(OB_VK_SUBMIT(vkQueueSubmit2(dev->queue, 1, &submit, dev->oneshot_fence)));
         if (vr >= 0) {
-            vr = OB_VK_CHECK(vkWaitForFences(dev->device, 1, &dev->oneshot_fence, VK_TRUE, UINT64_MAX));
+            vr = OB_VK_CHECK(OB_VK_WAIT(
+                vkWaitForFences(dev->device, 1, &dev->oneshot_fence, VK_TRUE, UINT64_MAX)));
             OB_VK_CHECK(vkResetFences(dev->device, 1, &dev->oneshot_fence));
             if (vr < 0) {
                 /* Possibly still pending: the pool frees it at destroy. */
@@ -463,7 +464,7 @@ ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd)
 
 ob_result ob_device_wait_idle(ob_device *dev)
 {
-    VkResult vr = OB_VK_CHECK(vkDeviceWaitIdle(dev->device));
+    VkResult vr = OB_VK_CHECK(OB_VK_WAIT(vkDeviceWaitIdle(dev->device)));
     ob_device_note_result(dev, vr);
     return ob_result_from_vk(vr);
 }

@@ -49,6 +49,18 @@ const char *ob_vk_result_name(VkResult res);
     (ob_fault_should_fail(OB_FAULT_VK_OBJECT) ? VK_ERROR_OUT_OF_DEVICE_MEMORY : (call))
 /* OB_VK_CHECK(OB_VK_CREATE(call)) that logs the call text without the wrapper. */
 #define OB_VK_CHECK_CREATE(call) ob_vk_check(OB_VK_CREATE(call), #call, __FILE__, __LINE__)
+/* Wrap every vkQueueSubmit* in OB_VK_SUBMIT: a test can make the Nth
+ * submission report VK_ERROR_DEVICE_LOST (OB_FAULT_DEVICE_LOST) or
+ * VK_ERROR_OUT_OF_DEVICE_MEMORY (OB_FAULT_SUBMIT_OOM) without submitting. */
+#define OB_VK_SUBMIT(call)                                                              \
+    (ob_fault_should_fail(OB_FAULT_DEVICE_LOST)  ? VK_ERROR_DEVICE_LOST                 \
+     : ob_fault_should_fail(OB_FAULT_SUBMIT_OOM) ? VK_ERROR_OUT_OF_DEVICE_MEMORY        \
+                                                 : (call))
+/* Wrap every vkWaitForFences / vkDeviceWaitIdle of a frame in OB_VK_WAIT: the
+ * wait always happens (so nothing is left running), then a test can make
+ * the Nth wait report VK_ERROR_DEVICE_LOST (OB_FAULT_DEVICE_LOST). */
+#define OB_VK_WAIT(call) ob_vk_wait_result(call)
+VkResult ob_vk_wait_result(VkResult res);
 /* Maps a VkResult to an ob_result (OUT_OF_DEVICE_MEMORY, DEVICE_LOST, ...).
  * Non-negative results (VK_SUCCESS, VK_INCOMPLETE, VK_TIMEOUT, ...) map to OB_OK. */
 ob_result ob_result_from_vk(VkResult res);

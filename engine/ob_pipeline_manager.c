@@ -163,6 +163,9 @@ fail_free:
     ob_free(pm);
     pm = NULL;
 done:
+    if (r != OB_OK)
+        OB_LOG_E("pm", "pipeline manager '%s' not created: %s",
+                 desc && desc->name ? desc->name : "pm", ob_result_name(r));
     if (out_result) *out_result = r;
     return pm;
 }

@@ -133,6 +133,7 @@ fail_free:
     ob_free(r);
     r = NULL;
 fail:
+    OB_LOG_E("renderer", "renderer not created: %s", ob_result_name(res));
     if (out_result) *out_result = res;
     return NULL;
 }
@@ -261,16 +262,27 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
         OB_LOG_E("renderer", "begin_frame called twice without end_frame");
         return OB_ERR_WRONG_STATE;
     }
-    if (ob_device_is_lost(r->dev)) return OB_ERR_DEVICE_LOST;
+    if (ob_device_is_lost(r->dev)) {
+        OB_LOG_E("renderer", "frame refused: the device is lost (destroy the renderer and "
+                 "create a new one)");
+        return OB_ERR_DEVICE_LOST;
+    }
     uint64_t t0 = ob_time_ns();
     r->slot = (uint32_t)(r->serial % r->frames_in_flight);
     ob_frame_slot *fs = &r->frames[r->slot];
     VkDevice vk = ob_device_vk(r->dev);
-    VkResult vr = OB_VK_CHECK(vkWaitForFences(vk, 1, &fs->fence, VK_TRUE, UINT64_MAX));
+    /* A slot whose last submission failed has nothing pending: its fence was
+     * reset for that submission and never signals. */
+    VkResult vr = VK_SUCCESS;
+    if (!fs->unsubmitted)
+        vr = OB_VK_CHECK(OB_VK_WAIT(vkWaitForFences(vk, 1, &fs->fence, VK_TRUE, UINT64_MAX)));
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu: waiting for frame slot %u failed: %s",
+                 (unsigned long long)r->serial + 1, r->slot, ob_vk_result_name(vr));
         return ob_result_from_vk(vr);
     }
+    fs->unsubmitted = false;
     collect_frame(r, fs);
     r->serial++;
     ob_device_begin_frame_slot(r->dev, r->slot);
@@ -473,11 +485,13 @@ ob_result ob_renderer_end_frame(ob_renderer *r)
 
 ob_result ob_renderer_wait_idle(ob_renderer *r)
 {
-    VkResult vr = OB_VK_CHECK(vkDeviceWaitIdle(ob_device_vk(r->dev)));
+    VkResult vr = OB_VK_CHECK(OB_VK_WAIT(vkDeviceWaitIdle(ob_device_vk(r->dev))));
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
         return ob_result_from_vk(vr);
     }
+    /* Idle, but a lost device's frames never completed: no stats to collect. */
+    if (ob_device_is_lost(r->dev)) return OB_ERR_DEVICE_LOST;
     /* Collect in submission order so `last` ends as the newest frame. */
     for (uint64_t k = r->frames_in_flight; k > 0; k--) {
         uint32_t slot = (uint32_t)((r->serial + r->frames_in_flight - k) % r->frames_in_flight);

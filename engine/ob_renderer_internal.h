@@ -45,9 +45,18 @@ typedef struct ob_frame_slot {
     VkQueryPool queries;
     uint32_t query_capacity;
     bool pending;               /* submitted, stats not yet collected */
+    bool unsubmitted;           /* the fence was reset but the submission failed */
     uint32_t view_queries;      /* views with timestamps in the pending frame */
     ob_frame_stats stats;
 } ob_frame_slot;
+
+/* An image's tracked state before the frame's first barrier on it: restored
+ * when the frame is not submitted, so the tracking matches the GPU again. */
+typedef struct ob_image_undo {
+    ob_image img;
+    ob_image_state before;
+} ob_image_undo;
+#define OB_MAX_FRAME_IMAGES (4 * OB_MAX_FRAME_VIEWS)
 
 typedef struct ob_attachment {
     uint32_t node_id;
@@ -89,6 +98,10 @@ struct ob_renderer {
 
     ob_job *jobs;
     uint32_t job_count, job_cap;
+
+    ob_image_undo undo[OB_MAX_FRAME_IMAGES];
+    uint32_t undo_count;
+    bool undo_overflow;
 
     pthread_mutex_t lock;
     pthread_cond_t wake, done;

@@ -46,14 +46,20 @@ static void worker_release(ob_renderer *r, ob_worker *w)
 }
 
 /* Next secondary command buffer of this worker for the current frame slot
- * (allocated once, reused every time the slot comes round). */
-static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
+ * (allocated once, reused every time the slot comes round). On failure
+ * returns VK_NULL_HANDLE with *out_result set and logged. */
+static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *out_result)
 {
     uint32_t f = r->slot;
+    *out_result = OB_OK;
     if (w->cmd_used >= w->cmd_count[f]) {
-        if (ob_array_reserve((void **)&w->cmds[f], &w->cmd_cap[f], w->cmd_count[f] + 1,
-                             sizeof(VkCommandBuffer)) != OB_OK)
+        *out_result = ob_array_reserve((void **)&w->cmds[f], &w->cmd_cap[f], w->cmd_count[f] + 1,
+                                       sizeof(VkCommandBuffer));
+        if (*out_result != OB_OK) {
+            OB_LOG_E("renderer", "worker %u: its list of secondary command buffers cannot grow "
+                     "past %u: %s", w->index, w->cmd_count[f], ob_result_name(*out_result));
             return VK_NULL_HANDLE;
+        }
         VkCommandBufferAllocateInfo ai = {
             .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
             .commandPool = w->pools[f],
@@ -62,7 +68,11 @@ static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w)
         };
         VkCommandBuffer cmd;
         VkResult vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(ob_device_vk(r->dev), &ai, &cmd));
-        if (vr != VK_SUCCESS) return VK_NULL_HANDLE;
+        if (vr != VK_SUCCESS) {
+            ob_device_note_result(r->dev, vr);
+            *out_result = ob_result_from_vk(vr);
+            return VK_NULL_HANDLE;
+        }
         w->cmds[f][w->cmd_count[f]++] = cmd;
     }
     return w->cmds[f][w->cmd_used++];
@@ -95,9 +105,13 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
     ob_view *v = job->view;
     uint64_t t0 = ob_time_ns();
     job->worker = (int32_t)w->index;
-    job->cmd = worker_next_cmd(r, w);
+    ob_result res;
+    job->cmd = worker_next_cmd(r, w, &res);
     if (!job->cmd) {
-        w->error = OB_ERR_OUT_OF_DEVICE_MEMORY;
+        OB_LOG_E("renderer", "view '%s' (layer %u, items %u..%u) not recorded by worker %u: %s",
+                 v->name, job->layer, job->first, job->first + job->count, w->index,
+                 ob_result_name(res));
+        w->error = res;
         return;
     }
     VkFormat color = image_format(r->dev, v->color);
@@ -269,12 +283,44 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 /* Colour and depth of each dependency, the inputs, the view's own two targets. */
 #define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 2)
 
+/* Keep img's tracked state from before this frame's first barrier on it. */
+static void remember_state(ob_renderer *r, ob_image img)
+{
+    for (uint32_t i = 0; i < r->undo_count; i++)
+        if (r->undo[i].img.id == img.id) return;
+    if (r->undo_count >= OB_MAX_FRAME_IMAGES) {
+        r->undo_overflow = true;
+        return;
+    }
+    ob_image_undo *u = &r->undo[r->undo_count];
+    if (ob_image_get_state(r->dev, img, &u->before) == OB_OK) {
+        u->img = img;
+        r->undo_count++;
+    }
+}
+
+/* The primary will not run: put the layout tracking back to what the GPU
+ * last saw, or the next frame's barriers would start from layouts the
+ * images never reached (and say so to the validation layer). */
+static void undo_states(ob_renderer *r)
+{
+    for (uint32_t i = 0; i < r->undo_count; i++)
+        ob_image_set_state(r->dev, r->undo[i].img, &r->undo[i].before);
+    if (r->undo_overflow)
+        OB_LOG_E("renderer", "frame %llu touched more than %u images: the layout tracking of the "
+                 "others may not match the device after this failed frame",
+                 (unsigned long long)r->serial, OB_MAX_FRAME_IMAGES);
+    r->undo_count = 0;
+    r->undo_overflow = false;
+}
+
 static void add_image_barrier(ob_renderer *r, ob_image img, VkImageLayout layout,
                               VkPipelineStageFlags2 stages, VkAccessFlags2 access,
                               VkImageMemoryBarrier2 *barriers, uint32_t *n)
 {
     if (!img.id || *n >= VIEW_MAX_BARRIERS) return;
     ob_image_state next = {layout, stages, access};
+    remember_state(r, img);
     if (ob_image_transition(r->dev, img, &next, &barriers[*n])) (*n)++;
 }
 
@@ -290,6 +336,7 @@ static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img
     VkImageMemoryBarrier2 b;
     ob_image_state dst = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
                           VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    remember_state(r, img);
     if (!ob_image_transition(r->dev, img, &dst, &b)) return;
     VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
                             .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
@@ -427,6 +474,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_frame_slot *fs = &r->frames[r->slot];
     ob_frame_stats *st = &r->cur;
     VkDevice vk = ob_device_vk(r->dev);
+    VkResult vr;
     bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
     uint32_t active = multi ? r->active : 0;
     st->workers = active;
@@ -434,10 +482,18 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     for (uint32_t i = 0; i < count; i++) stat_view(st, i, order[i]);
 
     ob_param_registry_begin_recording(r->reg);
+    r->undo_count = 0;
+    r->undo_overflow = false;
     uint64_t t_record = ob_time_ns();
     ob_result res = OB_OK;
     if (multi) {
         res = build_jobs(r, order, count, active);
+        if (res != OB_OK) {
+            OB_LOG_E("renderer", "frame %llu: the job list for %u views cannot grow (%s); the "
+                     "frame is submitted without their draws", (unsigned long long)r->serial,
+                     count, ob_result_name(res));
+            r->job_count = 0;
+        }
         if (res == OB_OK && r->job_count > 0) run_jobs(r);
         for (uint32_t i = 0; i < r->worker_count; i++) {
             if (r->workers[i].error != OB_OK && res == OB_OK) res = r->workers[i].error;
@@ -450,9 +506,13 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkCommandBuffer cmd = fs->primary;
     VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                    .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-    if (OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi)) != VK_SUCCESS) {
+    vr = OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    if (vr != VK_SUCCESS) {
         ob_param_registry_end_recording(r->reg);
-        return OB_ERR_VULKAN;
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not recorded: its primary command buffer could not begin",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
     }
     bool timestamps = fs->queries && 2 * count + 2 <= fs->query_capacity;
     if (timestamps) {
@@ -466,7 +526,11 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     uint32_t job_total = multi ? r->job_count : 0;
     if (job_total) {
         by_view = ob_malloc(sizeof *by_view * job_total);
-        if (!by_view) res = OB_ERR_OUT_OF_HOST_MEMORY;
+        if (!by_view) {
+            res = OB_ERR_OUT_OF_HOST_MEMORY;
+            OB_LOG_E("renderer", "frame %llu: no memory to order %u recorded jobs; the frame is "
+                     "submitted without their draws", (unsigned long long)r->serial, job_total);
+        }
         for (uint32_t j = 0; by_view && j < job_total; j++) {
             ob_job *job = &r->jobs[j];
             /* insertion into (view_index, layer, first) order */
@@ -539,26 +603,39 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
 
-    if (OB_VK_CHECK(vkEndCommandBuffer(cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
+    if (vr != VK_SUCCESS) {
+        undo_states(r);
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not submitted: its command buffer could not be ended",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
+    }
     uint64_t t_submit = ob_time_ns();
-    VkResult vr = OB_VK_CHECK(vkResetFences(vk, 1, &fs->fence));
-    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    vr = OB_VK_CHECK(vkResetFences(vk, 1, &fs->fence));
+    if (vr != VK_SUCCESS) {
+        undo_states(r);
+        ob_device_note_result(r->dev, vr);
+        OB_LOG_E("renderer", "frame %llu not submitted: its fence could not be reset",
+                 (unsigned long long)r->serial);
+        return ob_result_from_vk(vr);
+    }
     VkCommandBufferSubmitInfo cbi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
                                      .commandBuffer = cmd};
     VkSubmitInfo2 si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
                         .commandBufferInfoCount = 1,
                         .pCommandBufferInfos = &cbi};
-    vr = OB_VK_CHECK(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence));
+    vr = OB_VK_CHECK(OB_VK_SUBMIT(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence)));
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
-        /* Nothing was submitted: leave the fence signalled so the slot can be reused. */
-        VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
-                                 .flags = VK_FENCE_CREATE_SIGNALED_BIT};
-        VkFence f;
-        if (vkCreateFence(vk, &fci, NULL, &f) == VK_SUCCESS) {
-            vkDestroyFence(vk, fs->fence, NULL);
-            fs->fence = f;
-        }
+        /* Nothing was submitted: the reset fence will not signal, so the
+         * slot's next begin_frame must not wait for it (creating a signalled
+         * replacement could fail too and leave that wait hanging). */
+        fs->unsubmitted = true;
+        undo_states(r);
+        OB_LOG_E("renderer", "frame %llu not submitted (%s): nothing of it was drawn%s",
+                 (unsigned long long)r->serial, ob_vk_result_name(vr),
+                 vr == VK_ERROR_DEVICE_LOST ? "" : "; the next frame starts afresh");
         return ob_result_from_vk(vr);
     }
     st->submit_ns = ob_time_ns() - t_submit;

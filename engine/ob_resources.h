@@ -116,6 +116,10 @@ ob_result ob_image_get_state(const ob_device *dev, ob_image img, ob_image_state 
  * src of the barrier = tracked stages/access/layout, dst = next. */
 bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *next,
                          VkImageMemoryBarrier2 *out_barrier);
+/* Sets the tracked state without recording anything: rolls the tracking
+ * back when recorded barriers were never submitted (a failed frame).
+ * OB_ERR_INVALID_HANDLE / OB_ERR_INVALID_ARGUMENT, logged. [render thread] */
+ob_result ob_image_set_state(ob_device *dev, ob_image img, const ob_image_state *state);
 
 /* Reads the image (layer 0) back as tightly packed RGBA8 (colour formats
  * R8G8B8A8/B8G8R8A8 UNORM/SRGB and R8G8B8A8_UINT, swizzled to RGBA). Waits

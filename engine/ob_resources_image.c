@@ -502,3 +502,15 @@ bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *nex
     }
     return ob_res_image_transition(rec, next, out_barrier);
 }
+
+ob_result ob_image_set_state(ob_device *dev, ob_image img, const ob_image_state *state)
+{
+    ob_image_rec *rec = ob_res_image_get(dev, img, "ob_image_set_state");
+    if (!rec) return OB_ERR_INVALID_HANDLE;
+    if (!state) {
+        OB_LOG_E("resources", "image '%s': ob_image_set_state without a state", rec->name);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    rec->state = *state;
+    return OB_OK;
+}

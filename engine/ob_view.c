@@ -75,7 +75,13 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     v->culled = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
-    if (res != OB_OK) return res;
+    if (res != OB_OK) {
+        /* The view goes on empty this frame; the next frame tries again. */
+        OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",
+                 v->name, count, ob_result_name(res));
+        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        return res;
+    }
     ob_frustum frustum;
     ob_frustum_from_matrix(v->view_proj, &frustum);
     bool out_of_range = false;

@@ -72,6 +72,11 @@ VkResult ob_vk_check(VkResult res, const char *call_text, const char *file, int 
     return res;
 }
 
+VkResult ob_vk_wait_result(VkResult res)
+{
+    return ob_fault_should_fail(OB_FAULT_DEVICE_LOST) ? VK_ERROR_DEVICE_LOST : res;
+}
+
 ob_result ob_result_from_vk(VkResult res)
 {
     if (res >= 0) return OB_OK;

@@ -177,7 +177,11 @@ ob_result ob_effect_context_save_cache(ob_effect_context *ctx)
         return OB_ERR_VULKAN;
     if (size == 0) return OB_OK;
     void *data = ob_malloc(size);
-    if (!data) return OB_ERR_OUT_OF_HOST_MEMORY;
+    if (!data) {
+        OB_LOG_W("effect", "pipeline cache not saved to '%s': no memory for %zu bytes",
+                 ctx->cache_path, size);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
     VkResult vr = vkGetPipelineCacheData(vk, ctx->cache, &size, data);
     ob_result r = OB_OK;
     if (vr != VK_SUCCESS && vr != VK_INCOMPLETE) {
@@ -597,9 +601,13 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
     if (OB_VK_CHECK(vr) != VK_SUCCESS) {
         ob_device_note_result(e->ctx->dev, vr);
         atomic_fetch_add(&e->ctx->pipelines_failed, 1);
+        bool transient = vr == VK_ERROR_OUT_OF_HOST_MEMORY || vr == VK_ERROR_OUT_OF_DEVICE_MEMORY;
         OB_LOG_E("effect", "effect '%s': pipeline for colour format %d, depth format %d not "
-                 "created (%s); its draws are skipped", e->name, (int)color, (int)depth,
-                 ob_vk_result_name(vr));
+                 "created (%s); its draws are skipped%s", e->name, (int)color, (int)depth,
+                 ob_vk_result_name(vr), transient ? " until a later try succeeds" : "");
+        /* Memory may come back: leave the pair unpublished so the next
+         * request tries again (a frame that failed must not stay broken). */
+        if (transient) return NULL;
     } else {
         entry->pipeline = pipeline;
         atomic_fetch_add(&e->ctx->pipelines_created, 1);

@@ -133,7 +133,9 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
  * first use and cached. *out_pipeline_id (optional) receives a stable id
  * (hash of the effect name and formats) for command hashes. On failure
  * returns VK_NULL_HANDLE after logging once with the effect's name; later
- * calls for the same formats fail fast without logging again. [any thread] */
+ * calls for the same formats fail fast without logging again — except after
+ * an out-of-memory result, which is transient: the next call tries again.
+ * [any thread] */
 VkPipeline ob_effect_pipeline(ob_effect *e, VkFormat color, VkFormat depth,
                               uint32_t *out_pipeline_id);
 

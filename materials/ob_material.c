@@ -170,8 +170,8 @@ ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect ki
         desc.name = name;
         e = ob_effect_create(lib->ctx, &desc, &r);
         if (e) atomic_store_explicit(&slot->effect, e, memory_order_release);
-        /* Host memory may come back; a broken shader or device limit will not. */
-        else if (r != OB_ERR_OUT_OF_HOST_MEMORY) slot->failure = r;
+        /* Memory may come back; a broken shader or device limit will not. */
+        else if (r != OB_ERR_OUT_OF_HOST_MEMORY && r != OB_ERR_OUT_OF_DEVICE_MEMORY) slot->failure = r;
     }
     if (out_result) *out_result = e ? OB_OK : r;
     return e;

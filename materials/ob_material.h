@@ -146,7 +146,8 @@ ob_effect_context *ob_material_library_context(const ob_material_library *lib);
 
 /* The standard effect variant, compiled and built on first request.
  * Failure: NULL, *out_result, logged (and not retried: later calls return
- * NULL with the same result quietly). [render thread, not while recording] */
+ * NULL with the same result quietly — unless it ran out of host or device
+ * memory, which the next call tries again). [render thread, not while recording] */
 ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect kind,
                                       uint32_t variant, ob_result *out_result);
 /* The variant if it exists already, else NULL; never compiles. [any thread] */

@@ -56,6 +56,7 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
     ob_result r = OB_OK;
     ob_composite_view *cv = NULL;
     if (!ctx || !source || !source->color.id) {
+        OB_LOG_E("views", "composite view: needs a source view with a colour target");
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
@@ -84,6 +85,8 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
         cv = NULL;
     }
 done:
+    if (r != OB_OK && r != OB_ERR_INVALID_ARGUMENT)
+        OB_LOG_E("views", "composite view of '%s' not created: %s", source->name, ob_result_name(r));
     if (out_result) *out_result = r;
     return cv;
 }

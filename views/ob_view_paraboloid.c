@@ -25,6 +25,9 @@ static void paraboloid_pre_draw(ob_view *v, ob_renderer *r)
     ob_mat4_identity(v->view_proj);
     ob_view_cull(v, r, ob_renderer_scene(r), pv->owner);
     ob_view_pre_render_items(v, r);
+    /* A particle system the map sees must step before the map draws it and
+     * hand it its parameters (it becomes a dependency), as for a camera. */
+    ob_views_queue_simulations(pv->ctx, r, v);
     ob_material_library_prepare_view(pv->ctx->materials, r, v);
 }
 

@@ -37,8 +37,11 @@ static void perspective_pre_draw(ob_view *v, ob_renderer *r)
     ob_mat4_mul(pv->proj, pv->view, v->view_proj);
     ob_view_cull(v, r, scene, NULL);
     ob_views_queue_shadows(pv->ctx, r, v);
-    ob_views_queue_simulations(pv->ctx, r, v);
     ob_view_pre_render_items(v, r);
+    /* After the items' PreRender: an environment map queued there that sees
+     * a particle system has queued the simulation after itself, so the step
+     * runs before the map and this view (queue order is run in reverse). */
+    ob_views_queue_simulations(pv->ctx, r, v);
     ob_material_library_prepare_view(pv->ctx->materials, r, v);
 }
 
@@ -87,6 +90,9 @@ ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspect
         pv = NULL;
     }
 done:
+    if (r != OB_OK && r != OB_ERR_INVALID_ARGUMENT)
+        OB_LOG_E("views", "perspective view '%s' not created: %s",
+                 desc->name ? desc->name : "camera", ob_result_name(r));
     if (out_result) *out_result = r;
     return pv;
 }

@@ -170,6 +170,8 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     return ps;
 
 fail:
+    OB_LOG_E("views", "particle system '%s' not created: %s",
+             desc && desc->name ? desc->name : "particles", ob_result_name(r));
     ob_free(init);
     ob_particle_system_destroy(ctx, ps);
     if (out_result) *out_result = r;

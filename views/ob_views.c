@@ -221,6 +221,9 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             }
             if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
                           (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
+                OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
+                         "skipped this frame", ob_node_name(entity), id);
+                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
                 ob_paraboloid_view_destroy(ctx, pv);
                 return;
             }
@@ -230,8 +233,17 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
         /* Only a map that renders this frame is sampled: one left out (past
          * the recursion bound, say) was never written, so the entity is
          * drawn without its reflection instead. */
-        if (e->view->queued_frame == ob_renderer_frame_serial(r))
-            ob_renderer_attach_view(r, entity, e->view);
+        if (e->view->queued_frame == ob_renderer_frame_serial(r)) {
+            ob_result res = ob_renderer_attach_view(r, entity, e->view);
+            if (res != OB_OK) {
+                /* Unattached, the material cannot find the map: the entity
+                 * draws without its reflection this frame. */
+                OB_LOG_E("views", "entity '%s' (id %u): environment map not attached (%s); "
+                         "drawn without reflections this frame", ob_node_name(entity), id,
+                         ob_result_name(res));
+                ob_renderer_note_skipped(r, e->view->name, OB_SKIP_ERROR);
+            }
+        }
     }
 }
 
@@ -261,6 +273,9 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             }
             if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
                           (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
+                OB_LOG_E("views", "light '%s': no memory to keep its shadow map; skipped this frame",
+                         ob_node_name(lights[i]));
+                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
                 ob_shadow_view_destroy(ctx, sv);
                 continue;
             }
@@ -367,6 +382,7 @@ fail:
     ob_views_destroy(ctx);
     ctx = NULL;
 done:
+    if (r != OB_OK) OB_LOG_E("views", "views context not created: %s", ob_result_name(r));
     if (out_result) *out_result = r;
     return ctx;
 }

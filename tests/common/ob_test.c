@@ -2,6 +2,7 @@
 #include "ob_test.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@ static pthread_mutex_t capture_lock = PTHREAD_MUTEX_INITIALIZER;
 static char *captured[CAPTURE_MAX];
 static ob_log_level captured_level[CAPTURE_MAX];
 static uint32_t captured_count;
+static atomic_bool echo_off;
 
 static void capture_sink(void *user, ob_log_level level, const char *module,
                          const char *file, int line, const char *message)
@@ -20,7 +22,7 @@ static void capture_sink(void *user, ob_log_level level, const char *module,
     char buf[1400];
     const char *base = strrchr(file, '/');
     snprintf(buf, sizeof buf, "[%s] %s (%s:%d)", module, message, base ? base + 1 : file, line);
-    if (level >= OB_LOG_WARN || getenv("OB_LOG")) fprintf(stderr, "%s\n", buf);
+    if ((level >= OB_LOG_WARN && !atomic_load(&echo_off)) || getenv("OB_LOG")) fprintf(stderr, "%s\n", buf);
     pthread_mutex_lock(&capture_lock);
     if (captured_count < CAPTURE_MAX) {
         size_t n = strlen(buf) + 1;
@@ -53,6 +55,8 @@ void ob_test_setup_log(void)
 
 void ob_test_log_clear(void) { free_captured(); }
 
+void ob_test_log_set_echo(bool on) { atomic_store(&echo_off, !on); }
+
 bool ob_test_log_has(const char *needle, ...)
 {
     bool found = false;
@@ -78,6 +82,18 @@ uint32_t ob_test_log_count(ob_log_level min_level)
     for (uint32_t i = 0; i < captured_count; i++) n += captured_level[i] >= min_level;
     pthread_mutex_unlock(&capture_lock);
     return n;
+}
+
+void ob_test_log_dump(ob_log_level min_level, uint32_t max)
+{
+    uint32_t shown = 0;
+    pthread_mutex_lock(&capture_lock);
+    for (uint32_t i = 0; i < captured_count && shown < max; i++) {
+        if (captured_level[i] < min_level) continue;
+        fprintf(stderr, "    | %s\n", captured[i]);
+        shown++;
+    }
+    pthread_mutex_unlock(&capture_lock);
 }
 
 uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h)

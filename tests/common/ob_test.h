@@ -20,11 +20,17 @@
 void ob_test_setup_log(void);
 /* Forget captured lines. */
 void ob_test_log_clear(void);
+/* Echo captured WARN/ERROR lines to stderr (the default) or keep them
+ * quiet; fault-injection walks log thousands of expected errors. */
+void ob_test_log_set_echo(bool on);
 /* True if any captured line (since the last clear) contains every given
  * substring (NULL-terminated list). */
 bool ob_test_log_has(const char *needle, ...);
 /* Count of captured lines at or above level since the last clear. */
 uint32_t ob_test_log_count(ob_log_level min_level);
+/* Print up to max captured lines at or above level (since the last clear)
+ * to stderr, to show what led to a failed assertion. */
+void ob_test_log_dump(ob_log_level min_level, uint32_t max);
 
 /* A device with validation (and synchronization validation) forced on.
  * Fails the test if no device exists. */

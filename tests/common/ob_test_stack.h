@@ -1,0 +1,81 @@
+/* ob_test_stack.h — the whole engine stack for tests that expect things to
+ * fail: every step returns its ob_result instead of failing the test, and
+ * ob_test_stack_stop destroys whatever exists after any failure.
+ *
+ * ob_test_world (ob_test_world.h) is the harness for tests where every step
+ * must succeed; this one is for fault injection and device loss, where a
+ * step failing cleanly is the behaviour under test.
+ *
+ * The scene (ob_test_stack_build_scene) is tiny but exercises every lazy
+ * path of a first frame: a shadow-casting directional light and caster, a
+ * reflective sphere (a paraboloid environment map), a particle system (a
+ * compute simulation and a blended draw) and the composite to the final
+ * target. Its image depends only on the frame index, never on earlier
+ * frames: the particles live shorter than a frame, so every step respawns
+ * all of them from the simulation time. A frame that failed therefore
+ * leaves nothing behind in the pixels, and the frame after it can be
+ * compared with an undisturbed run.
+ *
+ * Lifecycle: ob_test_stack_start → [ob_test_stack_build_scene →
+ * ob_test_stack_frame*] → ob_test_stack_stop. Thread rule: one thread.
+ */
+#ifndef OB_TEST_STACK_H
+#define OB_TEST_STACK_H
+
+#include "ob_test.h"
+#include "ob_views.h"
+
+#define OB_TEST_STACK_MAX_GEOMETRY 4
+
+typedef struct ob_test_stack_desc {
+    uint32_t workers;          /* 0 → 2 */
+    uint32_t width, height;    /* 0 → 48 x 32 */
+    uint32_t env_map_size;     /* 0 → 16 */
+    uint32_t shadow_map_size;  /* 0 → 32 */
+    const char *cache_dir;     /* NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack */
+} ob_test_stack_desc;
+
+typedef struct ob_test_stack {
+    ob_renderer *r;
+    ob_device *dev;
+    ob_effect_context *fx;
+    ob_material_library *lib;
+    ob_views *views;
+    ob_scene *scene;
+    ob_node *camera;
+    ob_perspective_view *main;
+    ob_composite_view *composite;
+    ob_particle_system *particles;
+    ob_geometry *geometry[OB_TEST_STACK_MAX_GEOMETRY];
+    uint32_t geometry_count;
+    uint32_t width, height, env_map_size, shadow_map_size, workers;
+    uint64_t frames;           /* frames attempted (time = frames / 60 s) */
+    /* ob_fault_count of each kind when the last frame's PreRender ended:
+     * the points after it are the recording and submission. */
+    uint64_t fault_points_before_record[OB_FAULT_KIND_COUNT];
+    char cache_dir[512];
+} ob_test_stack;
+
+/* Renderer (validation on), effect context, material library and views.
+ * On failure everything created so far is destroyed and the error returned. */
+ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc);
+/* Scene, camera, main perspective view, composite, geometry, materials,
+ * entities, lights and the particle system. On failure the stack keeps what
+ * it made (ob_test_stack_stop frees it) and returns the error. */
+ob_result ob_test_stack_build_scene(ob_test_stack *s);
+/* One frame in `mode` (workers active, 0 = all), waited for. The frame's
+ * time advances even when a step fails, so frame k always shows time k/60.
+ * Returns the first failure of update, begin_frame, end_frame or wait_idle. */
+ob_result ob_test_stack_frame(ob_test_stack *s, ob_threading mode, uint32_t workers);
+/* The same frame in two halves, to act between them: _begin updates, begins
+ * the frame and runs the PreRender; _end (only after a successful _begin)
+ * records, submits and waits. */
+ob_result ob_test_stack_frame_begin(ob_test_stack *s, ob_threading mode, uint32_t workers);
+ob_result ob_test_stack_frame_end(ob_test_stack *s);
+/* The final image (width * height * 4 bytes). */
+ob_result ob_test_stack_read(ob_test_stack *s, uint8_t *out);
+/* Waits idle (a lost device is fine) and destroys everything. Safe on a
+ * stack whose start failed, and twice. */
+void ob_test_stack_stop(ob_test_stack *s);
+
+#endif
