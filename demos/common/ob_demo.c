@@ -127,7 +127,9 @@ static void on_stats(void *user, const ob_frame_stats *st)
     ob_demo *d = user;
     if (ob_array_reserve((void **)&d->history, &d->history_cap, d->history_count + 1,
                          sizeof *d->history) == OB_OK)
-        d->history[d->history_count++] = *st;
+        d->history[d->history_count++] = (ob_demo_frame_times){
+            st->workers, st->update_ns, st->pre_render_ns, st->record_ns, st->assemble_ns,
+            st->submit_ns, st->frame_ns, st->gpu_ms};
     if (!d->opt.quiet) {
         printf("frame %4llu %-3s workers %u  cpu %7.3f ms (update %.3f pre-render %.3f record %.3f "
                "assemble %.3f submit %.3f)  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
@@ -283,9 +285,9 @@ double ob_demo_median_ms(const ob_demo *d, int mode, size_t phase_offset)
     uint32_t n = 0;
     if (!v) return NAN;
     for (uint32_t i = 0; i < d->history_count; i++) {
-        const ob_frame_stats *st = &d->history[i];
+        const ob_demo_frame_times *st = &d->history[i];
         if (mode >= 0 && (st->workers > 0) != (mode == 1)) continue;
-        if (phase_offset == offsetof(ob_frame_stats, gpu_ms)) {
+        if (phase_offset == offsetof(ob_demo_frame_times, gpu_ms)) {
             if (st->gpu_ms < 0) continue;
             v[n++] = st->gpu_ms;
         } else {
@@ -350,13 +352,13 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st)
 static void print_summary(const ob_demo *d)
 {
     static const struct { const char *name; size_t off; } phases[] = {
-        {"update", offsetof(ob_frame_stats, update_ns)},
-        {"pre-render", offsetof(ob_frame_stats, pre_render_ns)},
-        {"record", offsetof(ob_frame_stats, record_ns)},
-        {"assemble", offsetof(ob_frame_stats, assemble_ns)},
-        {"submit", offsetof(ob_frame_stats, submit_ns)},
-        {"frame", offsetof(ob_frame_stats, frame_ns)},
-        {"gpu", offsetof(ob_frame_stats, gpu_ms)},
+        {"update", offsetof(ob_demo_frame_times, update_ns)},
+        {"pre-render", offsetof(ob_demo_frame_times, pre_render_ns)},
+        {"record", offsetof(ob_demo_frame_times, record_ns)},
+        {"assemble", offsetof(ob_demo_frame_times, assemble_ns)},
+        {"submit", offsetof(ob_demo_frame_times, submit_ns)},
+        {"frame", offsetof(ob_demo_frame_times, frame_ns)},
+        {"gpu", offsetof(ob_demo_frame_times, gpu_ms)},
     };
     uint32_t counts[2] = {0, 0};
     for (uint32_t i = 0; i < d->history_count; i++) counts[d->history[i].workers > 0]++;

@@ -43,6 +43,14 @@ typedef struct ob_demo_options {
 bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
                            ob_demo_options *o, int *out_exit);
 
+/* What the summary keeps of each completed frame. (A whole ob_frame_stats
+ * is 23 KB: kept for every frame, 10,000 frames grew the process by 230 MB.) */
+typedef struct ob_demo_frame_times {
+    uint32_t workers;         /* 0 = single-threaded */
+    uint64_t update_ns, pre_render_ns, record_ns, assemble_ns, submit_ns, frame_ns;
+    double gpu_ms;
+} ob_demo_frame_times;
+
 typedef struct ob_demo {
     ob_demo_options opt;
     ob_renderer *r;
@@ -58,7 +66,7 @@ typedef struct ob_demo {
     uint32_t geometry_count, geometry_cap;
     ob_particle_system **systems;
     uint32_t system_count, system_cap;
-    ob_frame_stats *history;  /* completed frames' stats, in order */
+    ob_demo_frame_times *history;  /* completed frames' times, in order */
     uint32_t history_count, history_cap;
     FILE *json;
     double time;
@@ -87,7 +95,8 @@ typedef void (*ob_demo_update_fn)(ob_demo *d, uint32_t frame, double time, void 
  * frame and a summary, writing --stats-json and --out. Returns 0 on success. */
 int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user);
 
-/* Medians of a phase over the recorded frames of one mode (NAN if none). */
+/* Medians of a phase over the recorded frames of one mode (NAN if none);
+ * phase_offset is offsetof(ob_demo_frame_times, <phase>). */
 double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase_offset);
 
 /* Median of v[0..n), NaNs left out (v is reordered); NAN if nothing is left. */
