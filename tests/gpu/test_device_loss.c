@@ -18,7 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ob_test_lsan.h"
 #include "ob_test_stack.h"
 
 
