@@ -5,7 +5,7 @@
 #     include(${CMAKE_CURRENT_LIST_DIR}/model.cmake)
 #
 # Needs clang. The loader and what it uses (engine/ob_core.c,
-# geometry/ob_mesh.c, geometry/ob_model.c) are compiled again for this
+# geometry/ob_mesh.c, geometry/ob_model*.c) are compiled again for this
 # target with coverage instrumentation (-fsanitize=fuzzer-no-link) and
 # ASan + UBSan, whatever OB_SANITIZE says, so findings in our code are
 # reported. libassimp itself is Debian's (not instrumented, asserts on).
@@ -17,10 +17,11 @@ get_filename_component(OB_FUZZ_ROOT ${CMAKE_CURRENT_LIST_DIR}/.. ABSOLUTE)
 set(OB_FUZZ_SANITIZE -g -fsanitize=address,undefined -fno-sanitize-recover=undefined
                      -fno-omit-frame-pointer)
 
+file(GLOB OB_FUZZ_MODEL_SOURCES CONFIGURE_DEPENDS ${OB_FUZZ_ROOT}/geometry/ob_model*.c)
 add_library(ob_fuzz_model_lib STATIC
             ${OB_FUZZ_ROOT}/engine/ob_core.c
             ${OB_FUZZ_ROOT}/geometry/ob_mesh.c
-            ${OB_FUZZ_ROOT}/geometry/ob_model.c)
+            ${OB_FUZZ_MODEL_SOURCES})
 target_include_directories(ob_fuzz_model_lib PUBLIC ${OB_FUZZ_ROOT}/engine
                                                     ${OB_FUZZ_ROOT}/geometry)
 target_compile_options(ob_fuzz_model_lib PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer-no-link)
