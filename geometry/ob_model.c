@@ -18,9 +18,14 @@
  *   lines are split off by SortByPType and skipped here), a file without
  *   polygons is rejected beforehand, and faceless meshes get a type. Only an
  *   allocation failure inside a step can still take that path.
+ * A third, found by fuzz/fuzz_model.c: its PLY reader hangs on a truncated
+ * header and reads out of bounds when the header or the data lie, all
+ * inside aiImportFile. PLY files are checked against their own header
+ * first (ob_model_ply.c).
  */
 #define _POSIX_C_SOURCE 200809L
 #include "ob_mesh.h"
+#include "ob_model_internal.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -458,6 +463,8 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
     }
     model_ctx c = {.path = desc->path};
     ob_result r = check_readable(c.path);
+    if (r != OB_OK) return r;
+    r = ob_model_ply_precheck(c.path);
     if (r != OB_OK) return r;
 
     char err[512];
