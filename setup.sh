@@ -4,10 +4,11 @@
 #   ./setup.sh demo   install missing packages, build, render the main demo headless
 #   ./setup.sh test   install missing packages, then build and run the whole test
 #                     suite three times: plain (build/), address+undefined
-#                     sanitizers (build-address/) and thread sanitizer (build-thread/)
+#                     sanitizers (build-address/) and thread sanitizer (build-thread/),
+#                     then a minute of libFuzzer on each fuzz target (build-fuzz/)
 #   ./setup.sh deps | build
 #
-# Options: --sanitize none|address|thread|undefined  one build only (none = plain)
+# Options: --sanitize none|address|thread|undefined|fuzz  one build only (none = plain)
 #          --build-dir DIR
 # Anything else is passed on to the demo (demo) or to ctest (test).
 set -euo pipefail
@@ -66,6 +67,15 @@ suite() {
   ctest --test-dir "$dir" --output-on-failure -j"$(nproc)" "${extra[@]}"
 }
 
+# fuzz: the libFuzzer targets (clang) and their bounded runs (ctest label fuzz).
+fuzz() {
+  local dir; dir=$([ -n "$build_dir" ] && echo "$build_dir" || echo build-fuzz)
+  echo "== fuzzing: one bounded run per target ($dir)"
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+        -DOB_FUZZ=ON >/dev/null
+  cmake --build "$dir" -j"$(nproc)" --target fuzz_scene_file fuzz_model
+  ctest --test-dir "$dir" -L fuzz --output-on-failure -j"$(nproc)" "${extra[@]}"
+}
 # lavapipe and the loader warn about a missing XDG_RUNTIME_DIR on bare machines.
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
 
@@ -78,10 +88,12 @@ case "$cmd" in
     "$dir"/bin/obelisk-mirror --frames 60 --out "$dir"/obelisk-mirror.png "${extra[@]}" ;;
   test)
     deps
-    if [ -n "$sanitize_given" ]; then
+    if [ "$sanitize" = fuzz ]; then
+      fuzz
+    elif [ -n "$sanitize_given" ]; then
       suite "$sanitize"
     else
-      suite ""; suite address; suite thread
+      suite ""; suite address; suite thread; fuzz
     fi ;;
-  *) echo "usage: $0 demo|test|deps|build [--sanitize none|address|thread|undefined]" >&2; exit 2 ;;
+  *) echo "usage: $0 demo|test|deps|build [--sanitize none|address|thread|undefined|fuzz]" >&2; exit 2 ;;
 esac

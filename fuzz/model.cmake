@@ -1,10 +1,6 @@
 # fuzz/model.cmake — the libFuzzer target for the model loader (fuzz_model)
-# and its bounded ctest run. Meant to be included from fuzz/CMakeLists.txt,
-# which the top level adds when OB_FUZZ is ON:
-#
-#     include(${CMAKE_CURRENT_LIST_DIR}/model.cmake)
-#
-# Needs clang. The loader and what it uses (engine/ob_core.c,
+# and its bounded ctest run, included from fuzz/CMakeLists.txt (which the
+# top level adds when OB_FUZZ is ON). Needs clang. The loader and what it uses (engine/ob_core.c,
 # geometry/ob_mesh.c, geometry/ob_model*.c) are compiled again for this
 # target with coverage instrumentation (-fsanitize=fuzzer-no-link) and
 # ASan + UBSan, whatever OB_SANITIZE says, so findings in our code are
@@ -31,7 +27,6 @@ add_executable(fuzz_model ${CMAKE_CURRENT_LIST_DIR}/fuzz_model.c)
 target_compile_options(fuzz_model PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer)
 target_link_options(fuzz_model PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer)
 target_link_libraries(fuzz_model PRIVATE ob_fuzz_model_lib)
-set_target_properties(fuzz_model PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
 
 # One minute of fuzzing from the seeds (label fuzz; not part of `ctest -L gpu`),
 # in fork mode so that assimp's own crashes do not end it, then a triage of
@@ -42,6 +37,6 @@ add_test(NAME fuzz_model
          COMMAND ${CMAKE_COMMAND} -DFUZZER=$<TARGET_FILE:fuzz_model>
                  -DWORK=${CMAKE_BINARY_DIR}/fuzz/corpus-model
                  -DSEEDS=${CMAKE_CURRENT_LIST_DIR}/corpus/model
-                 -DARTIFACTS=${CMAKE_BINARY_DIR}/fuzz/artifacts -DSECONDS=60
+                 -DARTIFACTS=${CMAKE_BINARY_DIR}/fuzz/artifacts-model -DSECONDS=${OB_FUZZ_SECONDS}
                  -P ${CMAKE_CURRENT_LIST_DIR}/model_run.cmake)
 set_tests_properties(fuzz_model PROPERTIES LABELS fuzz TIMEOUT 600)
