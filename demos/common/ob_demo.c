@@ -6,6 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 /* ------------------------------------------------------------ options */
 
@@ -122,6 +125,26 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
 
 /* ------------------------------------------------------------ set-up */
 
+ob_demo_memory ob_demo_memory_now(void)
+{
+    ob_demo_memory m = {0, 0, 0};
+    FILE *f = fopen("/proc/self/status", "r");
+    if (f) {
+        char line[128];
+        while (fgets(line, sizeof line, f)) {
+            unsigned long long v;
+            if (sscanf(line, "VmRSS: %llu kB", &v) == 1) m.rss_kb = v;
+            else if (sscanf(line, "VmHWM: %llu kB", &v) == 1) m.peak_rss_kb = v;
+        }
+        fclose(f);
+    }
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+    struct mallinfo2 mi = mallinfo2();
+    m.heap_in_use_kb = (unsigned long long)(mi.uordblks + mi.hblkhd) / 1024;
+#endif
+    return m;
+}
+
 static void on_stats(void *user, const ob_frame_stats *st)
 {
     ob_demo *d = user;
@@ -141,7 +164,10 @@ static void on_stats(void *user, const ob_frame_stats *st)
     }
     if (d->json) {
         if (d->history_count > 1) fputs(",\n", d->json);
-        ob_demo_write_stats_json(d->json, st);
+        /* The process's memory after this frame: the soak (tests/soak)
+         * tells the allocator's kept pages (rss) from live memory (heap). */
+        ob_demo_memory mem = ob_demo_memory_now();
+        ob_demo_write_stats_json(d->json, st, &mem);
     }
 }
 
@@ -311,7 +337,7 @@ double ob_demo_median(double *v, uint32_t n)
     return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
-void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st)
+void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_memory *mem)
 {
     fprintf(f,
             "{\"frame\":%llu,\"mode\":\"%s\",\"workers\":%u,\"update_ms\":%.4f,"
@@ -346,7 +372,11 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st)
     for (uint32_t i = 0; i < st->skipped_count; i++)
         fprintf(f, "%s{\"name\":\"%s\",\"reason\":\"%s\"}", i ? "," : "", st->skipped[i].name,
                 ob_skip_reason_name(st->skipped[i].reason));
-    fputs("]}", f);
+    fputs("]", f);
+    if (mem)
+        fprintf(f, ",\"rss_kb\":%llu,\"peak_rss_kb\":%llu,\"heap_in_use_kb\":%llu", mem->rss_kb,
+                mem->peak_rss_kb, mem->heap_in_use_kb);
+    fputs("}", f);
 }
 
 static void print_summary(const ob_demo *d)
@@ -442,6 +472,10 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     }
     if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
     print_summary(d);
+    ob_demo_memory mem = ob_demo_memory_now();
+    if (mem.rss_kb)
+        printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB\n",
+               mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0, mem.heap_in_use_kb / 1024.0);
     ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
     if (ob_device_validation_enabled(ob_renderer_device(d->r)))
         printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);

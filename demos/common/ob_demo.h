@@ -102,7 +102,16 @@ double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase
 /* Median of v[0..n), NaNs left out (v is reordered); NAN if nothing is left. */
 double ob_demo_median(double *v, uint32_t n);
 
-/* Writes one frame's stats as a JSON object. */
-void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st);
+/* The process's memory: resident set and its peak (/proc/self/status, 0
+ * where there is none) and what the C heap holds live (glibc's mallinfo2,
+ * 0 elsewhere). */
+typedef struct ob_demo_memory {
+    unsigned long long rss_kb, peak_rss_kb, heap_in_use_kb;
+} ob_demo_memory;
+ob_demo_memory ob_demo_memory_now(void);
+
+/* Writes one frame's stats as a JSON object (with the memory figures when
+ * mem is not NULL). */
+void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_memory *mem);
 
 #endif /* OB_DEMO_H */
