@@ -246,7 +246,9 @@ static void scene_far_from_origin_renders_the_same(void **state)
     assert_non_null(shadow);
     assert_non_null(env);
     assert_true(shadow->draws >= 3);
-    assert_true(env->draws >= 6);
+    /* Three neighbours in the map, at least one reaching both halves. */
+    assert_true(env->items >= 3);
+    assert_true(env->draws > env->items);
 
     static const struct {
         const char *what;
