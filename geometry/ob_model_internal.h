@@ -5,8 +5,9 @@
 
 #include "ob_core.h"
 
-/* Checks a file that starts like a PLY ("ply" and a line break) before
- * assimp reads it: the header must be well formed and end with end_header,
+/* Checks a file that assimp would read as a PLY (a .ply extension, or
+ * content starting with "ply") before assimp reads it: the first line must
+ * be "ply", the header must be well formed and end with end_header,
  * and the data must hold every element the header declares (binary: every
  * record walked, list lengths included; ASCII: at least two bytes per
  * value). assimp 5.2's PLY reader loops forever on a truncated header and

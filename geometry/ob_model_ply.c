@@ -230,17 +230,31 @@ static ob_result check_ascii(const char *path, size_t size, const ply_header *h)
     return OB_OK;
 }
 
+/* True if path ends in ".ply", in any case. */
+static bool has_ply_extension(const char *path)
+{
+    size_t n = strlen(path);
+    if (n < 4 || path[n - 4] != '.') return false;
+    for (int i = 0; i < 3; i++)
+        if ((path[n - 3 + i] | 0x20) != "ply"[i]) return false;
+    return true;
+}
+
 ob_result ob_model_ply_precheck(const char *path)
 {
-    char head[5] = {0};
+    char head[3] = {0};
     FILE *f = fopen(path, "rb");
     if (!f) {
         OB_LOG_E(PLY_LOG, "%s: cannot open model file: %s", path, strerror(errno));
         return OB_ERR_IO;
     }
-    size_t got = fread(head, 1, 4, f);
+    size_t got = fread(head, 1, 3, f);
     fclose(f);
-    if (got < 4 || memcmp(head, "ply", 3) || (head[3] != '\n' && head[3] != '\r')) return OB_OK;
+    /* assimp hands a file to its PLY reader for its extension, or for "ply"
+     * at the start of its content (whatever follows: "plyU" too, and then
+     * it never returns). Either way the first line must be exactly "ply". */
+    if (got == 0) return OB_OK;   /* assimp says it is empty */
+    if (!has_ply_extension(path) && (got < 3 || memcmp(head, "ply", 3))) return OB_OK;
 
     size_t size = 0;
     ob_result r;

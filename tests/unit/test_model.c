@@ -348,6 +348,26 @@ static const char ply_header[] =
     "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
     "property float z\nelement face 2\nproperty list uchar uint vertex_indices\nend_header\n";
 
+/* assimp's PLY reader takes any file starting with "ply" and never returns
+ * from one whose first line is more than that (found by fuzz/fuzz_model). */
+static void rejects_ply_with_a_damaged_first_line(void **state)
+{
+    (void)state;
+    static const struct { const char *first, *name, *problem; } cases[] = {
+        {"plyU", "first1.ply", "PLY file does not start with a 'ply' line"},
+        {"ply\001ply", "first2.obj", "PLY header line 1 is not a line of text"},
+        {"plycce", "first3.stl", "PLY file does not start with a 'ply' line"},
+        {"solid", "first4.ply", "PLY file does not start with a 'ply' line"},
+    };
+    char text[1024];
+    for (size_t i = 0; i < OB_ARRAY_COUNT(cases); i++) {
+        snprintf(text, sizeof text, "%s%s0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+                 cases[i].first, ply_header + 3);
+        const char *path = write_temp(cases[i].name, text, strlen(text));
+        expect_rejected(path, OB_ERR_BAD_MODEL, cases[i].problem);
+    }
+}
+
 static void rejects_out_of_range_index_in_ply(void **state)
 {
     (void)state;
@@ -580,6 +600,7 @@ int main(void)
         cmocka_unit_test(loads_obj_and_generates_outward_normals),
         cmocka_unit_test(rejects_broken_package_models),
         cmocka_unit_test(documents_what_assimp_fixes_silently),
+        cmocka_unit_test(rejects_ply_with_a_damaged_first_line),
         cmocka_unit_test(rejects_out_of_range_index_in_ply),
         cmocka_unit_test(rejects_out_of_range_index_in_obj),
         cmocka_unit_test(rejects_empty_faces_before_assimp_asserts),
