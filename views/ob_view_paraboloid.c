@@ -1,5 +1,6 @@
 #include "ob_views_internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -63,8 +64,9 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
      * shaders discard every fragment of the other one. An item whose bound
      * lies wholly in the other hemisphere therefore leaves no pixel in this
      * layer: skipping it changes nothing but the cost (about half the items
-     * of a map whose owner stands among them). The bound is widened a little
-     * so that float rounding of vertices on its surface cannot matter.
+     * of a map whose owner stands among them). The bound is widened by far
+     * more than the float rounding of a vertex relative to the owner (about
+     * 1e-7 of its distance), so that no vertex can round across the plane.
      * Runs of items this layer draws are recorded together. */
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     uint32_t run = first;
@@ -72,8 +74,10 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
         double c[3];
         float radius;
         ob_node_world_sphere(v->items[i].node, c, &radius);
-        double z = (c[2] - v->origin[2]) * side;
-        if (z + (double)radius * 1.001 + 1e-6 >= 0.0) continue;
+        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
+        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+        double margin = ((double)radius + dist) * 1e-5 + 1e-6;
+        if (rel[2] * side + (double)radius + margin >= 0.0) continue;
         if (i > run) ob_view_record_items(v, r, pm, run, i - run);
         run = i + 1;
     }
