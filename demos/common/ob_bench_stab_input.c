@@ -75,7 +75,6 @@ ob_result ob_stab_zero_scale(ob_stab_ctx *c)
     ob_stab_scale(ball, 0, 0, 0);
     const ob_frame_stats *st;
     uint8_t *with = ob_stab_render(&w, &st);
-    ob_stab_render(&w, NULL);   /* timing */
     const ob_view_stats *main = ob_stab_view_stats(st, "main");
     uint32_t black = ob_stab_nan_black(without, with, N);
     ob_result r = OB_OK;
@@ -272,7 +271,6 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     ob_skip_reason skip = ob_stab_skip_reason(st, "shadow:sun");
     if (b.sun) ob_node_destroy(w.d.scene, b.sun);
     uint8_t *none = ob_stab_render(&w, NULL);
-    ob_stab_render(&w, NULL);   /* timing */
     ob_result r = OB_OK;
     if (w.err == OB_OK) {
         uint32_t d_zero = ob_stab_diff_count(zero, none, N, 0);
