@@ -14,10 +14,14 @@
  *   quality    env-map and shadow-map sizes: image error against the
  *              highest-quality single-threaded image next to frame time; the
  *              threading modes must give that image byte for byte
+ *   stability  numerical precision and extreme cases (ob_bench_stability.h):
+ *              each case's error against the bound its test asserts, and its
+ *              run time
  *
  * Medians of repeated frames after warm-up; every ratio comes from one run.
  * Fixed seeds. A program, not a test: it never judges a time; it fails
- * (exit 4) only when a threading mode's image or command hashes differ.
+ * when a threading mode's image or command hashes differ (exit 4) or a
+ * stability case exceeds its bound (exit 5).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -33,6 +37,7 @@
 
 typedef struct bench_options {
     bool quick, progress;
+    bool perf, stability;      /* which sections run */
     const char *json, *csv, *charts;
     uint32_t seed;
     uint32_t views[MAX_LIST], view_count;
@@ -47,10 +52,13 @@ typedef struct bench_options {
 
 static const char usage_text[] =
     "usage: obelisk-bench [options]\n"
-    "  --quick            a reduced run (under a minute on 2 cores)\n"
+    "  --quick            a reduced run (about a minute on 2 cores)\n"
+    "  --stability-only   only the numerical stability and extreme cases section\n"
+    "  --no-stability     leave that section out\n"
     "  --json FILE        write every result and the summary as JSON\n"
-    "  --csv FILE         write every result as CSV (one row per configuration)\n"
-    "  --charts DIR       write speedup.png and error.png (gnuplot)\n"
+    "  --csv FILE         write every result as CSV (one row per configuration); the\n"
+    "                     stability rows go to FILE-stability.csv (FILE less .csv)\n"
+    "  --charts DIR       write speedup.png and error.png (gnuplot; performance only)\n"
     "  --views LIST       perspective views per frame (default 1,4,8,16)\n"
     "  --objects LIST     objects (default 1000,10000,50000; at most 100000)\n"
     "  --modes LIST       ST, worker counts, auto (default ST,1,2,4,auto)\n"
@@ -113,7 +121,8 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
 {
     bool quick = false;
     for (int i = 1; i < argc; i++) quick |= !strcmp(argv[i], "--quick");
-    *o = (bench_options){.quick = quick, .progress = true, .seed = 1, .view_width = 256,
+    *o = (bench_options){.quick = quick, .progress = true, .perf = true, .stability = true,
+                         .seed = 1, .view_width = 256,
                          .view_height = 192, .image_width = 640, .image_height = 480,
                          .raw_objects = 10000};
     const char *views = quick ? "1,8" : "1,4,8,16";
@@ -134,6 +143,10 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
             takes = false;
         } else if (!strcmp(a, "--no-progress")) {
             o->progress = takes = false;
+        } else if (!strcmp(a, "--stability-only")) {
+            o->perf = takes = false;
+        } else if (!strcmp(a, "--no-stability")) {
+            o->stability = takes = false;
         } else if (!v) {
             fprintf(stderr, "obelisk-bench: %s needs a value (or is unknown)\n%s", a, usage_text);
             return false;
@@ -176,6 +189,15 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
         !parse_list(objects, o->objects, &o->object_count, 100000) || !parse_modes(modes, o)) {
         fprintf(stderr, "obelisk-bench: bad --views, --objects or --modes list (modes must start "
                         "with ST; views 1..%u)\n", OB_BENCH_MAX_VIEWS);
+        return false;
+    }
+    if (!o->perf && !o->stability) {
+        fprintf(stderr, "obelisk-bench: --stability-only and --no-stability leave nothing to run\n");
+        return false;
+    }
+    if (!o->perf && o->charts) {
+        fprintf(stderr, "obelisk-bench: --charts draws the performance sections, which "
+                        "--stability-only leaves out\n");
         return false;
     }
     *out_exit = 0;
@@ -350,15 +372,22 @@ static int run(const bench_options *o)
         .modes = o->modes, .mode_count = o->mode_count,
     };
     uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1;
-    uint64_t total = 3 * (o->warmup + o->rounds + 2 * o->flight + 1) +
-                     quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1);
-    for (uint32_t n = 0; n < o->object_count; n++) {
-        for (uint32_t v = 0; v < o->view_count; v++) {
-            uint32_t w, r, f;
-            frame_counts(o, o->views[v], o->objects[n], &w, &r, &f);
-            total += (uint64_t)o->mode_count * (w + r + f + 1) * frame_weight(o->views[v], o->objects[n]);
+    uint64_t total = 0;
+    if (o->perf) {
+        total += 3 * (o->warmup + o->rounds + 2 * o->flight + 1) +
+                 quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1);
+        for (uint32_t n = 0; n < o->object_count; n++) {
+            for (uint32_t v = 0; v < o->view_count; v++) {
+                uint32_t w, r, f;
+                frame_counts(o, o->views[v], o->objects[n], &w, &r, &f);
+                total += (uint64_t)o->mode_count * (w + r + f + 1) *
+                         frame_weight(o->views[v], o->objects[n]);
+            }
         }
     }
+    /* A stability case takes about as long as a dozen mirror-scene frames. */
+    const uint64_t stability_unit = 12;
+    if (o->stability) total += ob_bench_stability_case_count() * stability_unit;
     ob_bench_progress prog;
     ob_bench_progress_init(&prog, total, o->progress);
     qd.tick = ob_bench_progress_tick;
@@ -366,9 +395,12 @@ static int run(const bench_options *o)
 
     int code = 0;
     ob_result r = OB_OK;
-    rep.sweep = ob_calloc(o->view_count * o->object_count, sizeof *rep.sweep);
-    if (!rep.sweep) r = OB_ERR_OUT_OF_HOST_MEMORY;
-    for (uint32_t n = 0; n < o->object_count && r == OB_OK; n++) {
+    rep.perf = o->perf;
+    if (o->perf) {
+        rep.sweep = ob_calloc(o->view_count * o->object_count, sizeof *rep.sweep);
+        if (!rep.sweep) r = OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    for (uint32_t n = 0; n < o->object_count && r == OB_OK && o->perf; n++) {
         for (uint32_t v = 0; v < o->view_count && r == OB_OK; v++) {
             ob_bench_progress_label(&prog, "sweep: %u views, %u objects", o->views[v], o->objects[n]);
             prog.unit = frame_weight(o->views[v], o->objects[n]);
@@ -377,13 +409,26 @@ static int run(const bench_options *o)
         }
     }
     prog.unit = 1;
-    if (r == OB_OK) {
+    if (r == OB_OK && o->perf) {
         ob_bench_progress_label(&prog, "mirror scene, 200 objects: ST / MT / auto");
         r = scene200(o, &rep, &prog);
     }
-    if (r == OB_OK) {
+    if (r == OB_OK && o->perf) {
         ob_bench_progress_label(&prog, "quality and threading check (mirror scene)");
         r = ob_bench_quality_run(&qd, &rep.quality, &rep.quality_count);
+    }
+    ob_bench_stability stab = {0};
+    if (r == OB_OK && o->stability) {
+        prog.unit = stability_unit;
+        ob_bench_stability_desc sd = {.quick = o->quick, .progress = &prog};
+        r = ob_bench_stability_run(&sd, &stab);
+        rep.stability = &stab;
+        if (!rep.device_name[0]) {
+            snprintf(rep.device_name, sizeof rep.device_name, "%s", stab.device_name);
+            snprintf(rep.driver_info, sizeof rep.driver_info, "%s", stab.driver_info);
+        }
+        rep.validation |= stab.validation;
+        if (!o->perf) rep.pool_workers = stab.workers;
     }
     ob_bench_progress_finish(&prog);
     rep.seconds = (double)(ob_time_ns() - t0) * 1e-9;
@@ -393,23 +438,37 @@ static int run(const bench_options *o)
         fprintf(stderr, "obelisk-bench: failed: %s (%s)\n", ob_result_name(r), ob_result_text(r));
         code = 1;
     } else {
-        summarize(&rep);
+        if (o->perf) summarize(&rep);
         ob_bench_report_print(&rep, stdout);
         if (o->json && ob_bench_report_json(&rep, o->json) != OB_OK) code = 1;
-        if (o->csv && ob_bench_report_csv(&rep, o->csv) != OB_OK) code = 1;
+        if (o->csv && o->perf && ob_bench_report_csv(&rep, o->csv) != OB_OK) code = 1;
+        if (o->csv && rep.stability) {
+            char path[1024];
+            ob_bench_report_stability_csv_path(o->csv, path, sizeof path);
+            if (ob_bench_report_stability_csv(rep.stability, path) != OB_OK) code = 1;
+        }
         if (o->charts && ob_bench_report_charts(&rep, o->charts) != OB_OK) code = 1;
-        if (!rep.summary.threading_identical) {
+        if (o->perf && !rep.summary.threading_identical) {
             fprintf(stderr, "obelisk-bench: threading modes differ from single-threaded "
                             "(max abs diff %u, %u hash mismatches)\n",
                     rep.summary.threading_max_abs_diff, rep.summary.hash_mismatches);
             code = 4;
         }
-        if (ob_log_count(OB_LOG_ERROR) > 0) {
-            fprintf(stderr, "obelisk-bench: %llu errors were logged\n",
-                    (unsigned long long)ob_log_count(OB_LOG_ERROR));
+        for (uint32_t i = 0; rep.stability && i < stab.count; i++) {
+            const ob_bench_stability_row *row = &stab.rows[i];
+            if (row->pass) continue;
+            fprintf(stderr, "obelisk-bench: stability case '%s' failed: error %.6g %s, bound %.6g "
+                            "(%s)\n", row->name, row->error, row->unit, row->bound, row->detail);
+            if (!code) code = 5;
+        }
+        /* The stability cases log refused NaNs and the like on purpose. */
+        uint64_t errors = ob_log_count(OB_LOG_ERROR) - stab.expected_errors;
+        if (errors > 0) {
+            fprintf(stderr, "obelisk-bench: %llu errors were logged\n", (unsigned long long)errors);
             if (!code) code = 3;
         }
     }
+    ob_bench_stability_release(&stab);
     ob_free(rep.sweep);
     ob_free(rep.quality);
     return code;

@@ -84,11 +84,8 @@ static void print_header(FILE *f)
             "rec+asm", "gpu", "frame", "spdup", "draws/s", "desc binds");
 }
 
-void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
+static void print_perf(const ob_bench_report *rep, FILE *f)
 {
-    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s\n",
-            rep->quick ? " --quick" : "", rep->device_name, rep->driver_info, rep->cores,
-            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "");
     fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up; frame = "
                "in-flight period over %u frames (%u, %u, %u for frames over ~%u draws); "
                "spdup = ST rec+asm / this\n",
@@ -125,6 +122,56 @@ void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
             s->engine_vs_raw_per_draw, s->auto_vs_best_200, s->threading_identical ? "yes" : "NO",
             s->threading_max_abs_diff, s->hash_mismatches, rep->seconds, rep->load_start,
             rep->load_end);
+}
+
+/* Pixel counts and levels as integers, small errors in %g. */
+static void format_value(double v, char *buf, size_t n)
+{
+    if (isnan(v)) snprintf(buf, n, "-");
+    else if (v == floor(v) && fabs(v) < 1e9) snprintf(buf, n, "%.0f", v);
+    else snprintf(buf, n, "%.3g", v);
+}
+
+static const char *row_verdict(const ob_bench_stability_row *row)
+{
+    return !row->pass ? "FAIL" : isnan(row->bound) ? "-" : "ok";
+}
+
+static void print_stability(const ob_bench_stability *s, FILE *f)
+{
+    fprintf(f, "\nnumerical stability and extreme cases%s: %u rows from %u cases, %u failed (over "
+               "the bound the test asserts, or a check of the case); bound '-' = measured only; "
+               "ms = median frame (after a renderer's first) or update time; renderers with %u "
+               "workers\n",
+            s->quick ? " (--quick: two cases shrunk, see their rows)" : "", s->count, s->cases,
+            s->failed, s->workers);
+    fprintf(f, "  %-38s %10s %-11s %8s %-4s %9s  %s\n", "case", "error", "unit", "bound", "pass",
+            "ms", "measure / detail");
+    for (uint32_t i = 0; i < s->count; i++) {
+        const ob_bench_stability_row *row = &s->rows[i];
+        char err[32], bound[32], ms[32];
+        format_value(row->error, err, sizeof err);
+        format_value(row->bound, bound, sizeof bound);
+        if (isnan(row->ms)) snprintf(ms, sizeof ms, "-");
+        else snprintf(ms, sizeof ms, "%.1f", row->ms);
+        fprintf(f, "  %-38s %10s %-11s %8s %-4s %9s  %s\n", row->name, err, row->unit, bound,
+                row_verdict(row), ms, row->measure);
+        if (row->detail[0]) fprintf(f, "  %-38s %48s%s\n", "", "", row->detail);
+    }
+    fprintf(f, "  section: %.1f s; log lines the cases provoked (caught and checked, not printed): "
+               "%llu error(s), %llu warning(s); validation layer %s (%u messages)\n",
+            s->seconds, (unsigned long long)s->expected_errors,
+            (unsigned long long)s->expected_warnings, s->validation ? "on" : "off",
+            s->validation_messages);
+}
+
+void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
+{
+    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s\n",
+            rep->quick ? " --quick" : "", rep->device_name, rep->driver_info, rep->cores,
+            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "");
+    if (rep->perf) print_perf(rep, f);
+    if (rep->stability) print_stability(rep->stability, f);
 }
 
 /* ------------------------------------------------------------ JSON */
@@ -205,12 +252,51 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_num(f, s->auto_vs_best_200);
     fprintf(f, ",\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",
             s->threading_max_abs_diff, s->hash_mismatches, s->threading_identical ? "true" : "false");
+    if (rep->stability) fprintf(f, "\"stability_failed\":%u,", rep->stability->failed);
     fputs("\"device\":{\"name\":", f);
     json_str(f, rep->device_name);
     fputs(",\"driver\":", f);
     json_str(f, rep->driver_info);
     fputs("}}", f);
 }
+
+static void json_stability(FILE *f, const ob_bench_stability *s)
+{
+    fputs("\"stability\":[\n  ", f);
+    for (uint32_t i = 0; i < s->count; i++) {
+        const ob_bench_stability_row *row = &s->rows[i];
+        if (i) fputs(",\n  ", f);
+        fputs("{\"name\":", f);
+        json_str(f, row->name);
+        fputs(",\"measure\":", f);
+        json_str(f, row->measure);
+        fputs(",\"error\":", f);
+        json_num(f, row->error);
+        fputs(",\"unit\":", f);
+        json_str(f, row->unit);
+        fputs(",\"bound\":", f);
+        json_num(f, row->bound);
+        fprintf(f, ",\"pass\":%s,\"ms\":", row->pass ? "true" : "false");
+        json_num(f, row->ms);
+        fputs(",\"detail\":", f);
+        json_str(f, row->detail);
+        fputs("}", f);
+    }
+    fprintf(f, "],\n\"stability_info\":{\"quick\":%s,\"rows\":%u,\"cases\":%u,\"failed\":%u,"
+               "\"workers\":%u,\"validation\":%s,\"validation_messages\":%u,"
+               "\"expected_log_errors\":%llu,\"expected_log_warnings\":%llu,\"seconds\":%.1f,"
+               "\"device\":{\"name\":",
+            s->quick ? "true" : "false", s->count, s->cases, s->failed, s->workers,
+            s->validation ? "true" : "false",
+            s->validation_messages, (unsigned long long)s->expected_errors,
+            (unsigned long long)s->expected_warnings, s->seconds);
+    json_str(f, s->device_name);
+    fputs(",\"driver\":", f);
+    json_str(f, s->driver_info);
+    fputs("}}\n", f);
+}
+
+static void json_perf(FILE *f, const ob_bench_report *rep);
 
 ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
 {
@@ -225,6 +311,15 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
     fputs(",", f);
     json_num(f, rep->load_end);
     fputs("]},\n", f);
+    if (rep->perf) json_perf(f, rep);
+    if (rep->perf && rep->stability) fputs(",\n", f);
+    if (rep->stability) json_stability(f, rep->stability);
+    fputs("}\n", f);
+    return close_out(f, path);
+}
+
+static void json_perf(FILE *f, const ob_bench_report *rep)
+{
     fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"flight\":%u,"
                "\"big_frames\":{\"over_draws\":%u,\"warmup\":%u,\"rounds\":%u,\"flight\":%u},"
                "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u},\n",
@@ -269,8 +364,6 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
     }
     fputs("],\n", f);
     json_summary(f, rep);
-    fputs("}\n", f);
-    return close_out(f, path);
 }
 
 /* ------------------------------------------------------------ CSV */
@@ -331,6 +424,46 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
     csv_num(f, rep->raw.record_ms > 0 ? rep->raw.draws / (rep->raw.record_ms * 1e-3) : NAN);
     fputs(",,,,,,,,,,,,,,,,,\n", f);
     return close_out(f, path);
+}
+
+static void csv_text(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"') fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+ob_result ob_bench_report_stability_csv(const ob_bench_stability *s, const char *path)
+{
+    FILE *f = open_out(path);
+    if (!f) return OB_ERR_IO;
+    fputs("name,measure,error,unit,bound,pass,ms,detail\n", f);
+    for (uint32_t i = 0; i < s->count; i++) {
+        const ob_bench_stability_row *row = &s->rows[i];
+        csv_text(f, row->name);
+        fputc(',', f);
+        csv_text(f, row->measure);
+        csv_num(f, row->error);
+        fputc(',', f);
+        csv_text(f, row->unit);
+        csv_num(f, row->bound);
+        fprintf(f, ",%s", row->pass ? "true" : "false");
+        csv_num(f, row->ms);
+        fputc(',', f);
+        csv_text(f, row->detail);
+        fputc('\n', f);
+    }
+    return close_out(f, path);
+}
+
+void ob_bench_report_stability_csv_path(const char *csv, char *dest, size_t dest_size)
+{
+    size_t len = strlen(csv);
+    if (len >= 4 && strcmp(csv + len - 4, ".csv") == 0) len -= 4;
+    snprintf(dest, dest_size, "%.*s-stability.csv", (int)len, csv);
 }
 
 /* ------------------------------------------------------------ charts */

@@ -1,5 +1,7 @@
 /* ob_bench_report.h — what obelisk-bench measured, and its outputs: a
- * table on stdout, JSON, CSV, gnuplot charts.
+ * table on stdout, JSON, CSV, gnuplot charts. Either section may be left
+ * out: the performance one (sweep, raw, scene200, quality: perf = false)
+ * or the stability one (ob_bench_stability.h: stability = NULL).
  *
  * Lifecycle: the program fills an ob_bench_report, then calls the writers.
  * Thread rule: any one thread. Writers report I/O failures as OB_ERR_IO
@@ -14,6 +16,7 @@
 #include "ob_bench_quality.h"
 #include "ob_bench_raw.h"
 #include "ob_bench_run.h"
+#include "ob_bench_stability.h"
 
 #define OB_BENCH_MAX_MODES 8
 
@@ -36,6 +39,8 @@ typedef struct ob_bench_summary {
 
 typedef struct ob_bench_report {
     bool quick;
+    bool perf;                                     /* the performance sections ran */
+    const ob_bench_stability *stability;           /* NULL: that section did not run */
     uint32_t seed, cores, pool_workers;
     char device_name[256], driver_info[256];   /* ob_device_name / ob_device_driver_info */
     bool validation;
@@ -60,7 +65,14 @@ typedef struct ob_bench_report {
 
 void ob_bench_report_print(const ob_bench_report *rep, FILE *f);
 ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path);
+/* The performance sections, one row per configuration and mode. */
 ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path);
+/* The stability section: header name,measure,error,unit,bound,pass,ms,detail,
+ * one row a case (empty fields for NAN). */
+ob_result ob_bench_report_stability_csv(const ob_bench_stability *s, const char *path);
+/* Where the stability CSV of --csv FILE goes: FILE without a trailing
+ * ".csv", then "-stability.csv". */
+void ob_bench_report_stability_csv_path(const char *csv, char *dest, size_t dest_size);
 /* Writes DIR/speedup.png (record-time speedup against workers, one line
  * per object count, one panel per view count) and DIR/error.png (PSNR
  * against frame time for the quality settings), with their .dat and .gp

@@ -1,6 +1,8 @@
 # obelisk-bench --quick: runs, writes JSON/CSV/charts, has every summary
-# field with a numeric value, and every threading mode renders the same
-# image and commands as single-threaded. Times are never judged.
+# field with a numeric value, every threading mode renders the same image
+# and commands as single-threaded, and every stability case (numerical
+# precision, extreme input and load) is reported and within the bound its
+# test asserts. Times are never judged.
 # Run by ctest as: cmake -DBIN=<build>/bin -DSRC=<src> -DOUT=<dir> -P bench_quick.cmake
 cmake_minimum_required(VERSION 3.25)
 foreach(var BIN OUT)
@@ -79,6 +81,56 @@ foreach(i RANGE ${last})
   endforeach()
 endforeach()
 
+# Stability: every case family reported, each row with a numeric error, a
+# unit, and pass = true (a row over its bound also makes the program exit 5).
+string(JSON rows ERROR_VARIABLE err LENGTH "${json}" stability)
+if(err OR rows LESS 40)
+  message(FATAL_ERROR "stability has ${rows} rows (expected 40 or more) ${err}")
+endif()
+set(names "")
+math(EXPR last "${rows} - 1")
+foreach(i RANGE ${last})
+  string(JSON name GET "${json}" stability ${i} name)
+  string(JSON pass GET "${json}" stability ${i} pass)
+  string(JSON etype TYPE "${json}" stability ${i} error)
+  string(JSON unit GET "${json}" stability ${i} unit)
+  string(JSON measure GET "${json}" stability ${i} measure)
+  if(NOT etype STREQUAL "NUMBER" OR unit STREQUAL "" OR measure STREQUAL "")
+    message(FATAL_ERROR "stability row '${name}': error is ${etype}, unit '${unit}', measure '${measure}'")
+  endif()
+  if(NOT pass STREQUAL "ON" AND NOT pass STREQUAL "true")
+    string(JSON error GET "${json}" stability ${i} error)
+    string(JSON detail GET "${json}" stability ${i} detail)
+    message(FATAL_ERROR "stability row '${name}' failed: error ${error} ${unit} (${detail})")
+  endif()
+  list(APPEND names "${name}")
+endforeach()
+foreach(family depth_precision depth_resolution "large_coordinates 1e7" "large_coordinates 1e11"
+        "large_coordinates matrices" scale_invariance "deep_hierarchy 10000" "deep_hierarchy 100000"
+        long_run_rotation zero_scale flattened_box up_parallel_to_direction
+        refused_views_and_cameras empty_scene light_intensity_0 non_finite_transform
+        non_finite_light non_finite_camera non_finite_material non_finite_parameter
+        beyond_float_range views_64 view_cap_128 env_recursion objects_ shadow_map_no_casters)
+  string(FIND "${names}" "${family}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "no stability row for '${family}'")
+  endif()
+endforeach()
+string(JSON failed GET "${json}" stability_info failed)
+string(JSON validation GET "${json}" stability_info validation)
+if(NOT failed EQUAL 0)
+  message(FATAL_ERROR "stability_info.failed is ${failed}")
+endif()
+if((validation STREQUAL "ON" OR validation STREQUAL "true") AND NOT "${names}" MATCHES "validation_layer")
+  message(FATAL_ERROR "validation was on but there is no validation_layer row")
+endif()
+file(STRINGS ${OUT}/bench-stability.csv stability_lines)
+list(LENGTH stability_lines stability_count)
+math(EXPR want "${rows} + 1")
+if(NOT stability_count EQUAL want)
+  message(FATAL_ERROR "bench-stability.csv has ${stability_count} lines, expected ${want}")
+endif()
+
 file(STRINGS ${OUT}/bench.csv csv_lines)
 list(LENGTH csv_lines csv_count)
 if(csv_count LESS 10)
@@ -89,4 +141,4 @@ foreach(png speedup.png error.png)
     message(FATAL_ERROR "chart ${png} was not written")
   endif()
 endforeach()
-message(STATUS "obelisk-bench --quick: summary ${summary}")
+message(STATUS "obelisk-bench --quick: summary ${summary}; ${rows} stability rows, all within their bounds")
