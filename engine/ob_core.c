@@ -9,6 +9,9 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 /* ---------------------------------------------------------------- results */
 
@@ -117,25 +120,74 @@ bool ob_fault_should_fail(ob_fault_kind kind)
 
 /* ------------------------------------------------------------- allocation */
 
+/* What Obelisk holds on the C heap, so that a long run can tell its own
+ * memory from the driver's and the allocator's (ob_heap_stats_now). Block
+ * sizes come from the allocator (malloc_usable_size), so nothing is stored
+ * next to a block; without glibc only blocks are counted. */
+static atomic_llong heap_live_bytes, heap_live_blocks;
+
+static size_t block_size(void *p)
+{
+#if defined(__GLIBC__)
+    return malloc_usable_size(p);
+#else
+    (void)p;
+    return 0;
+#endif
+}
+
+static void *counted(void *p)
+{
+    if (p) {
+        atomic_fetch_add_explicit(&heap_live_bytes, (long long)block_size(p), memory_order_relaxed);
+        atomic_fetch_add_explicit(&heap_live_blocks, 1, memory_order_relaxed);
+    }
+    return p;
+}
+
+ob_heap_stats ob_heap_stats_now(void)
+{
+    long long bytes = atomic_load_explicit(&heap_live_bytes, memory_order_relaxed);
+    long long blocks = atomic_load_explicit(&heap_live_blocks, memory_order_relaxed);
+#if defined(__GLIBC__)
+    bool sized = true;
+#else
+    bool sized = false;
+#endif
+    return (ob_heap_stats){bytes > 0 ? (uint64_t)bytes : 0, blocks > 0 ? (uint64_t)blocks : 0, sized};
+}
+
 void *ob_malloc(size_t size)
 {
     if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
-    return malloc(size ? size : 1);
+    return counted(malloc(size ? size : 1));
 }
 
 void *ob_calloc(size_t count, size_t size)
 {
     if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
-    return calloc(count ? count : 1, size ? size : 1);
+    return counted(calloc(count ? count : 1, size ? size : 1));
 }
 
 void *ob_realloc(void *ptr, size_t size)
 {
     if (ob_fault_should_fail(OB_FAULT_HOST_ALLOC)) return NULL;
-    return realloc(ptr, size ? size : 1);
+    if (!ptr) return counted(malloc(size ? size : 1));
+    size_t before = block_size(ptr);
+    void *q = realloc(ptr, size ? size : 1);
+    if (q)
+        atomic_fetch_add_explicit(&heap_live_bytes, (long long)block_size(q) - (long long)before,
+                                  memory_order_relaxed);
+    return q;
 }
 
-void ob_free(void *ptr) { free(ptr); }
+void ob_free(void *ptr)
+{
+    if (!ptr) return;
+    atomic_fetch_sub_explicit(&heap_live_bytes, (long long)block_size(ptr), memory_order_relaxed);
+    atomic_fetch_sub_explicit(&heap_live_blocks, 1, memory_order_relaxed);
+    free(ptr);
+}
 
 void *ob_aligned_alloc(size_t alignment, size_t size)
 {
@@ -143,10 +195,10 @@ void *ob_aligned_alloc(size_t alignment, size_t size)
     void *p = NULL;
     if (alignment < sizeof(void *)) alignment = sizeof(void *);
     if (posix_memalign(&p, alignment, size ? size : 1) != 0) return NULL;
-    return p;
+    return counted(p);
 }
 
-void ob_aligned_free(void *ptr) { free(ptr); }
+void ob_aligned_free(void *ptr) { ob_free(ptr); }
 
 char *ob_strdup(const char *s)
 {

@@ -104,6 +104,18 @@ void *ob_aligned_alloc(size_t alignment, size_t size);
 void ob_aligned_free(void *ptr);
 char *ob_strdup(const char *s);
 
+/* Live blocks allocated through the functions above and not yet freed, and
+ * their bytes as the allocator sized them (sized = false where the C library
+ * cannot tell a block's size: then live_bytes stays 0). Everything Obelisk
+ * allocates on the host, the libraries it hooks (stb, cJSON in the demos)
+ * included; not the driver's or the validation layer's memory. [any thread;
+ * a snapshot: other threads may allocate meanwhile] */
+typedef struct ob_heap_stats {
+    uint64_t live_bytes, live_blocks;
+    bool sized;
+} ob_heap_stats;
+ob_heap_stats ob_heap_stats_now(void);
+
 /* Grow a dynamic array so it holds at least `need` elements of elem_size.
  * *items and *cap are updated only on success. */
 ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t elem_size);

@@ -127,7 +127,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
 
 ob_demo_memory ob_demo_memory_now(void)
 {
-    ob_demo_memory m = {0, 0, 0};
+    ob_demo_memory m = {0, 0, 0, 0};
     FILE *f = fopen("/proc/self/status", "r");
     if (f) {
         char line[128];
@@ -138,6 +138,7 @@ ob_demo_memory ob_demo_memory_now(void)
         }
         fclose(f);
     }
+    m.obelisk_heap_kb = ob_heap_stats_now().live_bytes / 1024;
 #if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
     struct mallinfo2 mi = mallinfo2();
     m.heap_in_use_kb = (unsigned long long)(mi.uordblks + mi.hblkhd) / 1024;
@@ -374,8 +375,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
                 ob_skip_reason_name(st->skipped[i].reason));
     fputs("]", f);
     if (mem)
-        fprintf(f, ",\"rss_kb\":%llu,\"peak_rss_kb\":%llu,\"heap_in_use_kb\":%llu", mem->rss_kb,
-                mem->peak_rss_kb, mem->heap_in_use_kb);
+        fprintf(f, ",\"rss_kb\":%llu,\"peak_rss_kb\":%llu,\"heap_in_use_kb\":%llu,"
+                "\"obelisk_heap_kb\":%llu", mem->rss_kb, mem->peak_rss_kb, mem->heap_in_use_kb,
+                mem->obelisk_heap_kb);
     fputs("}", f);
 }
 
@@ -474,8 +476,9 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     print_summary(d);
     ob_demo_memory mem = ob_demo_memory_now();
     if (mem.rss_kb)
-        printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB\n",
-               mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0, mem.heap_in_use_kb / 1024.0);
+        printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB, of it "
+               "Obelisk's %.1f MiB\n", mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0,
+               mem.heap_in_use_kb / 1024.0, mem.obelisk_heap_kb / 1024.0);
     ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
     if (ob_device_validation_enabled(ob_renderer_device(d->r)))
         printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);

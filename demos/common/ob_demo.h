@@ -103,10 +103,11 @@ double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase
 double ob_demo_median(double *v, uint32_t n);
 
 /* The process's memory: resident set and its peak (/proc/self/status, 0
- * where there is none) and what the C heap holds live (glibc's mallinfo2,
- * 0 elsewhere). */
+ * where there is none), what the C heap holds live (glibc's mallinfo2, 0
+ * elsewhere: the driver's and the validation layer's memory included) and
+ * what of it Obelisk allocated (ob_heap_stats_now). */
 typedef struct ob_demo_memory {
-    unsigned long long rss_kb, peak_rss_kb, heap_in_use_kb;
+    unsigned long long rss_kb, peak_rss_kb, heap_in_use_kb, obelisk_heap_kb;
 } ob_demo_memory;
 ob_demo_memory ob_demo_memory_now(void);
 

@@ -14,6 +14,7 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     ob_test_setup_log();
     ob_test_world_desc d = desc ? *desc : (ob_test_world_desc){0};
     memset(w, 0, sizeof *w);
+    w->heap_at_create = ob_heap_stats_now();
     w->width = d.width ? d.width : 160;
     w->height = d.height ? d.height : 120;
     ob_result r;
@@ -74,9 +75,16 @@ void ob_test_world_destroy(ob_test_world *w)
     ob_effect_context_destroy(w->fx);
     ob_renderer_destroy(w->r);
     free(w->pixels);
+    ob_heap_stats before = w->heap_at_create, after = ob_heap_stats_now();
     memset(w, 0, sizeof *w);
     if (vc.errors || vc.warnings)
         fail_msg("validation layer reported %u errors and %u warnings", vc.errors, vc.warnings);
+    /* Everything the world made is gone: a leak the sanitizer build would
+     * also catch, but this also catches memory kept in a list until exit. */
+    if (after.live_blocks != before.live_blocks || after.live_bytes != before.live_bytes)
+        fail_msg("Obelisk's heap holds %lld blocks (%lld bytes) more after the world was destroyed",
+                 (long long)(after.live_blocks - before.live_blocks),
+                 (long long)(after.live_bytes - before.live_bytes));
 }
 
 ob_geometry *ob_test_world_geometry(ob_test_world *w, const ob_mesh *mesh, const char *name)

@@ -41,6 +41,7 @@ typedef struct ob_test_world {
     uint8_t *pixels;           /* width * height * 4, filled by ob_test_world_read */
     double time;
     char cache_dir[256];
+    ob_heap_stats heap_at_create;   /* destroy checks Obelisk's heap is back to it */
 } ob_test_world;
 
 void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc);

@@ -66,6 +66,48 @@ static void nth_host_allocation_fails(void **state)
     ob_free(d);
 }
 
+/* The live count follows every allocation function, back to where it
+ * started once all is freed (the soak tells Obelisk's memory from the
+ * driver's with it). */
+static void heap_stats_follow_every_allocation(void **state)
+{
+    (void)state;
+    ob_heap_stats before = ob_heap_stats_now();
+    void *a = ob_malloc(1000);
+    void *b = ob_calloc(10, 100);
+    void *c = ob_aligned_alloc(64, 256);
+    char *d = ob_strdup("obelisk");
+    assert_non_null(a);
+    assert_non_null(b);
+    assert_non_null(c);
+    assert_non_null(d);
+    ob_heap_stats mid = ob_heap_stats_now();
+    assert_int_equal(mid.live_blocks, before.live_blocks + 4);
+    if (mid.sized) assert_true(mid.live_bytes >= before.live_bytes + 1000 + 1000 + 256 + 8);
+    a = ob_realloc(a, 100000);
+    assert_non_null(a);
+    ob_heap_stats grown = ob_heap_stats_now();
+    assert_int_equal(grown.live_blocks, mid.live_blocks);
+    if (grown.sized) assert_true(grown.live_bytes >= mid.live_bytes + 99000);
+    void *e = ob_realloc(NULL, 10);
+    assert_non_null(e);
+    assert_int_equal(ob_heap_stats_now().live_blocks, mid.live_blocks + 1);
+    ob_free(a);
+    ob_free(b);
+    ob_aligned_free(c);
+    ob_free(d);
+    ob_free(e);
+    ob_free(NULL);
+    ob_heap_stats after = ob_heap_stats_now();
+    assert_int_equal(after.live_blocks, before.live_blocks);
+    assert_int_equal(after.live_bytes, before.live_bytes);
+    /* A failed allocation counts nothing. */
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 1);
+    assert_null(ob_malloc(64));
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+    assert_int_equal(ob_heap_stats_now().live_blocks, before.live_blocks);
+}
+
 static void missing_file_names_path(void **state)
 {
     (void)state;
@@ -85,6 +127,7 @@ int main(void)
         cmocka_unit_test(pool_grows_and_iterates),
         cmocka_unit_test(result_names_are_stable),
         cmocka_unit_test(nth_host_allocation_fails),
+        cmocka_unit_test(heap_stats_follow_every_allocation),
         cmocka_unit_test(missing_file_names_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
