@@ -230,6 +230,12 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
         }
         fputs("[\n", d->json);
     }
+    /* The summary's 64 bytes per frame, taken once: a headless run's memory
+     * then does not grow with its frames (what the soak measures). */
+    if (!d->window && o->frames &&
+        (r = ob_array_reserve((void **)&d->history, &d->history_cap, o->frames,
+                              sizeof *d->history)) != OB_OK)
+        return r;
     return OB_OK;
 }
 
