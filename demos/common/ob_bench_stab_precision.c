@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ob_demo.h"
 #include "ob_bench_stab_world.h"
 
 /* ------------------------------------------------------- depth ordering */
@@ -383,7 +384,7 @@ ob_result ob_stab_scene_matrices(ob_stab_ctx *c)
     return ob_stab_add(c, "large_coordinates matrices",
                        "max relative element difference of the camera-relative view and world "
                        "matrices at 1e7 vs the origin",
-                       worst, "relative", 1e-6, naive_worst > 0.01, ob_stab_median(ms, 3),
+                       worst, "relative", 1e-6, naive_worst > 0.01, ob_demo_median(ms, 3),
                        "3 offsets; hierarchy with scale, controllers, camera; float world "
                        "matrices would be off by %.3g units (must be > 0.01); ms = build + 31 "
                        "updates", naive_worst);
@@ -553,7 +554,7 @@ ob_result ob_stab_deep_hierarchy(ob_stab_ctx *c, uint32_t levels)
     ob_dquat_from_axis_angle(u, levels * th, q);
     ob_dquat_to_mat3(q, rot);
     for (int i = 0; i < 9; i++) rot_err = fmax(rot_err, fabs(wa.m[i] - rot[i]));
-    double update_ms = ob_stab_median(ms, 3);
+    double update_ms = ob_demo_median(ms, 3);
     char name[48];
     snprintf(name, sizeof name, "deep_hierarchy %u position", levels);
     r = ob_stab_add(c, name, "world position vs double closed form: max |p_k - ref_k| / k over "

@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ob_bench_stab_world.h"
 
+#include "ob_demo.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -34,23 +36,10 @@ ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, dou
     return OB_OK;
 }
 
-double ob_stab_median(double *v, uint32_t n)
-{
-    /* Insertion sort: a case has at most a few hundred frames. */
-    for (uint32_t i = 1; i < n; i++) {
-        double x = v[i];
-        uint32_t j = i;
-        for (; j > 0 && v[j - 1] > x; j--) v[j] = v[j - 1];
-        v[j] = x;
-    }
-    if (n == 0) return NAN;
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 double ob_stab_take_ms(ob_stab_ctx *c)
 {
-    double ms = c->steady_count ? ob_stab_median(c->steady_ms, c->steady_count)
-                                : ob_stab_median(c->first_ms, c->first_count);
+    double ms = c->steady_count ? ob_demo_median(c->steady_ms, c->steady_count)
+                                : ob_demo_median(c->first_ms, c->first_count);
     c->steady_count = c->first_count = 0;
     return ms;
 }

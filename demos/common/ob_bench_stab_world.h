@@ -60,8 +60,6 @@ double ob_stab_take_ms(ob_stab_ctx *c);
 void ob_stab_expect(ob_stab_ctx *c, const char *const *needles);
 /* A captured line contains every string of the NULL-terminated list. */
 bool ob_stab_log_has(ob_stab_ctx *c, const char *needle, ...);
-/* Median of v[0..n) (reordered); NAN for n = 0. */
-double ob_stab_median(double *v, uint32_t n);
 
 typedef struct ob_stab_world_desc {
     uint32_t width, height;        /* 0 → 160 x 120 */
