@@ -13,9 +13,42 @@ struct ob_paraboloid_view {
     ob_views *ctx;
     ob_node *owner;
     ob_param direction, env_map, env_matrix;
+    /* Per item of this frame's draw list: bit L set when its bound reaches
+     * layer L's hemisphere (filled in pre_draw, read by the recording). */
+    uint8_t *reach;
+    uint32_t reach_cap;
+    bool reach_valid;      /* false: no memory for it this frame, draw all */
 };
 
 #define PARABOLOID_NEAR 0.05f
+
+/* A layer holds one hemisphere (z * side >= 0 around the owner); the
+ * shaders discard every fragment of the other one. An item whose bound lies
+ * wholly in the other hemisphere therefore leaves no pixel in that layer:
+ * not drawing it there changes nothing but the cost (about half the items
+ * of a map whose owner stands among them). The bound is widened by far more
+ * than the float rounding of a vertex relative to the owner (about 1e-7 of
+ * its distance), so that no vertex can round across the plane. */
+static void paraboloid_reach(ob_paraboloid_view *pv)
+{
+    ob_view *v = &pv->base;
+    pv->reach_valid = ob_array_reserve((void **)&pv->reach, &pv->reach_cap, v->item_count,
+                                       sizeof *pv->reach) == OB_OK;
+    if (!pv->reach_valid) {
+        OB_LOG_W("view", "view '%s': no memory for the per-layer item masks; every item is drawn "
+                 "in both layers this frame", v->name);
+        return;
+    }
+    for (uint32_t i = 0; i < v->item_count; i++) {
+        double c[3];
+        float radius;
+        ob_node_world_sphere(v->items[i].node, c, &radius);
+        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
+        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+        double reach = (double)radius + ((double)radius + dist) * 1e-5 + 1e-6;
+        pv->reach[i] = (uint8_t)((rel[2] + reach >= 0.0 ? 1u : 0u) | (-rel[2] + reach >= 0.0 ? 2u : 0u));
+    }
+}
 
 static void paraboloid_pre_draw(ob_view *v, ob_renderer *r)
 {
@@ -25,6 +58,7 @@ static void paraboloid_pre_draw(ob_view *v, ob_renderer *r)
     ob_node_world_sphere(pv->owner, v->origin, &radius);
     ob_mat4_identity(v->view_proj);
     ob_view_cull(v, r, ob_renderer_scene(r), pv->owner);
+    paraboloid_reach(pv);
     ob_view_pre_render_items(v, r);
     /* A particle system the map sees must step before the map draws it and
      * hand it its parameters (it becomes a dependency), as for a camera. */
@@ -60,24 +94,12 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
     float side = layer == 0 ? 1.0f : -1.0f;
     float dir[4] = {side, PARABOLOID_NEAR, 0.0f, 0.0f};
     ob_params_set_vec4(ob_pm_params(pm), pv->direction, dir);
-    /* A layer holds one hemisphere (z * side >= 0 around the owner); the
-     * shaders discard every fragment of the other one. An item whose bound
-     * lies wholly in the other hemisphere therefore leaves no pixel in this
-     * layer: skipping it changes nothing but the cost (about half the items
-     * of a map whose owner stands among them). The bound is widened by far
-     * more than the float rounding of a vertex relative to the owner (about
-     * 1e-7 of its distance), so that no vertex can round across the plane.
-     * Runs of items this layer draws are recorded together. */
+    /* Runs of items this layer draws are recorded together. */
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     uint32_t run = first;
-    for (uint32_t i = first; i < end; i++) {
-        double c[3];
-        float radius;
-        ob_node_world_sphere(v->items[i].node, c, &radius);
-        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
-        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
-        double margin = ((double)radius + dist) * 1e-5 + 1e-6;
-        if (rel[2] * side + (double)radius + margin >= 0.0) continue;
+    uint8_t bit = (uint8_t)(1u << layer);
+    for (uint32_t i = first; i < end && pv->reach_valid; i++) {
+        if (pv->reach[i] & bit) continue;
         if (i > run) ob_view_record_items(v, r, pm, run, i - run);
         run = i + 1;
     }
@@ -128,7 +150,9 @@ done:
 
 void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v)
 {
-    if (v) ob_views_free_view(ctx, &v->base);
+    if (!v) return;
+    ob_free(v->reach);
+    ob_views_free_view(ctx, &v->base);
 }
 
 ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v) { return &v->base; }
