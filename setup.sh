@@ -34,7 +34,7 @@ packages=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev spirv-tools libspirv-cross-c-shared-dev
   libcglm-dev libstb-dev libassimp-dev assimp-testmodels libcjson-dev
-  libcmocka-dev gnuplot-nox libglfw3-dev
+  libcmocka-dev gnuplot-nox libglfw3-dev xvfb xauth
 )
 
 deps() {

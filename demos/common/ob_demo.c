@@ -16,7 +16,7 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
 {
     fprintf(f,
             "usage: %s [options]%s\n"
-            "  --frames F        frames to render (default 60)\n"
+            "  --frames F        frames to render (default 60; with --window, until it closes)\n"
             "  --threads T       0 = single-threaded, N = N workers, auto = decide per frame\n"
             "  --toggle K        switch single/multi-threaded every K frames\n"
             "  --size WxH        image size (default 640x480)\n"
@@ -70,6 +70,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
         } else if (!strcmp(a, "--frames")) {
             ok = parse_u32(v, &o->frames) && o->frames > 0;
             i++;
+            o->frames_given = true;
         } else if (!strcmp(a, "--threads")) {
             uint32_t t;
             if (!strcmp(v, "auto")) o->threads = -1;
@@ -232,7 +233,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     }
     /* The summary's 64 bytes per frame, taken once: a headless run's memory
      * then does not grow with its frames (what the soak measures). */
-    if (!d->window && o->frames &&
+    if ((!d->window || o->frames_given) && o->frames &&
         (r = ob_array_reserve((void **)&d->history, &d->history_cap, o->frames,
                               sizeof *d->history)) != OB_OK)
         return r;
@@ -451,8 +452,11 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     const double dt = 1.0 / 60.0;
     ob_view *final = d->overlay ? ob_overlay_view_base(d->overlay)
                                 : ob_composite_view_base(d->composite);
-    /* With a window the demo runs until it is closed; F1 flips the mode. */
-    for (uint32_t f = 0; d->window ? ob_window_poll(d->window) : f < d->opt.frames; f++) {
+    /* With a window the demo runs until it is closed (or for --frames when
+     * given); F1 flips the mode. */
+    const bool counted = !d->window || d->opt.frames_given;
+    for (uint32_t f = 0; (!counted || f < d->opt.frames) && (!d->window || ob_window_poll(d->window));
+         f++) {
         if (d->window && ob_window_take_toggle(d->window)) d->flipped = !d->flipped;
         ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
                                   d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
@@ -485,6 +489,11 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
         printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB, of it "
                "Obelisk's %.1f MiB\n", mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0,
                mem.heap_in_use_kb / 1024.0, mem.obelisk_heap_kb / 1024.0);
+    if (d->window) {
+        uint32_t skipped, presented = ob_window_presented(d->window, &skipped);
+        printf("window: %u frames presented, %u skipped (swapchain out of date)\n", presented,
+               skipped);
+    }
     ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
     if (ob_device_validation_enabled(ob_renderer_device(d->r)))
         printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);

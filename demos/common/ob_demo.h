@@ -17,7 +17,7 @@
 #include "ob_window.h"
 
 typedef struct ob_demo_options {
-    uint32_t frames;          /* --frames F (default 60) */
+    uint32_t frames;          /* --frames F (default 60; with --window: until closed) */
     int threads;              /* --threads T: 0 = single-threaded, N workers, -1 = auto */
     uint32_t toggle;          /* --toggle K: switch ST/MT every K frames (0 = never) */
     uint32_t width, height;   /* --size WxH (640x480) */
@@ -32,8 +32,9 @@ typedef struct ob_demo_options {
     bool quiet;               /* --quiet: no per-frame lines */
     const char *input;        /* positional argument (obelisk-view FILE) */
     /* Set by the parser when --size / --threads were given, so that settings
-     * from a scene file do not override the command line. */
-    bool size_given, threads_given;
+     * from a scene file do not override the command line; frames_given makes
+     * a windowed run stop after --frames. */
+    bool size_given, threads_given, frames_given;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
 } ob_demo_options;

@@ -23,6 +23,7 @@ struct ob_window {
     VkCommandPool pool;
     VkCommandBuffer cmds[SLOTS];
     uint32_t frame;
+    uint32_t presented, skipped;
     bool toggle;
 };
 
@@ -173,7 +174,10 @@ ob_result ob_window_present(ob_window *w, ob_image image)
     uint32_t index;
     VkResult vr = vkAcquireNextImageKHR(vk, w->swapchain, UINT64_MAX, w->acquired[slot],
                                         VK_NULL_HANDLE, &index);
-    if (vr == VK_ERROR_OUT_OF_DATE_KHR) return OB_OK; /* not resizable: skip this frame */
+    if (vr == VK_ERROR_OUT_OF_DATE_KHR) { /* not resizable: skip this frame */
+        w->skipped++;
+        return OB_OK;
+    }
     if (vr < 0) return ob_result_from_vk(OB_VK_CHECK(vr));
     vkResetFences(vk, 1, &w->fences[slot]);
     VkCommandBuffer cmd = w->cmds[slot];
@@ -244,8 +248,19 @@ ob_result ob_window_present(ob_window *w, ob_image image)
                            .swapchainCount = 1, .pSwapchains = &w->swapchain,
                            .pImageIndices = &index};
     vr = vkQueuePresentKHR(ob_device_vk_queue(w->dev), &pi);
-    if (vr < 0 && vr != VK_ERROR_OUT_OF_DATE_KHR) return ob_result_from_vk(OB_VK_CHECK(vr));
+    if (vr == VK_ERROR_OUT_OF_DATE_KHR) {
+        w->skipped++;
+        return OB_OK;
+    }
+    if (vr < 0) return ob_result_from_vk(OB_VK_CHECK(vr));
+    w->presented++;
     return OB_OK;
+}
+
+uint32_t ob_window_presented(const ob_window *w, uint32_t *out_skipped)
+{
+    *out_skipped = w->skipped;
+    return w->presented;
 }
 
 void ob_window_close(ob_window *w)
@@ -306,6 +321,12 @@ ob_result ob_window_present(ob_window *w, ob_image image)
     (void)w;
     (void)image;
     return OB_ERR_UNSUPPORTED;
+}
+uint32_t ob_window_presented(const ob_window *w, uint32_t *out_skipped)
+{
+    (void)w;
+    *out_skipped = 0;
+    return 0;
 }
 void ob_window_close(ob_window *w) { (void)w; }
 

@@ -1,0 +1,56 @@
+# obelisk-mirror in a window (GLFW, X11 surface, swapchain) on a virtual X
+# server, under the validation layer with synchronization validation:
+#   - switching single/multi-threaded every frame, overlay off: exits 0 (3 =
+#     the validation layer spoke), says every frame was presented, and its
+#     final image is byte-identical to a headless single-threaded run's;
+#   - with the overlay (on by default with --window): exits 0, all presented.
+# Skipped (prints SKIP) when the build has no window support or xvfb-run is
+# missing; ./setup.sh installs both (libglfw3-dev, xvfb, xauth).
+# Run by ctest: cmake -DBIN=... -DSRC=... -DOUT=... -DWINDOW=ON|OFF -DXVFB_RUN=path -P mirror_window.cmake
+foreach(var BIN OUT)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "mirror_window: -D${var}=... is required")
+  endif()
+endforeach()
+if(NOT WINDOW)
+  message("SKIP: this build has no window support (configure with GLFW: libglfw3-dev)")
+  return()
+endif()
+if(NOT XVFB_RUN)
+  message("SKIP: xvfb-run not found (Debian: xvfb xauth)")
+  return()
+endif()
+file(MAKE_DIRECTORY ${OUT})
+set(frames 6)
+set(common --objects 120 --size 320x240 --frames ${frames} --quiet)
+
+function(run name)
+  execute_process(COMMAND ${ARGN} ${common} --out ${OUT}/${name}.png
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${name}: exited with ${rc}\n${out}\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+endfunction()
+
+# -a: the first free display; the screen is larger than the window.
+set(xvfb ${XVFB_RUN} -a -s "-screen 0 640x480x24")
+
+run(window ${xvfb} ${BIN}/obelisk-mirror --window --no-overlay --threads 2 --toggle 1)
+if(NOT out MATCHES "window: ${frames} frames presented, 0 skipped")
+  message(FATAL_ERROR "window: not every frame was presented\n${out}")
+endif()
+if(NOT out MATCHES "validation: 0 errors, 0 warnings")
+  message(FATAL_ERROR "window: the run did not report a silent validation layer\n${out}")
+endif()
+run(headless ${BIN}/obelisk-mirror --no-overlay --threads 0)
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/window.png ${OUT}/headless.png
+                RESULT_VARIABLE same)
+if(NOT same EQUAL 0)
+  message(FATAL_ERROR "the windowed run's image differs from the headless single-threaded one")
+endif()
+
+run(window_overlay ${xvfb} ${BIN}/obelisk-mirror --window --threads 2 --toggle 2)
+if(NOT out MATCHES "window: ${frames} frames presented, 0 skipped")
+  message(FATAL_ERROR "window_overlay: not every frame was presented\n${out}")
+endif()
