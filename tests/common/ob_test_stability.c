@@ -18,8 +18,8 @@ void ob_test_stability_run(void **state)
     for (uint32_t i = 0; i < s.count; i++) {
         const ob_bench_stability_row *row = &s.rows[i];
         char bound[32] = "measured only";
-        if (!isnan(row->bound)) snprintf(bound, sizeof bound, "bound %.3g", row->bound);
-        print_message("%s: %.3g %s (%s) %s: %s; %s\n", row->name, row->error, row->unit, bound,
+        if (!isnan(row->bound)) snprintf(bound, sizeof bound, "bound %.7g", row->bound);
+        print_message("%s: %.7g %s (%s) %s: %s; %s\n", row->name, row->error, row->unit, bound,
                       row->pass ? "ok" : "FAILED", row->measure, row->detail);
     }
     uint32_t rows = s.count, failed = s.failed, messages = s.validation_messages;
