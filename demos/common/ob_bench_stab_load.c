@@ -1,7 +1,8 @@
 /* Stability cases about extreme workloads: 64 views in one frame, the
  * 128-view cap, env-map recursion bounds 0..4, 100,000 objects single- and
- * multi-threaded, a shadow map without casters. Scenes and bounds are those
- * of tests/gpu/test_extreme_load.c; times are reported, never judged. */
+ * multi-threaded, a shadow map without casters. tests/gpu/test_extreme_load.c
+ * runs these cases and asserts on their rows; times are reported, never
+ * judged. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>

@@ -77,6 +77,14 @@ bool ob_stab_log_has(ob_stab_ctx *c, const char *needle, ...)
     return found;
 }
 
+uint64_t ob_stab_expected_errors(ob_stab_ctx *c)
+{
+    pthread_mutex_lock(&c->log.lock);
+    uint64_t n = c->log.expected[OB_LOG_ERROR];
+    pthread_mutex_unlock(&c->log.lock);
+    return n;
+}
+
 /* ------------------------------------------------------------ world */
 
 static void fail(ob_stab_world *w, ob_result r, const char *what, const char *name)

@@ -60,6 +60,8 @@ double ob_stab_take_ms(ob_stab_ctx *c);
 void ob_stab_expect(ob_stab_ctx *c, const char *const *needles);
 /* A captured line contains every string of the NULL-terminated list. */
 bool ob_stab_log_has(ob_stab_ctx *c, const char *needle, ...);
+/* Expected lines logged at ERROR so far in the run. */
+uint64_t ob_stab_expected_errors(ob_stab_ctx *c);
 
 typedef struct ob_stab_world_desc {
     uint32_t width, height;        /* 0 → 160 x 120 */

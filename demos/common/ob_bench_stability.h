@@ -57,9 +57,10 @@ typedef struct ob_bench_stability_desc {
     bool quick;                     /* shrink the two long cases (said in their rows) */
     uint32_t workers;               /* renderer worker pool, 0 → 4 (as the tests) */
     ob_bench_progress *progress;    /* NULL: none; one tick per case, labelled */
+    const char *only;               /* NULL: every case; else the one case with this label */
 } ob_bench_stability_desc;
 
-/* Progress ticks one run gives (one per case). */
+/* Progress ticks a run of every case gives (one per case). */
 uint32_t ob_bench_stability_case_count(void);
 
 typedef struct ob_bench_stability {
@@ -74,9 +75,9 @@ typedef struct ob_bench_stability {
     char device_name[256], driver_info[256];
 } ob_bench_stability;
 
-/* Runs every case into *out (zeroed first). Failure: a renderer, scene or
- * allocation failure (logged); out holds the rows done so far and must still
- * be released. A case over its bound is not a failure here: it is a row with
+/* Runs every case (or desc->only) into *out (zeroed first). Failure: a
+ * renderer, scene or allocation failure, or an unknown `only` (logged); out
+ * holds the rows done so far and must still be released. A case over its bound is not a failure here: it is a row with
  * pass = false, counted in out->failed. */
 ob_result ob_bench_stability_run(const ob_bench_stability_desc *desc, ob_bench_stability *out);
 /* Frees the rows; zeroed s ok. */
