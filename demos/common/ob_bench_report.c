@@ -16,11 +16,20 @@ static const char *threading_name(ob_threading t)
     return t == OB_THREADING_SINGLE ? "single" : t == OB_THREADING_MULTI ? "multi" : "auto";
 }
 
+/* A finite number as the files carry it: whole numbers (pixel sums, counts)
+ * exactly, others to 9 significant digits (%.6g wrote 4100181 as 4.10018e+06). */
+static void num_text(double v, char buf[40])
+{
+    if (v == floor(v) && fabs(v) < 1e15) snprintf(buf, 40, "%.0f", v);
+    else snprintf(buf, 40, "%.9g", v);
+}
+
 /* JSON has no NaN or infinity: those become null. */
 static void json_num(FILE *f, double v)
 {
-    if (isfinite(v)) fprintf(f, "%.6g", v);
-    else fputs("null", f);
+    char buf[40];
+    if (isfinite(v)) num_text(v, buf);
+    fputs(isfinite(v) ? buf : "null", f);
 }
 
 static void json_str(FILE *f, const char *s)
@@ -39,7 +48,11 @@ static void csv_num(FILE *f, double v)
 {
     if (isnan(v)) fputs(",", f);
     else if (isinf(v)) fputs(",inf", f);
-    else fprintf(f, ",%.6g", v);
+    else {
+        char buf[40];
+        num_text(v, buf);
+        fprintf(f, ",%s", buf);
+    }
 }
 
 static FILE *open_out(const char *path)

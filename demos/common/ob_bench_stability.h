@@ -77,8 +77,9 @@ typedef struct ob_bench_stability {
 
 /* Runs every case (or desc->only) into *out (zeroed first). Failure: a
  * renderer, scene or allocation failure, or an unknown `only` (logged); out
- * holds the rows done so far and must still be released. A case over its bound is not a failure here: it is a row with
- * pass = false, counted in out->failed. */
+ * holds the rows done so far and must still be released. A case over its
+ * bound is not a failure here: it is a row with pass = false, counted in
+ * out->failed. */
 ob_result ob_bench_stability_run(const ob_bench_stability_desc *desc, ob_bench_stability *out);
 /* Frees the rows; zeroed s ok. */
 void ob_bench_stability_release(ob_bench_stability *s);
