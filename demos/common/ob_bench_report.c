@@ -27,9 +27,13 @@ static void num_text(double v, char buf[40])
 /* JSON has no NaN or infinity: those become null. */
 static void json_num(FILE *f, double v)
 {
+    if (!isfinite(v)) {
+        fputs("null", f);
+        return;
+    }
     char buf[40];
-    if (isfinite(v)) num_text(v, buf);
-    fputs(isfinite(v) ? buf : "null", f);
+    num_text(v, buf);
+    fputs(buf, f);
 }
 
 static void json_str(FILE *f, const char *s)

@@ -173,6 +173,10 @@ static void on_stats(void *user, const ob_frame_stats *st)
     }
 }
 
+/* Headless runs render --frames frames; windowed runs until the window
+ * closes, or for --frames when it was given. */
+static bool frames_bound_run(const ob_demo_options *o) { return !o->window || o->frames_given; }
+
 ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
 {
     memset(d, 0, sizeof *d);
@@ -233,7 +237,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     }
     /* The summary's 64 bytes per frame, taken once: a headless run's memory
      * then does not grow with its frames (what the soak measures). */
-    if ((!d->window || o->frames_given) && o->frames &&
+    if (frames_bound_run(o) &&
         (r = ob_array_reserve((void **)&d->history, &d->history_cap, o->frames,
                               sizeof *d->history)) != OB_OK)
         return r;
@@ -452,9 +456,8 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     const double dt = 1.0 / 60.0;
     ob_view *final = d->overlay ? ob_overlay_view_base(d->overlay)
                                 : ob_composite_view_base(d->composite);
-    /* With a window the demo runs until it is closed (or for --frames when
-     * given); F1 flips the mode. */
-    const bool counted = !d->window || d->opt.frames_given;
+    /* F1 in the window flips the mode. */
+    const bool counted = frames_bound_run(&d->opt);
     for (uint32_t f = 0; (!counted || f < d->opt.frames) && (!d->window || ob_window_poll(d->window));
          f++) {
         if (d->window && ob_window_take_toggle(d->window)) d->flipped = !d->flipped;
