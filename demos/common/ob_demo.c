@@ -177,8 +177,40 @@ static void on_stats(void *user, const ob_frame_stats *st)
  * closes, or for --frames when it was given. */
 static bool frames_bound_run(const ob_demo_options *o) { return !o->window || o->frames_given; }
 
+/* The allocator policy of the demos' processes (glibc only).
+ *
+ * glibc's default mmap threshold is dynamic: freeing a large mmap'd block
+ * raises it (up to 32 MiB), after which blocks of that size come from the
+ * arenas, and the trim threshold follows it (twice the mmap threshold). The
+ * driver allocates and frees many blocks of hundreds of kB to a few MB per
+ * frame (lavapipe's binned scenes and command buffers), so after a new
+ * high-water mark an arena keeps tens of MB of free pages resident, and RSS
+ * rises in steps whose timing depends on scheduling. Measured on the soak
+ * command (docs/soak.md: obelisk-mirror --objects 2000, switching ST/MT
+ * every frame, LP_NUM_THREADS=0): with the default policy RSS went
+ * 220.3 -> 225.1 MB in steps over 6,000 frames, the arenas holding 150 MB
+ * with ~22 MB free; with both thresholds fixed at 128 KiB it stayed within
+ * 0.03% at 190 MB, the arenas holding 127 MB with 6.6 MB free.
+ *
+ * Fixed thresholds: blocks of 128 KiB and more are mmap'd and returned to
+ * the system when freed, and an arena gives back its top once 128 KiB are
+ * free there. A user who sets glibc.malloc tunables in GLIBC_TUNABLES keeps
+ * them: this is a demo's choice, not the engine's, so it never overrides
+ * the user's. */
+static void set_allocator_policy(void)
+{
+#if defined(__GLIBC__)
+    const char *t = getenv("GLIBC_TUNABLES");
+    if (t && strstr(t, "glibc.malloc.")) return;
+    enum { threshold = 128 * 1024 };
+    if (!mallopt(M_MMAP_THRESHOLD, threshold) || !mallopt(M_TRIM_THRESHOLD, threshold))
+        OB_LOG_W("demo", "mallopt refused the allocator thresholds: RSS may rise in steps");
+#endif
+}
+
 ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
 {
+    set_allocator_policy();
     memset(d, 0, sizeof *d);
     d->opt = *o;
     ob_result r;
