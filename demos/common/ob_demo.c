@@ -203,8 +203,10 @@ static void set_allocator_policy(void)
     const char *t = getenv("GLIBC_TUNABLES");
     if (t && strstr(t, "glibc.malloc.")) return;
     enum { threshold = 128 * 1024 };
+    /* A replaced allocator (ASan's, or one preloaded) refuses: not an error,
+     * its own policy applies. */
     if (!mallopt(M_MMAP_THRESHOLD, threshold) || !mallopt(M_TRIM_THRESHOLD, threshold))
-        OB_LOG_W("demo", "mallopt refused the allocator thresholds: RSS may rise in steps");
+        OB_LOG_D("demo", "the allocator ignores mallopt: glibc's thresholds are not in use");
 #endif
 }
 
