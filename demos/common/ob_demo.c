@@ -27,7 +27,9 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --shadow-size N   shadow map size\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
             "  --window          show the scene live (F1 toggles the mode)\n"
-            "  --quiet           no per-frame lines\n%s",
+            "  --quiet           no per-frame lines\n"
+            "  --malloc-threshold KIB  fix glibc's mmap and trim thresholds (steady RSS on\n"
+            "                    long runs, slower frames on lavapipe; docs/soak.md)\n%s",
             prog, takes_input ? " FILE" : "", extra ? extra : "");
 }
 
@@ -99,6 +101,10 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             i++;
         } else if (!strcmp(a, "--env-size")) {
             ok = parse_u32(v, &o->env_size) && o->env_size >= 8 && o->env_size <= 4096;
+            i++;
+        } else if (!strcmp(a, "--malloc-threshold")) {
+            ok = parse_u32(v, &o->malloc_threshold_kib) && o->malloc_threshold_kib >= 1 &&
+                 o->malloc_threshold_kib <= 32 * 1024;
             i++;
         } else if (!strcmp(a, "--shadow-size")) {
             ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= 16 && o->shadow_size <= 8192;
@@ -177,42 +183,41 @@ static void on_stats(void *user, const ob_frame_stats *st)
  * closes, or for --frames when it was given. */
 static bool frames_bound_run(const ob_demo_options *o) { return !o->window || o->frames_given; }
 
-/* The allocator policy of the demos' processes (glibc only).
+/* --malloc-threshold: glibc's allocator policy, for long runs (glibc only).
  *
  * glibc's default mmap threshold is dynamic: freeing a large mmap'd block
  * raises it (up to 32 MiB), after which blocks of that size come from the
  * arenas, and the trim threshold follows it (twice the mmap threshold). The
  * driver allocates and frees many blocks of hundreds of kB to a few MB per
- * frame (lavapipe's binned scenes and command buffers), so after a new
- * high-water mark an arena keeps tens of MB of free pages resident, and RSS
- * rises in steps whose timing depends on scheduling. Measured on the soak
- * command (docs/soak.md: obelisk-mirror --objects 2000, switching ST/MT
- * every frame, LP_NUM_THREADS=0): with the default policy RSS went
- * 220.3 -> 225.1 MB in steps over 6,000 frames, the arenas holding 150 MB
- * with ~22 MB free; with both thresholds fixed at 128 KiB it stayed within
- * 0.03% at 190 MB, the arenas holding 127 MB with 6.6 MB free.
- *
- * Fixed thresholds: blocks of 128 KiB and more are mmap'd and returned to
- * the system when freed, and an arena gives back its top once 128 KiB are
- * free there. A user who sets glibc.malloc tunables in GLIBC_TUNABLES keeps
- * them: this is a demo's choice, not the engine's, so it never overrides
- * the user's. */
-static void set_allocator_policy(void)
+ * frame (lavapipe's binned scenes and command buffers), so after each new
+ * high-water mark an arena keeps more free pages resident: over the 10,000
+ * frames of the soak (docs/soak.md) RSS rose 220.3 -> 225.1 MB in steps
+ * until frame ~6,000, while the live heap stayed flat and the arenas held
+ * ~22 MB free. Fixed thresholds end that: blocks of the threshold and more
+ * are mmap'd and unmapped when freed, and an arena gives its top back once
+ * that much is free there. The price is a page fault per fresh page of
+ * every such block, paid by the driver each frame: on lavapipe a frame of
+ * the soak's scene took 659-692 ms with 128 KiB against 511-602 ms with the
+ * default (medians of 100 frames, docs/soak.md). So it is an option, not
+ * the default; a GPU driver's per-frame host allocations are small, and
+ * there it should cost little. */
+static void set_allocator_policy(uint32_t threshold_kib)
 {
+    if (!threshold_kib) return;
 #if defined(__GLIBC__)
-    const char *t = getenv("GLIBC_TUNABLES");
-    if (t && strstr(t, "glibc.malloc.")) return;
-    enum { threshold = 128 * 1024 };
+    int bytes = (int)(threshold_kib * 1024u);
     /* A replaced allocator (ASan's, or one preloaded) refuses: not an error,
      * its own policy applies. */
-    if (!mallopt(M_MMAP_THRESHOLD, threshold) || !mallopt(M_TRIM_THRESHOLD, threshold))
-        OB_LOG_D("demo", "the allocator ignores mallopt: glibc's thresholds are not in use");
+    if (!mallopt(M_MMAP_THRESHOLD, bytes) || !mallopt(M_TRIM_THRESHOLD, bytes))
+        OB_LOG_W("demo", "--malloc-threshold: the allocator ignores mallopt (not glibc's?)");
+#else
+    OB_LOG_W("demo", "--malloc-threshold: only glibc's allocator has these thresholds");
 #endif
 }
 
 ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
 {
-    set_allocator_policy();
+    set_allocator_policy(o->malloc_threshold_kib);
     memset(d, 0, sizeof *d);
     d->opt = *o;
     ob_result r;

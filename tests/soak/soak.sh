@@ -19,14 +19,18 @@
 #     pixels).
 #
 # Usage: tests/soak/soak.sh [--frames N] [--objects N] [--build DIR] [--out DIR]
-#                           [--warmup-frames N] [--no-reference] [--parallel]
-#                           [-- MIRROR-ARGS...]
+#                           [--warmup-frames N] [--malloc-threshold KIB]
+#                           [--no-reference] [--parallel] [-- MIRROR-ARGS...]
 # Defaults: 10000 frames, 2000 objects, build dir ./build, out dir
 # ./build/soak, warm-up = the first 10% of the frames. MIRROR-ARGS go to both
 # runs (e.g. --size 320x240). --parallel runs the reference at the same time
 # as the soak instead of after it (same results, less wall time when the
-# machine has cores to spare). LP_NUM_THREADS defaults to 0 for both runs
-# (lavapipe; why below). See docs/soak.md for measured results and times.
+# machine has cores to spare). --malloc-threshold goes to the soak run
+# (default 128: glibc's mmap and trim thresholds fixed at 128 KiB; 0 leaves
+# glibc's dynamic policy, under which RSS rises in steps for thousands of
+# frames as arenas keep freed driver blocks; see docs/soak.md).
+# LP_NUM_THREADS defaults to 0 for both runs (lavapipe; why below). See
+# docs/soak.md for measured results and times.
 set -eu
 
 frames=10000
@@ -36,6 +40,7 @@ out=
 warmup_frames=
 reference=1
 parallel=0
+malloc_threshold=128
 
 while [ $# -gt 0 ]; do
     case "$1" in
@@ -44,10 +49,11 @@ while [ $# -gt 0 ]; do
     --build) build=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --warmup-frames) warmup_frames=$2; shift 2 ;;
+    --malloc-threshold) malloc_threshold=$2; shift 2 ;;
     --no-reference) reference=0; shift ;;
     --parallel) parallel=1; shift ;;
     --) shift; break ;;
-    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) echo "soak.sh: unknown argument '$1'" >&2; exit 2 ;;
     esac
 done
@@ -105,15 +111,19 @@ fi
 echo "soak: $frames frames, $objects objects, toggling ST/MT every frame (2 workers), validation on"
 t0=$(date +%s)
 rc=0
+policy=
+[ "$malloc_threshold" = 0 ] || policy="--malloc-threshold $malloc_threshold"
+# $policy is unquoted on purpose: empty, or an option and its value.
+# shellcheck disable=SC2086
 OB_VALIDATION=1 "$mirror" --objects "$objects" --frames "$frames" --toggle 1 --threads 2 --quiet \
-    --out "$out/soak.png" --stats-json "$out/soak.json" "$@" > "$out/soak.log" 2>&1 || rc=$?
+    --out "$out/soak.png" --stats-json "$out/soak.json" $policy "$@" > "$out/soak.log" 2>&1 || rc=$?
 soak_s=$(( $(date +%s) - t0 ))
 errors=$(sed -n 's/^validation: \([0-9]*\) errors, \([0-9]*\) warnings$/\1/p' "$out/soak.log")
 warnings=$(sed -n 's/^validation: \([0-9]*\) errors, \([0-9]*\) warnings$/\2/p' "$out/soak.log")
 
 status=0
 {
-    echo "soak run: obelisk-mirror --objects $objects --frames $frames --toggle 1 --threads 2 $*" \
+    echo "soak run: obelisk-mirror --objects $objects --frames $frames --toggle 1 --threads 2 $policy $*" \
          "(LP_NUM_THREADS=$LP_NUM_THREADS)"
     echo "  exit $rc after $soak_s s; validation: ${errors:-?} errors, ${warnings:-?} warnings"
 } | tee "$out/report.txt"
