@@ -196,19 +196,19 @@ static bool frames_bound_run(const ob_demo_options *o) { return !o->window || o-
  * ~22 MB free. Fixed thresholds end that: blocks of the threshold and more
  * are mmap'd and unmapped when freed, and an arena gives its top back once
  * that much is free there (with 128 KiB the same soak held RSS at 192 MB,
- * +0.219% from frame 1,000 to 10,000). The price is a page fault per fresh page of
- * every such block, paid by the driver each frame: on lavapipe a frame of
- * the soak's scene took 659-692 ms with 128 KiB against 511-602 ms with the
- * default (medians of 100 frames, docs/soak.md). So it is an option, not
- * the default; a GPU driver's per-frame host allocations are small, and
- * there it should cost little. */
+ * +0.219% from frame 1,000 to 10,000). The price is a page fault per fresh
+ * page of every such block, paid by the driver each frame: on lavapipe a
+ * frame of the soak's scene took 659-692 ms with 128 KiB against 511-602 ms
+ * with the default (medians of 100 frames, docs/soak.md). So it is an
+ * option, not the default; a GPU driver's per-frame host allocations are
+ * small, and there it should cost little. */
 static void set_allocator_policy(uint32_t threshold_kib)
 {
     if (!threshold_kib) return;
 #if defined(__GLIBC__)
     int bytes = (int)(threshold_kib * 1024u);
-    /* A replaced allocator (ASan's, or one preloaded) refuses: not an error,
-     * its own policy applies. */
+    /* A replaced allocator (ASan's, or one preloaded) refuses: the run goes
+     * on under its policy, and the warning says the option had no effect. */
     if (!mallopt(M_MMAP_THRESHOLD, bytes) || !mallopt(M_TRIM_THRESHOLD, bytes))
         OB_LOG_W("demo", "--malloc-threshold: the allocator ignores mallopt (not glibc's?)");
 #else

@@ -30,7 +30,7 @@ typedef struct ob_demo_options {
     bool overlay;             /* --overlay / --no-overlay */
     bool window;              /* --window */
     bool quiet;               /* --quiet: no per-frame lines */
-    uint32_t malloc_threshold_kib; /* --malloc-threshold KiB: glibc's fixed thresholds (0 = its default) */
+    uint32_t malloc_threshold_kib; /* --malloc-threshold: glibc's thresholds (0 = its own) */
     const char *input;        /* positional argument (obelisk-view FILE) */
     /* Set by the parser when --size / --threads were given, so that settings
      * from a scene file do not override the command line; frames_given makes
