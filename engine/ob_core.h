@@ -184,6 +184,8 @@ static inline uint64_t ob_hash_str(uint64_t h, const char *s);
 
 /* Monotonic time in nanoseconds. */
 uint64_t ob_time_ns(void);
+/* CPU time the calling thread has used, in nanoseconds. */
+uint64_t ob_thread_cpu_ns(void);
 
 /* Read a whole file into a NUL-terminated buffer (ob_free it). On failure
  * returns NULL, logs the path and the OS error, and sets *out_result. */

@@ -98,6 +98,14 @@ typedef struct ob_frame_stats {
     struct { char name[48]; ob_skip_reason reason; } skipped[OB_MAX_FRAME_VIEWS];
     uint32_t draws, culled;
     ob_pm_stats pm;              /* summed over every manager */
+    /* CPU time (CLOCK_THREAD_CPUTIME_ID) each thread spent recording this
+     * frame: [0] the render thread (inline recording or its share of the
+     * jobs, plus assembling the primary), [i] pool worker i. Shows the work
+     * apart from scheduling: on a loaded machine wall time grows, this not. */
+    uint64_t record_cpu_ns[OB_MAX_WORKERS + 1];
+    /* Host allocations the driver made through the command pools'
+     * allocation callbacks while this frame was recorded, all threads. */
+    uint64_t cmd_host_allocs;
     uint32_t pipelines_created, variants_created;
     uint64_t frame_hash;         /* all view hashes in order */
 } ob_frame_stats;
