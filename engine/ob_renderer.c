@@ -32,7 +32,8 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
         .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
         .queueFamilyIndex = ob_device_queue_family(r->dev),
     };
-    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, NULL, &fs->pool));
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, &r->primary_alloc.callbacks,
+                                                         &fs->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
@@ -67,7 +68,7 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
     VkDevice vk = ob_device_vk(r->dev);
     if (fs->queries) vkDestroyQueryPool(vk, fs->queries, NULL);
     if (fs->fence) vkDestroyFence(vk, fs->fence, NULL);
-    if (fs->pool) vkDestroyCommandPool(vk, fs->pool, NULL);
+    if (fs->pool) vkDestroyCommandPool(vk, fs->pool, &r->primary_alloc.callbacks);
     memset(fs, 0, sizeof *fs);
 }
 
@@ -94,9 +95,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     if (d.device.frames_in_flight > OB_MAX_FRAMES_IN_FLIGHT)
         d.device.frames_in_flight = OB_MAX_FRAMES_IN_FLIGHT;
     r->frames_in_flight = d.device.frames_in_flight;
-    pthread_mutex_init(&r->lock, NULL);
-    pthread_cond_init(&r->wake, NULL);
-    pthread_cond_init(&r->done, NULL);
+    ob_cmd_allocator_init(&r->primary_alloc);
 
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free;
@@ -127,9 +126,6 @@ fail_destroy:
     r = NULL;
     goto fail;
 fail_free:
-    pthread_cond_destroy(&r->done);
-    pthread_cond_destroy(&r->wake);
-    pthread_mutex_destroy(&r->lock);
     ob_free(r);
     r = NULL;
 fail:
@@ -150,9 +146,6 @@ void ob_renderer_destroy(ob_renderer *r)
     ob_device_destroy(r->dev);
     ob_free(r->jobs);
     ob_free(r->attachments);
-    pthread_cond_destroy(&r->done);
-    pthread_cond_destroy(&r->wake);
-    pthread_mutex_destroy(&r->lock);
     ob_free(r);
 }
 
@@ -288,11 +281,10 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     ob_device_begin_frame_slot(r->dev, r->slot);
     vr = OB_VK_CHECK(vkResetCommandPool(vk, fs->pool, 0));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    for (uint32_t i = 0; i < r->worker_count; i++) {
-        ob_worker *w = &r->workers[i];
-        vkResetCommandPool(vk, w->pools[r->slot], 0);
-        ob_pm_begin_frame(w->pm, r->slot, r->serial);
-    }
+    /* Each worker resets its own pools when it next records in this slot,
+     * so the driver's blocks are freed on the thread that allocated them. */
+    for (uint32_t i = 0; i < r->worker_count; i++)
+        ob_pm_begin_frame(r->workers[i].pm, r->slot, r->serial);
     ob_pm_begin_frame(r->immediate, r->slot, r->serial);
 
     r->mode = r->pending_mode;

@@ -5,6 +5,7 @@
 #define OB_RENDERER_INTERNAL_H
 
 #include <pthread.h>
+#include <semaphore.h>
 #include <stdatomic.h>
 
 #include "ob_renderer.h"
@@ -25,16 +26,34 @@ typedef struct ob_job {
     int32_t worker;
 } ob_job;
 
+/* Counts the driver's host allocations through a command pool's callbacks
+ * (lavapipe allocates one block per recorded command). */
+typedef struct ob_cmd_allocator {
+    VkAllocationCallbacks callbacks;
+    atomic_uint_fast64_t allocations;
+} ob_cmd_allocator;
+
+/* Worker i's recording state: pipeline manager i (parameter slot i), a
+ * command pool per frame slot and its secondaries. A batch of worker i is
+ * recorded by pool thread i, or, for the last active worker, by the render
+ * thread itself (it would otherwise sleep while the others record). Only the
+ * thread recording a batch touches this state; batches are handed over
+ * through semaphores, so one thread at a time. */
 typedef struct ob_worker {
     ob_renderer *renderer;
     pthread_t thread;
     bool started;
+    sem_t go;                   /* posted once per batch, and to quit */
+    bool go_ready;
     uint32_t index;             /* 1-based: parameter slot and pair index */
     ob_pipeline_manager *pm;
     VkCommandPool pools[OB_MAX_FRAMES_IN_FLIGHT];
+    bool pool_recorded[OB_MAX_FRAMES_IN_FLIGHT]; /* reset before its next use */
     VkCommandBuffer *cmds[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
+    uint64_t cpu_ns;            /* thread CPU time of its last batch */
+    ob_cmd_allocator alloc;
     ob_result error;
 } ob_worker;
 
@@ -103,12 +122,11 @@ struct ob_renderer {
     uint32_t undo_count;
     bool undo_overflow;
 
-    pthread_mutex_t lock;
-    pthread_cond_t wake, done;
-    uint64_t batch;
-    uint32_t workers_done;
+    sem_t done;                 /* each pool thread posts it when its batch is recorded */
+    bool done_ready;
     atomic_uint next_job;
     bool quit;
+    ob_cmd_allocator primary_alloc; /* the frame slots' pools */
 
     ob_frame_stats_fn stats_fn;
     void *stats_user;
@@ -121,5 +139,6 @@ struct ob_renderer {
 ob_result ob_renderer_workers_start(ob_renderer *r);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
+void ob_cmd_allocator_init(ob_cmd_allocator *a);
 
 #endif /* OB_RENDERER_INTERNAL_H */

@@ -5,6 +5,67 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* ------------------------------------------------------------ allocation */
+
+/* Blocks carry their start in front of the aligned pointer, so frees and
+ * reallocations of any alignment go back to malloc. */
+typedef struct alloc_header {
+    void *base;
+    size_t size;
+} alloc_header;
+
+static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
+                                     VkSystemAllocationScope scope)
+{
+    (void)scope;
+    ob_cmd_allocator *a = user;
+    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
+    uint8_t *base = malloc(size + align + sizeof(alloc_header));
+    if (!base) return NULL;
+    uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+    ((alloc_header *)p)[-1] = (alloc_header){base, size};
+    atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
+    return (void *)p;
+}
+
+static void VKAPI_PTR counted_free(void *user, void *mem)
+{
+    (void)user;
+    if (mem) free(((alloc_header *)mem)[-1].base);
+}
+
+static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
+                                       VkSystemAllocationScope scope)
+{
+    if (!old) return counted_alloc(user, size, align, scope);
+    if (size == 0) {
+        counted_free(user, old);
+        return NULL;
+    }
+    void *mem = counted_alloc(user, size, align, scope);
+    if (!mem) return NULL;
+    size_t old_size = ((alloc_header *)old)[-1].size;
+    memcpy(mem, old, old_size < size ? old_size : size);
+    counted_free(user, old);
+    return mem;
+}
+
+void ob_cmd_allocator_init(ob_cmd_allocator *a)
+{
+    a->callbacks = (VkAllocationCallbacks){
+        .pUserData = a,
+        .pfnAllocation = counted_alloc,
+        .pfnReallocation = counted_realloc,
+        .pfnFree = counted_free,
+    };
+    atomic_init(&a->allocations, 0);
+}
+
+static uint64_t allocations(ob_cmd_allocator *a)
+{
+    return atomic_load_explicit(&a->allocations, memory_order_relaxed);
+}
+
 /* ------------------------------------------------------------ worker pool */
 
 static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
@@ -12,6 +73,12 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     ob_result res;
     w->renderer = r;
     w->index = index;
+    ob_cmd_allocator_init(&w->alloc);
+    if (sem_init(&w->go, 0, 0) != 0) {
+        OB_LOG_E("renderer", "worker %u: its wake-up semaphore cannot be created", index);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    w->go_ready = true;
     char name[32];
     snprintf(name, sizeof name, "worker%u", index);
     ob_pipeline_manager_desc pmd = {
@@ -29,7 +96,8 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
             .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
             .queueFamilyIndex = ob_device_queue_family(r->dev),
         };
-        VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci, NULL, &w->pools[f]));
+        VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci,
+                                                             &w->alloc.callbacks, &w->pools[f]));
         if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     }
     return OB_OK;
@@ -38,10 +106,11 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
 static void worker_release(ob_renderer *r, ob_worker *w)
 {
     for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) {
-        if (w->pools[f]) vkDestroyCommandPool(ob_device_vk(r->dev), w->pools[f], NULL);
+        if (w->pools[f]) vkDestroyCommandPool(ob_device_vk(r->dev), w->pools[f], &w->alloc.callbacks);
         ob_free(w->cmds[f]);
     }
     ob_pipeline_manager_destroy(w->pm);
+    if (w->go_ready) sem_destroy(&w->go);
     memset(w, 0, sizeof *w);
 }
 
@@ -150,39 +219,57 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
     job->record_ns = ob_time_ns() - t0;
 }
 
+/* Worker w's share of the frame's jobs, taken one at a time from the shared
+ * counter until none is left (biggest first: build_jobs sorted them). Runs
+ * on w's pool thread or on the render thread. */
+static void record_batch(ob_renderer *r, ob_worker *w)
+{
+    uint64_t c0 = ob_thread_cpu_ns();
+    uint32_t f = r->slot;
+    w->cmd_used = 0;
+    if (w->pool_recorded[f]) {
+        /* The slot's fence was waited for in begin_frame: its secondaries
+         * are done executing. */
+        VkResult vr = OB_VK_CHECK(vkResetCommandPool(ob_device_vk(r->dev), w->pools[f], 0));
+        if (vr != VK_SUCCESS) {
+            ob_device_note_result(r->dev, vr);
+            OB_LOG_E("renderer", "worker %u records nothing this frame: its command pool could "
+                     "not be reset", w->index);
+            w->error = ob_result_from_vk(vr);
+            w->cpu_ns = ob_thread_cpu_ns() - c0;
+            return;
+        }
+        w->pool_recorded[f] = false;
+    }
+    for (;;) {
+        uint32_t j = atomic_fetch_add_explicit(&r->next_job, 1, memory_order_relaxed);
+        if (j >= r->job_count) break;
+        w->pool_recorded[f] = true;
+        record_job(r, w, &r->jobs[j]);
+    }
+    w->cpu_ns = ob_thread_cpu_ns() - c0;
+}
+
 static void *worker_main(void *arg)
 {
     ob_worker *w = arg;
     ob_renderer *r = w->renderer;
-    uint64_t seen = 0;
     for (;;) {
-        pthread_mutex_lock(&r->lock);
-        while (r->batch == seen && !r->quit) pthread_cond_wait(&r->wake, &r->lock);
-        if (r->quit) {
-            pthread_mutex_unlock(&r->lock);
-            break;
-        }
-        seen = r->batch;
-        bool active = w->index <= r->active;
-        pthread_mutex_unlock(&r->lock);
-        if (active) {
-            w->cmd_used = 0;
-            for (;;) {
-                uint32_t j = atomic_fetch_add(&r->next_job, 1);
-                if (j >= r->job_count) break;
-                record_job(r, w, &r->jobs[j]);
-            }
-        }
-        pthread_mutex_lock(&r->lock);
-        r->workers_done++;
-        pthread_cond_signal(&r->done);
-        pthread_mutex_unlock(&r->lock);
+        while (sem_wait(&w->go) != 0) {} /* EINTR */
+        if (r->quit) break;
+        record_batch(r, w);
+        sem_post(&r->done);
     }
     return NULL;
 }
 
 ob_result ob_renderer_workers_start(ob_renderer *r)
 {
+    if (sem_init(&r->done, 0, 0) != 0) {
+        OB_LOG_E("renderer", "the workers' completion semaphore cannot be created");
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    r->done_ready = true;
     for (uint32_t i = 0; i < r->worker_count; i++) {
         ob_result res = worker_init(r, &r->workers[i], i + 1);
         if (res != OB_OK) return res;
@@ -199,26 +286,28 @@ ob_result ob_renderer_workers_start(ob_renderer *r)
 
 void ob_renderer_workers_stop(ob_renderer *r)
 {
-    pthread_mutex_lock(&r->lock);
     r->quit = true;
-    pthread_cond_broadcast(&r->wake);
-    pthread_mutex_unlock(&r->lock);
+    for (uint32_t i = 0; i < r->worker_count; i++)
+        if (r->workers[i].started) sem_post(&r->workers[i].go);
     for (uint32_t i = 0; i < r->worker_count; i++) {
         if (r->workers[i].started) pthread_join(r->workers[i].thread, NULL);
         worker_release(r, &r->workers[i]);
     }
+    if (r->done_ready) sem_destroy(&r->done);
+    r->done_ready = false;
 }
 
-/* Hand every job of the frame to the workers at once and wait for all. */
-static void run_jobs(ob_renderer *r)
+/* Hand the frame's jobs to the active workers and wait for all. Only the
+ * pool threads that have a job to take are woken; the render thread records
+ * the last active worker's share instead of sleeping. */
+static void run_jobs(ob_renderer *r, uint32_t active)
 {
-    pthread_mutex_lock(&r->lock);
-    atomic_store(&r->next_job, 0);
-    r->workers_done = 0;
-    r->batch++;
-    pthread_cond_broadcast(&r->wake);
-    while (r->workers_done < r->worker_count) pthread_cond_wait(&r->done, &r->lock);
-    pthread_mutex_unlock(&r->lock);
+    atomic_store_explicit(&r->next_job, 0, memory_order_relaxed);
+    uint32_t helpers = OB_MIN(active - 1, r->job_count - 1);
+    for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
+    record_batch(r, &r->workers[active - 1]);
+    for (uint32_t i = 0; i < helpers; i++)
+        while (sem_wait(&r->done) != 0) {} /* EINTR */
 }
 
 /* ------------------------------------------------------------ jobs */
@@ -227,6 +316,15 @@ static int compare_jobs_by_cost(const void *a, const void *b)
 {
     const ob_job *x = a, *y = b;
     if (x->predicted_ns != y->predicted_ns) return x->predicted_ns > y->predicted_ns ? -1 : 1;
+    if (x->view_index != y->view_index) return x->view_index < y->view_index ? -1 : 1;
+    if (x->layer != y->layer) return x->layer < y->layer ? -1 : 1;
+    return (x->first > y->first) - (x->first < y->first);
+}
+
+/* Assembly order: view, layer, then position in the draw list. */
+static int compare_jobs_in_view_order(const void *a, const void *b)
+{
+    const ob_job *x = *(const ob_job *const *)a, *y = *(const ob_job *const *)b;
     if (x->view_index != y->view_index) return x->view_index < y->view_index ? -1 : 1;
     if (x->layer != y->layer) return x->layer < y->layer ? -1 : 1;
     return (x->first > y->first) - (x->first < y->first);
@@ -475,6 +573,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_frame_stats *st = &r->cur;
     VkDevice vk = ob_device_vk(r->dev);
     VkResult vr;
+    uint64_t cpu0 = ob_thread_cpu_ns();
+    uint64_t allocs0 = allocations(&r->primary_alloc);
+    for (uint32_t i = 0; i < r->worker_count; i++) allocs0 += allocations(&r->workers[i].alloc);
     bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
     uint32_t active = multi ? r->active : 0;
     st->workers = active;
@@ -494,10 +595,14 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
                      count, ob_result_name(res));
             r->job_count = 0;
         }
-        if (res == OB_OK && r->job_count > 0) run_jobs(r);
+        if (res == OB_OK && r->job_count > 0) run_jobs(r, active);
         for (uint32_t i = 0; i < r->worker_count; i++) {
-            if (r->workers[i].error != OB_OK && res == OB_OK) res = r->workers[i].error;
-            r->workers[i].error = OB_OK;
+            ob_worker *w = &r->workers[i];
+            if (w->error != OB_OK && res == OB_OK) res = w->error;
+            w->error = OB_OK;
+            /* The render thread's share is in its own CPU time. */
+            if (i + 1 < active) st->record_cpu_ns[i + 1] = w->cpu_ns;
+            w->cpu_ns = 0;
         }
     }
     st->record_ns = multi ? ob_time_ns() - t_record : 0;
@@ -531,21 +636,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
             OB_LOG_E("renderer", "frame %llu: no memory to order %u recorded jobs; the frame is "
                      "submitted without their draws", (unsigned long long)r->serial, job_total);
         }
-        for (uint32_t j = 0; by_view && j < job_total; j++) {
-            ob_job *job = &r->jobs[j];
-            /* insertion into (view_index, layer, first) order */
-            uint32_t k = j;
-            while (k > 0) {
-                ob_job *p = by_view[k - 1];
-                bool after = p->view_index > job->view_index ||
-                             (p->view_index == job->view_index &&
-                              (p->layer > job->layer || (p->layer == job->layer && p->first > job->first)));
-                if (!after) break;
-                by_view[k] = p;
-                k--;
-            }
-            by_view[k] = job;
-        }
+        for (uint32_t j = 0; by_view && j < job_total; j++) by_view[j] = &r->jobs[j];
+        if (by_view) qsort(by_view, job_total, sizeof *by_view, compare_jobs_in_view_order);
     }
     uint32_t next = 0;
     uint64_t record_cost = 0;
@@ -560,12 +652,17 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         for (uint32_t l = 0; l < layers; l++) {
             if (v->layer_count > 0) begin_rendering(r, cmd, v, l, multi);
             if (multi) {
-                VkCommandBuffer secs[256];
+                /* Executed in batches: a view may have any number of chunks. */
+                VkCommandBuffer secs[64];
                 uint32_t ns = 0;
                 while (by_view && next < job_total && by_view[next]->view_index == i &&
                        by_view[next]->layer == l) {
                     ob_job *job = by_view[next++];
-                    if (job->cmd && ns < OB_ARRAY_COUNT(secs)) secs[ns++] = job->cmd;
+                    if (job->cmd) secs[ns++] = job->cmd;
+                    if (ns == OB_ARRAY_COUNT(secs)) {
+                        vkCmdExecuteCommands(cmd, ns, secs);
+                        ns = 0;
+                    }
                     vs->hash = ob_cmd_hash_concat(vs->hash, job->hash);
                     ob_pm_stats_add(&st->pm, &job->stats);
                     vs->draws += job->stats.draws;
@@ -591,17 +688,23 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         }
         v->cost_ns = vs->record_ns;
         record_cost += vs->record_ns;
+        /* The end stamp waits for the view's work (at top of pipe it would
+         * be written as soon as the commands are read, on a real GPU). */
         if (timestamps)
-            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 3 + 2 * i);
+            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 3 + 2 * i);
         st->draws += vs->draws;
         st->frame_hash = ob_hash_u64(ob_hash_u64(st->frame_hash, v->id), vs->hash.hash);
     }
     ob_free(by_view);
-    if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 1);
+    if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 1);
     ob_param_registry_end_recording(r->reg);
     r->last_record_cost_ns = record_cost;
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
+    st->record_cpu_ns[0] = ob_thread_cpu_ns() - cpu0;
+    uint64_t allocs1 = allocations(&r->primary_alloc);
+    for (uint32_t i = 0; i < r->worker_count; i++) allocs1 += allocations(&r->workers[i].alloc);
+    st->cmd_host_allocs = allocs1 - allocs0;
 
     vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
     if (vr != VK_SUCCESS) {

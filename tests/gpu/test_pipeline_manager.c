@@ -327,6 +327,34 @@ static void primary_and_secondaries_record_the_same(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A view cut into more chunks than one vkCmdExecuteCommands batch holds
+ * (one draw per chunk, 300 boxes): every chunk is executed, the image and
+ * the hashes are those of the single-threaded frame. */
+static void a_view_of_many_chunks_draws_everything(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 2, .chunk_draws = 1});
+    frame_camera(&w);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    add_grid(&w, 300, &m, 1);
+    ob_frame_stats ref = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
+    const ob_view_stats *ref_main = ob_test_view_stats(&ref, "main");
+    assert_true(ref_main->draws > 256);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 2);
+    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    assert_int_equal(main->chunks, ref_main->draws);
+    assert_int_equal(main->draws, ref_main->draws);
+    assert_true(main->hash.hash == ref_main->hash.hash);
+    assert_true(st->frame_hash == ref.frame_hash);
+    ob_test_world_read(&w);
+    assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+    free(ref_pixels);
+    ob_test_world_destroy(&w);
+}
+
 /* A fragment shader sampling "TestTexture" (and "TestTextureSampler"). */
 static const char textured_frag[] =
     "#version 450\n"
@@ -489,6 +517,7 @@ int main(void)
         cmocka_unit_test(uniforms_packed_only_after_a_change),
         cmocka_unit_test(many_programs_each_read_their_own_uniforms),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
+        cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),
     };
