@@ -32,9 +32,11 @@
 typedef struct ob_material_iface {
     /* Render flag for the view type (Hieroglyph's Params[type].bRender). */
     bool (*renders)(const struct ob_material *m, ob_view_type type);
-    /* Sort class: 0 opaque, 1 blended; priority orders within a class. */
+    /* Sort class: 0 opaque, 1 blended; priority orders within a class;
+     * state groups draws that bind the same pipeline and parameters (a
+     * dense id: its low 16 bits go into the sort key). */
     void (*sort_info)(const struct ob_material *m, ob_view_type type,
-                      uint32_t *out_class, uint32_t *out_priority);
+                      uint32_t *out_class, uint32_t *out_priority, uint32_t *out_state);
     /* An entity with this material is visible to view v: queue what it needs
      * (env maps, ...), and make the pipeline for v's targets exist (render thread). */
     void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);

@@ -29,7 +29,9 @@ void ob_view_release(ob_view *v)
 {
     if (!v) return;
     ob_free(v->items);
+    ob_free(v->sort_scratch);
     v->items = NULL;
+    v->sort_scratch = NULL;
     v->item_count = v->item_cap = 0;
 }
 
@@ -46,35 +48,77 @@ void ob_view_add_dependency(ob_view *v, ob_view *dep)
     }
 }
 
-/* Sort key: class (opaque first), priority, then distance — ascending for
- * opaque (front to back), descending for blended (back to front). Node ids
- * break ties, so the order is total and independent of threads. */
-static uint64_t sort_key(uint32_t cls, uint32_t priority, float dist2)
+/* The draw-list key (bgfx-style): sort_hi holds the class (opaque first)
+ * and the priority; sort_key, for opaque items, a coarse depth band (the
+ * distance's exponent in steps of 4x), the material's state group, the mesh
+ * and the fine depth, so that draws binding the same state follow each
+ * other while the front-to-back order survives between bands; for blended
+ * items the full depth, back to front, then state group and mesh. dist2 is
+ * >= 0, and positive floats order like their bits. */
+static void item_key(ob_draw_item *it, uint32_t cls, uint32_t priority, uint32_t state,
+                     uint32_t mesh, float dist2)
 {
     uint32_t bits;
-    memcpy(&bits, &dist2, sizeof bits); /* positive floats order like their bits */
-    if (cls) bits = ~bits;
-    return ((uint64_t)(cls & 1u) << 63) | ((uint64_t)(priority & 0x7fffffffu) << 32) | bits;
+    memcpy(&bits, &dist2, sizeof bits);
+    it->sort_hi = ((cls & 1u) << 31) | (priority & 0x7fffffffu);
+    if (cls & 1u) {
+        it->sort_key = ((uint64_t)~bits << 32) | ((uint64_t)(state & 0xffffu) << 16) | (mesh & 0xffffu);
+    } else {
+        uint64_t band = bits >> 25;            /* sign 0, top 6 bits of the exponent */
+        uint64_t fine = (bits >> 5) & 0xfffffu; /* the rest of the depth, 20 bits */
+        it->sort_key = (band << 58) | ((uint64_t)(state & 0xfffu) << 46) |
+                       ((uint64_t)(mesh & 0x3ffffu) << 28) | (fine << 8);
+    }
 }
 
-static int compare_items(const void *a, const void *b)
+static uint32_t item_digit(const ob_draw_item *it, uint32_t pass)
 {
-    const ob_draw_item *x = a, *y = b;
-    if (x->sort_key != y->sort_key) return x->sort_key < y->sort_key ? -1 : 1;
-    uint32_t ix = ob_node_id(x->node), iy = ob_node_id(y->node);
-    return (ix > iy) - (ix < iy);
+    if (pass < 4) return (it->node_id >> (8 * pass)) & 0xffu;
+    if (pass < 12) return (uint32_t)(it->sort_key >> (8 * (pass - 4))) & 0xffu;
+    return (it->sort_hi >> (8 * (pass - 12))) & 0xffu;
+}
+
+/* Stable LSD radix sort on (sort_hi, sort_key, node_id), a byte per pass:
+ * linear in the item count, no comparator calls. A pass in which every item
+ * has the same byte is skipped (most of the high bytes in practice). */
+static void sort_items(ob_draw_item *items, ob_draw_item *scratch, uint32_t n)
+{
+    ob_draw_item *src = items, *dst = scratch;
+    for (uint32_t pass = 0; pass < 16; pass++) {
+        uint32_t count[256] = {0};
+        for (uint32_t i = 0; i < n; i++) count[item_digit(&src[i], pass)]++;
+        if (count[item_digit(&src[0], pass)] == n) continue;
+        uint32_t sum = 0;
+        for (uint32_t b = 0; b < 256; b++) {
+            uint32_t c = count[b];
+            count[b] = sum;
+            sum += c;
+        }
+        for (uint32_t i = 0; i < n; i++) dst[count[item_digit(&src[i], pass)]++] = src[i];
+        ob_draw_item *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != items) memcpy(items, src, sizeof *items * n);
 }
 
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
 {
     const ob_material_iface *mi = ob_renderer_material_iface(r);
+    const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
     uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
     ob_node *const *nodes = ob_scene_renderables(scene, &count);
     v->item_count = 0;
     v->culled = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
+    uint32_t cap = v->item_cap;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
+    if (res == OB_OK && (v->item_cap != cap || !v->sort_scratch) && v->item_cap > 0) {
+        ob_draw_item *scratch = ob_realloc(v->sort_scratch, sizeof *scratch * v->item_cap);
+        if (scratch) v->sort_scratch = scratch;
+        else res = OB_ERR_OUT_OF_HOST_MEMORY;
+    }
     if (res != OB_OK) {
         /* The view goes on empty this frame; the next frame tries again. */
         OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",
@@ -123,14 +167,15 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
             v->culled++;
             continue;
         }
-        uint32_t cls = 0, priority = 0;
-        mi->sort_info(rd->material, v->type, &cls, &priority);
+        uint32_t cls = 0, priority = 0, state = 0;
+        mi->sort_info(rd->material, v->type, &cls, &priority, &state);
         float d2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
-        v->items[v->item_count++] = (ob_draw_item){sort_key(cls, priority, d2), n};
+        ob_draw_item *it = &v->items[v->item_count++];
+        *it = (ob_draw_item){.node_id = ob_node_id(n), .node = n};
+        item_key(it, cls, priority, state, gi && rd->geometry ? gi->id(rd->geometry) : 0, d2);
     }
     if (!out_of_range) v->range_reported = false;
-    /* items is NULL for an empty scene, and qsort's pointer must not be. */
-    if (v->item_count > 1) qsort(v->items, v->item_count, sizeof *v->items, compare_items);
+    if (v->item_count > 1) sort_items(v->items, v->sort_scratch, v->item_count);
     v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
 }

@@ -49,9 +49,14 @@ const char *ob_view_type_name(ob_view_type t);
 
 typedef struct ob_view ob_view;
 
-/* One entry of a view's draw list. */
+/* One entry of a view's draw list, ordered by (sort_hi, sort_key, node_id):
+ * class and priority, then for opaque items a coarse depth band, material
+ * state, mesh and fine depth (front to back), for blended items depth (back
+ * to front), material state and mesh. The entity id makes the order total. */
 typedef struct ob_draw_item {
-    uint64_t sort_key;      /* class, depth, priority; ties broken by entity id */
+    uint64_t sort_key;
+    uint32_t sort_hi;       /* class (top bit) and priority */
+    uint32_t node_id;
     ob_node *node;
 } ob_draw_item;
 
@@ -100,6 +105,7 @@ struct ob_view {
     /* Per frame, filled during pre_draw; owned by the view. */
     ob_draw_item *items;
     uint32_t item_count, item_cap;
+    ob_draw_item *sort_scratch;     /* item_cap entries: the radix sort's other buffer */
     uint32_t culled;                  /* entities rejected by frustum or render flag */
     uint32_t recursion_depth;         /* how deep in the PreRender chain it was queued */
     ob_view *deps[OB_VIEW_MAX_DEPS];  /* views that must execute before this one */

@@ -27,6 +27,7 @@ struct ob_material_library {
     ob_sampler samplers[SAMPLER_COUNT];
     ob_material **materials;
     uint32_t material_count, material_cap;
+    uint32_t next_id;
 };
 
 struct ob_material {
@@ -36,6 +37,7 @@ struct ob_material {
     float diffuse[4], specular[4], emissive[4], reflectivity[4];
     bool casts_shadows, blended;
     uint32_t priority;
+    uint32_t id;                   /* creation order in its library: groups draws */
     bool render[OB_VIEW_TYPE_COUNT];
     ob_effect *custom[OB_VIEW_TYPE_COUNT];
     atomic_bool warned;            /* a skipped draw is logged once */
@@ -411,6 +413,7 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
     m->casts_shadows = desc->casts_shadows;
     m->blended = desc->blended;
     m->priority = desc->priority;
+    m->id = lib->next_id++;
     set_render_flags(m);
     lib->materials[lib->material_count++] = m;
     if (out_result) *out_result = OB_OK;
@@ -644,11 +647,12 @@ static bool iface_renders(const struct ob_material *m, ob_view_type type)
 }
 
 static void iface_sort_info(const struct ob_material *m, ob_view_type type,
-                            uint32_t *out_class, uint32_t *out_priority)
+                            uint32_t *out_class, uint32_t *out_priority, uint32_t *out_state)
 {
     /* Overlay elements blend over each other: back to front, then priority. */
     *out_class = m->blended || type == OB_VIEW_OVERLAY ? 1u : 0u;
     *out_priority = m->priority;
+    *out_state = m->id;
 }
 
 static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v)

@@ -198,16 +198,17 @@ static void test_sort_info(void **state)
     ob_material *opaque = make_material(lib, OB_MATERIAL_LIT, false, false, 3);
     ob_material *glass = make_material(lib, OB_MATERIAL_LIT, false, true, 7);
     ob_material *hud = make_material(lib, OB_MATERIAL_UNLIT, false, false, 9);
-    uint32_t cls, prio;
-    mi->sort_info(opaque, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    uint32_t cls, prio, group0, group;
+    mi->sort_info(opaque, OB_VIEW_PERSPECTIVE, &cls, &prio, &group0);
     assert_int_equal(cls, 0);
     assert_int_equal(prio, 3);
-    mi->sort_info(glass, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    mi->sort_info(glass, OB_VIEW_PERSPECTIVE, &cls, &prio, &group);
+    assert_int_not_equal(group, group0); /* two materials, two state groups */
     assert_int_equal(cls, 1);
     assert_int_equal(prio, 7);
-    mi->sort_info(hud, OB_VIEW_PERSPECTIVE, &cls, &prio);
+    mi->sort_info(hud, OB_VIEW_PERSPECTIVE, &cls, &prio, &group);
     assert_int_equal(cls, 0);
-    mi->sort_info(hud, OB_VIEW_OVERLAY, &cls, &prio);
+    mi->sort_info(hud, OB_VIEW_OVERLAY, &cls, &prio, &group);
     assert_int_equal(cls, 1);
     assert_int_equal(prio, 9);
     destroy_library(f, lib);
@@ -379,7 +380,7 @@ static void test_apply_and_prepare_view(void **state)
     ob_node *n = ob_node_create(scene, NULL, "box", &r);
     assert_int_equal(ob_node_set_renderable(n, &(ob_renderable){.material = red,
                                                                  .local_radius = 1}), OB_OK);
-    ob_draw_item item = {0, n};
+    ob_draw_item item = {.node = n};
     persp.items = &item;
     persp.item_count = 1;
     ob_material_library_prepare_view(lib, NULL, &persp);
