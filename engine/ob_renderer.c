@@ -249,6 +249,28 @@ void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason r
 
 /* ------------------------------------------------------------ frame */
 
+/* A measurement is stale after this many frames recorded the other way. */
+#define AUTO_REMEASURE_FRAMES 32
+
+/* AUTO: record the way that measured cheaper for this scene; measure a way
+ * never measured (or with another worker count) first, and re-measure the
+ * other way when its figure is old or the draw count has moved by a quarter
+ * since it was taken. */
+static bool auto_choice(ob_renderer *r)
+{
+    const uint32_t workers = r->active;
+    bool have_st = r->measured[0].cost_ns > 0;
+    bool have_mt = r->measured[1].cost_ns > 0 && r->measured[1].workers == workers;
+    if (!have_st) return false;
+    if (!have_mt) return true;
+    bool multi = r->measured[1].cost_ns < r->measured[0].cost_ns;
+    uint32_t other = multi ? 0u : 1u;
+    uint32_t now = r->measured[!other].draws, then = r->measured[other].draws;
+    bool resized = 4ull * (now > then ? now - then : then - now) > (uint64_t)OB_MAX(now, then);
+    if (r->measured[other].age >= AUTO_REMEASURE_FRAMES || resized) multi = !multi;
+    return multi;
+}
+
 ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 {
     if (r->in_frame) {
@@ -289,11 +311,7 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 
     r->mode = r->pending_mode;
     r->active = r->pending_active;
-    if (r->mode == OB_THREADING_AUTO) {
-        /* Hand out work only when last frame's recording cost more than the
-         * hand-off costs (wake-ups and secondaries: tens of microseconds). */
-        r->auto_multi = r->last_record_cost_ns > 400000;
-    }
+    if (r->mode == OB_THREADING_AUTO) r->auto_multi = auto_choice(r);
     r->scene = scene;
     r->queue_count = 0;
     r->stack_depth = 0;

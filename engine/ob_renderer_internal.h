@@ -57,6 +57,12 @@ typedef struct ob_worker {
     ob_result error;
 } ob_worker;
 
+/* What recording a scene one way (inline or on workers) cost. */
+typedef struct ob_record_cost {
+    uint64_t cost_ns;           /* moving average; 0 = never measured */
+    uint32_t draws, age, workers;
+} ob_record_cost;
+
 typedef struct ob_frame_slot {
     VkCommandPool pool;
     VkCommandBuffer primary;
@@ -99,7 +105,13 @@ struct ob_renderer {
     ob_threading mode, pending_mode;
     uint32_t active, pending_active;
     bool auto_multi;            /* AUTO's decision for this frame */
-    uint64_t last_record_cost_ns;
+    /* Measured recording cost (wall time from the start of recording to the
+     * primary's end) of each way of recording this scene, [0] inline and [1]
+     * with the active workers: a moving average over the frames recorded
+     * that way (in any mode), with the draw count it was measured at and the
+     * frames since. AUTO records the cheaper way and re-measures the other
+     * when it is stale or the scene has changed size. */
+    ob_record_cost measured[2];
 
     ob_material_iface material_iface;
     ob_geometry_iface geometry_iface;

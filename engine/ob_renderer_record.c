@@ -567,6 +567,20 @@ static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
     st->culled += v->culled;
 }
 
+/* The measured cost of recording this frame's way (see auto_choice): an
+ * average that follows a changed scene within a few frames. */
+static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
+{
+    ob_record_cost *m = &r->measured[multi];
+    if (m->cost_ns == 0 || m->workers != workers) m->cost_ns = ns;
+    else m->cost_ns = (3 * m->cost_ns + ns) / 4;
+    m->cost_ns = OB_MAX(m->cost_ns, (uint64_t)1);
+    m->draws = draws;
+    m->workers = workers;
+    m->age = 0;
+    r->measured[!multi].age++;
+}
+
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count)
 {
     ob_frame_slot *fs = &r->frames[r->slot];
@@ -640,7 +654,6 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         if (by_view) qsort(by_view, job_total, sizeof *by_view, compare_jobs_in_view_order);
     }
     uint32_t next = 0;
-    uint64_t record_cost = 0;
     for (uint32_t i = 0; i < count; i++) {
         ob_view *v = order[i];
         ob_view_stats *vs = &st->views[i];
@@ -687,7 +700,6 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
             vs->record_ns = ob_time_ns() - tv;
         }
         v->cost_ns = vs->record_ns;
-        record_cost += vs->record_ns;
         /* The end stamp waits for the view's work (at top of pipe it would
          * be written as soon as the commands are read, on a real GPU). */
         if (timestamps)
@@ -698,7 +710,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_free(by_view);
     if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 1);
     ob_param_registry_end_recording(r->reg);
-    r->last_record_cost_ns = record_cost;
+    note_cost(r, multi, active, st->record_ns + st->assemble_ns, st->draws);
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
     st->record_cpu_ns[0] = ob_thread_cpu_ns() - cpu0;

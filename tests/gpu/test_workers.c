@@ -125,6 +125,31 @@ static void threading_change_takes_effect_at_next_frame(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* AUTO decides from measured cost: it measures each way of recording the
+ * scene first (inline, then on the workers), and keeps re-measuring the way
+ * it did not choose, so a scene whose cost changes is followed. (Which way
+ * wins depends on the machine; that both are measured does not.) */
+static void auto_measures_both_ways(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 2, .chunk_draws = 1});
+    lit_cube(&w);
+    uint32_t inline_frames = 0, worker_frames = 0;
+    for (int f = 0; f < 40; f++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_AUTO, 0);
+        assert_int_equal(st->mode, OB_THREADING_AUTO);
+        if (f == 0) assert_int_equal(st->workers, 0);
+        if (f == 1) assert_int_equal(st->workers, 2);
+        if (st->workers) worker_frames++;
+        else inline_frames++;
+    }
+    /* 40 frames: each way at least once past the first two. */
+    assert_true(inline_frames >= 2);
+    assert_true(worker_frames >= 2);
+    ob_test_world_destroy(&w);
+}
+
 /* Views are recorded by workers of the active set only. */
 static void only_active_workers_record(void **state)
 {
@@ -197,6 +222,7 @@ int main(void)
         cmocka_unit_test(worker_pool_starts_and_stops_with_the_renderer),
         cmocka_unit_test(threading_change_takes_effect_at_next_frame),
         cmocka_unit_test(only_active_workers_record),
+        cmocka_unit_test(auto_measures_both_ways),
         cmocka_unit_test(failed_creation_leaves_no_worker_behind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
