@@ -18,7 +18,6 @@
 #include "ob_bench_run.h"
 #include "ob_bench_stability.h"
 
-#define OB_BENCH_MAX_MODES 8
 
 /* One scene (views × objects) measured in every mode of the list. */
 typedef struct ob_bench_sweep_entry {
