@@ -52,7 +52,8 @@ typedef struct bench_options {
 
 static const char usage_text[] =
     "usage: obelisk-bench [options]\n"
-    "  --quick            a reduced run (about a minute on 2 cores)\n"
+    "  --quick            a reduced run (one to two minutes on 2 cores; views 1,8, modes\n"
+    "                     ST,2,auto, and 50000 objects in 1 view only)\n"
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
     "  --json FILE        write every result and the summary as JSON\n"
@@ -126,11 +127,13 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
                          .view_height = 192, .image_width = 640, .image_height = 480,
                          .raw_objects = 10000};
     const char *views = quick ? "1,8" : "1,4,8,16";
-    const char *objects = quick ? "1000,10000" : "1000,10000,50000";
+    const char *objects = "1000,10000,50000";
     const char *modes = quick ? "ST,2,auto" : "ST,1,2,4,auto";
     o->warmup = quick ? 1 : 2;
-    o->rounds = quick ? 3 : 5;
-    o->flight = quick ? 3 : 5;
+    /* Medians of per-round ratios need rounds to hold still from run to
+     * run; the in-flight loop feeds no summary ratio, so --quick keeps it short. */
+    o->rounds = quick ? 15 : 5;
+    o->flight = quick ? 2 : 5;
     *out_exit = 2;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -239,6 +242,13 @@ static void frame_counts(const bench_options *o, uint32_t views, uint32_t object
     *flight = big ? OB_MIN(o->flight, 2u) : o->flight;
 }
 
+/* --quick measures 50k objects in one view only (the per-object growth
+ * from 1k to 50k), not in several: that keeps it near a minute. */
+static bool config_runs(const bench_options *o, uint32_t views, uint32_t objects)
+{
+    return !(o->quick && views > 1 && objects > 10000);
+}
+
 /* Progress units of one sweep frame: its draws, so the bar follows time
  * (a mirror-scene frame, about 1500 draws at 640x480, counts as one). */
 static uint64_t frame_weight(uint32_t views, uint32_t objects)
@@ -246,7 +256,61 @@ static uint64_t frame_weight(uint32_t views, uint32_t objects)
     return OB_MAX((uint64_t)views * objects / 3 / 1500, (uint64_t)1);
 }
 
-/* One sweep configuration, and the raw baseline when it is the raw one. */
+/* The raw baseline inside the sweep's idle rounds: after the engine's
+ * frames of every round, one raw recording of the same draw list, so the
+ * engine and the raw loop are priced under the same state of the machine
+ * and their ratio is taken per round. */
+typedef struct raw_rounds {
+    ob_demo *demo;
+    const ob_view *view;
+    ob_bench_raw *raw;         /* made at the first round, once the view has a draw list */
+    ob_bench_raw_sample last;
+    double *raw_ms, *allocs_per_draw, *engine_vs_raw;  /* one per measured round */
+    uint32_t n, cap;
+} raw_rounds;
+
+static ob_result raw_round(void *user, uint32_t round, bool measured,
+                           const ob_bench_round_sample *modes)
+{
+    (void)round;
+    raw_rounds *rr = user;
+    ob_result r = OB_OK;
+    if (!rr->raw) {
+        rr->raw = ob_bench_raw_create(rr->demo, rr->view, &r);
+        /* One unmeasured pass warms the driver's allocator and the caches. */
+        if (rr->raw) r = ob_bench_raw_record(rr->raw, &rr->last);
+        if (r != OB_OK) return r;
+    }
+    r = ob_bench_raw_record(rr->raw, &rr->last);
+    if (r != OB_OK || !measured || rr->n >= rr->cap || rr->last.draws == 0) return r;
+    double raw_ns = (double)rr->last.ns / rr->last.draws;
+    double engine_ns = modes[0].draws ? modes[0].record_total_ms * 1e6 / modes[0].draws : NAN;
+    rr->raw_ms[rr->n] = rr->last.ns * 1e-6;
+    rr->allocs_per_draw[rr->n] = (double)rr->last.host_allocs / rr->last.draws;
+    rr->engine_vs_raw[rr->n] = engine_ns / raw_ns;
+    rr->n++;
+    return OB_OK;
+}
+
+/* The raw result and the per-round engine/raw ratio from the rounds. */
+static void raw_results(raw_rounds *rr, ob_bench_report *rep)
+{
+    ob_bench_raw_result *o = &rep->raw;
+    ob_bench_spread ms, allocs;
+    ob_bench_spread_of(rr->raw_ms, rr->n, &ms);
+    ob_bench_spread_of(rr->allocs_per_draw, rr->n, &allocs);
+    ob_bench_spread_of(rr->engine_vs_raw, rr->n, &rep->engine_vs_raw);
+    *o = (ob_bench_raw_result){
+        .draws = rr->last.draws, .reps = rr->n, .buffer_binds = rr->last.buffer_binds,
+        .record_ms = ms.median,
+        .ns_per_draw = rr->last.draws ? ms.median * 1e6 / rr->last.draws : NAN,
+        .commands_per_object = rr->last.draws ? (double)rr->last.commands / rr->last.draws : NAN,
+        .host_allocs_per_object = allocs.median,
+    };
+}
+
+/* One sweep configuration, with the raw baseline in its rounds when it is
+ * the raw one. */
 static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint32_t views,
                               uint32_t objects, ob_bench_progress *prog, ob_bench_sweep_entry *out)
 {
@@ -267,15 +331,32 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
                             .tick = ob_bench_progress_tick, .tick_user = prog};
     frame_counts(o, views, objects, &rd.warmup, &rd.rounds, &rd.flight);
     *out = (ob_bench_sweep_entry){.views = views, .objects = objects, .mode_count = o->mode_count};
+    raw_rounds rr = {.demo = &d};
+    bool raw = views == 1 && objects == o->raw_objects;
+    if (r == OB_OK && raw) {
+        rr.view = s.views[0];
+        rr.cap = rd.rounds;
+        rr.raw_ms = ob_calloc(3 * (size_t)rr.cap, sizeof *rr.raw_ms);
+        if (rr.raw_ms) {
+            rr.allocs_per_draw = rr.raw_ms + rr.cap;
+            rr.engine_vs_raw = rr.raw_ms + 2 * rr.cap;
+            rd.round_hook = raw_round;
+            rd.round_user = &rr;
+        } else {
+            r = OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+    }
     if (r == OB_OK) r = ob_bench_run_modes(&s, &rd, out->results);
-    if (r == OB_OK && views == 1 && objects == o->raw_objects) {
-        r = ob_bench_raw_measure(&d, s.views[0], 2 * o->rounds + 1, &rep->raw);
+    if (r == OB_OK && raw) {
+        raw_results(&rr, rep);
         rep->raw_views = views;
         rep->raw_objects = objects;
         const ob_bench_result *st = &out->results[0];
         rep->engine_ns_per_draw = st->record_total_ms * 1e6 / st->draws;
     }
     if (d.r) ob_renderer_wait_idle(d.r);
+    ob_bench_raw_destroy(rr.raw);
+    ob_free(rr.raw_ms);
     ob_bench_scene_release(&s);
     ob_demo_shutdown(&d);
     return r;
@@ -303,30 +384,72 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
     return r;
 }
 
+static const ob_bench_sweep_entry *find_entry(const ob_bench_report *rep, uint32_t views,
+                                              uint32_t objects)
+{
+    for (uint32_t i = 0; i < rep->sweep_count; i++)
+        if (rep->sweep[i].views == views && rep->sweep[i].objects == objects) return &rep->sweep[i];
+    return NULL;
+}
+
+/* The first auto mode's recording against the fastest fixed mode's, per
+ * round (ob_bench_result.vs_best_fixed_record). */
+static ob_bench_spread auto_vs_best(const ob_bench_sweep_entry *e)
+{
+    for (uint32_t m = 0; e && m < e->mode_count; m++)
+        if (e->results[m].mode.threading == OB_THREADING_AUTO)
+            return e->results[m].vs_best_fixed_record;
+    return (ob_bench_spread){NAN, NAN, NAN};
+}
+
+/* ST recording time per draw (ratio of the medians). */
+static double st_ns_per_draw(const ob_bench_sweep_entry *e)
+{
+    if (!e || e->mode_count == 0 || e->results[0].draws == 0) return NAN;
+    return e->results[0].record_total_ms * 1e6 / e->results[0].draws;
+}
+
 static void summarize(ob_bench_report *rep)
 {
     ob_bench_summary *s = &rep->summary;
-    s->mt_speedup_record_10k_8views = NAN;
+    s->mt_speedup_record_10k_8views = (ob_bench_spread){NAN, NAN, NAN};
     for (uint32_t i = 0; i < rep->sweep_count; i++) {
         const ob_bench_sweep_entry *e = &rep->sweep[i];
         for (uint32_t m = 0; m < e->mode_count; m++) s->hash_mismatches += e->results[m].hash_mismatches;
-        if (e->views != 8 || e->objects != 10000) continue;
-        double best = INFINITY;
-        for (uint32_t m = 1; m < e->mode_count; m++) {
-            const ob_bench_result *r = &e->results[m];
-            if (r->mode.threading != OB_THREADING_MULTI || !(r->record_total_ms < best)) continue;
-            best = r->record_total_ms;
-            s->mt_speedup_best_mode = r->mode.name;
-        }
-        if (isfinite(best)) s->mt_speedup_record_10k_8views = e->results[0].record_total_ms / best;
     }
+    const ob_bench_sweep_entry *e8 = find_entry(rep, 8, 10000);
+    for (uint32_t m = 1; e8 && m < e8->mode_count; m++) {
+        const ob_bench_result *r = &e8->results[m];
+        double best = s->mt_speedup_record_10k_8views.median;
+        if (r->mode.threading != OB_THREADING_MULTI || !(isnan(best) || r->speedup_record > best))
+            continue;
+        s->mt_speedup_record_10k_8views = (ob_bench_spread){r->speedup_record,
+                                                            r->speedup_record_p25,
+                                                            r->speedup_record_p75};
+        s->mt_speedup_best_mode = r->mode.name;
+    }
+    s->auto_vs_best_10k_8views = auto_vs_best(e8);
     for (uint32_t m = 0; m < rep->scene200.mode_count; m++)
         s->hash_mismatches += rep->scene200.results[m].hash_mismatches;
-    s->engine_vs_raw_per_draw = rep->raw.ns_per_draw > 0.0
-                                    ? rep->engine_ns_per_draw / rep->raw.ns_per_draw : NAN;
+    s->engine_vs_raw_per_object = rep->engine_vs_raw;
+    /* Per visible object is per draw in ST: the old name keeps its meaning. */
+    s->engine_vs_raw_per_draw = rep->engine_vs_raw.median;
     const ob_bench_result *r200 = rep->scene200.results;
-    s->auto_vs_best_200 = rep->scene200.mode_count == 3
-                              ? r200[2].frame_ms / fmin(r200[0].frame_ms, r200[1].frame_ms) : NAN;
+    s->auto_vs_best_200 = rep->scene200.mode_count == 3 ? r200[2].vs_best_fixed_record
+                                                        : (ob_bench_spread){NAN, NAN, NAN};
+    s->auto_vs_best_200_frame = rep->scene200.mode_count == 3
+                                    ? r200[2].frame_ms / fmin(r200[0].frame_ms, r200[1].frame_ms)
+                                    : NAN;
+    /* Different scenes cannot share a round, so this one is a ratio of
+     * medians: it reads how the per-object cost grows with the scene
+     * (caches, culling, sorting), not a speedup. */
+    s->per_object_growth_50k_vs_1k = st_ns_per_draw(find_entry(rep, 1, 50000)) /
+                                     st_ns_per_draw(find_entry(rep, 1, 1000));
+    const ob_bench_sweep_entry *raw = find_entry(rep, rep->raw_views, rep->raw_objects);
+    s->commands_per_object_engine = raw ? raw->results[0].commands_per_object : NAN;
+    s->host_allocs_per_object_engine = raw ? raw->results[0].cmd_host_allocs_per_object : NAN;
+    s->commands_per_object_raw = rep->raw.commands_per_object;
+    s->host_allocs_per_object_raw = rep->raw.host_allocs_per_object;
     for (uint32_t i = 0; i < rep->quality_count; i++) {
         const ob_bench_quality_row *q = &rep->quality[i];
         if (q->kind != OB_BENCH_QUALITY_THREADING) continue;
@@ -357,6 +480,11 @@ static int run(const bench_options *o)
                            .image_width = o->image_width, .image_height = o->image_height,
                            .image_frames = o->quick ? 3 : 4};
     rep.pool_workers = pool_size(o, rep.cores);
+    /* Unknown until the raw configuration has run (it may not be in the lists). */
+    rep.engine_vs_raw = (ob_bench_spread){NAN, NAN, NAN};
+    rep.raw = (ob_bench_raw_result){.record_ms = NAN, .ns_per_draw = NAN,
+                                    .commands_per_object = NAN, .host_allocs_per_object = NAN};
+    rep.engine_ns_per_draw = NAN;
     rep.big_draws = BIG_FRAME_DRAWS;
     frame_counts(o, 1000, 1000000, &rep.big_warmup, &rep.big_rounds, &rep.big_flight);
     uint64_t t0 = ob_time_ns();
@@ -378,6 +506,7 @@ static int run(const bench_options *o)
                  quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1);
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
+                if (!config_runs(o, o->views[v], o->objects[n])) continue;
                 uint32_t w, r, f;
                 frame_counts(o, o->views[v], o->objects[n], &w, &r, &f);
                 total += (uint64_t)o->mode_count * (w + r + f + 1) *
@@ -402,6 +531,7 @@ static int run(const bench_options *o)
     }
     for (uint32_t n = 0; n < o->object_count && r == OB_OK && o->perf; n++) {
         for (uint32_t v = 0; v < o->view_count && r == OB_OK; v++) {
+            if (!config_runs(o, o->views[v], o->objects[n])) continue;
             ob_bench_progress_label(&prog, "sweep: %u views, %u objects", o->views[v], o->objects[n]);
             prog.unit = frame_weight(o->views[v], o->objects[n]);
             r = sweep_config(o, &rep, o->views[v], o->objects[n], &prog, &rep.sweep[rep.sweep_count]);

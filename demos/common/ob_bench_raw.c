@@ -30,7 +30,61 @@ typedef struct raw_draw {
     uint32_t index_count;
 } raw_draw;
 
-typedef struct raw_state {
+/* Driver host allocations through the pool: the callbacks honour the
+ * requested alignment by over-allocating and keeping the block's start and
+ * size in a header just before the aligned pointer. */
+typedef struct alloc_header {
+    void *base;
+    size_t size;
+} alloc_header;
+
+typedef struct alloc_counter {
+    uint64_t allocs;           /* allocations + reallocations */
+} alloc_counter;
+
+static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
+                                     VkSystemAllocationScope scope)
+{
+    (void)scope;
+    alloc_counter *c = user;
+    if (align < sizeof(void *)) align = sizeof(void *);
+    size_t total = size + align + sizeof(alloc_header);
+    char *base = ob_malloc(total);
+    if (!base) return NULL;
+    uintptr_t at = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+    alloc_header h = {base, size};
+    memcpy((char *)at - sizeof h, &h, sizeof h);
+    c->allocs++;
+    return (void *)at;
+}
+
+static void VKAPI_PTR counted_free(void *user, void *mem)
+{
+    (void)user;
+    if (!mem) return;
+    alloc_header h;
+    memcpy(&h, (char *)mem - sizeof h, sizeof h);
+    ob_free(h.base);
+}
+
+static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
+                                       VkSystemAllocationScope scope)
+{
+    if (!old) return counted_alloc(user, size, align, scope);
+    if (size == 0) {
+        counted_free(user, old);
+        return NULL;
+    }
+    alloc_header h;
+    memcpy(&h, (char *)old - sizeof h, sizeof h);
+    void *mem = counted_alloc(user, size, align, scope);
+    if (!mem) return NULL;     /* Vulkan: the old block stays valid */
+    memcpy(mem, old, OB_MIN(size, h.size));
+    counted_free(user, old);
+    return mem;
+}
+
+struct ob_bench_raw {
     VkDevice vk;
     VkShaderModule vert, frag;
     VkPipelineLayout layout;
@@ -40,7 +94,12 @@ typedef struct raw_state {
     raw_draw *draws;
     float *push;               /* 32 floats per draw, 32-byte aligned */
     uint32_t count;
-} raw_state;
+    uint32_t width, height;    /* the view's, for viewport and scissor */
+    alloc_counter counter;
+    VkAllocationCallbacks pool_alloc;  /* counting into counter; the pool's only */
+};
+
+typedef struct ob_bench_raw raw_state;
 
 static ob_result make_module(ob_demo *d, const char *name, const char *source, ob_shader_stage stage,
                              VkShaderModule *out)
@@ -122,7 +181,11 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
     VkCommandPoolCreateInfo pci = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                    .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
                                    .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->r))};
-    VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, NULL, &s->pool));
+    s->pool_alloc = (VkAllocationCallbacks){.pUserData = &s->counter,
+                                            .pfnAllocation = counted_alloc,
+                                            .pfnReallocation = counted_realloc,
+                                            .pfnFree = counted_free};
+    VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, &s->pool_alloc, &s->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
                                       .commandPool = s->pool,
@@ -156,9 +219,9 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
     return s->count ? OB_OK : OB_ERR_INVALID_ARGUMENT;
 }
 
-/* The timed part: one recording of every draw. */
-static ob_result record_once(raw_state *s, const ob_view *v, uint32_t *out_binds, uint64_t *out_ns)
+ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
 {
+    memset(out, 0, sizeof *out);
     VkFormat color = COLOR_FORMAT;
     VkCommandBufferInheritanceRenderingInfo rendering = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO,
@@ -172,11 +235,12 @@ static ob_result record_once(raw_state *s, const ob_view *v, uint32_t *out_binds
                  VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT,
         .pInheritanceInfo = &inherit};
     if (OB_VK_CHECK(vkResetCommandPool(s->vk, s->pool, 0)) != VK_SUCCESS) return OB_ERR_VULKAN;
+    uint64_t allocs0 = s->counter.allocs;
     uint64_t t0 = ob_time_ns();
     if (OB_VK_CHECK(vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return OB_ERR_VULKAN;
     vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s->pipeline);
-    VkViewport viewport = {0.0f, 0.0f, (float)v->width, (float)v->height, 0.0f, 1.0f};
-    VkRect2D scissor = {{0, 0}, {v->width, v->height}};
+    VkViewport viewport = {0.0f, 0.0f, (float)s->width, (float)s->height, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {s->width, s->height}};
     vkCmdSetViewport(s->cmd, 0, 1, &viewport);
     vkCmdSetScissor(s->cmd, 0, 1, &scissor);
     VkBuffer vb = VK_NULL_HANDLE, ib = VK_NULL_HANDLE;
@@ -199,55 +263,48 @@ static ob_result record_once(raw_state *s, const ob_view *v, uint32_t *out_binds
         vkCmdDrawIndexed(s->cmd, dr->index_count, 1, 0, 0, 0);
     }
     if (OB_VK_CHECK(vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
-    *out_ns = ob_time_ns() - t0;
-    *out_binds = binds;
+    uint64_t ns = ob_time_ns() - t0;
+    /* Pipeline, viewport, scissor, then per draw push + draw, plus binds. */
+    *out = (ob_bench_raw_sample){.ns = ns, .draws = s->count, .buffer_binds = binds,
+                                 .commands = 3 + 2 * s->count + binds,
+                                 .host_allocs = s->counter.allocs - allocs0};
     return OB_OK;
 }
 
-static void release(raw_state *s)
+void ob_bench_raw_destroy(ob_bench_raw *s)
 {
-    if (s->pool) vkDestroyCommandPool(s->vk, s->pool, NULL);
+    if (!s) return;
+    if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc);
     if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
     if (s->layout) vkDestroyPipelineLayout(s->vk, s->layout, NULL);
     if (s->vert) vkDestroyShaderModule(s->vk, s->vert, NULL);
     if (s->frag) vkDestroyShaderModule(s->vk, s->frag, NULL);
     ob_free(s->draws);
     ob_aligned_free(s->push);
+    ob_free(s);
 }
 
-ob_result ob_bench_raw_measure(ob_demo *d, const ob_view *v, uint32_t reps,
-                               ob_bench_raw_result *out)
+ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_result)
 {
-    memset(out, 0, sizeof *out);
-    if (!v || v->item_count == 0 || reps == 0) {
+    if (!v || v->item_count == 0) {
         OB_LOG_E("bench", "raw baseline: view '%s' has no draws to record",
                  v ? v->name : "(none)");
-        return OB_ERR_INVALID_ARGUMENT;
+        *out_result = OB_ERR_INVALID_ARGUMENT;
+        return NULL;
     }
-    raw_state s = {.vk = ob_device_vk(ob_renderer_device(d->r))};
-    double *times = ob_calloc(reps, sizeof *times);
-    ob_result r = times ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
-    if (r == OB_OK) r = gather(d, v, &s);
-    if (r == OB_OK) r = make_pipeline(d, &s);
-    if (r == OB_OK) r = make_commands(d, &s);
-    /* One unmeasured pass warms the driver's allocator and the caches. */
-    uint64_t ns = 0;
-    uint32_t binds = 0;
-    if (r == OB_OK) r = record_once(&s, v, &binds, &ns);
-    for (uint32_t i = 0; i < reps && r == OB_OK; i++) {
-        r = record_once(&s, v, &binds, &ns);
-        times[i] = (double)ns * 1e-6;
+    ob_bench_raw *s = ob_calloc(1, sizeof *s);
+    if (!s) {
+        *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
+        return NULL;
     }
-    if (r == OB_OK) {
-        out->draws = s.count;
-        out->reps = reps;
-        out->buffer_binds = binds;
-        out->record_ms = ob_demo_median(times, reps);
-        out->ns_per_draw = out->record_ms * 1e6 / s.count;
-    } else {
-        OB_LOG_E("bench", "raw baseline on view '%s' failed: %s", v->name, ob_result_name(r));
-    }
-    release(&s);
-    ob_free(times);
-    return r;
+    *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->r)), .width = v->width,
+                        .height = v->height};
+    ob_result r = gather(d, v, s);
+    if (r == OB_OK) r = make_pipeline(d, s);
+    if (r == OB_OK) r = make_commands(d, s);
+    *out_result = r;
+    if (r == OB_OK) return s;
+    OB_LOG_E("bench", "raw baseline on view '%s' failed: %s", v->name, ob_result_name(r));
+    ob_bench_raw_destroy(s);
+    return NULL;
 }

@@ -11,27 +11,50 @@
  * index buffers only when the geometry changes from the previous draw, and
  * per object vkCmdPushConstants (128 bytes: world + normal matrix, the
  * engine's push block) + vkCmdDrawIndexed. Only recording is timed (begin to
- * end); nothing is submitted. Repeated `reps` times, median reported.
+ * end); nothing is submitted. The pool allocates through counting
+ * callbacks, so a recording also says how many host allocations the driver
+ * made for it, and how many vkCmd calls it made.
  *
- * Lifecycle: one call. Thread rule: render thread, outside a frame, with the
- * device idle (it makes and destroys Vulkan objects of its own).
+ * Lifecycle: create (from the view's draw list of the last frame) → record
+ * once per measuring round, interleaved with the engine's frames → destroy.
+ * Thread rule: render thread, outside a frame, with the device idle (it
+ * makes, resets and destroys Vulkan objects of its own); no global state.
  */
 #ifndef OB_BENCH_RAW_H
 #define OB_BENCH_RAW_H
 
 #include "ob_demo.h"
 
+typedef struct ob_bench_raw ob_bench_raw;
+
+/* One recording. */
+typedef struct ob_bench_raw_sample {
+    uint64_t ns;               /* vkBeginCommandBuffer to vkEndCommandBuffer */
+    uint32_t draws;
+    uint32_t buffer_binds;     /* vertex + index binds */
+    uint32_t commands;         /* vkCmd* calls */
+    uint64_t host_allocs;      /* driver allocations and reallocations through the pool */
+} ob_bench_raw_sample;
+
+/* What a run of recordings gave (filled by the caller from the samples). */
 typedef struct ob_bench_raw_result {
     uint32_t draws;
-    uint32_t reps;
+    uint32_t reps;             /* measured recordings */
     uint32_t buffer_binds;     /* vertex + index binds per recording */
     double record_ms;          /* median recording time */
-    double ns_per_draw;        /* record_ms / draws */
+    double ns_per_draw;        /* median over recordings of ns / draws */
+    double commands_per_object;    /* vkCmd calls / draws */
+    double host_allocs_per_object; /* median of host allocations / draws */
 } ob_bench_raw_result;
 
-/* Failure: an ob_result (shader compile, Vulkan creation; logged); nothing
- * stays allocated. A view with no draws is OB_ERR_INVALID_ARGUMENT. */
-ob_result ob_bench_raw_measure(ob_demo *d, const ob_view *v, uint32_t reps,
-                               ob_bench_raw_result *out);
+/* Gathers v's draws and makes the pipeline and pool. Failure: NULL, the
+ * reason in *out_result (shader compile, Vulkan creation; logged; a view
+ * with no draws is OB_ERR_INVALID_ARGUMENT) and nothing stays allocated. */
+ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_result);
+/* Resets the pool and records every draw once, timed. Failure: OB_ERR_VULKAN
+ * (logged); *out is then zero. */
+ob_result ob_bench_raw_record(ob_bench_raw *raw, ob_bench_raw_sample *out);
+/* Destroys what create made. NULL ok. */
+void ob_bench_raw_destroy(ob_bench_raw *raw);
 
 #endif /* OB_BENCH_RAW_H */

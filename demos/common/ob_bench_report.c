@@ -83,12 +83,16 @@ static void print_entry(FILE *f, const ob_bench_sweep_entry *e)
 {
     for (uint32_t m = 0; m < e->mode_count; m++) {
         const ob_bench_result *r = &e->results[m];
+        char spread[32];
+        snprintf(spread, sizeof spread, "%.2f [%.2f,%.2f]", r->speedup_record,
+                 r->speedup_record_p25, r->speedup_record_p75);
         fprintf(f,
-                "  %5u %6u %-5s %4.1f %7u %8.2f %8.2f %8.2f %8.2f %7.2f %8.2f %8.2f %8.2f %6.2f "
-                "%9.0f %6u/%-6u %s\n",
+                "  %5u %6u %-5s %4.1f %7u %8.2f %8.2f %8.2f %8.2f %7.2f %8.2f %7.2f %7.2f %7.2f "
+                "%8.2f %8.2f %-18s %9.0f %6u/%-6u %s\n",
                 e->views, e->objects, r->mode.name, r->workers_used, r->draws, r->update_ms,
                 r->pre_render_ms, r->record_ms, r->assemble_ms, r->submit_ms, r->record_total_ms,
-                r->gpu_ms, r->frame_ms, r->speedup_record, r->draws_per_s,
+                r->record_cpu_render_ms, r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
+                r->gpu_ms, r->frame_ms, spread, r->draws_per_s,
                 r->pm.descriptor_binds_issued, r->pm.descriptor_binds_requested,
                 r->hash_mismatches ? "HASH MISMATCH" : "");
     }
@@ -96,16 +100,24 @@ static void print_entry(FILE *f, const ob_bench_sweep_entry *e)
 
 static void print_header(FILE *f)
 {
-    fprintf(f, "  %5s %6s %-5s %4s %7s %8s %8s %8s %8s %7s %8s %8s %8s %6s %9s %13s\n", "views",
-            "objs", "mode", "wrk", "draws", "update", "pre-rend", "record", "assemble", "submit",
-            "rec+asm", "gpu", "frame", "spdup", "draws/s", "desc binds");
+    fprintf(f, "  %5s %6s %-5s %4s %7s %8s %8s %8s %8s %7s %8s %7s %7s %7s %8s %8s %-18s %9s %13s\n",
+            "views", "objs", "mode", "wrk", "draws", "update", "pre-rend", "record", "assemble",
+            "submit", "rec+asm", "cpu-rt", "cpu-wk", "cpu-wmx", "gpu", "frame", "spdup [p25,p75]",
+            "draws/s", "desc binds");
+}
+
+static void print_spread(FILE *f, const char *name, ob_bench_spread v)
+{
+    fprintf(f, "  %-30s %.3f [%.3f, %.3f]", name, v.median, v.p25, v.p75);
 }
 
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
     fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up; frame = "
                "in-flight period over %u frames (%u, %u, %u for frames over ~%u draws); "
-               "spdup = ST rec+asm / this\n",
+               "spdup = median over rounds of ST rec+asm / this, [p25,p75]; cpu-rt, cpu-wk, "
+               "cpu-wmx = recording CPU time of the render thread, all workers, busiest worker "
+               "(nan: not reported by the engine)\n",
             rep->rounds, rep->warmup, rep->flight, rep->big_rounds, rep->big_warmup,
             rep->big_flight, rep->big_draws);
     print_header(f);
@@ -113,10 +125,14 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
     print_header(f);
     print_entry(f, &rep->scene200);
-    fprintf(f, "\nraw Vulkan baseline (%u views, %u objects): %u draws, raw %.1f ns/draw, "
-               "engine (ST) %.1f ns/draw, ratio %.2f\n",
-            rep->raw_views, rep->raw_objects, rep->raw.draws, rep->raw.ns_per_draw,
-            rep->engine_ns_per_draw, rep->summary.engine_vs_raw_per_draw);
+    fprintf(f, "\nraw Vulkan baseline (%u views, %u objects), one recording in each of %u idle "
+               "rounds: %u draws, raw %.1f ns/draw, engine (ST) %.1f ns/draw, ratio %.2f "
+               "(median of per-round ratios); vkCmd calls/object raw %.2f, engine ~%.2f; host "
+               "allocations/object raw %.2f, engine %.2f\n",
+            rep->raw_views, rep->raw_objects, rep->raw.reps, rep->raw.draws, rep->raw.ns_per_draw,
+            rep->engine_ns_per_draw, rep->summary.engine_vs_raw_per_draw,
+            rep->summary.commands_per_object_raw, rep->summary.commands_per_object_engine,
+            rep->summary.host_allocs_per_object_raw, rep->summary.host_allocs_per_object_engine);
     fprintf(f, "\nimage error against the reference (ST, highest quality), mirror scene %ux%u, "
                "frame %u:\n  %-10s %5s %6s %-5s %8s %9s %9s %9s %9s %s\n",
             rep->image_width, rep->image_height, rep->image_frames, "kind", "env", "shadow",
@@ -131,14 +147,24 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                                                       : "equal");
     }
     const ob_bench_summary *s = &rep->summary;
-    fprintf(f, "\nsummary:\n  mt_speedup_record_10k_8views %.3f (best MT mode %s)\n"
-               "  engine_vs_raw_per_draw       %.3f\n  auto_vs_best_200             %.3f\n"
-               "  threading modes identical    %s (max abs diff %u, hash mismatches %u)\n"
-               "  run time                     %.0f s (load average %.1f at start, %.1f at end)\n",
-            s->mt_speedup_record_10k_8views, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "-",
-            s->engine_vs_raw_per_draw, s->auto_vs_best_200, s->threading_identical ? "yes" : "NO",
-            s->threading_max_abs_diff, s->hash_mismatches, rep->seconds, rep->load_start,
-            rep->load_end);
+    fprintf(f, "\nsummary (ratios: median of per-round ratios [p25, p75]):\n");
+    print_spread(f, "mt_speedup_record_10k_8views", s->mt_speedup_record_10k_8views);
+    fprintf(f, " (best MT mode %s)\n", s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "-");
+    print_spread(f, "engine_vs_raw_per_object", s->engine_vs_raw_per_object);
+    fputs(" (= engine_vs_raw_per_draw)\n", f);
+    print_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
+    fprintf(f, " (recording; in-flight frames %.3f)\n", s->auto_vs_best_200_frame);
+    print_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
+    fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
+               "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
+            "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
+            s->commands_per_object_engine, s->commands_per_object_raw, "host_allocs_per_object",
+            s->host_allocs_per_object_engine, s->host_allocs_per_object_raw);
+    fprintf(f, "  %-30s %s (max abs diff %u, hash mismatches %u)\n"
+               "  %-30s %.0f s (load average %.1f at start, %.1f at end)\n",
+            "threading modes identical", s->threading_identical ? "yes" : "NO",
+            s->threading_max_abs_diff, s->hash_mismatches, "run time", rep->seconds,
+            rep->load_start, rep->load_end);
 }
 
 /* Pixel counts and levels as integers, small errors in %g. */
@@ -209,10 +235,21 @@ static void json_result(FILE *f, const ob_bench_result *r)
     static const char *const names[] = {"update_ms", "pre_render_ms", "record_ms", "assemble_ms",
                                         "submit_ms", "record_total_ms", "cpu_frame_ms", "gpu_ms",
                                         "frame_ms", "draws_per_s", "speedup_record",
-                                        "speedup_frame"};
+                                        "speedup_frame", "speedup_record_p25",
+                                        "speedup_record_p75", "vs_best_fixed_record",
+                                        "vs_best_fixed_record_p25", "vs_best_fixed_record_p75",
+                                        "record_cpu_render_ms", "record_cpu_workers_ms",
+                                        "record_cpu_max_worker_ms", "cmd_host_allocs_per_object",
+                                        "commands_per_object"};
     const double values[] = {r->update_ms, r->pre_render_ms, r->record_ms, r->assemble_ms,
                              r->submit_ms, r->record_total_ms, r->cpu_frame_ms, r->gpu_ms,
-                             r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame};
+                             r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame,
+                             r->speedup_record_p25, r->speedup_record_p75,
+                             r->vs_best_fixed_record.median, r->vs_best_fixed_record.p25,
+                             r->vs_best_fixed_record.p75, r->record_cpu_render_ms,
+                             r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
+                             r->cmd_host_allocs_per_object, r->commands_per_object};
+    _Static_assert(OB_ARRAY_COUNT(names) == OB_ARRAY_COUNT(values), "a name per value");
     for (size_t i = 0; i < OB_ARRAY_COUNT(names); i++) {
         fprintf(f, ",\"%s\":", names[i]);
         json_num(f, values[i]);
@@ -256,18 +293,44 @@ static void json_quality(FILE *f, const ob_bench_quality_row *q)
     fprintf(f, ",\"draws\":%u,\"hash_mismatches\":%u}", q->draws, q->hash_mismatches);
 }
 
+/* "name":median,"name_p25":p25,"name_p75":p75, */
+static void json_spread(FILE *f, const char *name, ob_bench_spread v)
+{
+    const double values[3] = {v.median, v.p25, v.p75};
+    static const char *const suffix[3] = {"", "_p25", "_p75"};
+    for (int i = 0; i < 3; i++) {
+        fprintf(f, "\"%s%s\":", name, suffix[i]);
+        json_num(f, values[i]);
+        fputc(',', f);
+    }
+}
+
+static void json_field(FILE *f, const char *name, double v)
+{
+    fprintf(f, "\"%s\":", name);
+    json_num(f, v);
+    fputc(',', f);
+}
+
 static void json_summary(FILE *f, const ob_bench_report *rep)
 {
     const ob_bench_summary *s = &rep->summary;
-    fputs("\"summary\":{\"mt_speedup_record_10k_8views\":", f);
-    json_num(f, s->mt_speedup_record_10k_8views);
-    fputs(",\"mt_speedup_best_mode\":", f);
+    fputs("\"summary\":{", f);
+    json_spread(f, "mt_speedup_record_10k_8views", s->mt_speedup_record_10k_8views);
+    fputs("\"mt_speedup_best_mode\":", f);
     json_str(f, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "");
-    fputs(",\"engine_vs_raw_per_draw\":", f);
-    json_num(f, s->engine_vs_raw_per_draw);
-    fputs(",\"auto_vs_best_200\":", f);
-    json_num(f, s->auto_vs_best_200);
-    fprintf(f, ",\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",
+    fputc(',', f);
+    json_field(f, "engine_vs_raw_per_draw", s->engine_vs_raw_per_draw);
+    json_spread(f, "engine_vs_raw_per_object", s->engine_vs_raw_per_object);
+    json_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
+    json_field(f, "auto_vs_best_200_frame", s->auto_vs_best_200_frame);
+    json_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
+    json_field(f, "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k);
+    json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
+    json_field(f, "commands_per_object_raw", s->commands_per_object_raw);
+    json_field(f, "host_allocs_per_object_engine", s->host_allocs_per_object_engine);
+    json_field(f, "host_allocs_per_object_raw", s->host_allocs_per_object_raw);
+    fprintf(f, "\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",
             s->threading_max_abs_diff, s->hash_mismatches, s->threading_identical ? "true" : "false");
     if (rep->stability) fprintf(f, "\"stability_failed\":%u,", rep->stability->failed);
     fputs("\"device\":{\"name\":", f);
@@ -358,6 +421,10 @@ static void json_perf(FILE *f, const ob_bench_report *rep)
     json_num(f, rep->raw.ns_per_draw);
     fputs(",\"engine_ns_per_draw\":", f);
     json_num(f, rep->engine_ns_per_draw);
+    fputs(",\"commands_per_object\":", f);
+    json_num(f, rep->raw.commands_per_object);
+    fputs(",\"host_allocs_per_object\":", f);
+    json_num(f, rep->raw.host_allocs_per_object);
     fputs("},\n\"quality\":[\n  ", f);
     uint32_t written = 0;
     for (uint32_t i = 0; i < rep->quality_count; i++) {
@@ -394,11 +461,18 @@ static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t ob
                         r->assemble_ms, r->submit_ms, r->record_total_ms, r->cpu_frame_ms,
                         r->gpu_ms, r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame};
     for (size_t i = 0; i < OB_ARRAY_COUNT(v); i++) csv_num(f, v[i]);
-    fprintf(f, ",%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,,,%u\n", p->pipeline_binds_requested,
+    fprintf(f, ",%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,%u,,,%u", p->pipeline_binds_requested,
             p->pipeline_binds_issued, p->descriptor_binds_requested, p->descriptor_binds_issued,
             p->push_descriptor_requested, p->push_descriptor_issued, p->push_constant_requested,
             p->push_constant_issued, p->vertex_binds_requested, p->vertex_binds_issued,
             p->index_binds_requested, p->index_binds_issued, r->hash_mismatches);
+    /* Columns added later go last, so older readers keep their indices. */
+    const double added[] = {r->speedup_record_p25, r->speedup_record_p75,
+                            r->vs_best_fixed_record.median, r->record_cpu_render_ms,
+                            r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
+                            r->cmd_host_allocs_per_object, r->commands_per_object};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(added); i++) csv_num(f, added[i]);
+    fputc('\n', f);
 }
 
 ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
@@ -410,7 +484,9 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
           "frame_ms,draws_per_s,speedup_record,speedup_frame,pipeline_req,pipeline_iss,"
           "descriptor_req,descriptor_iss,push_descriptor_req,push_descriptor_iss,push_constant_req,"
           "push_constant_iss,vertex_req,vertex_iss,index_req,index_iss,max_abs_diff,psnr_db,"
-          "hash_mismatches\n",
+          "hash_mismatches,speedup_record_p25,speedup_record_p75,vs_best_fixed_record,"
+          "record_cpu_render_ms,record_cpu_workers_ms,record_cpu_max_worker_ms,"
+          "cmd_host_allocs_per_object,commands_per_object\n",
           f);
     for (uint32_t i = 0; i < rep->sweep_count; i++)
         for (uint32_t m = 0; m < rep->sweep[i].mode_count; m++)
@@ -430,7 +506,7 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
         fputs(",,,,,,,,,,,,,,,", f);
         fprintf(f, ",%u", q->max_abs_diff);
         csv_num(f, q->psnr_db);
-        fprintf(f, ",%u\n", q->hash_mismatches);
+        fprintf(f, ",%u,,,,,,,,\n", q->hash_mismatches);
     }
     /* Raw: record time in record_ms and record_total_ms, and draws/s. */
     fprintf(f, "raw,%u,%u,,,raw,0,,%u,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
@@ -439,7 +515,10 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
     csv_num(f, rep->raw.record_ms);
     fputs(",,,", f);
     csv_num(f, rep->raw.record_ms > 0 ? rep->raw.draws / (rep->raw.record_ms * 1e-3) : NAN);
-    fputs(",,,,,,,,,,,,,,,,,\n", f);
+    fputs(",,,,,,,,,,,,,,,,,,,,,,,", f);
+    csv_num(f, rep->raw.host_allocs_per_object);
+    csv_num(f, rep->raw.commands_per_object);
+    fputc('\n', f);
     return close_out(f, path);
 }
 

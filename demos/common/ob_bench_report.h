@@ -18,7 +18,6 @@
 #include "ob_bench_run.h"
 #include "ob_bench_stability.h"
 
-#define OB_BENCH_MAX_MODES 8
 
 /* One scene (views × objects) measured in every mode of the list. */
 typedef struct ob_bench_sweep_entry {
@@ -27,11 +26,30 @@ typedef struct ob_bench_sweep_entry {
     ob_bench_result results[OB_BENCH_MAX_MODES];
 } ob_bench_sweep_entry;
 
+/* Ratios between modes are medians of per-round ratios from the idle
+ * rounds, with p25 and p75 beside them (ob_bench_run.h). */
 typedef struct ob_bench_summary {
-    double mt_speedup_record_10k_8views;   /* ST record / best MT record, 10k objects, 8 views */
+    ob_bench_spread mt_speedup_record_10k_8views;  /* ST record / MT record, 10k objects,
+                                                      8 views, the MT mode with the best median */
     const char *mt_speedup_best_mode;      /* the MT mode that was best there */
-    double engine_vs_raw_per_draw;         /* engine ST record ns per draw / raw ns per draw */
-    double auto_vs_best_200;               /* auto frame / min(ST, MT) frame, 200-object scene */
+    /* engine ST record_total per visible object / raw ns per object, 1 view,
+     * raw_objects; both recorded in every idle round */
+    ob_bench_spread engine_vs_raw_per_object;
+    double engine_vs_raw_per_draw;         /* the same median, under its older name */
+    /* auto record_total / min(ST, MT) record_total: 200-object mirror scene,
+     * and 10k objects in 8 views */
+    ob_bench_spread auto_vs_best_200, auto_vs_best_10k_8views;
+    double auto_vs_best_200_frame;         /* auto frame_ms / min(ST, MT) frame_ms (in flight) */
+    /* ST record per draw, 1 view: 50k objects / 1k objects (ratio of medians:
+     * different scenes share no round) */
+    double per_object_growth_50k_vs_1k;
+    /* vkCmd calls per visible object: the engine's estimated from the
+     * pipeline manager's issued counters, the raw loop's counted; in the raw
+     * configuration, ST */
+    double commands_per_object_engine, commands_per_object_raw;
+    /* driver host allocations through the command pools per visible object
+     * (engine: NAN until the engine reports them) */
+    double host_allocs_per_object_engine, host_allocs_per_object_raw;
     uint32_t threading_max_abs_diff;       /* largest image difference of any mode vs ST */
     uint32_t hash_mismatches;              /* frames of any mode whose hash differed from ST's */
     bool threading_identical;              /* both of the above are 0 */
@@ -57,6 +75,7 @@ typedef struct ob_bench_report {
     ob_bench_raw_result raw;                       /* raw Vulkan baseline */
     uint32_t raw_views, raw_objects;               /* the sweep entry it is compared with */
     double engine_ns_per_draw;                     /* that entry's ST record / draws */
+    ob_bench_spread engine_vs_raw;                 /* per-round ratio of the two per draw */
     ob_bench_quality_row *quality;
     uint32_t quality_count;
     ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */

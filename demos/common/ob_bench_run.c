@@ -13,6 +13,7 @@ typedef struct sample {
     double update_ms, pre_render_ms, record_ms, assemble_ms, submit_ms, cpu_frame_ms;
     double cpu_no_update_ms, record_total_ms, gpu_ms, wall_ms;
     double draws, views;
+    double cpu_render_ms, cpu_workers_ms, cpu_max_worker_ms, host_allocs_per_object;
     uint32_t workers;
     ob_pm_stats pm;
     uint64_t hash;
@@ -41,6 +42,27 @@ void ob_bench_set_mode(ob_renderer *r, const ob_bench_mode *m)
     ob_renderer_set_threading(r, m->threading, m->threading == OB_THREADING_SINGLE ? 0 : m->workers);
 }
 
+/* The recording CPU times of st into p. The render thread always records
+ * or assembles something, so its 0 means the engine does not measure: NAN
+ * then, so that medians say "unknown" rather than "free". */
+static void cpu_figures(const ob_frame_stats *st, sample *p)
+{
+    if (st->record_cpu_ns[0] == 0) {
+        p->cpu_render_ms = p->cpu_workers_ms = p->cpu_max_worker_ms = NAN;
+        p->host_allocs_per_object = NAN;
+        return;
+    }
+    uint64_t sum = 0, max = 0;
+    for (uint32_t i = 1; i <= OB_MAX_WORKERS; i++) {
+        sum += st->record_cpu_ns[i];
+        max = OB_MAX(max, st->record_cpu_ns[i]);
+    }
+    p->cpu_render_ms = st->record_cpu_ns[0] * 1e-6;
+    p->cpu_workers_ms = sum * 1e-6;
+    p->cpu_max_worker_ms = max * 1e-6;
+    p->host_allocs_per_object = st->draws ? (double)st->cmd_host_allocs / st->draws : NAN;
+}
+
 /* One frame in mode m, its CPU stats kept as a sample. */
 static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                        uint32_t mode, uint32_t round, sample_kind kind, bool advance)
@@ -61,13 +83,25 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
         .gpu_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
     };
+    cpu_figures(st, p);
     if (desc->tick) desc->tick(desc->tick_user);
     return OB_OK;
+}
+
+/* The round's frames (the last mode_count samples) to the hook, device idle. */
+static ob_result round_hook(const ob_bench_run_desc *desc, const collector *c, uint32_t round,
+                            ob_bench_round_sample *buf)
+{
+    const sample *first = &c->samples[c->count - desc->mode_count];
+    for (uint32_t m = 0; m < desc->mode_count; m++)
+        buf[m] = (ob_bench_round_sample){first[m].record_total_ms, (uint32_t)first[m].draws};
+    return desc->round_hook(desc->round_user, round, round >= desc->warmup, buf);
 }
 
 static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c)
 {
     ob_renderer *r = s->demo->r;
+    ob_bench_round_sample round_modes[OB_BENCH_MAX_MODES];
     for (uint32_t round = 0; round < desc->warmup + desc->rounds; round++) {
         sample_kind kind = round < desc->warmup ? SAMPLE_WARMUP : SAMPLE_IDLE;
         for (uint32_t m = 0; m < desc->mode_count; m++) {
@@ -75,6 +109,10 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
             if (res == OB_OK) res = frame(s, desc, c, m, round, kind, m == 0);
             if (res != OB_OK) return res;
         }
+        if (!desc->round_hook) continue;
+        ob_result res = ob_renderer_wait_idle(r);
+        if (res == OB_OK) res = round_hook(desc, c, round, round_modes);
+        if (res != OB_OK) return res;
     }
     return ob_renderer_wait_idle(r);
 }
@@ -108,6 +146,71 @@ static double field_median(const collector *c, uint32_t mode, sample_kind kind, 
         if (p->mode == mode && p->kind == kind) memcpy(&buf[n++], (const char *)p + offset, sizeof *buf);
     }
     return ob_demo_median(buf, n);
+}
+
+void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (!isnan(values[i])) values[k++] = values[i];
+    if (!k) {
+        *out = (ob_bench_spread){NAN, NAN, NAN};
+        return;
+    }
+    /* ob_demo_median sorts; its median is the 0.5 quantile below. */
+    out->median = ob_demo_median(values, k);
+    double at[2] = {0.25 * (k - 1), 0.75 * (k - 1)};
+    double q[2];
+    for (int i = 0; i < 2; i++) {
+        uint32_t lo = (uint32_t)at[i], hi = OB_MIN(lo + 1, k - 1);
+        q[i] = values[lo] + (values[hi] - values[lo]) * (at[i] - lo);
+    }
+    out->p25 = q[0];
+    out->p75 = q[1];
+}
+
+/* The idle frame of a mode in a round; NULL if it is missing. */
+static const sample *idle_sample(const collector *c, uint32_t mode, uint32_t round)
+{
+    for (uint32_t i = 0; i < c->count; i++) {
+        const sample *p = &c->samples[i];
+        if (p->kind == SAMPLE_IDLE && p->mode == mode && p->round == round) return p;
+    }
+    return NULL;
+}
+
+/* Ratios within each idle round, then their median: both frames of a ratio
+ * saw the same state of the machine, which a ratio of two medians taken
+ * from different frames does not promise. */
+static void round_ratios(const ob_bench_run_desc *desc, const collector *c, double *buf,
+                         ob_bench_result *out)
+{
+    double *best = buf + desc->rounds;
+    for (uint32_t k = 0; k < desc->rounds; k++) {
+        best[k] = INFINITY;
+        for (uint32_t m = 0; m < desc->mode_count; m++) {
+            const sample *p = idle_sample(c, m, desc->warmup + k);
+            if (p && desc->modes[m].threading != OB_THREADING_AUTO)
+                best[k] = fmin(best[k], p->record_total_ms);
+        }
+    }
+    for (uint32_t m = 0; m < desc->mode_count; m++) {
+        ob_bench_spread sp;
+        for (uint32_t k = 0; k < desc->rounds; k++) {
+            const sample *ref = idle_sample(c, 0, desc->warmup + k);
+            const sample *p = idle_sample(c, m, desc->warmup + k);
+            buf[k] = ref && p ? ref->record_total_ms / p->record_total_ms : NAN;
+        }
+        ob_bench_spread_of(buf, desc->rounds, &sp);
+        out[m].speedup_record = sp.median;
+        out[m].speedup_record_p25 = sp.p25;
+        out[m].speedup_record_p75 = sp.p75;
+        for (uint32_t k = 0; k < desc->rounds; k++) {
+            const sample *p = idle_sample(c, m, desc->warmup + k);
+            buf[k] = p && isfinite(best[k]) ? p->record_total_ms / best[k] : NAN;
+        }
+        ob_bench_spread_of(buf, desc->rounds, &out[m].vs_best_fixed_record);
+    }
 }
 
 #define MEDIAN(m, kind, field) field_median(c, m, kind, offsetof(sample, field), buf)
@@ -154,21 +257,33 @@ static void summarize(const ob_bench_run_desc *desc, const collector *c, double 
         o->gpu_ms = MEDIAN(m, SAMPLE_IDLE, gpu_ms);
         o->frame_ms = MEDIAN(m, SAMPLE_FLIGHT, wall_ms);
         o->draws_per_s = o->record_total_ms > 0.0 ? o->draws / (o->record_total_ms * 1e-3) : NAN;
+        o->record_cpu_render_ms = MEDIAN(m, SAMPLE_IDLE, cpu_render_ms);
+        o->record_cpu_workers_ms = MEDIAN(m, SAMPLE_IDLE, cpu_workers_ms);
+        o->record_cpu_max_worker_ms = MEDIAN(m, SAMPLE_IDLE, cpu_max_worker_ms);
+        o->cmd_host_allocs_per_object = MEDIAN(m, SAMPLE_IDLE, host_allocs_per_object);
+        const ob_pm_stats *p = &o->pm;
+        uint64_t commands = (uint64_t)p->draws + p->dispatches + p->pipeline_binds_issued +
+                            p->descriptor_binds_issued + p->push_descriptor_issued +
+                            p->push_constant_issued + p->vertex_binds_issued + p->index_binds_issued;
+        o->commands_per_object = p->draws ? (double)commands / p->draws : NAN;
     }
-    for (uint32_t m = 0; m < desc->mode_count; m++) {
-        out[m].speedup_record = out[0].record_total_ms / out[m].record_total_ms;
+    /* The flight loop runs the modes one after another: no rounds to pair. */
+    for (uint32_t m = 0; m < desc->mode_count; m++)
         out[m].speedup_frame = out[0].frame_ms / out[m].frame_ms;
-    }
+    round_ratios(desc, c, buf, out);
 }
 
 ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
                              ob_bench_result *out)
 {
     ob_renderer *r = s->demo->r;
+    if (desc->mode_count == 0 || desc->mode_count > OB_BENCH_MAX_MODES)
+        return OB_ERR_INVALID_ARGUMENT;
     collector c = {0};
     c.cap = desc->mode_count * (desc->warmup + desc->rounds + desc->flight + 1);
     c.samples = ob_calloc(c.cap, sizeof *c.samples);
-    double *buf = ob_calloc(c.cap, sizeof *buf);
+    /* Medians take up to cap values; round ratios two arrays of rounds. */
+    double *buf = ob_calloc(OB_MAX(c.cap, 2 * desc->rounds), sizeof *buf);
     if (!c.samples || !buf) {
         ob_free(c.samples);
         ob_free(buf);

@@ -11,7 +11,14 @@
  *            Gives the CPU phases, GPU time (timestamps), binds.
  *   flight   per mode, consecutive frames without waiting (frames in
  *            flight, the normal way to run): gives the frame period.
- * Warm-up frames (idle, round-robin) come first. Reported values are medians.
+ * Warm-up frames (idle, round-robin) come first. Reported values are medians;
+ * ratios between modes are medians of per-round ratios (both frames of a
+ * ratio from the same round, so a slow spell of the machine divides out),
+ * with their quartiles. The in-flight loop runs the modes one after another,
+ * so its ratio (speedup_frame) stays a ratio of medians.
+ * An optional hook runs after the modes of every idle round with the device
+ * idle, given that round's recording times: a baseline measured there (the
+ * raw Vulkan loop) shares the rounds' conditions.
  *
  * Lifecycle: fill ob_bench_run_desc → ob_bench_run_modes → read results.
  * Thread rule: render thread; the renderer's stats callback is taken over
@@ -22,6 +29,9 @@
 
 #include "ob_bench_scene.h"
 
+/* Modes one run (and one report entry) holds. */
+#define OB_BENCH_MAX_MODES 8
+
 typedef struct ob_bench_mode {
     const char *name;          /* "ST", "1", "2", "4", "auto" */
     ob_threading threading;
@@ -30,6 +40,23 @@ typedef struct ob_bench_mode {
 
 /* Called once per rendered frame (progress display). */
 typedef void (*ob_bench_tick_fn)(void *user);
+
+/* One mode's frame of an idle round, as the round hook sees it. */
+typedef struct ob_bench_round_sample {
+    double record_total_ms;    /* record + assemble */
+    uint32_t draws;
+} ob_bench_round_sample;
+
+/* After the modes of idle round `round` (warm-up rounds first, measured
+ * false), device idle; modes[m] is mode m's frame of the round. [render
+ * thread]. A result other than OB_OK stops the run with that result. */
+typedef ob_result (*ob_bench_round_fn)(void *user, uint32_t round, bool measured,
+                                       const ob_bench_round_sample *modes);
+
+/* Median and quartiles of values taken one per round. */
+typedef struct ob_bench_spread {
+    double median, p25, p75;   /* NAN when there was no value */
+} ob_bench_spread;
 
 typedef struct ob_bench_run_desc {
     const ob_bench_mode *modes;
@@ -40,6 +67,8 @@ typedef struct ob_bench_run_desc {
     double dt;                 /* scene time step, e.g. 1/60 */
     ob_bench_tick_fn tick;
     void *tick_user;
+    ob_bench_round_fn round_hook;  /* optional */
+    void *round_user;
 } ob_bench_run_desc;
 
 typedef struct ob_bench_result {
@@ -57,17 +86,39 @@ typedef struct ob_bench_result {
     double gpu_ms;             /* timestamps (NAN if unavailable) */
     double draws_per_s;        /* draws / record_total */
     double frame_ms;           /* in-flight frame period (median), NAN without the loop */
-    double speedup_record;     /* reference mode's record_total / this one's */
-    double speedup_frame;      /* reference mode's frame_ms / this one's */
+    double speedup_record;     /* median over idle rounds of (reference mode's record_total /
+                                  this one's) in the same round */
+    double speedup_record_p25, speedup_record_p75;
+    double speedup_frame;      /* reference mode's frame_ms / this one's (ratio of medians) */
+    /* Median over idle rounds of this mode's record_total / the fastest
+     * fixed mode's (ST or MULTI) of the same round: what auto is judged by,
+     * since recording is what it decides on. */
+    ob_bench_spread vs_best_fixed_record;
+    /* Recording CPU time (ob_frame_stats.record_cpu_ns), medians over idle
+     * frames: render thread, sum over workers, busiest worker. NAN when the
+     * engine does not report it (every frame read 0). Next to the wall times
+     * they tell a loaded machine (wall grows, CPU not) from a slow design. */
+    double record_cpu_render_ms, record_cpu_workers_ms, record_cpu_max_worker_ms;
+    /* Median of cmd_host_allocs / draws (NAN when the engine reports no
+     * per-frame CPU or allocation figures). */
+    double cmd_host_allocs_per_object;
+    /* Estimate of vkCmd calls the pipeline manager made per draw: (every
+     * *_issued counter + draws + dispatches) / draws, last measured frame. */
+    double commands_per_object;
     ob_pm_stats pm;            /* bind counters of the last measured frame */
     uint64_t frame_hash;       /* of the last measured frame */
     uint32_t hash_mismatches;  /* measured frames whose hash differed from the reference mode's */
 } ob_bench_result;
 
-/* Runs the loops; out has desc->mode_count entries. Failure: the first
- * frame error (logged); out is then incomplete. */
+/* Runs the loops; out has desc->mode_count entries (1..OB_BENCH_MAX_MODES,
+ * else OB_ERR_INVALID_ARGUMENT). Failure: the first frame or hook error
+ * (logged); out is then incomplete. */
 ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
                              ob_bench_result *out);
+
+/* Median and quartiles (linear interpolation) of the non-NAN values; sorts
+ * them in place. [any thread]. No value: every field NAN. */
+void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out);
 
 /* Sets the renderer's threading mode for the next frame. */
 void ob_bench_set_mode(ob_renderer *r, const ob_bench_mode *m);

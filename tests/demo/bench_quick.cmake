@@ -34,13 +34,52 @@ if(err)
 endif()
 
 set(number "^-?[0-9]+(\\.[0-9]+)?([eE][-+]?[0-9]+)?$")
-foreach(field mt_speedup_record_10k_8views engine_vs_raw_per_draw auto_vs_best_200)
+# Ratios come with their spread over rounds (_p25, _p75).
+set(positive engine_vs_raw_per_draw auto_vs_best_200_frame per_object_growth_50k_vs_1k
+    commands_per_object_engine commands_per_object_raw)
+foreach(field mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_best_200
+        auto_vs_best_10k_8views)
+  list(APPEND positive ${field} ${field}_p25 ${field}_p75)
+endforeach()
+foreach(field ${positive})
   string(JSON type ERROR_VARIABLE err TYPE "${json}" summary ${field})
   string(JSON value ERROR_VARIABLE err2 GET "${json}" summary ${field})
   if(err OR err2 OR NOT type STREQUAL "NUMBER" OR NOT value MATCHES "${number}" OR value LESS_EQUAL 0)
     message(FATAL_ERROR "summary.${field} is not a positive number: '${value}' (${type}) ${err}")
   endif()
 endforeach()
+foreach(spread mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_best_200
+        auto_vs_best_10k_8views)
+  string(JSON lo GET "${json}" summary ${spread}_p25)
+  string(JSON mid GET "${json}" summary ${spread})
+  string(JSON hi GET "${json}" summary ${spread}_p75)
+  if(lo GREATER mid OR mid GREATER hi)
+    message(FATAL_ERROR "summary.${spread}: p25 ${lo}, median ${mid}, p75 ${hi} are out of order")
+  endif()
+endforeach()
+# Host allocations: the raw loop counts its own (a driver may make none); the
+# engine's are null until the recording path reports them.
+foreach(field host_allocs_per_object_raw host_allocs_per_object_engine)
+  string(JSON type ERROR_VARIABLE err TYPE "${json}" summary ${field})
+  if(err OR NOT (type STREQUAL "NUMBER" OR type STREQUAL "NULL"))
+    message(FATAL_ERROR "summary.${field} is missing or not a number: ${type} ${err}")
+  endif()
+endforeach()
+string(JSON type TYPE "${json}" summary host_allocs_per_object_raw)
+if(NOT type STREQUAL "NUMBER")
+  message(FATAL_ERROR "summary.host_allocs_per_object_raw is ${type}: the raw loop counts them itself")
+endif()
+# Per mode: the speedup's spread and the recording CPU times (null until the
+# engine reports them) sit next to the wall times.
+foreach(field speedup_record_p25 speedup_record_p75 vs_best_fixed_record record_cpu_render_ms
+        record_cpu_workers_ms record_cpu_max_worker_ms cmd_host_allocs_per_object
+        commands_per_object)
+  string(JSON type ERROR_VARIABLE err TYPE "${json}" sweep 0 modes 0 ${field})
+  if(err OR NOT (type STREQUAL "NUMBER" OR type STREQUAL "NULL"))
+    message(FATAL_ERROR "sweep[0].modes[0].${field} is missing: ${type} ${err}")
+  endif()
+endforeach()
+
 foreach(field name driver)
   string(JSON value ERROR_VARIABLE err GET "${json}" summary device ${field})
   if(err OR value STREQUAL "")
