@@ -710,9 +710,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     ob_free(by_view);
     if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 1);
     ob_param_registry_end_recording(r->reg);
-    note_cost(r, multi, active, st->record_ns + st->assemble_ns, st->draws);
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
+    note_cost(r, multi, active, st->record_ns + st->assemble_ns, st->draws);
     st->record_cpu_ns[0] = ob_thread_cpu_ns() - cpu0;
     uint64_t allocs1 = allocations(&r->primary_alloc);
     for (uint32_t i = 0; i < r->worker_count; i++) allocs1 += allocations(&r->workers[i].alloc);
