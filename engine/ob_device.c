@@ -699,3 +699,64 @@ bool ob_device_is_lost(const ob_device *dev)
 {
     return atomic_load(&((ob_device *)dev)->lost);
 }
+
+/* ------------------------------------------------------ counting allocator */
+
+/* Blocks carry their start in front of the aligned pointer, so frees and
+ * reallocations of any alignment go back to malloc. */
+typedef struct alloc_header {
+    void *base;
+    size_t size;
+} alloc_header;
+
+static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
+                                     VkSystemAllocationScope scope)
+{
+    (void)scope;
+    ob_counting_allocator *a = user;
+    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
+    uint8_t *base = malloc(size + align + sizeof(alloc_header));
+    if (!base) return NULL;
+    uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+    ((alloc_header *)p)[-1] = (alloc_header){base, size};
+    atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
+    return (void *)p;
+}
+
+static void VKAPI_PTR counted_free(void *user, void *mem)
+{
+    (void)user;
+    if (mem) free(((alloc_header *)mem)[-1].base);
+}
+
+static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
+                                       VkSystemAllocationScope scope)
+{
+    if (!old) return counted_alloc(user, size, align, scope);
+    if (size == 0) {
+        counted_free(user, old);
+        return NULL;
+    }
+    void *mem = counted_alloc(user, size, align, scope);
+    if (!mem) return NULL;
+    size_t old_size = ((alloc_header *)old)[-1].size;
+    memcpy(mem, old, old_size < size ? old_size : size);
+    counted_free(user, old);
+    return mem;
+}
+
+void ob_counting_allocator_init(ob_counting_allocator *a)
+{
+    a->callbacks = (VkAllocationCallbacks){
+        .pUserData = a,
+        .pfnAllocation = counted_alloc,
+        .pfnReallocation = counted_realloc,
+        .pfnFree = counted_free,
+    };
+    atomic_init(&a->allocations, 0);
+}
+
+uint64_t ob_counting_allocator_count(ob_counting_allocator *a)
+{
+    return atomic_load_explicit(&a->allocations, memory_order_relaxed);
+}

@@ -30,6 +30,7 @@
 
 #include "ob_core.h"
 
+#include <stdatomic.h>
 #include <vulkan/vulkan.h>
 
 #ifdef __cplusplus
@@ -163,6 +164,18 @@ ob_result ob_device_wait_idle(ob_device *dev);
  * device refuses new work with OB_ERR_DEVICE_LOST but can still be destroyed. */
 void ob_device_note_result(ob_device *dev, VkResult res);
 bool ob_device_is_lost(const ob_device *dev);
+
+/* VkAllocationCallbacks that count the host allocations a driver makes
+ * through them (malloc underneath, any alignment): give `callbacks` to the
+ * create and destroy calls of one object, a command pool say, to see what
+ * recording into it allocates (lavapipe: a block per command). The count is
+ * atomic: any thread may allocate through it and read it. */
+typedef struct ob_counting_allocator {
+    VkAllocationCallbacks callbacks;
+    atomic_uint_fast64_t allocations;   /* allocations + reallocations */
+} ob_counting_allocator;
+void ob_counting_allocator_init(ob_counting_allocator *a);
+uint64_t ob_counting_allocator_count(ob_counting_allocator *a);
 
 #ifdef __cplusplus
 }

@@ -95,7 +95,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     if (d.device.frames_in_flight > OB_MAX_FRAMES_IN_FLIGHT)
         d.device.frames_in_flight = OB_MAX_FRAMES_IN_FLIGHT;
     r->frames_in_flight = d.device.frames_in_flight;
-    ob_cmd_allocator_init(&r->primary_alloc);
+    ob_counting_allocator_init(&r->primary_alloc);
 
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free;

@@ -26,13 +26,6 @@ typedef struct ob_job {
     int32_t worker;
 } ob_job;
 
-/* Counts the driver's host allocations through a command pool's callbacks
- * (lavapipe allocates one block per recorded command). */
-typedef struct ob_cmd_allocator {
-    VkAllocationCallbacks callbacks;
-    atomic_uint_fast64_t allocations;
-} ob_cmd_allocator;
-
 /* Worker i's recording state: pipeline manager i (parameter slot i), a
  * command pool per frame slot and its secondaries. A batch of worker i is
  * recorded by pool thread i, or, for the last active worker, by the render
@@ -53,7 +46,7 @@ typedef struct ob_worker {
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
     uint64_t cpu_ns;            /* thread CPU time of its last batch */
-    ob_cmd_allocator alloc;
+    ob_counting_allocator alloc;
     ob_result error;
 } ob_worker;
 
@@ -138,7 +131,7 @@ struct ob_renderer {
     bool done_ready;
     atomic_uint next_job;
     bool quit;
-    ob_cmd_allocator primary_alloc; /* the frame slots' pools */
+    ob_counting_allocator primary_alloc; /* the frame slots' pools */
 
     ob_frame_stats_fn stats_fn;
     void *stats_user;
@@ -151,6 +144,5 @@ struct ob_renderer {
 ob_result ob_renderer_workers_start(ob_renderer *r);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
-void ob_cmd_allocator_init(ob_cmd_allocator *a);
 
 #endif /* OB_RENDERER_INTERNAL_H */

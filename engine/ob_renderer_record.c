@@ -5,67 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ------------------------------------------------------------ allocation */
-
-/* Blocks carry their start in front of the aligned pointer, so frees and
- * reallocations of any alignment go back to malloc. */
-typedef struct alloc_header {
-    void *base;
-    size_t size;
-} alloc_header;
-
-static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
-                                     VkSystemAllocationScope scope)
-{
-    (void)scope;
-    ob_cmd_allocator *a = user;
-    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
-    uint8_t *base = malloc(size + align + sizeof(alloc_header));
-    if (!base) return NULL;
-    uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
-    ((alloc_header *)p)[-1] = (alloc_header){base, size};
-    atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
-    return (void *)p;
-}
-
-static void VKAPI_PTR counted_free(void *user, void *mem)
-{
-    (void)user;
-    if (mem) free(((alloc_header *)mem)[-1].base);
-}
-
-static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
-                                       VkSystemAllocationScope scope)
-{
-    if (!old) return counted_alloc(user, size, align, scope);
-    if (size == 0) {
-        counted_free(user, old);
-        return NULL;
-    }
-    void *mem = counted_alloc(user, size, align, scope);
-    if (!mem) return NULL;
-    size_t old_size = ((alloc_header *)old)[-1].size;
-    memcpy(mem, old, old_size < size ? old_size : size);
-    counted_free(user, old);
-    return mem;
-}
-
-void ob_cmd_allocator_init(ob_cmd_allocator *a)
-{
-    a->callbacks = (VkAllocationCallbacks){
-        .pUserData = a,
-        .pfnAllocation = counted_alloc,
-        .pfnReallocation = counted_realloc,
-        .pfnFree = counted_free,
-    };
-    atomic_init(&a->allocations, 0);
-}
-
-static uint64_t allocations(ob_cmd_allocator *a)
-{
-    return atomic_load_explicit(&a->allocations, memory_order_relaxed);
-}
-
 /* ------------------------------------------------------------ worker pool */
 
 static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
@@ -73,7 +12,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     ob_result res;
     w->renderer = r;
     w->index = index;
-    ob_cmd_allocator_init(&w->alloc);
+    ob_counting_allocator_init(&w->alloc);
     if (sem_init(&w->go, 0, 0) != 0) {
         OB_LOG_E("renderer", "worker %u: its wake-up semaphore cannot be created", index);
         return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -588,8 +527,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkDevice vk = ob_device_vk(r->dev);
     VkResult vr;
     uint64_t cpu0 = ob_thread_cpu_ns();
-    uint64_t allocs0 = allocations(&r->primary_alloc);
-    for (uint32_t i = 0; i < r->worker_count; i++) allocs0 += allocations(&r->workers[i].alloc);
+    uint64_t allocs0 = ob_counting_allocator_count(&r->primary_alloc);
+    for (uint32_t i = 0; i < r->worker_count; i++) allocs0 += ob_counting_allocator_count(&r->workers[i].alloc);
     bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
     uint32_t active = multi ? r->active : 0;
     st->workers = active;
@@ -714,8 +653,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
     note_cost(r, multi, active, st->record_ns + st->assemble_ns, st->draws);
     st->record_cpu_ns[0] = ob_thread_cpu_ns() - cpu0;
-    uint64_t allocs1 = allocations(&r->primary_alloc);
-    for (uint32_t i = 0; i < r->worker_count; i++) allocs1 += allocations(&r->workers[i].alloc);
+    uint64_t allocs1 = ob_counting_allocator_count(&r->primary_alloc);
+    for (uint32_t i = 0; i < r->worker_count; i++) allocs1 += ob_counting_allocator_count(&r->workers[i].alloc);
     st->cmd_host_allocs = allocs1 - allocs0;
 
     vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));

@@ -30,60 +30,6 @@ typedef struct raw_draw {
     uint32_t index_count;
 } raw_draw;
 
-/* Driver host allocations through the pool: the callbacks honour the
- * requested alignment by over-allocating and keeping the block's start and
- * size in a header just before the aligned pointer. */
-typedef struct alloc_header {
-    void *base;
-    size_t size;
-} alloc_header;
-
-typedef struct alloc_counter {
-    uint64_t allocs;           /* allocations + reallocations */
-} alloc_counter;
-
-static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
-                                     VkSystemAllocationScope scope)
-{
-    (void)scope;
-    alloc_counter *c = user;
-    if (align < sizeof(void *)) align = sizeof(void *);
-    size_t total = size + align + sizeof(alloc_header);
-    char *base = ob_malloc(total);
-    if (!base) return NULL;
-    uintptr_t at = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
-    alloc_header h = {base, size};
-    memcpy((char *)at - sizeof h, &h, sizeof h);
-    c->allocs++;
-    return (void *)at;
-}
-
-static void VKAPI_PTR counted_free(void *user, void *mem)
-{
-    (void)user;
-    if (!mem) return;
-    alloc_header h;
-    memcpy(&h, (char *)mem - sizeof h, sizeof h);
-    ob_free(h.base);
-}
-
-static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
-                                       VkSystemAllocationScope scope)
-{
-    if (!old) return counted_alloc(user, size, align, scope);
-    if (size == 0) {
-        counted_free(user, old);
-        return NULL;
-    }
-    alloc_header h;
-    memcpy(&h, (char *)old - sizeof h, sizeof h);
-    void *mem = counted_alloc(user, size, align, scope);
-    if (!mem) return NULL;     /* Vulkan: the old block stays valid */
-    memcpy(mem, old, OB_MIN(size, h.size));
-    counted_free(user, old);
-    return mem;
-}
-
 struct ob_bench_raw {
     VkDevice vk;
     VkShaderModule vert, frag;
@@ -95,8 +41,7 @@ struct ob_bench_raw {
     float *push;               /* 32 floats per draw, 32-byte aligned */
     uint32_t count;
     uint32_t width, height;    /* the view's, for viewport and scissor */
-    alloc_counter counter;
-    VkAllocationCallbacks pool_alloc;  /* counting into counter; the pool's only */
+    ob_counting_allocator pool_alloc;  /* the pool's only: driver allocations per draw */
 };
 
 typedef struct ob_bench_raw raw_state;
@@ -181,11 +126,8 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
     VkCommandPoolCreateInfo pci = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                    .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
                                    .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->r))};
-    s->pool_alloc = (VkAllocationCallbacks){.pUserData = &s->counter,
-                                            .pfnAllocation = counted_alloc,
-                                            .pfnReallocation = counted_realloc,
-                                            .pfnFree = counted_free};
-    VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, &s->pool_alloc, &s->pool));
+    ob_counting_allocator_init(&s->pool_alloc);
+    VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, &s->pool_alloc.callbacks, &s->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
                                       .commandPool = s->pool,
@@ -235,7 +177,7 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
                  VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT,
         .pInheritanceInfo = &inherit};
     if (OB_VK_CHECK(vkResetCommandPool(s->vk, s->pool, 0)) != VK_SUCCESS) return OB_ERR_VULKAN;
-    uint64_t allocs0 = s->counter.allocs;
+    uint64_t allocs0 = ob_counting_allocator_count(&s->pool_alloc);
     uint64_t t0 = ob_time_ns();
     if (OB_VK_CHECK(vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return OB_ERR_VULKAN;
     vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s->pipeline);
@@ -267,14 +209,14 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
     /* Pipeline, viewport, scissor, then per draw push + draw, plus binds. */
     *out = (ob_bench_raw_sample){.ns = ns, .draws = s->count, .buffer_binds = binds,
                                  .commands = 3 + 2 * s->count + binds,
-                                 .host_allocs = s->counter.allocs - allocs0};
+                                 .host_allocs = ob_counting_allocator_count(&s->pool_alloc) - allocs0};
     return OB_OK;
 }
 
 void ob_bench_raw_destroy(ob_bench_raw *s)
 {
     if (!s) return;
-    if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc);
+    if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc.callbacks);
     if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
     if (s->layout) vkDestroyPipelineLayout(s->vk, s->layout, NULL);
     if (s->vert) vkDestroyShaderModule(s->vk, s->vert, NULL);
