@@ -506,6 +506,15 @@ static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
     st->culled += v->culled;
 }
 
+/* Driver host allocations through every command pool so far. */
+static uint64_t cmd_allocations(ob_renderer *r)
+{
+    uint64_t n = ob_counting_allocator_count(&r->primary_alloc);
+    for (uint32_t i = 0; i < r->worker_count; i++)
+        n += ob_counting_allocator_count(&r->workers[i].alloc);
+    return n;
+}
+
 /* The measured cost of recording this frame's way (see auto_choice): an
  * average that follows a changed scene within a few frames. */
 static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
@@ -527,8 +536,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkDevice vk = ob_device_vk(r->dev);
     VkResult vr;
     uint64_t cpu0 = ob_thread_cpu_ns();
-    uint64_t allocs0 = ob_counting_allocator_count(&r->primary_alloc);
-    for (uint32_t i = 0; i < r->worker_count; i++) allocs0 += ob_counting_allocator_count(&r->workers[i].alloc);
+    uint64_t allocs0 = cmd_allocations(r);
     bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
     uint32_t active = multi ? r->active : 0;
     st->workers = active;
@@ -653,9 +661,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);
     note_cost(r, multi, active, st->record_ns + st->assemble_ns, st->draws);
     st->record_cpu_ns[0] = ob_thread_cpu_ns() - cpu0;
-    uint64_t allocs1 = ob_counting_allocator_count(&r->primary_alloc);
-    for (uint32_t i = 0; i < r->worker_count; i++) allocs1 += ob_counting_allocator_count(&r->workers[i].alloc);
-    st->cmd_host_allocs = allocs1 - allocs0;
+    st->cmd_host_allocs = cmd_allocations(r) - allocs0;
 
     vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
     if (vr != VK_SUCCESS) {

@@ -32,6 +32,7 @@ void ob_view_release(ob_view *v)
     ob_free(v->sort_scratch);
     v->items = NULL;
     v->sort_scratch = NULL;
+    v->sort_scratch_cap = 0;
     v->item_count = v->item_cap = 0;
 }
 
@@ -112,13 +113,10 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     v->item_count = 0;
     v->culled = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
-    uint32_t cap = v->item_cap;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
-    if (res == OB_OK && (v->item_cap != cap || !v->sort_scratch) && v->item_cap > 0) {
-        ob_draw_item *scratch = ob_realloc(v->sort_scratch, sizeof *scratch * v->item_cap);
-        if (scratch) v->sort_scratch = scratch;
-        else res = OB_ERR_OUT_OF_HOST_MEMORY;
-    }
+    if (res == OB_OK)
+        res = ob_array_reserve((void **)&v->sort_scratch, &v->sort_scratch_cap, count,
+                               sizeof *v->sort_scratch);
     if (res != OB_OK) {
         /* The view goes on empty this frame; the next frame tries again. */
         OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",

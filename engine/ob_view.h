@@ -105,7 +105,8 @@ struct ob_view {
     /* Per frame, filled during pre_draw; owned by the view. */
     ob_draw_item *items;
     uint32_t item_count, item_cap;
-    ob_draw_item *sort_scratch;     /* item_cap entries: the radix sort's other buffer */
+    ob_draw_item *sort_scratch;     /* the radix sort's other buffer */
+    uint32_t sort_scratch_cap;
     uint32_t culled;                  /* entities rejected by frustum or render flag */
     uint32_t recursion_depth;         /* how deep in the PreRender chain it was queued */
     ob_view *deps[OB_VIEW_MAX_DEPS];  /* views that must execute before this one */
