@@ -212,6 +212,33 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16])
     memcpy(dest, r, sizeof r);
 }
 
+void ob_mat4_normal_cofactor(const float w[16], float dest[16])
+{
+    float c[3][3], largest = 0.0f;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            c[i][k] = w[i * 4 + k];
+            float a = c[i][k] < 0.0f ? -c[i][k] : c[i][k];
+            largest = a > largest ? a : largest;
+        }
+    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
+        int exponent;
+        frexpf(largest, &exponent);
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) c[i][k] = ldexpf(c[i][k], -exponent);
+    }
+    /* Column i is c[i+1] x c[i+2]. */
+    for (int i = 0; i < 3; i++) {
+        const float *a = c[(i + 1) % 3], *b = c[(i + 2) % 3];
+        dest[i * 4 + 0] = a[1] * b[2] - a[2] * b[1];
+        dest[i * 4 + 1] = a[2] * b[0] - a[0] * b[2];
+        dest[i * 4 + 2] = a[0] * b[1] - a[1] * b[0];
+        dest[i * 4 + 3] = 0.0f;
+    }
+    dest[12] = dest[13] = dest[14] = 0.0f;
+    dest[15] = 1.0f;
+}
+
 void ob_math_perspective_reverse_z(float fovy, float aspect, float znear, float dest[16])
 {
     /* clip.z = znear and clip.w = -z, so depth = znear / -z: exactly 1 on the

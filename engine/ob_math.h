@@ -138,6 +138,14 @@ void ob_daffine_to_relative(const ob_daffine *a, const double origin[3], float d
 void ob_mat4_identity(float dest[16]);
 /* dest = a * b. dest may alias a or b. */
 void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
+/* The normal matrix of world w (column-major): the cofactor matrix of its
+ * upper 3x3 (columns c1×c2, c2×c0, c0×c1), i.e. det · inverse-transpose:
+ * correct for non-uniform scale, finite for zero scale, and the shader
+ * normalizes anyway. It grows as scale²; outside 2^±60 the columns are first
+ * scaled by a power of two (exact; only the direction matters), so it neither
+ * overflows nor turns denormal for any finite w. Row and column 3 are those
+ * of the identity. */
+void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
 
 /* Infinite reversed-Z perspective for Vulkan clip space: a view-space point
  * at z = -znear gets depth 1, depth → 0 as -z → infinity, and +Y up in view

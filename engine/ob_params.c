@@ -223,6 +223,15 @@ ob_param_registry *ob_param_registry_create(const ob_param_registry_desc *desc,
     }
     reg->slot_count = slots;
     ob_pool_init(&reg->pool);
+    reg->slot_serials = ob_aligned_alloc(OB_CACHE_LINE, (size_t)slots * OB_CACHE_LINE);
+    if (!reg->slot_serials) {
+        OB_LOG_E("params", "registry: out of host memory");
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        ob_param_registry_destroy(reg);
+        reg = NULL;
+        goto done;
+    }
+    memset(reg->slot_serials, 0, (size_t)slots * OB_CACHE_LINE);
 
     ob_param *role_handle[OB_PARAM_ROLE_COUNT] = {
         [OB_PARAM_ROLE_WORLD] = &reg->builtins.world,
@@ -263,6 +272,7 @@ void ob_param_registry_destroy(ob_param_registry *reg)
     while ((info = ob_pool_next(&reg->pool, &cursor, NULL))) info_free(info);
     ob_pool_release(&reg->pool);
     ob_free(reg->names);
+    ob_aligned_free(reg->slot_serials);
     ob_free(reg);
 }
 

@@ -195,6 +195,10 @@ ob_result ob_params_get_bytes(const ob_params *pm, ob_param p, uint32_t size, vo
 const void *ob_params_value_ptr(const ob_params *pm, ob_param p);
 /* The slot's value id: 0 = never written; grows by one per real change. */
 uint64_t ob_params_value_id(const ob_params *pm, ob_param p);
+/* Grows by one per real change of any value in the slot (a write of an equal
+ * value changes nothing): equal serials mean every value is as it was. 0 for
+ * a NULL manager or bad slot. [worker: own slot only] */
+uint64_t ob_params_serial(const ob_params *pm);
 
 /* ------------------------------------------------------------------ packing */
 
@@ -216,6 +220,15 @@ void ob_param_mapping_destroy(ob_param_mapping *map);
 uint32_t ob_param_mapping_block_size(const ob_param_mapping *map);
 uint32_t ob_param_mapping_unmapped_count(const ob_param_mapping *map);
 uint32_t ob_param_mapping_mapped_count(const ob_param_mapping *map);
+
+/* True when a mapped member is the world matrix or one derived from it
+ * (world-view, world-view-projection, normal): the block changes per draw. */
+bool ob_param_mapping_reads_world(const ob_param_mapping *map);
+/* True when the block is exactly the standard per-draw block: 128 bytes,
+ * WorldMatrix at 0 and NormalMatrix at 64 and nothing else (materials/
+ * shaders/common.glsl's PerDraw). The pipeline manager fills such a block
+ * from ob_pm_set_world directly. */
+bool ob_param_mapping_is_world_normal(const ob_param_mapping *map);
 
 /* True when some mapped parameter's value id in pm's slot differs from the
  * one last packed for that slot, or the slot never packed. False (logged) for

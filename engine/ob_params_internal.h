@@ -67,7 +67,17 @@ struct ob_param_registry {
     uint32_t names_cap;
     ob_param_builtins builtins;
     ob_param_info *role_info[OB_PARAM_ROLE_COUNT];
+    /* Per slot, on its own cache line (OB_SERIAL_STRIDE words apart): grows
+     * by one per real change of any value in that slot. */
+    uint64_t *slot_serials;
 };
+
+#define OB_SERIAL_STRIDE (OB_CACHE_LINE / sizeof(uint64_t))
+
+static inline void ob_param_slot_changed(const ob_param_registry *reg, uint32_t slot)
+{
+    reg->slot_serials[(size_t)slot * OB_SERIAL_STRIDE]++;
+}
 
 /* The parameter for p, or NULL (no log) if p is zero or stale. Lock-free:
  * the tables only change outside recording. */

@@ -245,6 +245,41 @@ bool ob_params_pack(const ob_params *pm, ob_param_mapping *map, void *dst, bool 
     return true;
 }
 
+static bool reads_world(const ob_param_info *info)
+{
+    switch (info->derive_role) {
+    case OB_PARAM_ROLE_WORLD:
+    case OB_PARAM_ROLE_WORLD_VIEW:
+    case OB_PARAM_ROLE_WORLD_VIEW_PROJ:
+    case OB_PARAM_ROLE_NORMAL:
+        return true;
+    default:
+        return false;
+    }
+}
+
+bool ob_param_mapping_reads_world(const ob_param_mapping *map)
+{
+    if (!map) return false;
+    for (uint32_t i = 0; i < map->entry_count; i++)
+        if (reads_world(map->entries[i].info)) return true;
+    return false;
+}
+
+bool ob_param_mapping_is_world_normal(const ob_param_mapping *map)
+{
+    if (!map || map->block_size != 128 || map->entry_count != 2) return false;
+    const map_entry *w = &map->entries[0], *n = &map->entries[1];
+    if (w->offset > n->offset) {
+        const map_entry *t = w;
+        w = n;
+        n = t;
+    }
+    return w->info->derive_role == OB_PARAM_ROLE_WORLD && w->offset == 0 &&
+           w->elem_count == 1 && n->info->derive_role == OB_PARAM_ROLE_NORMAL &&
+           n->offset == 64 && n->elem_count == 1;
+}
+
 uint64_t *ob_param_mapping_slot_user(ob_param_mapping *map, uint32_t slot)
 {
     if (!map || slot >= map->slot_count) {

@@ -2,6 +2,8 @@
  * ids, and the derived built-in matrices. */
 #include "ob_params_internal.h"
 
+#include "ob_math.h"
+
 #include <cglm/cglm.h>
 #include <stdio.h>
 #include <string.h>
@@ -97,8 +99,8 @@ static ob_result fail_null(const ob_param_info *info, uint32_t slot, const char 
 
 /* Compare, then copy: the value id moves only on a real change (or the
  * first write, so "never written" stays distinguishable from zeros). */
-static bool cell_store(const ob_param_info *info, uint32_t slot, const void *src,
-                       uint32_t offset, uint32_t size)
+static bool cell_store(const ob_param_registry *reg, const ob_param_info *info, uint32_t slot,
+                       const void *src, uint32_t offset, uint32_t size)
 {
     unsigned char *cell = ob_param_cell(info, slot);
     uint64_t *id = (uint64_t *)(void *)cell;
@@ -106,6 +108,7 @@ static bool cell_store(const ob_param_info *info, uint32_t slot, const void *src
     if (size == 0 || (*id != 0 && memcmp(val, src, size) == 0)) return false;
     memcpy(val, src, size);
     ++*id;
+    ob_param_slot_changed(reg, slot);
     return true;
 }
 
@@ -113,10 +116,10 @@ static void store(const ob_param_registry *reg, const ob_param_info *info, uint3
                   const void *src, uint32_t offset, uint32_t size)
 {
     if (slot != ALL_SLOTS) {
-        cell_store(info, slot, src, offset, size);
+        cell_store(reg, info, slot, src, offset, size);
         return;
     }
-    for (uint32_t s = 0; s < reg->slot_count; s++) cell_store(info, s, src, offset, size);
+    for (uint32_t s = 0; s < reg->slot_count; s++) cell_store(reg, info, s, src, offset, size);
 }
 
 static bool all_finite(const float *f, size_t n)
@@ -138,33 +141,6 @@ typedef struct derived {
     mat4 world_view, view_proj, world_view_proj, normal;
 } derived;
 
-/* Cofactor matrix of the upper 3x3 (columns c1×c2, c2×c0, c0×c1) = det ·
- * inverse-transpose: correct for non-uniform scale, finite for zero scale,
- * and the shader normalizes anyway. It grows as scale²: past a scale of
- * ~1e19 it would overflow (and the whole World write be refused), below
- * ~1e-19 it would be denormal (flushed to zero on GPUs). Outside 2^±60 the
- * columns are first scaled by a power of two — exact, and the direction is
- * all the shader uses. */
-static void normal_from_world(mat4 w, mat4 dest)
-{
-    float largest = 0.0f;
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) largest = fmaxf(largest, fabsf(w[i][k]));
-    vec3 c[3];
-    for (int i = 0; i < 3; i++) glm_vec3_copy(w[i], c[i]);
-    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
-        int exponent;
-        frexpf(largest, &exponent);
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++) c[i][k] = ldexpf(c[i][k], -exponent);
-    }
-    glm_mat4_zero(dest);
-    glm_vec3_cross(c[1], c[2], dest[0]);
-    glm_vec3_cross(c[2], c[0], dest[1]);
-    glm_vec3_cross(c[0], c[1], dest[2]);
-    dest[3][3] = 1.0f;
-}
-
 /* Derived matrices of slot with source `role` replaced by src; returns false
  * if any is non-finite (products of huge finite values can overflow). */
 static bool derive(const ob_param_registry *reg, uint32_t slot, uint32_t role,
@@ -181,7 +157,7 @@ static bool derive(const ob_param_registry *reg, uint32_t slot, uint32_t role,
     bool ok = all_finite(&d->world_view[0][0], 16) && all_finite(&d->view_proj[0][0], 16) &&
               all_finite(&d->world_view_proj[0][0], 16);
     if (role == OB_PARAM_ROLE_WORLD) {
-        normal_from_world(m[0], d->normal);
+        ob_mat4_normal_cofactor((const float *)(const void *)m[0], (float *)(void *)d->normal);
         ok = ok && all_finite(&d->normal[0][0], 16);
     }
     return ok;
@@ -192,12 +168,12 @@ static void store_derived(const ob_param_registry *reg, uint32_t slot, uint32_t 
 {
     ob_param_info *const *out = reg->role_info;
     if (role != OB_PARAM_ROLE_PROJ)
-        cell_store(out[OB_PARAM_ROLE_WORLD_VIEW], slot, d->world_view, 0, 64);
+        cell_store(reg, out[OB_PARAM_ROLE_WORLD_VIEW], slot, d->world_view, 0, 64);
     if (role != OB_PARAM_ROLE_WORLD)
-        cell_store(out[OB_PARAM_ROLE_VIEW_PROJ], slot, d->view_proj, 0, 64);
-    cell_store(out[OB_PARAM_ROLE_WORLD_VIEW_PROJ], slot, d->world_view_proj, 0, 64);
+        cell_store(reg, out[OB_PARAM_ROLE_VIEW_PROJ], slot, d->view_proj, 0, 64);
+    cell_store(reg, out[OB_PARAM_ROLE_WORLD_VIEW_PROJ], slot, d->world_view_proj, 0, 64);
     if (role == OB_PARAM_ROLE_WORLD)
-        cell_store(out[OB_PARAM_ROLE_NORMAL], slot, d->normal, 0, 64);
+        cell_store(reg, out[OB_PARAM_ROLE_NORMAL], slot, d->normal, 0, 64);
 }
 
 /* A world/view/proj write: every affected slot is checked before any is
@@ -221,7 +197,7 @@ static ob_result store_transform(const ob_param_registry *reg, const ob_param_in
         }
     }
     for (uint32_t s = first; s < end; s++) {
-        if (!cell_store(info, s, src, 0, 64)) continue;
+        if (!cell_store(reg, info, s, src, 0, 64)) continue;
         if (end - first > 1) derive(reg, s, role, src, &d);
         store_derived(reg, s, role, &d);
     }
@@ -309,6 +285,12 @@ static ob_result write_bytes(ob_param_registry *reg, uint32_t slot, ob_param p,
     }
     store(reg, info, slot, data, 0, size);
     return OB_OK;
+}
+
+uint64_t ob_params_serial(const ob_params *pm)
+{
+    if (!pm || !pm->reg || pm->slot >= pm->reg->slot_count) return 0;
+    return pm->reg->slot_serials[(size_t)pm->slot * OB_SERIAL_STRIDE];
 }
 
 #define PM_REG(pm) ((pm) ? (pm)->reg : NULL)

@@ -1,5 +1,6 @@
 #include "ob_pipeline_manager.h"
 
+#include "ob_math.h"
 #include "ob_resources_internal.h"
 
 #include <stdio.h>
@@ -61,6 +62,7 @@ typedef struct bound_state {
     uint8_t push[128];
     bool push_valid;
     VkBuffer vb, ib;
+    uint32_t vb_id, ib_id;      /* handles of vb and ib: an equal id needs no lookup */
     uint64_t vb_offset, ib_offset;
     VkIndexType index_type;
     VkViewport viewport;
@@ -96,29 +98,23 @@ struct ob_pipeline_manager {
     VkRect2D scissor;
     bool viewport_set, scissor_set;
 
+    float world[16];            /* ob_pm_set_world's, for the next draw */
+    bool world_pending;
+
+    /* What the last full apply of uniforms and resources was made from: while
+     * the program and the slot's parameter serial are unchanged, the bound
+     * sets are still right and their hash is reused. */
+    const ob_program *applied_program;
+    uint64_t applied_serial;
+    uint64_t applied_hash;
+    uint32_t applied_ubos, applied_resources;  /* blocks reused / pushes requested */
+
     ob_cmd_hash hash;
     ob_pm_stats stats;
     bool logged_error;
 };
 
 /* ------------------------------------------------------------ utilities */
-
-static uint64_t hash_words(uint64_t h, const void *data, size_t size)
-{
-    const uint8_t *p = data;
-    size_t i = 0;
-    for (; i + 8 <= size; i += 8) {
-        uint64_t w;
-        memcpy(&w, p + i, 8);
-        h = ob_hash_u64(h, w);
-    }
-    if (i < size) {
-        uint64_t w = 0;
-        memcpy(&w, p + i, size - i);
-        h = ob_hash_u64(h, w);
-    }
-    return h;
-}
 
 static void log_once(ob_pipeline_manager *pm, const char *what)
 {
@@ -255,6 +251,8 @@ void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd)
     pm->program = NULL;
     pm->vb = pm->ib = (ob_buffer){0};
     pm->viewport_set = pm->scissor_set = false;
+    pm->world_pending = false;
+    pm->applied_program = NULL;
     pm->hash = ob_cmd_hash_empty();
 }
 
@@ -277,6 +275,12 @@ void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t p
     pm->pipeline = pipeline;
     pm->pipeline_id = pipeline_id;
     pm->program = program;
+}
+
+void ob_pm_set_world(ob_pipeline_manager *pm, const float world[16])
+{
+    memcpy(pm->world, world, sizeof pm->world);
+    pm->world_pending = true;
 }
 
 void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
@@ -504,7 +508,7 @@ static ob_result apply_uniforms(ob_pipeline_manager *pm, const ob_program *prog,
             uint8_t *dst = pm->ring->chunks[c].mapped + off;
             ob_params_pack(&pm->params, prog->ubos[i].mapping, dst, true);
             *entries[i] = (pack_entry){prog->ubos[i].mapping, pm->frame_serial, true, c, off,
-                                       hash_words(OB_HASH_SEED, dst, prog->ubos[i].size)};
+                                       ob_hash_block(OB_HASH_SEED, dst, prog->ubos[i].size)};
             pack[i] = false;
             pm->stats.blocks_packed++;
             pm->stats.uniform_bytes += prog->ubos[i].size;
@@ -627,12 +631,36 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
     return OB_OK;
 }
 
-static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, uint64_t *h)
+static bool all_finite(const float *f, size_t n)
 {
-    if (!prog->push_mapping) return;
-    uint8_t bytes[128];
-    ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
-    *h = hash_words(*h, bytes, prog->push_size);
+    uint32_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits;
+        memcpy(&bits, &f[i], sizeof bits);
+        bad |= (bits & 0x7f800000u) == 0x7f800000u;
+    }
+    return !bad;
+}
+
+/* The push block from parameters, or for the standard per-draw block from
+ * the world matrix given with the draw (world = true): then the normal matrix
+ * is made here, as the parameters would derive it. False = not finite. */
+static bool apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, bool world,
+                                 uint64_t *h)
+{
+    if (!prog->push_mapping) return true;
+    _Alignas(16) uint8_t bytes[128];
+    if (world && prog->push_world_normal) {
+        float *f = (float *)(void *)bytes;
+        memcpy(f, pm->world, 64);
+        ob_mat4_normal_cofactor(pm->world, f + 16);
+        if (!all_finite(f, 32)) return false;
+        /* The normal matrix follows from the world matrix: hash the input. */
+        *h = ob_hash_block(*h, pm->world, 64);
+    } else {
+        ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
+        *h = ob_hash_block(*h, bytes, prog->push_size);
+    }
     pm->stats.push_constant_requested++;
     if (!pm->cur.push_valid || memcmp(pm->cur.push, bytes, prog->push_size) != 0) {
         vkCmdPushConstants(pm->cmd, prog->layout, prog->push_stages, 0, prog->push_size, bytes);
@@ -640,6 +668,7 @@ static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog
         pm->cur.push_valid = true;
         pm->stats.push_constant_issued++;
     }
+    return true;
 }
 
 /* Everything a draw or dispatch needs, bound only where it differs. Returns
@@ -652,6 +681,19 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->stats.skipped_draws++;
         log_once(pm, "no pipeline set");
         return OB_ERR_WRONG_STATE;
+    }
+    bool world = pm->world_pending;
+    pm->world_pending = false;
+    if (world && !prog->push_world_normal) {
+        /* Another push layout, or a uniform block reads the world: the
+         * parameters derive what the program reads. */
+        ob_result wr = ob_params_set_mat4(&pm->params,
+                                          ob_param_registry_builtins(pm->params.reg)->world,
+                                          pm->world);
+        if (wr != OB_OK) {
+            pm->stats.skipped_draws++;
+            return wr;
+        }
     }
     *h = ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id);
 
@@ -667,57 +709,82 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->cur.set0 = VK_NULL_HANDLE;
         pm->cur.resources_valid = false;
         pm->cur.push_valid = false;
+        pm->applied_program = NULL;
     }
-    ob_param bad = {0};
-    ob_result r = apply_uniforms(pm, prog, h);
-    if (r == OB_OK) r = apply_resources(pm, prog, h, &bad);
-    if (r != OB_OK) {
-        pm->stats.skipped_draws++;
-        if (r == OB_ERR_INVALID_HANDLE) {
-            char what[160];
-            snprintf(what, sizeof what, "parameter '%s' of program '%s' holds an invalid or "
-                     "stale handle", ob_param_name(pm->params.reg, bad), prog->name);
-            log_once(pm, what);
-        } else {
-            log_once(pm, ob_result_text(r));
+    uint64_t serial = ob_params_serial(&pm->params);
+    if (pm->applied_program == prog && pm->applied_serial == serial) {
+        /* No parameter changed since this program's sets were bound. */
+        pm->stats.blocks_reused += pm->applied_ubos;
+        pm->stats.descriptor_binds_requested += pm->applied_ubos ? 1u : 0u;
+        pm->stats.push_descriptor_requested += pm->applied_resources ? 1u : 0u;
+        *h = ob_hash_u64(*h, pm->applied_hash);
+    } else {
+        uint64_t hs = OB_HASH_SEED;
+        ob_param bad = {0};
+        pm->applied_program = NULL;
+        ob_result r = apply_uniforms(pm, prog, &hs);
+        if (r == OB_OK) r = apply_resources(pm, prog, &hs, &bad);
+        if (r != OB_OK) {
+            pm->stats.skipped_draws++;
+            if (r == OB_ERR_INVALID_HANDLE) {
+                char what[160];
+                snprintf(what, sizeof what, "parameter '%s' of program '%s' holds an invalid or "
+                         "stale handle", ob_param_name(pm->params.reg, bad), prog->name);
+                log_once(pm, what);
+            } else {
+                log_once(pm, ob_result_text(r));
+            }
+            return r;
         }
-        return r;
+        pm->applied_program = prog;
+        pm->applied_serial = serial;
+        pm->applied_hash = hs;
+        pm->applied_ubos = prog->ubo_count;
+        pm->applied_resources = prog->resource_count;
+        *h = ob_hash_u64(*h, hs);
     }
-    apply_push_constants(pm, prog, h);
+    if (!apply_push_constants(pm, prog, world, h)) {
+        pm->stats.skipped_draws++;
+        return OB_ERR_NON_FINITE;
+    }
     if (prog->bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return OB_OK;
 
+    /* A buffer bound in this command buffer is still valid (resources are
+     * not destroyed while recording): an equal handle skips the lookup. */
     if (pm->vb.id) {
-        VkBuffer vb = ob_buffer_vk(pm->dev, pm->vb);
-        if (!vb) {
-            pm->stats.skipped_draws++;
-            log_once(pm, "the vertex buffer handle is invalid");
-            return OB_ERR_INVALID_HANDLE;
-        }
-        pm->stats.vertex_binds_requested++;
-        if (vb != pm->cur.vb || pm->vb_offset != pm->cur.vb_offset) {
+        if (pm->vb.id != pm->cur.vb_id || pm->vb_offset != pm->cur.vb_offset) {
+            VkBuffer vb = ob_buffer_vk(pm->dev, pm->vb);
+            if (!vb) {
+                pm->stats.skipped_draws++;
+                log_once(pm, "the vertex buffer handle is invalid");
+                return OB_ERR_INVALID_HANDLE;
+            }
             vkCmdBindVertexBuffers(pm->cmd, 0, 1, &vb, &pm->vb_offset);
             pm->cur.vb = vb;
+            pm->cur.vb_id = pm->vb.id;
             pm->cur.vb_offset = pm->vb_offset;
             pm->stats.vertex_binds_issued++;
         }
+        pm->stats.vertex_binds_requested++;
         *h = ob_hash_u64(*h, ((uint64_t)pm->vb.id << 32) ^ pm->vb_offset);
     }
     if (indexed) {
-        VkBuffer ib = ob_buffer_vk(pm->dev, pm->ib);
-        if (!ib) {
-            pm->stats.skipped_draws++;
-            log_once(pm, "the index buffer handle is invalid");
-            return OB_ERR_INVALID_HANDLE;
-        }
-        pm->stats.index_binds_requested++;
-        if (ib != pm->cur.ib || pm->ib_offset != pm->cur.ib_offset ||
+        if (!pm->ib.id || pm->ib.id != pm->cur.ib_id || pm->ib_offset != pm->cur.ib_offset ||
             pm->index_type != pm->cur.index_type) {
+            VkBuffer ib = ob_buffer_vk(pm->dev, pm->ib);
+            if (!ib) {
+                pm->stats.skipped_draws++;
+                log_once(pm, "the index buffer handle is invalid");
+                return OB_ERR_INVALID_HANDLE;
+            }
             vkCmdBindIndexBuffer(pm->cmd, ib, pm->ib_offset, pm->index_type);
             pm->cur.ib = ib;
+            pm->cur.ib_id = pm->ib.id;
             pm->cur.ib_offset = pm->ib_offset;
             pm->cur.index_type = pm->index_type;
             pm->stats.index_binds_issued++;
         }
+        pm->stats.index_binds_requested++;
         *h = ob_hash_u64(*h, ((uint64_t)pm->ib.id << 32) ^ pm->ib_offset);
     }
     if (pm->viewport_set &&

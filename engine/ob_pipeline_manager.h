@@ -87,15 +87,27 @@ ob_params *ob_pm_params(ob_pipeline_manager *pm);
 /* Desired state. The pipeline id is stable (for hashes). */
 void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
                         const ob_program *program);
+/* The world matrix (16 floats, column-major, camera-relative) of the next
+ * draw only. A program whose push block is the standard per-draw block
+ * (ob_program.push_world_normal) gets it and its normal matrix straight in
+ * its push constants, and the parameters are left alone, so the bound sets
+ * stay valid from one draw to the next; any other program gets it as the
+ * WorldMatrix parameter (with the derived matrices) before the draw. */
+void ob_pm_set_world(ob_pipeline_manager *pm, const float world[16]);
 void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset);
 void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
                             VkIndexType type);
 void ob_pm_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h);
 void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h);
 
-/* Draws apply the desired state, then record. They return OB_ERR_WRONG_STATE
- * (no pipeline), OB_ERR_INVALID_HANDLE (a stale buffer/image parameter) or
- * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) and skip the draw. */
+/* Draws apply the desired state, then record. Uniform blocks and resources
+ * are applied again only when the program or some parameter of the slot
+ * changed since the last draw. They return OB_ERR_WRONG_STATE (no pipeline),
+ * OB_ERR_INVALID_HANDLE (a stale buffer/image parameter),
+ * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) or OB_ERR_NON_FINITE (the
+ * world matrix given with ob_pm_set_world, or a matrix derived from it, is
+ * not finite; not logged here, the caller names the entity) and skip the
+ * draw. */
 ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
                      uint32_t first_vertex, uint32_t first_instance);
 ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,

@@ -178,6 +178,9 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
             r = OB_ERR_UNSUPPORTED;
             goto fail_free;
         }
+        prog->push_world_normal = ob_param_mapping_is_world_normal(prog->push_mapping);
+        for (uint32_t i = 0; i < prog->ubo_count; i++)
+            if (ob_param_mapping_reads_world(prog->ubos[i].mapping)) prog->push_world_normal = false;
     }
 
     VkDescriptorSetLayoutCreateInfo set0 = {

@@ -60,6 +60,10 @@ typedef struct ob_program {
     ob_param_mapping *push_mapping; /* NULL when the program has no push constants */
     uint32_t push_size;
     VkShaderStageFlags push_stages;
+    /* The push block is the standard per-draw block (WorldMatrix, NormalMatrix)
+     * and no uniform block reads the world matrix: a draw's world matrix goes
+     * straight into the push constants, not through the parameters. */
+    bool push_world_normal;
 } ob_program;
 
 /* Builds set layouts, the pipeline layout and parameter mappings. Errors: a

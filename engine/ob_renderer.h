@@ -29,6 +29,15 @@
 
 /* The engine calls up into materials and geometry through these (filled by
  * the higher layers: see ob_views_install in views/ob_views.h). */
+/* What a material's apply did. */
+typedef enum ob_apply_result {
+    OB_APPLY_SKIP = 0,      /* not drawn in this view */
+    OB_APPLY_ENTITY = 1,    /* applied, for this entity only: apply again for the next */
+    OB_APPLY_MATERIAL = 2,  /* applied, and the same for every entity with this
+                             * material in this view: the next one of those may
+                             * be drawn without applying again */
+} ob_apply_result;
+
 typedef struct ob_material_iface {
     /* Render flag for the view type (Hieroglyph's Params[type].bRender). */
     bool (*renders)(const struct ob_material *m, ob_view_type type);
@@ -40,9 +49,11 @@ typedef struct ob_material_iface {
     /* An entity with this material is visible to view v: queue what it needs
      * (env maps, ...), and make the pipeline for v's targets exist (render thread). */
     void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
-    /* Set the pipeline and the material's parameters for v. false = not drawn. */
-    bool (*apply)(struct ob_material *m, ob_node *entity, ob_renderer *r,
-                  ob_pipeline_manager *pm, const ob_view *v);
+    /* Set the pipeline and the material's parameters for v. Views draw the
+     * entities of a state group one after another and apply once per run of
+     * the same material when it answers OB_APPLY_MATERIAL. */
+    ob_apply_result (*apply)(struct ob_material *m, ob_node *entity, ob_renderer *r,
+                             ob_pipeline_manager *pm, const ob_view *v);
 } ob_material_iface;
 
 typedef struct ob_geometry_iface {

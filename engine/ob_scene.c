@@ -49,6 +49,7 @@ struct ob_node {
     bool renderable_now;     /* in the current snapshot's sense */
     bool fault_reported;     /* an error line about this node's own transform is out */
     bool dying;              /* marked while its subtree is being destroyed */
+    uint32_t proxy_index;    /* in the snapshot's proxies while renderable_now */
     char name[];
 };
 
@@ -65,6 +66,8 @@ struct ob_scene {
     uint32_t order_count, order_cap;
     ob_node **renderables;
     uint32_t renderable_count, renderable_cap;
+    ob_render_proxy *proxies;   /* parallel to renderables */
+    uint32_t proxy_cap;
     ob_node **lights;
     uint32_t light_count, light_cap;
 };
@@ -213,6 +216,7 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->by_id);
     ob_free(s->order);
     ob_free(s->renderables);
+    ob_free(s->proxies);
     ob_free(s->lights);
     ob_free(s);
 }
@@ -235,6 +239,13 @@ ob_node *const *ob_scene_renderables(const ob_scene *s, uint32_t *out_count)
 {
     *out_count = s->renderable_count;
     return s->renderables ? s->renderables : empty_snapshot;
+}
+
+const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_count)
+{
+    static const ob_render_proxy none[1];
+    *out_count = s->renderable_count;
+    return s->proxies ? s->proxies : none;
 }
 
 ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count)
@@ -288,6 +299,40 @@ static uint32_t filter_dying(ob_node **items, uint32_t count)
     return w;
 }
 
+/* filter_dying for the renderables and their proxies together. */
+static void filter_dying_renderables(ob_scene *s)
+{
+    uint32_t w = 0;
+    for (uint32_t r = 0; r < s->renderable_count; r++) {
+        ob_node *n = s->renderables[r];
+        if (n->dying) continue;
+        s->renderables[w] = n;
+        s->proxies[w] = s->proxies[r];
+        n->proxy_index = w++;
+    }
+    s->renderable_count = w;
+}
+
+static void proxy_set_renderable(ob_render_proxy *p, const ob_node *n)
+{
+    p->material = n->has_renderable ? n->renderable.material : NULL;
+    p->geometry = n->has_renderable ? n->renderable.geometry : NULL;
+    p->local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
+}
+
+static void proxy_fill(ob_render_proxy *p, ob_node *n)
+{
+    for (int c = 0; c < 3; c++) {
+        for (int r = 0; r < 3; r++) p->linear[c * 3 + r] = (float)n->world.m[c * 3 + r];
+        p->world_t[c] = n->world.t[c];
+        p->center[c] = n->world_center[c];
+    }
+    p->radius = n->world_radius;
+    p->node = n;
+    p->node_id = n->id;
+    proxy_set_renderable(p, n);
+}
+
 void ob_node_destroy(ob_scene *s, ob_node *n)
 {
     if (!n) return;
@@ -309,7 +354,7 @@ void ob_node_destroy(ob_scene *s, ob_node *n)
         in_snapshot |= m->renderable_now || (m->has_light && m->world_valid);
     }
     if (in_snapshot) {
-        s->renderable_count = filter_dying(s->renderables, s->renderable_count);
+        filter_dying_renderables(s);
         s->light_count = filter_dying(s->lights, s->light_count);
     }
 
@@ -419,6 +464,7 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
     if (!r) {
         n->has_renderable = false;
         memset(&n->renderable, 0, sizeof n->renderable);
+        if (n->renderable_now) proxy_set_renderable(&n->scene->proxies[n->proxy_index], n);
         return OB_OK;
     }
     if (!floats_finite(r->local_center, 3) || !isfinite(r->local_radius) || r->local_radius < 0.0f) {
@@ -428,6 +474,7 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
     }
     n->renderable = *r;
     n->has_renderable = true;
+    if (n->renderable_now) proxy_set_renderable(&n->scene->proxies[n->proxy_index], n);
     return OB_OK;
 }
 
@@ -527,6 +574,8 @@ static ob_result update_reserve(ob_scene *s)
         r = ob_array_reserve((void **)&s->renderables, &s->renderable_cap, need,
                              sizeof *s->renderables);
     if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->proxies, &s->proxy_cap, need, sizeof *s->proxies);
+    if (r == OB_OK)
         r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
     if (r != OB_OK)
         OB_LOG_E(SCENE_LOG, "scene update of %u nodes: %s; scene left as it was", need,
@@ -564,7 +613,11 @@ ob_result ob_scene_update(ob_scene *s, double dt)
         ob_node *n = s->by_id[i];
         bool visible = n->world_valid && !n->effective_hidden;
         n->renderable_now = visible && n->has_renderable;
-        if (n->renderable_now) s->renderables[rc++] = n;
+        if (n->renderable_now) {
+            proxy_fill(&s->proxies[rc], n);
+            n->proxy_index = rc;
+            s->renderables[rc++] = n;
+        }
         if (visible && n->has_light) s->lights[lc++] = n;
     }
     s->renderable_count = rc;

@@ -109,7 +109,8 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
     uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
-    ob_node *const *nodes = ob_scene_renderables(scene, &count);
+    const ob_render_proxy *proxies = ob_scene_render_proxies(scene, &count);
+    v->proxies = proxies;
     v->item_count = 0;
     v->culled = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
@@ -128,20 +129,18 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     ob_frustum_from_matrix(v->view_proj, &frustum);
     bool out_of_range = false;
     for (uint32_t i = 0; i < count; i++) {
-        ob_node *n = nodes[i];
-        const ob_renderable *rd = ob_node_renderable(n);
-        if (n == exclude || !rd || !rd->material || !mi->renders(rd->material, v->type)) {
+        const ob_render_proxy *p = &proxies[i];
+        if (p->node == exclude || !p->material || !mi->renders(p->material, v->type)) {
             v->culled++;
             continue;
         }
-        double c[3];
-        float radius;
-        ob_node_world_sphere(n, c, &radius);
+        const double *c = p->center;
+        float radius = p->radius;
         /* A bound that is not empty locally but zero in the world: the world
          * transform has zero scale, every triangle has zero area. Drawing it
          * yields nothing, but keeping it would still queue its env map and
          * stretch a shadow map's fit to its position. */
-        if (radius == 0.0f && rd->local_radius > 0.0f) {
+        if (radius == 0.0f && p->local_radius > 0.0f) {
             v->culled++;
             continue;
         }
@@ -154,7 +153,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
             if (!v->range_reported)
                 OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
                          "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
-                         v->name, ob_node_name(n), ob_node_id(n), c[0] - v->origin[0],
+                         v->name, ob_node_name(p->node), p->node_id, c[0] - v->origin[0],
                          c[1] - v->origin[1], c[2] - v->origin[2], (double)radius);
             out_of_range = true;
             v->range_reported = true;
@@ -166,11 +165,11 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
             continue;
         }
         uint32_t cls = 0, priority = 0, state = 0;
-        mi->sort_info(rd->material, v->type, &cls, &priority, &state);
+        mi->sort_info(p->material, v->type, &cls, &priority, &state);
         float d2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
         ob_draw_item *it = &v->items[v->item_count++];
-        *it = (ob_draw_item){.node_id = ob_node_id(n), .node = n};
-        item_key(it, cls, priority, state, gi && rd->geometry ? gi->id(rd->geometry) : 0, d2);
+        *it = (ob_draw_item){.node_id = p->node_id, .node = p->node, .proxy = i};
+        item_key(it, cls, priority, state, gi && p->geometry ? gi->id(p->geometry) : 0, d2);
     }
     if (!out_of_range) v->range_reported = false;
     if (v->item_count > 1) sort_items(v->items, v->sort_scratch, v->item_count);
@@ -194,22 +193,26 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
 {
     const ob_material_iface *mi = ob_renderer_material_iface(r);
     const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
-    ob_params *params = ob_pm_params(pm);
-    ob_param world = ob_param_registry_builtins(params->reg)->world;
+    /* Items are sorted by state: a run of one material is applied once. */
+    const struct ob_material *applied = NULL;
     float m[16];
-    for (uint32_t i = first; i < first + count && i < v->item_count; i++) {
-        ob_node *n = v->items[i].node;
-        const ob_renderable *rd = ob_node_renderable(n);
-        ob_node_world_relative(n, v->origin, m);
-        /* A refused matrix (logged by the parameter) would leave the previous
-         * entity's in the slot: drawing then puts this one in its place. */
-        if (ob_params_set_mat4(params, world, m) != OB_OK) {
-            OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix refused; not drawn",
-                     v->name, ob_node_name(n), ob_node_id(n));
-            continue;
+    uint32_t end = first + count < v->item_count ? first + count : v->item_count;
+    for (uint32_t i = first; i < end; i++) {
+        const ob_render_proxy *p = &v->proxies[v->items[i].proxy];
+        if (!p->material) continue;
+        if (p->material != applied) {
+            ob_apply_result a = mi->apply(p->material, p->node, r, pm, v);
+            applied = a == OB_APPLY_MATERIAL ? p->material : NULL;
+            if (a == OB_APPLY_SKIP) continue;
         }
-        if (!mi->apply(rd->material, n, r, pm, v)) continue;
-        gi->draw(rd->geometry, pm);
+        ob_render_proxy_world_relative(p, v->origin, m);
+        ob_pm_set_world(pm, m);
+        /* A refused matrix is not drawn (a stale one would put this entity
+         * where the previous one was). */
+        if (gi->draw(p->geometry, pm) == OB_ERR_NON_FINITE)
+            OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
+                     "(or its derived matrices); not drawn", v->name, ob_node_name(p->node),
+                     p->node_id);
     }
 }
 

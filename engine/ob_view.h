@@ -58,6 +58,7 @@ typedef struct ob_draw_item {
     uint32_t sort_hi;       /* class (top bit) and priority */
     uint32_t node_id;
     ob_node *node;
+    uint32_t proxy;         /* index in the view's proxies (the scene snapshot's) */
 } ob_draw_item;
 
 typedef struct ob_view_vtbl {
@@ -105,6 +106,7 @@ struct ob_view {
     /* Per frame, filled during pre_draw; owned by the view. */
     ob_draw_item *items;
     uint32_t item_count, item_cap;
+    const ob_render_proxy *proxies; /* the snapshot culled from (items index it) */
     ob_draw_item *sort_scratch;     /* the radix sort's other buffer */
     uint32_t sort_scratch_cap;
     uint32_t culled;                  /* entities rejected by frustum or render flag */

@@ -667,8 +667,8 @@ static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer
     prepare(m, r, entity, v, color, depth);
 }
 
-static bool iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
-                        ob_pipeline_manager *pm, const ob_view *v)
+static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
+                                   ob_pipeline_manager *pm, const ob_view *v)
 {
     uint32_t variant;
     ob_effect *e = resolve(m, r, entity, v, false, &variant, NULL);
@@ -677,13 +677,13 @@ static bool iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
             OB_LOG_W("material", "material '%s': no effect prepared for %s view '%s'; its "
                      "draws are skipped (was PreRender run for this view?)", m->name,
                      ob_view_type_name(v->type), v->name);
-        return false;
+        return OB_APPLY_SKIP;
     }
     VkFormat color, depth;
     view_formats(m->lib->dev, v, &color, &depth);
     uint32_t pipeline_id;
     VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
-    if (!pipeline) return false;
+    if (!pipeline) return OB_APPLY_SKIP;
     ob_pm_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
 
     ob_params *params = ob_pm_params(pm);
@@ -698,7 +698,11 @@ static bool iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
         if (env && env->vtbl && env->vtbl->set_usage_params)
             env->vtbl->set_usage_params(env, r, params, v);
     }
-    return true;
+    /* Only a reflective surface in a perspective view depends on the entity
+     * (its own env map decides the variant and is bound per draw). */
+    bool per_entity = m->kind == OB_MATERIAL_REFLECTIVE && v->type == OB_VIEW_PERSPECTIVE &&
+                      !m->custom[v->type];
+    return per_entity ? OB_APPLY_ENTITY : OB_APPLY_MATERIAL;
 }
 
 static const ob_material_iface material_iface = {
