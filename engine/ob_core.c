@@ -224,6 +224,24 @@ ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t el
     return OB_OK;
 }
 
+ob_result ob_array_reserve_aligned(void **items, uint32_t *cap, uint32_t need, size_t elem_size,
+                                   size_t alignment)
+{
+    if (need <= *cap) return OB_OK;
+    uint32_t new_cap = *cap ? *cap : 8;
+    while (new_cap < need) {
+        if (new_cap > UINT32_MAX / 2) return OB_ERR_LIMIT;
+        new_cap *= 2;
+    }
+    void *p = ob_aligned_alloc(alignment, (size_t)new_cap * elem_size);
+    if (!p) return OB_ERR_OUT_OF_HOST_MEMORY;
+    if (*items) memcpy(p, *items, (size_t)*cap * elem_size);
+    ob_aligned_free(*items);
+    *items = p;
+    *cap = new_cap;
+    return OB_OK;
+}
+
 /* ---------------------------------------------------------------- handles */
 
 #define GEN_SHIFT OB_HANDLE_INDEX_BITS

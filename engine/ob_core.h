@@ -119,6 +119,10 @@ ob_heap_stats ob_heap_stats_now(void);
 /* Grow a dynamic array so it holds at least `need` elements of elem_size.
  * *items and *cap are updated only on success. */
 ob_result ob_array_reserve(void **items, uint32_t *cap, uint32_t need, size_t elem_size);
+/* The same for an array from ob_aligned_alloc (freed with ob_aligned_free):
+ * the contents move to a new block aligned to `alignment`. */
+ob_result ob_array_reserve_aligned(void **items, uint32_t *cap, uint32_t need, size_t elem_size,
+                                   size_t alignment);
 
 /* ---------------------------------------------------------- fault injection */
 

@@ -1,6 +1,5 @@
 #include "ob_pipeline_manager.h"
 
-#include "ob_math.h"
 #include "ob_resources_internal.h"
 
 #include <stdio.h>
@@ -98,7 +97,7 @@ struct ob_pipeline_manager {
     VkRect2D scissor;
     bool viewport_set, scissor_set;
 
-    float world[16];            /* ob_pm_set_world's, for the next draw */
+    const float *world;         /* ob_pm_set_world's world and normal, for the next draw */
     bool world_pending;
 
     /* What the last full apply of uniforms and resources was made from: while
@@ -277,9 +276,9 @@ void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t p
     pm->program = program;
 }
 
-void ob_pm_set_world(ob_pipeline_manager *pm, const float world[16])
+void ob_pm_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
-    memcpy(pm->world, world, sizeof pm->world);
+    pm->world = world_normal;
     pm->world_pending = true;
 }
 
@@ -631,44 +630,32 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
     return OB_OK;
 }
 
-static bool all_finite(const float *f, size_t n)
-{
-    uint32_t bad = 0;
-    for (size_t i = 0; i < n; i++) {
-        uint32_t bits;
-        memcpy(&bits, &f[i], sizeof bits);
-        bad |= (bits & 0x7f800000u) == 0x7f800000u;
-    }
-    return !bad;
-}
-
-/* The push block from parameters, or for the standard per-draw block from
- * the world matrix given with the draw (world = true): then the normal matrix
- * is made here, as the parameters would derive it. False = not finite. */
-static bool apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, bool world,
+/* The push block from parameters, or for the standard per-draw block
+ * straight from ob_pm_set_world (world = true). */
+static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, bool world,
                                  uint64_t *h)
 {
-    if (!prog->push_mapping) return true;
-    _Alignas(16) uint8_t bytes[128];
-    if (world && prog->push_world_normal) {
-        float *f = (float *)(void *)bytes;
-        memcpy(f, pm->world, 64);
-        ob_mat4_normal_cofactor(pm->world, f + 16);
-        if (!all_finite(f, 32)) return false;
-        /* The normal matrix follows from the world matrix: hash the input. */
-        *h = ob_hash_block(*h, pm->world, 64);
-    } else {
-        ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
-        *h = ob_hash_block(*h, bytes, prog->push_size);
-    }
+    if (!prog->push_mapping) return;
     pm->stats.push_constant_requested++;
+    if (world && prog->push_world_normal) {
+        /* Another entity's transforms: always new, not worth a compare. The
+         * normal matrix follows from the world matrix: hash the input. */
+        *h = ob_hash_block(*h, pm->world, 64);
+        vkCmdPushConstants(pm->cmd, prog->layout, prog->push_stages, 0, prog->push_size,
+                           pm->world);
+        pm->cur.push_valid = false;
+        pm->stats.push_constant_issued++;
+        return;
+    }
+    _Alignas(16) uint8_t bytes[128];
+    ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
+    *h = ob_hash_block(*h, bytes, prog->push_size);
     if (!pm->cur.push_valid || memcmp(pm->cur.push, bytes, prog->push_size) != 0) {
         vkCmdPushConstants(pm->cmd, prog->layout, prog->push_stages, 0, prog->push_size, bytes);
         memcpy(pm->cur.push, bytes, prog->push_size);
         pm->cur.push_valid = true;
         pm->stats.push_constant_issued++;
     }
-    return true;
 }
 
 /* Everything a draw or dispatch needs, bound only where it differs. Returns
@@ -743,10 +730,7 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->applied_resources = prog->resource_count;
         *h = ob_hash_u64(*h, hs);
     }
-    if (!apply_push_constants(pm, prog, world, h)) {
-        pm->stats.skipped_draws++;
-        return OB_ERR_NON_FINITE;
-    }
+    apply_push_constants(pm, prog, world, h);
     if (prog->bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return OB_OK;
 
     /* A buffer bound in this command buffer is still valid (resources are

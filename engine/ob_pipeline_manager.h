@@ -87,13 +87,17 @@ ob_params *ob_pm_params(ob_pipeline_manager *pm);
 /* Desired state. The pipeline id is stable (for hashes). */
 void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
                         const ob_program *program);
-/* The world matrix (16 floats, column-major, camera-relative) of the next
- * draw only. A program whose push block is the standard per-draw block
- * (ob_program.push_world_normal) gets it and its normal matrix straight in
- * its push constants, and the parameters are left alone, so the bound sets
- * stay valid from one draw to the next; any other program gets it as the
- * WorldMatrix parameter (with the derived matrices) before the draw. */
-void ob_pm_set_world(ob_pipeline_manager *pm, const float world[16]);
+/* The per-draw transforms of the next draw only: world_normal[0..15] the
+ * world matrix (column-major, camera-relative), [16..31] its normal matrix
+ * (ob_mat4_normal_cofactor), all finite (the caller checks; the view loop
+ * has them from ob_render_proxy_per_draw). The array is read by the next
+ * draw, not copied: it must stay valid until then. A program whose push block is the
+ * standard per-draw block (ob_program.push_world_normal) gets them straight
+ * in its push constants and the parameters are left alone, so the bound sets
+ * stay valid from one draw to the next; any other program gets the world
+ * matrix as the WorldMatrix parameter (which derives the rest) before the
+ * draw. */
+void ob_pm_set_world(ob_pipeline_manager *pm, const float world_normal[32]);
 void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset);
 void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
                             VkIndexType type);
@@ -104,10 +108,10 @@ void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w
  * are applied again only when the program or some parameter of the slot
  * changed since the last draw. They return OB_ERR_WRONG_STATE (no pipeline),
  * OB_ERR_INVALID_HANDLE (a stale buffer/image parameter),
- * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) or OB_ERR_NON_FINITE (the
- * world matrix given with ob_pm_set_world, or a matrix derived from it, is
- * not finite; not logged here, the caller names the entity) and skip the
- * draw. */
+ * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) or OB_ERR_NON_FINITE (a
+ * matrix derived from the world matrix given with ob_pm_set_world is not
+ * finite; logged by the parameters, the caller names the entity) and skip
+ * the draw. */
 ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
                      uint32_t first_vertex, uint32_t first_instance);
 ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,

@@ -67,7 +67,8 @@ struct ob_scene {
     ob_node **renderables;
     uint32_t renderable_count, renderable_cap;
     ob_render_proxy *proxies;   /* parallel to renderables */
-    uint32_t proxy_cap;
+    ob_render_bound *bounds;    /* parallel to renderables */
+    uint32_t proxy_cap, bound_cap;
     ob_node **lights;
     uint32_t light_count, light_cap;
 };
@@ -216,7 +217,8 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->by_id);
     ob_free(s->order);
     ob_free(s->renderables);
-    ob_free(s->proxies);
+    ob_aligned_free(s->proxies);
+    ob_free(s->bounds);
     ob_free(s->lights);
     ob_free(s);
 }
@@ -246,6 +248,13 @@ const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_
     static const ob_render_proxy none[1];
     *out_count = s->renderable_count;
     return s->proxies ? s->proxies : none;
+}
+
+const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count)
+{
+    static const ob_render_bound none[1];
+    *out_count = s->renderable_count;
+    return s->bounds ? s->bounds : none;
 }
 
 ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count)
@@ -308,29 +317,51 @@ static void filter_dying_renderables(ob_scene *s)
         if (n->dying) continue;
         s->renderables[w] = n;
         s->proxies[w] = s->proxies[r];
+        s->bounds[w] = s->bounds[r];
         n->proxy_index = w++;
     }
     s->renderable_count = w;
 }
 
-static void proxy_set_renderable(ob_render_proxy *p, const ob_node *n)
+static void proxy_set_renderable(ob_scene *s, const ob_node *n)
 {
+    ob_render_proxy *p = &s->proxies[n->proxy_index];
     p->material = n->has_renderable ? n->renderable.material : NULL;
     p->geometry = n->has_renderable ? n->renderable.geometry : NULL;
-    p->local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
+    s->bounds[n->proxy_index].local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
 }
 
-static void proxy_fill(ob_render_proxy *p, ob_node *n)
+static bool floats_all_finite(const float *f, int n)
 {
+    bool ok = true;
+    for (int i = 0; i < n; i++) ok &= isfinite(f[i]) != 0;
+    return ok;
+}
+
+_Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
+
+static void proxy_fill(ob_scene *s, ob_node *n)
+{
+    ob_render_proxy *p = &s->proxies[n->proxy_index];
+    ob_render_bound *b = &s->bounds[n->proxy_index];
+    float w[16] = {0}, nm[16];
     for (int c = 0; c < 3; c++) {
-        for (int r = 0; r < 3; r++) p->linear[c * 3 + r] = (float)n->world.m[c * 3 + r];
+        for (int r = 0; r < 3; r++) w[c * 4 + r] = (float)n->world.m[c * 3 + r];
         p->world_t[c] = n->world.t[c];
-        p->center[c] = n->world_center[c];
+        b->center[c] = n->world_center[c];
     }
-    p->radius = n->world_radius;
+    w[15] = 1.0f;
+    ob_mat4_normal_cofactor(w, nm);
+    for (int c = 0; c < 3; c++)
+        for (int r = 0; r < 3; r++) {
+            p->linear[c * 3 + r] = w[c * 4 + r];
+            p->normal[c * 3 + r] = nm[c * 4 + r];
+        }
+    p->finite = floats_all_finite(p->linear, 9) && floats_all_finite(p->normal, 9);
+    b->radius = n->world_radius;
     p->node = n;
     p->node_id = n->id;
-    proxy_set_renderable(p, n);
+    proxy_set_renderable(s, n);
 }
 
 void ob_node_destroy(ob_scene *s, ob_node *n)
@@ -464,7 +495,7 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
     if (!r) {
         n->has_renderable = false;
         memset(&n->renderable, 0, sizeof n->renderable);
-        if (n->renderable_now) proxy_set_renderable(&n->scene->proxies[n->proxy_index], n);
+        if (n->renderable_now) proxy_set_renderable(n->scene, n);
         return OB_OK;
     }
     if (!floats_finite(r->local_center, 3) || !isfinite(r->local_radius) || r->local_radius < 0.0f) {
@@ -474,7 +505,7 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
     }
     n->renderable = *r;
     n->has_renderable = true;
-    if (n->renderable_now) proxy_set_renderable(&n->scene->proxies[n->proxy_index], n);
+    if (n->renderable_now) proxy_set_renderable(n->scene, n);
     return OB_OK;
 }
 
@@ -574,7 +605,10 @@ static ob_result update_reserve(ob_scene *s)
         r = ob_array_reserve((void **)&s->renderables, &s->renderable_cap, need,
                              sizeof *s->renderables);
     if (r == OB_OK)
-        r = ob_array_reserve((void **)&s->proxies, &s->proxy_cap, need, sizeof *s->proxies);
+        r = ob_array_reserve_aligned((void **)&s->proxies, &s->proxy_cap, need,
+                                     sizeof *s->proxies, OB_CACHE_LINE);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->bounds, &s->bound_cap, need, sizeof *s->bounds);
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
     if (r != OB_OK)
@@ -614,8 +648,8 @@ ob_result ob_scene_update(ob_scene *s, double dt)
         bool visible = n->world_valid && !n->effective_hidden;
         n->renderable_now = visible && n->has_renderable;
         if (n->renderable_now) {
-            proxy_fill(&s->proxies[rc], n);
             n->proxy_index = rc;
+            proxy_fill(s, n);
             s->renderables[rc++] = n;
         }
         if (visible && n->has_light) s->lights[lc++] = n;

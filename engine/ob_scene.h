@@ -80,38 +80,56 @@ ob_result ob_scene_update(ob_scene *s, double dt);
 ob_node *const *ob_scene_renderables(const ob_scene *s, uint32_t *out_count);
 ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count);
 
-/* A renderable's draw data for the frame, kept in one array parallel to the
- * renderables snapshot (same order, same count): what views read while
- * culling and recording, contiguous, so their loops do not chase nodes.
- * World data is as of the last ob_scene_update (as the node's queries);
- * material, geometry and local radius follow ob_node_set_renderable at once. */
+/* A renderable's draw data for the frame, kept in arrays parallel to the
+ * renderables snapshot (same order, same count), so that the views' loops
+ * read contiguous memory instead of chasing nodes: the proxy is what
+ * recording reads (two cache lines; the array is 64-byte aligned), the bound
+ * what culling adds to it. World data is as of the last ob_scene_update (as
+ * the node's queries); material, geometry and local radius follow
+ * ob_node_set_renderable at once. */
 typedef struct ob_render_proxy {
-    double world_t[3];           /* world translation */
-    double center[3];            /* world bounding-sphere centre */
     float linear[9];             /* world upper 3x3 in float, column-major */
-    float radius;                /* world bounding-sphere radius */
-    float local_radius;
-    uint32_t node_id;
+    float normal[9];             /* its normal matrix (ob_mat4_normal_cofactor), column-major */
+    double world_t[3];           /* world translation */
     struct ob_material *material; /* NULL when the node has no renderable now */
     struct ob_geometry *geometry;
     ob_node *node;
+    uint32_t node_id;
+    bool finite;                 /* linear and normal are finite in float */
 } ob_render_proxy;
 
-/* The proxies of the snapshot, *out_count of them (= the renderables'). Never
- * NULL. Valid until the next update or node destruction. [any thread, while
- * no mutation runs] */
+typedef struct ob_render_bound {
+    double center[3];            /* world bounding-sphere centre */
+    float radius;                /* world bounding-sphere radius */
+    float local_radius;
+} ob_render_bound;
+
+/* The proxies and bounds of the snapshot, *out_count of each (= the
+ * renderables'). Never NULL. Valid until the next update or node
+ * destruction. [any thread, while no mutation runs] */
 const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_count);
-/* The world matrix of a proxy relative to origin, as ob_node_world_relative
- * gives it for its node. */
-static inline void ob_render_proxy_world_relative(const ob_render_proxy *p,
-                                                  const double origin[3], float dest[16])
+const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count);
+
+/* The standard per-draw block of a proxy: its world matrix relative to
+ * origin (as ob_node_world_relative gives it for the node) in dest[0..15] and
+ * the normal matrix in dest[16..31]. False when some value is not finite in
+ * float (dest is written anyway). */
+static inline bool ob_render_proxy_per_draw(const ob_render_proxy *p, const double origin[3],
+                                            float dest[32])
 {
+    float t[3];
     for (int c = 0; c < 3; c++) {
-        for (int r = 0; r < 3; r++) dest[c * 4 + r] = p->linear[c * 3 + r];
-        dest[c * 4 + 3] = 0.0f;
-        dest[12 + c] = (float)(p->world_t[c] - origin[c]);
+        for (int r = 0; r < 3; r++) {
+            dest[c * 4 + r] = p->linear[c * 3 + r];
+            dest[16 + c * 4 + r] = p->normal[c * 3 + r];
+        }
+        dest[c * 4 + 3] = dest[16 + c * 4 + 3] = 0.0f;
+        t[c] = (float)(p->world_t[c] - origin[c]);
+        dest[12 + c] = t[c];
+        dest[28 + c] = 0.0f;
     }
-    dest[15] = 1.0f;
+    dest[15] = dest[31] = 1.0f;
+    return p->finite && isfinite(t[0]) && isfinite(t[1]) && isfinite(t[2]);
 }
 
 /* ------------------------------------------------------------------- nodes */

@@ -110,6 +110,7 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
     const ob_render_proxy *proxies = ob_scene_render_proxies(scene, &count);
+    const ob_render_bound *bounds = ob_scene_render_bounds(scene, &count);
     v->proxies = proxies;
     v->item_count = 0;
     v->culled = 0;
@@ -134,13 +135,13 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
             v->culled++;
             continue;
         }
-        const double *c = p->center;
-        float radius = p->radius;
+        const double *c = bounds[i].center;
+        float radius = bounds[i].radius;
         /* A bound that is not empty locally but zero in the world: the world
          * transform has zero scale, every triangle has zero area. Drawing it
          * yields nothing, but keeping it would still queue its env map and
          * stretch a shadow map's fit to its position. */
-        if (radius == 0.0f && p->local_radius > 0.0f) {
+        if (radius == 0.0f && bounds[i].local_radius > 0.0f) {
             v->culled++;
             continue;
         }
@@ -188,6 +189,9 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
     }
 }
 
+/* Items ahead of the one being drawn whose proxy is prefetched. */
+#define PROXY_PREFETCH 4u
+
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                           uint32_t first, uint32_t count)
 {
@@ -195,9 +199,16 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
     const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
     /* Items are sorted by state: a run of one material is applied once. */
     const struct ob_material *applied = NULL;
-    float m[16];
+    _Alignas(16) float m[32];
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     for (uint32_t i = first; i < end; i++) {
+        /* Items are in draw order, proxies in id order: fetch a few ahead so
+         * the loop does not wait on memory. */
+        if (i + PROXY_PREFETCH < end) {
+            const ob_render_proxy *ahead = &v->proxies[v->items[i + PROXY_PREFETCH].proxy];
+            __builtin_prefetch(ahead);
+            __builtin_prefetch((const char *)ahead + 64);
+        }
         const ob_render_proxy *p = &v->proxies[v->items[i].proxy];
         if (!p->material) continue;
         if (p->material != applied) {
@@ -205,11 +216,11 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
             applied = a == OB_APPLY_MATERIAL ? p->material : NULL;
             if (a == OB_APPLY_SKIP) continue;
         }
-        ob_render_proxy_world_relative(p, v->origin, m);
-        ob_pm_set_world(pm, m);
         /* A refused matrix is not drawn (a stale one would put this entity
          * where the previous one was). */
-        if (gi->draw(p->geometry, pm) == OB_ERR_NON_FINITE)
+        bool finite = ob_render_proxy_per_draw(p, v->origin, m);
+        if (finite) ob_pm_set_world(pm, m);
+        if (!finite || gi->draw(p->geometry, pm) == OB_ERR_NON_FINITE)
             OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
                      "(or its derived matrices); not drawn", v->name, ob_node_name(p->node),
                      p->node_id);
