@@ -5,7 +5,10 @@
 #   ./setup.sh test   install missing packages, then build and run the whole test
 #                     suite three times: plain (build/), address+undefined
 #                     sanitizers (build-address/) and thread sanitizer (build-thread/),
-#                     then a minute of libFuzzer on each fuzz target (build-fuzz/)
+#                     then a minute of libFuzzer on each fuzz target (build-fuzz/).
+#                     The plain suite also installs the build into
+#                     build/package/prefix and builds and runs examples/ against
+#                     it, out of tree (ctest label package, tests/package/)
 #   ./setup.sh deps | build
 #
 # Options: --sanitize none|address|thread|undefined|fuzz  one build only (none = plain)

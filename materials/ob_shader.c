@@ -13,10 +13,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#ifndef OB_SHADER_DIR
-#define OB_SHADER_DIR "materials/shaders"
-#endif
-
 /* Bump when anything that changes the SPIR-V for the same source changes
  * (target versions, glslang options); the glslang version is mixed in too. */
 #define COMPILER_REVISION 1u
@@ -151,8 +147,9 @@ ob_shader_compiler *ob_shader_compiler_create(const ob_shader_compiler_desc *des
     ob_shader_compiler *c = ob_calloc(1, sizeof *c);
     if (!c) goto fail;
     const char *env_shaders = getenv("OB_SHADER_DIR");
-    c->shader_dir = ob_strdup(d.shader_dir ? d.shader_dir
-                              : env_shaders && env_shaders[0] ? env_shaders : OB_SHADER_DIR);
+    c->shader_dir = d.shader_dir                    ? ob_strdup(d.shader_dir)
+                    : env_shaders && env_shaders[0] ? ob_strdup(env_shaders)
+                                                    : ob_shader_dir_default();
     if (!c->shader_dir) goto fail_free;
 
     if (!d.no_disk_cache) {

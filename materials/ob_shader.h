@@ -56,7 +56,10 @@ typedef struct ob_shader_define {
 } ob_shader_define;
 
 typedef struct ob_shader_compiler_desc {
-    /* NULL → $OB_SHADER_DIR → the OB_SHADER_DIR macro (materials/shaders). */
+    /* NULL → $OB_SHADER_DIR → share/obelisk/shaders beside the binary holding
+     * the engine: <libobelisk.so's folder>/../share/obelisk/shaders installed,
+     * build/share/obelisk/shaders in the build tree (then the configured
+     * install folder, for static programs outside the prefix). */
     const char *shader_dir;
     /* NULL → $OB_CACHE_DIR → $XDG_CACHE_HOME/obelisk → $HOME/.cache/obelisk.
      * Created if missing; SPIR-V goes in <cache_dir>/spirv/. If it cannot be

@@ -66,4 +66,10 @@ ob_result ob_shader_variant_describe(const ob_shader_desc *desc, char **out_name
  * NULL when out of memory. */
 char *ob_shader_path_join(const char *dir, const char *name);
 
+/* The shader folder when neither the desc nor $OB_SHADER_DIR names one:
+ * share/obelisk/shaders found relative to the binary holding the engine
+ * (materials/ob_shader_dir.c). ob_malloc'ed; NULL when out of memory. A
+ * missing folder is logged (warning) and the configured install path returned. */
+char *ob_shader_dir_default(void);
+
 #endif /* OB_SHADER_SOURCE_H */

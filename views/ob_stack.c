@@ -1,0 +1,127 @@
+#include "ob_stack.h"
+
+#include <string.h>
+
+ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
+{
+    ob_stack_desc d = desc ? *desc : (ob_stack_desc){0};
+    ob_result r = OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_stack *s = ob_calloc(1, sizeof *s);
+    if (!s) goto fail;
+
+    if (!(s->renderer = ob_renderer_create(&d.renderer, &r))) goto fail_destroy;
+    s->device = ob_renderer_device(s->renderer);
+    s->effects = ob_effect_context_create(s->device, ob_renderer_registry(s->renderer),
+                                          d.cache_dir, &r);
+    if (!s->effects) goto fail_destroy;
+    if (!(s->materials = ob_material_library_create(s->effects, NULL, &r))) goto fail_destroy;
+    ob_views_desc vd = {.renderer = s->renderer, .materials = s->materials,
+                        .effects = s->effects, .env_map_size = d.env_map_size,
+                        .shadow_map_size = d.shadow_map_size};
+    memcpy(vd.ambient, d.ambient, sizeof vd.ambient);
+    if (!(s->views = ob_views_create(&vd, &r))) goto fail_destroy;
+
+    if (!(s->scene = ob_scene_create(&r))) goto fail_destroy;
+    if (!(s->camera = ob_node_create(s->scene, NULL, "camera", &r))) goto fail_destroy;
+    if ((r = ob_node_set_camera(s->camera, &d.camera)) != OB_OK) goto fail_destroy;
+    ob_perspective_desc pd = {.name = "main", .camera = s->camera,
+                              .width = d.width ? d.width : 640,
+                              .height = d.height ? d.height : 480,
+                              .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
+    static const float no_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    if (memcmp(d.clear_color, no_color, sizeof no_color) != 0)
+        memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
+    if (!(s->main = ob_perspective_view_create(s->views, &pd, &r))) goto fail_destroy;
+    s->composite = ob_composite_view_create(s->views, ob_perspective_view_base(s->main), &r);
+    if (!s->composite) goto fail_destroy;
+    s->final_view = ob_composite_view_base(s->composite);
+    if (d.overlay) {
+        if (!(s->overlay = ob_overlay_view_create(s->views, s->final_view, &r))) goto fail_destroy;
+        s->final_view = ob_overlay_view_base(s->overlay);
+    }
+    if (out_result) *out_result = OB_OK;
+    return s;
+
+fail_destroy:
+    ob_stack_destroy(s);
+fail:
+    if (out_result) *out_result = r;
+    return NULL;
+}
+
+void ob_stack_destroy(ob_stack *s)
+{
+    if (!s) return;
+    if (s->renderer) ob_renderer_wait_idle(s->renderer);
+    if (s->views) {
+        ob_overlay_view_destroy(s->views, s->overlay);
+        ob_composite_view_destroy(s->views, s->composite);
+        ob_perspective_view_destroy(s->views, s->main);
+    }
+    ob_scene_destroy(s->scene);
+    ob_views_destroy(s->views);
+    ob_material_library_destroy(s->materials);
+    for (uint32_t i = 0; i < s->geometry_count; i++) ob_geometry_destroy(s->device, s->geometry[i]);
+    ob_free(s->geometry);
+    ob_effect_context_destroy(s->effects);
+    ob_renderer_destroy(s->renderer);
+    ob_free(s);
+}
+
+ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char *name,
+                                   ob_result *out_result)
+{
+    ob_result r = ob_array_reserve((void **)&s->geometry, &s->geometry_cap,
+                                   s->geometry_count + 1, sizeof *s->geometry);
+    ob_geometry *g = NULL;
+    if (r == OB_OK) {
+        ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = s->geometry_count + 1};
+        g = ob_geometry_create(s->device, &gd, &r);
+        if (g) s->geometry[s->geometry_count++] = g;
+    }
+    if (out_result) *out_result = r;
+    return g;
+}
+
+ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_geometry *geometry,
+                             ob_material *material, ob_result *out_result)
+{
+    ob_result r = OB_ERR_INVALID_ARGUMENT;
+    ob_node *n = NULL;
+    const ob_bounds *b = ob_geometry_bounds(geometry);
+    if (!b) {
+        OB_LOG_E("stack", "entity '%s': no geometry", name ? name : "");
+        goto out;
+    }
+    if (!(n = ob_node_create(s->scene, parent, name, &r))) goto out;
+    ob_renderable rd = {.material = material, .geometry = geometry, .local_radius = b->radius};
+    memcpy(rd.local_center, b->center, sizeof rd.local_center);
+    if ((r = ob_node_set_renderable(n, &rd)) != OB_OK) {
+        ob_node_destroy(s->scene, n);
+        n = NULL;
+    }
+out:
+    if (out_result) *out_result = r;
+    return n;
+}
+
+ob_result ob_stack_frame(ob_stack *s, double dt)
+{
+    double time = s->time;
+    bool first = s->frames++ == 0;
+    s->time += dt;
+    uint64_t t0 = ob_time_ns();
+    ob_result r = ob_scene_update(s->scene, first ? 0.0 : dt);
+    if (r != OB_OK) return r;
+    ob_views_set_time(s->views, time, dt);
+    uint64_t update_ns = ob_time_ns() - t0;
+    if ((r = ob_renderer_begin_frame(s->renderer, s->scene)) != OB_OK) return r;
+    ob_renderer_note_update_ns(s->renderer, update_ns);
+    ob_views_render(s->views, s->final_view);
+    return ob_renderer_end_frame(s->renderer);
+}
+
+ob_image ob_stack_final_image(const ob_stack *s)
+{
+    return s ? ob_composite_view_target(s->composite) : (ob_image){0};
+}

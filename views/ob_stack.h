@@ -1,0 +1,89 @@
+/* ob_stack.h — what a typical program sets up, created and destroyed in order:
+ * renderer → effect context → material library → views → scene with a
+ * camera node → main perspective view → composite (the final target) →
+ * optional overlay; plus the geometry the program uploads through it.
+ *
+ * Everything is plain engine objects reachable through the struct's fields,
+ * so a program that outgrows a default calls the module's own functions on
+ * them. The fields are read-only to the program: the stack owns what they
+ * point to.
+ *
+ * Lifecycle: ob_stack_create → [ob_stack_add_geometry, ob_stack_add_entity,
+ * materials in s->materials, lights on nodes of s->scene] → ob_stack_frame*
+ * → ob_stack_destroy. Views the program made itself on s->views (particle
+ * systems, more perspective views) are destroyed by the program first.
+ * Thread rule: [render thread] for every function (the renderer's rule).
+ */
+#ifndef OB_STACK_H
+#define OB_STACK_H
+
+#include "ob_views.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ob_stack_desc {
+    ob_renderer_desc renderer;   /* zero → defaults (worker count = cores, headless) */
+    const char *cache_dir;       /* pipeline cache folder; NULL → the effect context's default */
+    uint32_t width, height;      /* main view and final target; 0 → 640 x 480 */
+    float clear_color[4];        /* all zero → opaque (0.08, 0.09, 0.12) */
+    ob_camera_desc camera;       /* zero → ob_node_set_camera's defaults */
+    uint32_t env_map_size;       /* 0 → the views' default (256) */
+    uint32_t shadow_map_size;    /* 0 → the views' default (1024) */
+    float ambient[4];            /* rgb, w = intensity; zero → the views' default */
+    bool overlay;                /* also an overlay view, drawn last over the composite */
+} ob_stack_desc;
+
+typedef struct ob_stack {
+    ob_renderer *renderer;
+    ob_device *device;                /* the renderer's */
+    ob_effect_context *effects;
+    ob_material_library *materials;   /* owns the materials made from it */
+    ob_views *views;
+    ob_scene *scene;                  /* owns its nodes */
+    ob_node *camera;                  /* a node of scene with a camera */
+    ob_perspective_view *main;        /* sees the scene from camera */
+    ob_composite_view *composite;     /* main's colour in the final target */
+    ob_overlay_view *overlay;         /* NULL unless desc.overlay */
+    ob_view *final_view;              /* overlay or composite: what ob_stack_frame renders */
+    ob_geometry **geometry;           /* what ob_stack_add_geometry made */
+    uint32_t geometry_count, geometry_cap;
+    double time;                      /* seconds simulated by ob_stack_frame */
+    uint64_t frames;                  /* frames ob_stack_frame started */
+} ob_stack;
+
+/* Creates the whole stack. Failure: NULL, *out_result set (out_result may
+ * be NULL), the cause logged by the step that failed, and everything
+ * created so far destroyed. */
+ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result);
+/* Waits idle, then destroys in reverse order: overlay, composite, main
+ * view, scene (its nodes), views, material library (its materials),
+ * geometry, effect context, renderer. NULL is a no-op. */
+void ob_stack_destroy(ob_stack *s);
+
+/* Uploads mesh (the caller keeps and releases it) as geometry the stack
+ * owns; the id for command hashes is its index + 1. Failure: NULL,
+ * *out_result set, logged. */
+ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char *name,
+                                   ob_result *out_result);
+/* A node of s->scene under parent (NULL → root) drawing geometry with
+ * material, its bounds taken from the geometry. Failure: NULL, *out_result
+ * set, nothing left in the scene. */
+ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_geometry *geometry,
+                             ob_material *material, ob_result *out_result);
+
+/* One frame: updates the scene (by dt; 0 on the first frame), sets the
+ * views' time, begins the frame, runs the PreRender from s->final_view and
+ * ends the frame (records and submits; it does not wait: ob_renderer_wait_idle
+ * or a read-back such as ob_image_write_png does). s->time advances by dt
+ * even when a step fails. Returns the first failure of those steps. */
+ob_result ob_stack_frame(ob_stack *s, double dt);
+
+/* The final image: the composite's target (the overlay draws into it too). */
+ob_image ob_stack_final_image(const ob_stack *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_STACK_H */

@@ -1,0 +1,41 @@
+/* obelisk.h — the whole public API of an installed Obelisk:
+ * #include <obelisk/obelisk.h>, link Obelisk::obelisk (CMake) or
+ * `pkg-config --libs obelisk`. examples/cube_png.c is the smallest program.
+ *
+ * Layers, bottom up (each header says its lifecycle and thread rule):
+ *   engine     results, logging, allocation (ob_core.h); device and resources;
+ *              parameters; programs and the pipeline manager; scene graph and
+ *              math; the render-view interface; the renderer (frame, workers,
+ *              stats)
+ *   materials  run-time shader compiler, render effects, materials
+ *   geometry   meshes and generators, model loading, GPU geometry
+ *   views      the standard views (perspective, shadow, env map, simulation,
+ *              overlay, composite) and ob_stack, the usual set-up in one call
+ * Only the Vulkan headers come along; cglm and stb stay inside the library.
+ */
+#ifndef OBELISK_H
+#define OBELISK_H
+
+#include "ob_core.h"
+#include "ob_device.h"
+#include "ob_math.h"
+#include "ob_params.h"
+#include "ob_pipeline_manager.h"
+#include "ob_program.h"
+#include "ob_reflect.h"
+#include "ob_renderer.h"
+#include "ob_resources.h"
+#include "ob_scene.h"
+#include "ob_view.h"
+
+#include "ob_effect.h"
+#include "ob_material.h"
+#include "ob_shader.h"
+
+#include "ob_geometry.h"
+#include "ob_mesh.h"
+
+#include "ob_stack.h"
+#include "ob_views.h"
+
+#endif /* OBELISK_H */
