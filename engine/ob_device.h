@@ -177,6 +177,27 @@ typedef struct ob_counting_allocator {
 void ob_counting_allocator_init(ob_counting_allocator *a);
 uint64_t ob_counting_allocator_count(ob_counting_allocator *a);
 
+/* VkAllocationCallbacks for one command pool (the spec allows an allocator
+ * per pool): blocks are carved in order from 64 KiB chunks and a chunk is
+ * used again once all its blocks are freed, which a pool reset does. In the
+ * steady state recording asks the system for nothing and writes the same
+ * warm memory every frame, where malloc costs lavapipe a call per recorded
+ * command. Blocks over 16 KiB come from malloc. Counts allocations as
+ * ob_counting_allocator does. Not thread-safe, which a pool never needs:
+ * everything that allocates or frees through a pool is externally
+ * synchronized on it. */
+typedef struct ob_arena_chunk ob_arena_chunk;
+typedef struct ob_arena_allocator {
+    VkAllocationCallbacks callbacks;
+    ob_arena_chunk *current, *spare;
+    atomic_uint_fast64_t allocations;   /* allocations + reallocations */
+} ob_arena_allocator;
+void ob_arena_allocator_init(ob_arena_allocator *a);
+/* Frees the chunks. Destroy the pool first: a block still in use is logged
+ * and leaked, never freed under the driver. */
+void ob_arena_allocator_release(ob_arena_allocator *a);
+uint64_t ob_arena_allocator_count(ob_arena_allocator *a);
+
 #ifdef __cplusplus
 }
 #endif

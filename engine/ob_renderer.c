@@ -32,7 +32,8 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
         .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
         .queueFamilyIndex = ob_device_queue_family(r->dev),
     };
-    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, &r->primary_alloc.callbacks,
+    ob_arena_allocator_init(&fs->alloc);
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(vk, &pci, &fs->alloc.callbacks,
                                                          &fs->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {
@@ -68,7 +69,8 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
     VkDevice vk = ob_device_vk(r->dev);
     if (fs->queries) vkDestroyQueryPool(vk, fs->queries, NULL);
     if (fs->fence) vkDestroyFence(vk, fs->fence, NULL);
-    if (fs->pool) vkDestroyCommandPool(vk, fs->pool, &r->primary_alloc.callbacks);
+    if (fs->pool) vkDestroyCommandPool(vk, fs->pool, &fs->alloc.callbacks);
+    ob_arena_allocator_release(&fs->alloc);
     memset(fs, 0, sizeof *fs);
 }
 
@@ -95,7 +97,6 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     if (d.device.frames_in_flight > OB_MAX_FRAMES_IN_FLIGHT)
         d.device.frames_in_flight = OB_MAX_FRAMES_IN_FLIGHT;
     r->frames_in_flight = d.device.frames_in_flight;
-    ob_counting_allocator_init(&r->primary_alloc);
 
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free;

@@ -46,7 +46,7 @@ typedef struct ob_worker {
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
     uint64_t cpu_ns;            /* thread CPU time of its last batch */
-    ob_counting_allocator alloc;
+    ob_arena_allocator alloc[OB_MAX_FRAMES_IN_FLIGHT];  /* one per pool */
     ob_result error;
 } ob_worker;
 
@@ -58,6 +58,7 @@ typedef struct ob_record_cost {
 
 typedef struct ob_frame_slot {
     VkCommandPool pool;
+    ob_arena_allocator alloc;   /* the pool's */
     VkCommandBuffer primary;
     VkFence fence;
     VkQueryPool queries;
@@ -131,7 +132,6 @@ struct ob_renderer {
     bool done_ready;
     atomic_uint next_job;
     bool quit;
-    ob_counting_allocator primary_alloc; /* the frame slots' pools */
 
     ob_frame_stats_fn stats_fn;
     void *stats_user;

@@ -12,7 +12,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     ob_result res;
     w->renderer = r;
     w->index = index;
-    ob_counting_allocator_init(&w->alloc);
+    for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) ob_arena_allocator_init(&w->alloc[f]);
     if (sem_init(&w->go, 0, 0) != 0) {
         OB_LOG_E("renderer", "worker %u: its wake-up semaphore cannot be created", index);
         return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -36,7 +36,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
             .queueFamilyIndex = ob_device_queue_family(r->dev),
         };
         VkResult vr = OB_VK_CHECK_CREATE(vkCreateCommandPool(ob_device_vk(r->dev), &pci,
-                                                             &w->alloc.callbacks, &w->pools[f]));
+                                                             &w->alloc[f].callbacks, &w->pools[f]));
         if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     }
     return OB_OK;
@@ -45,7 +45,9 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
 static void worker_release(ob_renderer *r, ob_worker *w)
 {
     for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) {
-        if (w->pools[f]) vkDestroyCommandPool(ob_device_vk(r->dev), w->pools[f], &w->alloc.callbacks);
+        if (w->pools[f])
+            vkDestroyCommandPool(ob_device_vk(r->dev), w->pools[f], &w->alloc[f].callbacks);
+        ob_arena_allocator_release(&w->alloc[f]);
         ob_free(w->cmds[f]);
     }
     ob_pipeline_manager_destroy(w->pm);
@@ -509,9 +511,12 @@ static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
 /* Driver host allocations through every command pool so far. */
 static uint64_t cmd_allocations(ob_renderer *r)
 {
-    uint64_t n = ob_counting_allocator_count(&r->primary_alloc);
+    uint64_t n = 0;
+    for (uint32_t f = 0; f < r->frames_in_flight; f++)
+        n += ob_arena_allocator_count(&r->frames[f].alloc);
     for (uint32_t i = 0; i < r->worker_count; i++)
-        n += ob_counting_allocator_count(&r->workers[i].alloc);
+        for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++)
+            n += ob_arena_allocator_count(&r->workers[i].alloc[f]);
     return n;
 }
 
