@@ -90,6 +90,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     if (d.worker_count > OB_MAX_WORKERS) d.worker_count = OB_MAX_WORKERS;
     r->worker_count = d.worker_count;
     r->chunk_draws = d.chunk_draws ? d.chunk_draws : 2048;
+    r->no_affinity = d.no_thread_affinity;
     r->mode = r->pending_mode = d.threading;
     r->active = r->pending_active = r->worker_count;
     r->max_recursion = 4;
@@ -253,18 +254,28 @@ void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason r
 /* A measurement is stale after this many frames recorded the other way. */
 #define AUTO_REMEASURE_FRAMES 32
 
-/* AUTO: record the way that measured cheaper for this scene; measure a way
- * never measured (or with another worker count) first, and re-measure the
- * other way when its figure is old or the draw count has moved by a quarter
- * since it was taken. */
+/* AUTO: record the way that measured cheaper for this scene (per draw, or
+ * per frame before any frame had draws); measure a way never measured (or
+ * with another worker count) first, and re-measure the other way when its
+ * figure is old or the draw count has moved by a quarter since it was taken.
+ * The way in use is kept unless the other is cheaper by AUTO_MARGIN_PCT, so
+ * two nearly equal ways do not alternate on noise. */
+#define AUTO_MARGIN_PCT 3u
+
 static bool auto_choice(ob_renderer *r)
 {
     const uint32_t workers = r->active;
-    bool have_st = r->measured[0].cost_ns > 0;
-    bool have_mt = r->measured[1].cost_ns > 0 && r->measured[1].workers == workers;
+    const ob_record_cost *st = &r->measured[0], *mt = &r->measured[1];
+    bool have_st = st->cost_ns > 0;
+    bool have_mt = mt->cost_ns > 0 && mt->workers == workers;
     if (!have_st) return false;
     if (!have_mt) return true;
-    bool multi = r->measured[1].cost_ns < r->measured[0].cost_ns;
+    bool per_draw = st->per_draw_ps > 0 && mt->per_draw_ps > 0;
+    uint64_t cost[2] = {per_draw ? st->per_draw_ps : st->cost_ns,
+                        per_draw ? mt->per_draw_ps : mt->cost_ns};
+    bool cur = r->auto_multi;
+    bool multi = cur;
+    if (cost[!cur] * (100u + AUTO_MARGIN_PCT) < cost[cur] * 100u) multi = !cur;
     uint32_t other = multi ? 0u : 1u;
     uint32_t now = r->measured[!other].draws, then = r->measured[other].draws;
     bool resized = 4ull * (now > then ? now - then : then - now) > (uint64_t)OB_MAX(now, then);
@@ -304,10 +315,19 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     ob_device_begin_frame_slot(r->dev, r->slot);
     vr = OB_VK_CHECK(vkResetCommandPool(vk, fs->pool, 0));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    /* Each worker resets its own pools when it next records in this slot,
-     * so the driver's blocks are freed on the thread that allocated them. */
-    for (uint32_t i = 0; i < r->worker_count; i++)
-        ob_pm_begin_frame(r->workers[i].pm, r->slot, r->serial);
+    /* The workers' pools of this slot too, here like the primary's, outside
+     * the recording: the slot's fence was waited for, so their secondaries
+     * are done, and the workers are idle. (Each pool frees into its own
+     * arena, so which thread frees costs nothing.) */
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        ob_worker *w = &r->workers[i];
+        if (w->pool_recorded[r->slot]) {
+            vr = OB_VK_CHECK(vkResetCommandPool(vk, w->pools[r->slot], 0));
+            if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+            w->pool_recorded[r->slot] = false;
+        }
+        ob_pm_begin_frame(w->pm, r->slot, r->serial);
+    }
     ob_pm_begin_frame(r->immediate, r->slot, r->serial);
 
     r->mode = r->pending_mode;

@@ -74,6 +74,12 @@ typedef struct ob_renderer_desc {
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
     ob_threading threading;      /* initial mode */
     uint32_t chunk_draws;        /* target draws per job when splitting a view; 0 → 2048 */
+    /* The pool's threads are pinned, each to a CPU other than the one the
+     * render thread is recording on (re-pinned only when that changes):
+     * without it the scheduler often wakes a worker onto the render
+     * thread's CPU. The calling thread is never pinned. true = leave all
+     * placement to the scheduler. */
+    bool no_thread_affinity;
 } ob_renderer_desc;
 
 typedef enum ob_skip_reason {

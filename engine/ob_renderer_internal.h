@@ -41,19 +41,22 @@ typedef struct ob_worker {
     uint32_t index;             /* 1-based: parameter slot and pair index */
     ob_pipeline_manager *pm;
     VkCommandPool pools[OB_MAX_FRAMES_IN_FLIGHT];
-    bool pool_recorded[OB_MAX_FRAMES_IN_FLIGHT]; /* reset before its next use */
+    bool pool_recorded[OB_MAX_FRAMES_IN_FLIGHT]; /* reset in begin_frame before its next use */
     VkCommandBuffer *cmds[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
     uint64_t cpu_ns;            /* thread CPU time of its last batch */
     ob_arena_allocator alloc[OB_MAX_FRAMES_IN_FLIGHT];  /* one per pool */
+    int cpu;                    /* the CPU it is pinned to; -1 = none yet */
     ob_result error;
 } ob_worker;
 
 /* What recording a scene one way (inline or on workers) cost. */
 typedef struct ob_record_cost {
-    uint64_t cost_ns;           /* moving average; 0 = never measured */
-    uint32_t draws, age, workers;
+    uint64_t cost_ns;           /* moving average of a frame's; 0 = never measured */
+    uint64_t per_draw_ps;       /* moving average per draw (frames with draws) */
+    uint32_t draws;             /* moving average */
+    uint32_t age, workers;
 } ob_record_cost;
 
 typedef struct ob_frame_slot {
@@ -89,6 +92,9 @@ struct ob_renderer {
     ob_pipeline_manager *immediate;
     ob_worker workers[OB_MAX_WORKERS];
     uint32_t worker_count;
+    int cpus[64];               /* the CPUs the process may run on (at start) */
+    uint32_t cpu_count;
+    bool no_affinity;           /* desc.no_thread_affinity */
     uint32_t chunk_draws;
 
     ob_frame_slot frames[OB_MAX_FRAMES_IN_FLIGHT];

@@ -1,4 +1,4 @@
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE
 #include "ob_renderer_internal.h"
 
 #include <stdio.h>
@@ -12,6 +12,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     ob_result res;
     w->renderer = r;
     w->index = index;
+    w->cpu = -1;
     for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) ob_arena_allocator_init(&w->alloc[f]);
     if (sem_init(&w->go, 0, 0) != 0) {
         OB_LOG_E("renderer", "worker %u: its wake-up semaphore cannot be created", index);
@@ -168,20 +169,6 @@ static void record_batch(ob_renderer *r, ob_worker *w)
     uint64_t c0 = ob_thread_cpu_ns();
     uint32_t f = r->slot;
     w->cmd_used = 0;
-    if (w->pool_recorded[f]) {
-        /* The slot's fence was waited for in begin_frame: its secondaries
-         * are done executing. */
-        VkResult vr = OB_VK_CHECK(vkResetCommandPool(ob_device_vk(r->dev), w->pools[f], 0));
-        if (vr != VK_SUCCESS) {
-            ob_device_note_result(r->dev, vr);
-            OB_LOG_E("renderer", "worker %u records nothing this frame: its command pool could "
-                     "not be reset", w->index);
-            w->error = ob_result_from_vk(vr);
-            w->cpu_ns = ob_thread_cpu_ns() - c0;
-            return;
-        }
-        w->pool_recorded[f] = false;
-    }
     for (;;) {
         uint32_t j = atomic_fetch_add_explicit(&r->next_job, 1, memory_order_relaxed);
         if (j >= r->job_count) break;
@@ -206,6 +193,12 @@ static void *worker_main(void *arg)
 
 ob_result ob_renderer_workers_start(ob_renderer *r)
 {
+    /* The CPUs this process may run on (taskset, cgroups), for place_workers. */
+    cpu_set_t allowed;
+    r->cpu_count = 0;
+    if (sched_getaffinity(0, sizeof allowed, &allowed) == 0)
+        for (int c = 0; c < CPU_SETSIZE && r->cpu_count < OB_ARRAY_COUNT(r->cpus); c++)
+            if (CPU_ISSET(c, &allowed)) r->cpus[r->cpu_count++] = c;
     if (sem_init(&r->done, 0, 0) != 0) {
         OB_LOG_E("renderer", "the workers' completion semaphore cannot be created");
         return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -238,6 +231,30 @@ void ob_renderer_workers_stop(ob_renderer *r)
     r->done_ready = false;
 }
 
+/* Keep the pool threads about to be woken off the CPU the render thread is
+ * recording on, each on its own CPU of the process's set where there are
+ * enough. Left to itself the scheduler often wakes a worker onto the
+ * waker's CPU and leaves the two sharing it for milliseconds while the other
+ * CPU idles (seen here on 2 cores: one frame in two recorded at the speed of
+ * one thread). Only the pool's own threads are pinned, never the caller's;
+ * an affinity call is made only when a worker's CPU has to change. */
+static void place_workers(ob_renderer *r, uint32_t helpers)
+{
+    if (r->no_affinity || r->cpu_count < 2) return;
+    int here = sched_getcpu();
+    uint32_t next = 0;
+    for (uint32_t i = 0; i < helpers; i++) {
+        ob_worker *w = &r->workers[i];
+        int cpu = r->cpus[next++ % r->cpu_count];
+        if (cpu == here) cpu = r->cpus[next++ % r->cpu_count];
+        if (w->cpu == cpu) continue;
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(cpu, &set);
+        if (pthread_setaffinity_np(w->thread, sizeof set, &set) == 0) w->cpu = cpu;
+    }
+}
+
 /* Hand the frame's jobs to the active workers and wait for all. Only the
  * pool threads that have a job to take are woken; the render thread records
  * the last active worker's share instead of sleeping. */
@@ -245,6 +262,7 @@ static void run_jobs(ob_renderer *r, uint32_t active)
 {
     atomic_store_explicit(&r->next_job, 0, memory_order_relaxed);
     uint32_t helpers = OB_MIN(active - 1, r->job_count - 1);
+    place_workers(r, helpers);
     for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
     record_batch(r, &r->workers[active - 1]);
     for (uint32_t i = 0; i < helpers; i++)
@@ -525,10 +543,18 @@ static uint64_t cmd_allocations(ob_renderer *r)
 static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
 {
     ob_record_cost *m = &r->measured[multi];
-    if (m->cost_ns == 0 || m->workers != workers) m->cost_ns = ns;
-    else m->cost_ns = (3 * m->cost_ns + ns) / 4;
+    bool fresh = m->cost_ns == 0 || m->workers != workers;
+    m->cost_ns = fresh ? ns : (3 * m->cost_ns + ns) / 4;
     m->cost_ns = OB_MAX(m->cost_ns, (uint64_t)1);
-    m->draws = draws;
+    if (draws > 0) {
+        /* Per draw, so that frames that add views now and then (an env map
+         * refreshed every few frames) compare with those that do not. */
+        uint64_t ps = ns * 1000u / draws;
+        m->per_draw_ps = fresh || m->per_draw_ps == 0 ? ps : (3 * m->per_draw_ps + ps) / 4;
+        m->per_draw_ps = OB_MAX(m->per_draw_ps, (uint64_t)1);
+    }
+    /* Smoothed too: a view refreshed every few frames is not a new scene. */
+    m->draws = fresh ? draws : (uint32_t)((3ull * m->draws + draws) / 4);
     m->workers = workers;
     m->age = 0;
     r->measured[!multi].age++;

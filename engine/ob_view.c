@@ -190,7 +190,7 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
 }
 
 /* Items ahead of the one being drawn whose proxy is prefetched. */
-#define PROXY_PREFETCH 4u
+#define PROXY_PREFETCH 16u
 
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                           uint32_t first, uint32_t count)
