@@ -106,6 +106,8 @@ struct ob_pipeline_manager {
     const ob_program *applied_program;
     uint64_t applied_serial;
     uint64_t applied_hash;
+    uint64_t state_hash;        /* pipeline, program and applied_hash folded */
+    uint32_t state_pipeline_id; /* the pipeline state_hash was made with */
     uint32_t applied_ubos, applied_resources;  /* blocks reused / pushes requested */
 
     ob_cmd_hash hash;
@@ -682,8 +684,6 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
             return wr;
         }
     }
-    *h = ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id);
-
     pm->stats.pipeline_binds_requested++;
     if (pm->cur.pipeline != pm->pipeline) {
         vkCmdBindPipeline(pm->cmd, prog->bind_point, pm->pipeline);
@@ -704,7 +704,13 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->stats.blocks_reused += pm->applied_ubos;
         pm->stats.descriptor_binds_requested += pm->applied_ubos ? 1u : 0u;
         pm->stats.push_descriptor_requested += pm->applied_resources ? 1u : 0u;
-        *h = ob_hash_u64(*h, pm->applied_hash);
+        if (pm->state_pipeline_id != pm->pipeline_id) {
+            pm->state_hash = ob_hash_u64(
+                ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id),
+                pm->applied_hash);
+            pm->state_pipeline_id = pm->pipeline_id;
+        }
+        *h = pm->state_hash;
     } else {
         uint64_t hs = OB_HASH_SEED;
         ob_param bad = {0};
@@ -728,7 +734,10 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->applied_hash = hs;
         pm->applied_ubos = prog->ubo_count;
         pm->applied_resources = prog->resource_count;
-        *h = ob_hash_u64(*h, hs);
+        pm->state_hash = ob_hash_u64(
+            ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id), hs);
+        pm->state_pipeline_id = pm->pipeline_id;
+        *h = pm->state_hash;
     }
     apply_push_constants(pm, prog, world, h);
     if (prog->bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return OB_OK;
@@ -814,8 +823,9 @@ ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
     vkCmdDrawIndexed(pm->cmd, index_count, instance_count, first_index, vertex_offset,
                      first_instance);
     h = ob_hash_u64(h, ((uint64_t)index_count << 32) | instance_count);
-    h = ob_hash_u64(h, ((uint64_t)first_index << 32) | (uint32_t)vertex_offset);
-    fold(pm, ob_hash_u64(h, first_instance));
+    h = ob_hash_u64(h, (((uint64_t)first_index << 32) | (uint32_t)vertex_offset) ^
+                           ((uint64_t)first_instance * 0x9e3779b97f4a7c15ull));
+    fold(pm, h);
     pm->stats.draws++;
     return OB_OK;
 }
