@@ -264,22 +264,21 @@ void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason r
 
 static bool auto_choice(ob_renderer *r)
 {
-    const uint32_t workers = r->active;
-    const ob_record_cost *st = &r->measured[0], *mt = &r->measured[1];
-    bool have_st = st->cost_ns > 0;
-    bool have_mt = mt->cost_ns > 0 && mt->workers == workers;
-    if (!have_st) return false;
-    if (!have_mt) return true;
-    bool per_draw = st->per_draw_ps > 0 && mt->per_draw_ps > 0;
-    uint64_t cost[2] = {per_draw ? st->per_draw_ps : st->cost_ns,
-                        per_draw ? mt->per_draw_ps : mt->cost_ns};
+    /* Inline against the active worker count's own figure: a frame on
+     * another count says nothing about this one. */
+    const ob_record_cost *way[2] = {&r->measured[0], &r->measured[r->active]};
+    if (way[0]->cost_ns == 0) return false;
+    if (way[1]->cost_ns == 0) return true;
+    bool per_draw = way[0]->per_draw_ps > 0 && way[1]->per_draw_ps > 0;
+    uint64_t cost[2] = {per_draw ? way[0]->per_draw_ps : way[0]->cost_ns,
+                        per_draw ? way[1]->per_draw_ps : way[1]->cost_ns};
     bool cur = r->auto_multi;
     bool multi = cur;
     if (cost[!cur] * (100u + AUTO_MARGIN_PCT) < cost[cur] * 100u) multi = !cur;
-    uint32_t other = multi ? 0u : 1u;
-    uint32_t now = r->measured[!other].draws, then = r->measured[other].draws;
+    const ob_record_cost *other = way[!multi], *chosen = way[multi];
+    uint32_t now = chosen->draws, then = other->draws;
     bool resized = 4ull * (now > then ? now - then : then - now) > (uint64_t)OB_MAX(now, then);
-    if (r->measured[other].age >= AUTO_REMEASURE_FRAMES || resized) multi = !multi;
+    if (other->age >= AUTO_REMEASURE_FRAMES || resized) multi = !multi;
     return multi;
 }
 

@@ -54,7 +54,9 @@ typedef struct ob_worker {
 /* What recording a scene one way (inline or on workers) cost. */
 typedef struct ob_record_cost {
     uint64_t cost_ns;           /* moving average of a frame's; 0 = never measured */
-    uint64_t per_draw_ps;       /* moving average per draw (frames with draws) */
+    uint64_t per_draw_ps;       /* median of the last three frames' cost per draw */
+    uint64_t recent_ps[3];      /* those frames' (frames with draws), a ring */
+    uint32_t recent_count;
     uint32_t draws;             /* moving average */
     uint32_t age, workers;
 } ob_record_cost;
@@ -111,7 +113,7 @@ struct ob_renderer {
      * that way (in any mode), with the draw count it was measured at and the
      * frames since. AUTO records the cheaper way and re-measures the other
      * when it is stale or the scene has changed size. */
-    ob_record_cost measured[2];
+    ob_record_cost measured[OB_MAX_WORKERS + 1]; /* [0] inline, [n] on n workers */
 
     ob_material_iface material_iface;
     ob_geometry_iface geometry_iface;
