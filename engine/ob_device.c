@@ -729,20 +729,29 @@ static void VKAPI_PTR counted_free(void *user, void *mem)
     if (mem) free(((alloc_header *)mem)[-1].base);
 }
 
-static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
-                                       VkSystemAllocationScope scope)
+/* Reallocation of either allocator below: a new block, the old contents,
+ * the old block freed. Both keep an alloc_header in front of each block. */
+static void *realloc_by_copy(void *user, void *old, size_t size, size_t align,
+                             VkSystemAllocationScope scope, PFN_vkAllocationFunction alloc,
+                             PFN_vkFreeFunction release)
 {
-    if (!old) return counted_alloc(user, size, align, scope);
+    if (!old) return alloc(user, size, align, scope);
     if (size == 0) {
-        counted_free(user, old);
+        release(user, old);
         return NULL;
     }
-    void *mem = counted_alloc(user, size, align, scope);
+    void *mem = alloc(user, size, align, scope);
     if (!mem) return NULL;
     size_t old_size = ((alloc_header *)old)[-1].size;
     memcpy(mem, old, old_size < size ? old_size : size);
-    counted_free(user, old);
+    release(user, old);
     return mem;
+}
+
+static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
+                                       VkSystemAllocationScope scope)
+{
+    return realloc_by_copy(user, old, size, align, scope, counted_alloc, counted_free);
 }
 
 void ob_counting_allocator_init(ob_counting_allocator *a)
@@ -772,12 +781,8 @@ struct ob_arena_chunk {
     _Alignas(16) uint8_t data[ARENA_CHUNK_BYTES];
 };
 
-/* In front of every block: its chunk, or (low bit set) the malloc'd start of
- * a block too big for a chunk. */
-typedef struct arena_header {
-    uintptr_t owner;
-    size_t size;
-} arena_header;
+/* In front of every block, an alloc_header whose base is its chunk, or (low
+ * bit set) the malloc'd start of a block too big for a chunk. */
 
 static ob_arena_chunk *arena_take_chunk(ob_arena_allocator *a)
 {
@@ -799,14 +804,14 @@ static void *VKAPI_PTR arena_alloc(void *user, size_t size, size_t align,
 {
     (void)scope;
     ob_arena_allocator *a = user;
-    if (align < _Alignof(arena_header)) align = _Alignof(arena_header);
-    size_t need = size + align + sizeof(arena_header);
+    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
+    size_t need = size + align + sizeof(alloc_header);
     atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
     if (need > ARENA_CHUNK_BYTES / 4) {
         uint8_t *base = malloc(need);
         if (!base) return NULL;
-        uintptr_t p = ((uintptr_t)base + sizeof(arena_header) + align - 1) & ~(uintptr_t)(align - 1);
-        ((arena_header *)p)[-1] = (arena_header){(uintptr_t)base | 1u, size};
+        uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+        ((alloc_header *)p)[-1] = (alloc_header){(void *)((uintptr_t)base | 1u), size};
         return (void *)p;
     }
     ob_arena_chunk *c = a->current;
@@ -820,8 +825,8 @@ static void *VKAPI_PTR arena_alloc(void *user, size_t size, size_t align,
         if (!c) return NULL;
     }
     uintptr_t start = (uintptr_t)(c->data + c->used);
-    uintptr_t p = (start + sizeof(arena_header) + align - 1) & ~(uintptr_t)(align - 1);
-    ((arena_header *)p)[-1] = (arena_header){(uintptr_t)c, size};
+    uintptr_t p = (start + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+    ((alloc_header *)p)[-1] = (alloc_header){c, size};
     c->used = p + size - (uintptr_t)c->data;
     c->live++;
     return (void *)p;
@@ -831,12 +836,12 @@ static void VKAPI_PTR arena_free(void *user, void *mem)
 {
     ob_arena_allocator *a = user;
     if (!mem) return;
-    arena_header h = ((arena_header *)mem)[-1];
-    if (h.owner & 1u) {
-        free((void *)(h.owner & ~(uintptr_t)1u));
+    uintptr_t owner = (uintptr_t)((alloc_header *)mem)[-1].base;
+    if (owner & 1u) {
+        free((void *)(owner & ~(uintptr_t)1u));
         return;
     }
-    ob_arena_chunk *c = (ob_arena_chunk *)h.owner;
+    ob_arena_chunk *c = (ob_arena_chunk *)owner;
     if (--c->live > 0) return;
     if (c == a->current) {
         c->used = 0;   /* empty again: refill it from the start (still warm) */
@@ -849,17 +854,7 @@ static void VKAPI_PTR arena_free(void *user, void *mem)
 static void *VKAPI_PTR arena_realloc(void *user, void *old, size_t size, size_t align,
                                      VkSystemAllocationScope scope)
 {
-    if (!old) return arena_alloc(user, size, align, scope);
-    if (size == 0) {
-        arena_free(user, old);
-        return NULL;
-    }
-    void *mem = arena_alloc(user, size, align, scope);
-    if (!mem) return NULL;
-    size_t old_size = ((arena_header *)old)[-1].size;
-    memcpy(mem, old, old_size < size ? old_size : size);
-    arena_free(user, old);
-    return mem;
+    return realloc_by_copy(user, old, size, align, scope, arena_alloc, arena_free);
 }
 
 void ob_arena_allocator_init(ob_arena_allocator *a)

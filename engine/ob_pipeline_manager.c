@@ -108,7 +108,6 @@ struct ob_pipeline_manager {
     uint64_t applied_hash;
     uint64_t state_hash;        /* pipeline, program and applied_hash folded */
     uint32_t state_pipeline_id; /* the pipeline state_hash was made with */
-    uint32_t applied_ubos, applied_resources;  /* blocks reused / pushes requested */
 
     ob_cmd_hash hash;
     ob_pm_stats stats;
@@ -701,9 +700,9 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
     uint64_t serial = ob_params_serial(&pm->params);
     if (pm->applied_program == prog && pm->applied_serial == serial) {
         /* No parameter changed since this program's sets were bound. */
-        pm->stats.blocks_reused += pm->applied_ubos;
-        pm->stats.descriptor_binds_requested += pm->applied_ubos ? 1u : 0u;
-        pm->stats.push_descriptor_requested += pm->applied_resources ? 1u : 0u;
+        pm->stats.blocks_reused += prog->ubo_count;
+        pm->stats.descriptor_binds_requested += prog->ubo_count ? 1u : 0u;
+        pm->stats.push_descriptor_requested += prog->resource_count ? 1u : 0u;
         if (pm->state_pipeline_id != pm->pipeline_id) {
             pm->state_hash = ob_hash_u64(
                 ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id),
@@ -732,8 +731,6 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->applied_program = prog;
         pm->applied_serial = serial;
         pm->applied_hash = hs;
-        pm->applied_ubos = prog->ubo_count;
-        pm->applied_resources = prog->resource_count;
         pm->state_hash = ob_hash_u64(
             ob_hash_u64(OB_HASH_SEED, ((uint64_t)pm->pipeline_id << 32) | prog->id), hs);
         pm->state_pipeline_id = pm->pipeline_id;

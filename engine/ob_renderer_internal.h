@@ -58,7 +58,7 @@ typedef struct ob_record_cost {
     uint64_t recent_ps[3];      /* those frames' (frames with draws), a ring */
     uint32_t recent_count;
     uint32_t draws;             /* moving average */
-    uint32_t age, workers;
+    uint32_t age;               /* frames of the other way since this was taken */
 } ob_record_cost;
 
 typedef struct ob_frame_slot {

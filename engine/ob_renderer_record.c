@@ -559,7 +559,6 @@ static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns,
     }
     /* Smoothed too: a view refreshed every few frames is not a new scene. */
     m->draws = fresh ? draws : (uint32_t)((3ull * m->draws + draws) / 4);
-    m->workers = workers;
     m->age = 0;
     /* The other way AUTO weighs against this one ages. */
     r->measured[multi ? 0 : r->active].age++;

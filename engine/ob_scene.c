@@ -323,19 +323,19 @@ static void filter_dying_renderables(ob_scene *s)
     s->renderable_count = w;
 }
 
+static bool floats_finite(const float *v, int count)
+{
+    for (int i = 0; i < count; i++)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
 static void proxy_set_renderable(ob_scene *s, const ob_node *n)
 {
     ob_render_proxy *p = &s->proxies[n->proxy_index];
     p->material = n->has_renderable ? n->renderable.material : NULL;
     p->geometry = n->has_renderable ? n->renderable.geometry : NULL;
     s->bounds[n->proxy_index].local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
-}
-
-static bool floats_all_finite(const float *f, int n)
-{
-    bool ok = true;
-    for (int i = 0; i < n; i++) ok &= isfinite(f[i]) != 0;
-    return ok;
 }
 
 _Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
@@ -357,7 +357,7 @@ static void proxy_fill(ob_scene *s, ob_node *n)
             p->linear[c * 3 + r] = w[c * 4 + r];
             p->normal[c * 3 + r] = nm[c * 4 + r];
         }
-    p->finite = floats_all_finite(p->linear, 9) && floats_all_finite(p->normal, 9);
+    p->finite = floats_finite(p->linear, 9) && floats_finite(p->normal, 9);
     b->radius = n->world_radius;
     p->node = n;
     p->node_id = n->id;
@@ -482,13 +482,6 @@ void ob_node_get_scale(const ob_node *n, float dest[3])
 
 void ob_node_set_hidden(ob_node *n, bool hidden) { n->hidden = hidden; }
 bool ob_node_is_hidden(const ob_node *n) { return n->hidden; }
-
-static bool floats_finite(const float *v, int count)
-{
-    for (int i = 0; i < count; i++)
-        if (!isfinite(v[i])) return false;
-    return true;
-}
 
 ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
 {
