@@ -155,6 +155,8 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     print_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
     fprintf(f, " (recording; in-flight frames %.3f)\n", s->auto_vs_best_200_frame);
     print_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
+    fprintf(f, "\n  %-30s %.3f (200), %.3f (10k x 8): against each round's lower of ST and MT",
+            "auto_vs_round_min", s->auto_vs_round_min_200, s->auto_vs_round_min_10k_8views);
     fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
                "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
             "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
@@ -240,7 +242,7 @@ static void json_result(FILE *f, const ob_bench_result *r)
                                         "vs_best_fixed_record_p25", "vs_best_fixed_record_p75",
                                         "record_cpu_render_ms", "record_cpu_workers_ms",
                                         "record_cpu_max_worker_ms", "cmd_host_allocs_per_object",
-                                        "commands_per_object"};
+                                        "commands_per_object", "vs_round_min_record"};
     const double values[] = {r->update_ms, r->pre_render_ms, r->record_ms, r->assemble_ms,
                              r->submit_ms, r->record_total_ms, r->cpu_frame_ms, r->gpu_ms,
                              r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame,
@@ -248,7 +250,8 @@ static void json_result(FILE *f, const ob_bench_result *r)
                              r->vs_best_fixed_record.median, r->vs_best_fixed_record.p25,
                              r->vs_best_fixed_record.p75, r->record_cpu_render_ms,
                              r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
-                             r->cmd_host_allocs_per_object, r->commands_per_object};
+                             r->cmd_host_allocs_per_object, r->commands_per_object,
+                             r->vs_round_min_record.median};
     _Static_assert(OB_ARRAY_COUNT(names) == OB_ARRAY_COUNT(values), "a name per value");
     for (size_t i = 0; i < OB_ARRAY_COUNT(names); i++) {
         fprintf(f, ",\"%s\":", names[i]);
@@ -325,6 +328,8 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
     json_field(f, "auto_vs_best_200_frame", s->auto_vs_best_200_frame);
     json_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
+    json_field(f, "auto_vs_round_min_200", s->auto_vs_round_min_200);
+    json_field(f, "auto_vs_round_min_10k_8views", s->auto_vs_round_min_10k_8views);
     json_field(f, "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
     json_field(f, "commands_per_object_raw", s->commands_per_object_raw);
@@ -470,7 +475,8 @@ static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t ob
     const double added[] = {r->speedup_record_p25, r->speedup_record_p75,
                             r->vs_best_fixed_record.median, r->record_cpu_render_ms,
                             r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
-                            r->cmd_host_allocs_per_object, r->commands_per_object};
+                            r->cmd_host_allocs_per_object, r->commands_per_object,
+                            r->vs_round_min_record.median};
     for (size_t i = 0; i < OB_ARRAY_COUNT(added); i++) csv_num(f, added[i]);
     fputc('\n', f);
 }
@@ -486,7 +492,7 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
           "push_constant_iss,vertex_req,vertex_iss,index_req,index_iss,max_abs_diff,psnr_db,"
           "hash_mismatches,speedup_record_p25,speedup_record_p75,vs_best_fixed_record,"
           "record_cpu_render_ms,record_cpu_workers_ms,record_cpu_max_worker_ms,"
-          "cmd_host_allocs_per_object,commands_per_object\n",
+          "cmd_host_allocs_per_object,commands_per_object,vs_round_min_record\n",
           f);
     for (uint32_t i = 0; i < rep->sweep_count; i++)
         for (uint32_t m = 0; m < rep->sweep[i].mode_count; m++)
