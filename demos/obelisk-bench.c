@@ -38,6 +38,7 @@
 typedef struct bench_options {
     bool quick, progress;
     bool perf, stability;      /* which sections run */
+    ob_gpu_timing gpu_timing;  /* --gpu-timing */
     const char *json, *csv, *charts;
     uint32_t seed;
     uint32_t views[MAX_LIST], view_count;
@@ -46,6 +47,7 @@ typedef struct bench_options {
     char mode_names[OB_BENCH_MAX_MODES][8];
     uint32_t mode_count;
     uint32_t warmup, rounds, flight;
+    uint32_t settle;           /* --settle N */
     uint32_t view_width, view_height, image_width, image_height;
     uint32_t raw_objects;
 } bench_options;
@@ -56,6 +58,8 @@ static const char usage_text[] =
     "                     ST,2,auto, and 50000 objects in 1 view only)\n"
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
+    "  --gpu-timing sampled|views|off   GPU timestamps: the frame's every frame and each\n"
+    "                     view's every 16th (default), every view every frame, or none\n"
     "  --json FILE        write every result and the summary as JSON\n"
     "  --csv FILE         write every result as CSV (one row per configuration); the\n"
     "                     stability rows go to FILE-stability.csv (FILE less .csv)\n"
@@ -64,6 +68,7 @@ static const char usage_text[] =
     "  --objects LIST     objects (default 1000,10000,50000; at most 100000)\n"
     "  --modes LIST       ST, worker counts, auto (default ST,1,2,4,auto)\n"
     "  --warmup N --rounds N --flight N   frames per mode: warm-up, idle, in flight\n"
+    "  --settle N         unmeasured frames of a mode before each measured idle one (0)\n"
     "  --view-size WxH    size of each sweep view (default 256x192)\n"
     "  --size WxH         size of the quality images (default 640x480)\n"
     "  --seed S           scene seed (default 1)\n"
@@ -134,6 +139,7 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
      * run; the in-flight loop feeds no summary ratio, so --quick keeps it short. */
     o->rounds = quick ? 15 : 5;
     o->flight = quick ? 2 : 5;
+    o->settle = 0;
     *out_exit = 2;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -150,6 +156,7 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
             o->perf = takes = false;
         } else if (!strcmp(a, "--no-stability")) {
             o->stability = takes = false;
+
         } else if (!v) {
             fprintf(stderr, "obelisk-bench: %s needs a value (or is unknown)\n%s", a, usage_text);
             return false;
@@ -166,14 +173,25 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
         } else if (!strcmp(a, "--modes")) {
             modes = v;
         } else if (!strcmp(a, "--warmup") || !strcmp(a, "--rounds") || !strcmp(a, "--flight") ||
-                   !strcmp(a, "--seed")) {
+                   !strcmp(a, "--settle") || !strcmp(a, "--seed")) {
             char *end;
             unsigned long n = strtoul(v, &end, 10);
             ok = *v && !*end && n <= 1000;
             uint32_t *dst = !strcmp(a, "--warmup") ? &o->warmup : !strcmp(a, "--rounds") ? &o->rounds
-                            : !strcmp(a, "--flight") ? &o->flight : &o->seed;
+                            : !strcmp(a, "--flight") ? &o->flight
+                            : !strcmp(a, "--settle") ? &o->settle : &o->seed;
             *dst = (uint32_t)n;
             if (dst == &o->rounds) ok = ok && n > 0;
+        } else if (!strcmp(a, "--gpu-timing")) {
+            ok = true;
+            if (!strcmp(v, "sampled"))
+                o->gpu_timing = OB_GPU_TIMING_SAMPLED;
+            else if (!strcmp(v, "views"))
+                o->gpu_timing = OB_GPU_TIMING_EVERY_VIEW;
+            else if (!strcmp(v, "off"))
+                o->gpu_timing = OB_GPU_TIMING_OFF;
+            else
+                ok = false;
         } else if (!strcmp(a, "--view-size")) {
             ok = parse_size(v, &o->view_width, &o->view_height);
         } else if (!strcmp(a, "--size")) {
@@ -220,7 +238,8 @@ static ob_demo_options demo_options(const bench_options *o, uint32_t pool, uint3
                                     uint32_t objects)
 {
     return (ob_demo_options){.frames = 1, .threads = (int)pool, .width = w, .height = h,
-                             .seed = o->seed, .objects = objects, .quiet = true};
+                             .seed = o->seed, .objects = objects, .quiet = true,
+                             .gpu_timing = o->gpu_timing};
 }
 
 /* Lavapipe executes every frame on the same two cores, at some 10-25 us
@@ -330,6 +349,7 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     ob_bench_run_desc rd = {.modes = o->modes, .mode_count = o->mode_count, .dt = 1.0 / 60.0,
                             .tick = ob_bench_progress_tick, .tick_user = prog};
     frame_counts(o, views, objects, &rd.warmup, &rd.rounds, &rd.flight);
+    rd.settle = o->settle;
     *out = (ob_bench_sweep_entry){.views = views, .objects = objects, .mode_count = o->mode_count};
     raw_rounds rr = {.demo = &d};
     bool raw = views == 1 && objects == o->raw_objects;
@@ -374,7 +394,8 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
                               {"MT", OB_THREADING_MULTI, rep->cores},
                               {"auto", OB_THREADING_AUTO, rep->cores}};
     ob_bench_run_desc rd = {.modes = modes, .mode_count = 3, .warmup = o->warmup,
-                            .rounds = o->rounds, .flight = 2 * o->flight, .dt = 1.0 / 60.0,
+                            .rounds = o->rounds, .settle = o->settle, .flight = 2 * o->flight,
+                            .dt = 1.0 / 60.0,
                             .tick = ob_bench_progress_tick, .tick_user = prog};
     rep->scene200 = (ob_bench_sweep_entry){.views = 1, .objects = 200, .mode_count = 3};
     if (r == OB_OK) r = ob_bench_run_modes(&s, &rd, rep->scene200.results);
@@ -475,8 +496,10 @@ static double load_average(void)
 static int run(const bench_options *o)
 {
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    ob_bench_report rep = {.quick = o->quick, .seed = o->seed, .cores = ncpu > 0 ? (uint32_t)ncpu : 1,
-                           .warmup = o->warmup, .rounds = o->rounds, .flight = o->flight,
+    ob_bench_report rep = {.quick = o->quick, .gpu_timing = o->gpu_timing,
+                           .seed = o->seed, .cores = ncpu > 0 ? (uint32_t)ncpu : 1,
+                           .warmup = o->warmup, .rounds = o->rounds, .settle = o->settle,
+                           .flight = o->flight,
                            .view_width = o->view_width, .view_height = o->view_height,
                            .image_width = o->image_width, .image_height = o->image_height,
                            .image_frames = o->quick ? 3 : 4};

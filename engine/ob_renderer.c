@@ -51,7 +51,7 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
                              .flags = VK_FENCE_CREATE_SIGNALED_BIT};
     vr = OB_VK_CHECK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    if (ob_device_timestamp_period_ns(r->dev) > 0) {
+    if (r->gpu_timing != OB_GPU_TIMING_OFF && ob_device_timestamp_period_ns(r->dev) > 0) {
         fs->query_capacity = 2 * OB_MAX_FRAME_VIEWS + 2;
         VkQueryPoolCreateInfo qci = {
             .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
@@ -91,6 +91,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     r->worker_count = d.worker_count;
     r->chunk_draws = d.chunk_draws ? d.chunk_draws : 2048;
     r->no_affinity = d.no_thread_affinity;
+    r->gpu_timing = d.gpu_timing;
     r->mode = r->pending_mode = d.threading;
     r->active = r->pending_active = r->worker_count;
     r->max_recursion = 4;

@@ -69,6 +69,18 @@ typedef enum ob_threading {
     OB_THREADING_AUTO = 2,     /* decide per frame from last frames' measured cost */
 } ob_threading;
 
+/* GPU timestamps. A stamp written after a view's work waits for that work:
+ * on lavapipe each one flushes the rasteriser, so stamping every view of
+ * every frame costs 5-15% of the frame period at 1-8 views and up to ~40%
+ * at 16 views x 10k objects (docs/benchmark.md, "GPU timestamps"). */
+typedef enum ob_gpu_timing {
+    OB_GPU_TIMING_SAMPLED = 0,   /* the frame's GPU time every frame, each view's every
+                                    OB_VIEW_TIMESTAMP_INTERVAL-th frame (the default) */
+    OB_GPU_TIMING_EVERY_VIEW,    /* the frame's and each view's, every frame */
+    OB_GPU_TIMING_OFF,           /* none: gpu_ms is -1 everywhere */
+} ob_gpu_timing;
+#define OB_VIEW_TIMESTAMP_INTERVAL 16u
+
 typedef struct ob_renderer_desc {
     ob_device_desc device;
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
@@ -80,6 +92,9 @@ typedef struct ob_renderer_desc {
      * thread's CPU. The calling thread is never pinned. true = leave all
      * placement to the scheduler. */
     bool no_thread_affinity;
+    /* Which GPU timestamps frames write (ob_frame_stats.gpu_ms and the
+     * views' gpu_ms; -1 where none was written). */
+    ob_gpu_timing gpu_timing;
 } ob_renderer_desc;
 
 typedef enum ob_skip_reason {

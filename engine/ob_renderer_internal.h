@@ -97,6 +97,7 @@ struct ob_renderer {
     int cpus[64];               /* the CPUs the process may run on (at start) */
     uint32_t cpu_count;
     bool no_affinity;           /* desc.no_thread_affinity */
+    ob_gpu_timing gpu_timing;   /* desc.gpu_timing */
     uint32_t chunk_draws;
 
     ob_frame_slot frames[OB_MAX_FRAMES_IN_FLIGHT];

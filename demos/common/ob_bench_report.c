@@ -113,12 +113,13 @@ static void print_spread(FILE *f, const char *name, ob_bench_spread v)
 
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
-    fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up; frame = "
+    fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up, each after "
+               "%u unmeasured frame(s) of its mode; frame = "
                "in-flight period over %u frames (%u, %u, %u for frames over ~%u draws); "
                "spdup = median over rounds of ST rec+asm / this, [p25,p75]; cpu-rt, cpu-wk, "
                "cpu-wmx = recording CPU time of the render thread, all workers, busiest worker "
                "(nan: not reported by the engine)\n",
-            rep->rounds, rep->warmup, rep->flight, rep->big_rounds, rep->big_warmup,
+            rep->rounds, rep->warmup, rep->settle, rep->flight, rep->big_rounds, rep->big_warmup,
             rep->big_flight, rep->big_draws);
     print_header(f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
@@ -212,9 +213,12 @@ static void print_stability(const ob_bench_stability *s, FILE *f)
 
 void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
 {
-    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s\n",
+    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s%s\n",
             rep->quick ? " --quick" : "", rep->device_name, rep->driver_info, rep->cores,
-            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "");
+            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "",
+            rep->gpu_timing == OB_GPU_TIMING_SAMPLED ? ""
+            : rep->gpu_timing == OB_GPU_TIMING_OFF ? ", no GPU timestamps"
+                                                   : ", GPU timestamps on every view");
     if (rep->perf) print_perf(rep, f);
     if (rep->stability) print_stability(rep->stability, f);
 }
@@ -389,8 +393,12 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
     if (!f) return OB_ERR_IO;
     fprintf(f, "{\"program\":\"obelisk-bench\",\"quick\":%s,\"seed\":%u,\"seconds\":%.1f,\n",
             rep->quick ? "true" : "false", rep->seed, rep->seconds);
-    fprintf(f, "\"machine\":{\"cores\":%u,\"pool_workers\":%u,\"validation\":%s,", rep->cores,
-            rep->pool_workers, rep->validation ? "true" : "false");
+    fprintf(f, "\"machine\":{\"cores\":%u,\"pool_workers\":%u,\"validation\":%s,"
+               "\"gpu_timing\":\"%s\",",
+            rep->cores, rep->pool_workers, rep->validation ? "true" : "false",
+            rep->gpu_timing == OB_GPU_TIMING_SAMPLED ? "sampled"
+            : rep->gpu_timing == OB_GPU_TIMING_OFF   ? "off"
+                                                     : "views");
     fputs("\"load_average\":[", f);
     json_num(f, rep->load_start);
     fputs(",", f);
@@ -405,10 +413,10 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
 
 static void json_perf(FILE *f, const ob_bench_report *rep)
 {
-    fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"flight\":%u,"
+    fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"settle\":%u,\"flight\":%u,"
                "\"big_frames\":{\"over_draws\":%u,\"warmup\":%u,\"rounds\":%u,\"flight\":%u},"
                "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u},\n",
-            rep->warmup, rep->rounds, rep->flight, rep->big_draws, rep->big_warmup,
+            rep->warmup, rep->rounds, rep->settle, rep->flight, rep->big_draws, rep->big_warmup,
             rep->big_rounds, rep->big_flight, rep->view_width, rep->view_height,
             rep->image_width, rep->image_height, rep->image_frames);
     fputs("\"sweep\":[\n  ", f);

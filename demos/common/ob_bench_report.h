@@ -66,7 +66,9 @@ typedef struct ob_bench_report {
     uint32_t seed, cores, pool_workers;
     char device_name[256], driver_info[256];   /* ob_device_name / ob_device_driver_info */
     bool validation;
+    ob_gpu_timing gpu_timing;                      /* --gpu-timing */
     uint32_t warmup, rounds, flight;               /* sweep frame counts per mode */
+    uint32_t settle;                               /* ob_bench_run_desc.settle */
     uint32_t big_draws;                            /* frames of more draws (estimated) use */
     uint32_t big_warmup, big_rounds, big_flight;   /* these counts instead */
     uint32_t view_width, view_height;              /* sweep view size */

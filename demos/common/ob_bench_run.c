@@ -4,7 +4,8 @@
 #include <stddef.h>
 #include <string.h>
 
-typedef enum sample_kind { SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT } sample_kind;
+/* SAMPLE_SETTLE frames are rendered and not kept. */
+typedef enum sample_kind { SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT, SAMPLE_SETTLE } sample_kind;
 
 typedef struct sample {
     uint64_t serial;
@@ -63,14 +64,15 @@ static void cpu_figures(const ob_frame_stats *st, sample *p)
     p->host_allocs_per_object = st->draws ? (double)st->cmd_host_allocs / st->draws : NAN;
 }
 
-/* One frame in mode m, its CPU stats kept as a sample. */
+/* One frame in mode m, its CPU stats kept as a sample unless kind is
+ * SAMPLE_SETTLE. */
 static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                        uint32_t mode, uint32_t round, sample_kind kind, bool advance)
 {
     ob_renderer *r = s->demo->r;
     ob_bench_set_mode(r, &desc->modes[mode]);
     ob_result res = ob_bench_scene_frame(s, advance, desc->dt);
-    if (res != OB_OK) return res;
+    if (res != OB_OK || kind == SAMPLE_SETTLE) return res;
     const ob_frame_stats *st = ob_renderer_current_stats(r);
     sample *p = &c->samples[c->count++];
     *p = (sample){
@@ -112,9 +114,16 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
            after the workers ran (theirs warm from recording). */
         for (uint32_t i = 0; i < desc->mode_count; i++) {
             uint32_t m = (i + round) % desc->mode_count;
-            ob_result res = ob_renderer_wait_idle(r);
-            if (res == OB_OK) res = frame(s, desc, c, m, round, kind, i == 0);
-            if (res != OB_OK) return res;
+            /* Settle frames first: the measured one then finds the mode as
+             * a program running in it would (worker threads awake, their
+             * caches holding this scene), not just switched from another. */
+            for (uint32_t k = 0; k <= desc->settle; k++) {
+                ob_result res = ob_renderer_wait_idle(r);
+                if (res == OB_OK)
+                    res = frame(s, desc, c, m, round, k < desc->settle ? SAMPLE_SETTLE : kind,
+                                i == 0 && k == 0);
+                if (res != OB_OK) return res;
+            }
         }
         if (!desc->round_hook) continue;
         ob_result res = ob_renderer_wait_idle(r);

@@ -65,6 +65,9 @@ typedef struct ob_bench_run_desc {
     uint32_t mode_count;       /* the first mode is the reference for hashes and speedups */
     uint32_t warmup;           /* idle frames per mode before measuring */
     uint32_t rounds;           /* measured idle frames per mode */
+    /* Unmeasured idle frames of a mode right before each of its measured
+     * ones (0: the measured frame is the first after switching modes). */
+    uint32_t settle;
     uint32_t flight;           /* measured in-flight frames per mode (0 = skip the loop) */
     double dt;                 /* scene time step, e.g. 1/60 */
     ob_bench_tick_fn tick;

@@ -234,6 +234,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
         .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
         .threading = o->threads == 0 ? OB_THREADING_SINGLE
                      : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
+        .gpu_timing = o->gpu_timing,
     };
     d->r = ob_renderer_create(&rd, &r);
     if (!d->r) return r;

@@ -31,6 +31,7 @@ typedef struct ob_demo_options {
     bool window;              /* --window */
     bool quiet;               /* --quiet: no per-frame lines */
     uint32_t malloc_threshold_kib; /* --malloc-threshold: glibc's thresholds (0 = its own) */
+    ob_gpu_timing gpu_timing; /* ob_renderer_desc.gpu_timing (obelisk-bench --gpu-timing) */
     const char *input;        /* positional argument (obelisk-view FILE) */
     /* Set by the parser when --size / --threads were given, so that settings
      * from a scene file do not override the command line; frames_given makes
