@@ -4,7 +4,9 @@
  * Creation runs in stages (slots → instance → physical choice → logical
  * device → one-shot objects → resource registry); each stage undoes itself
  * on failure and create unwinds the earlier ones, so every fault-injection
- * point leaves nothing behind.
+ * point leaves nothing behind. An adopted device (desc.adopt) replaces the
+ * instance, choice and logical stages by one that checks the application's
+ * handles and only adds a messenger; the unwinding then leaves them alive.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "ob_device_internal.h"
@@ -33,9 +35,13 @@ struct ob_device {
     PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
     bool validation;
+    bool validation_required;   /* desc.validation > 0, not only $OB_VALIDATION */
     const char *const *extra_instance_exts;
     uint32_t extra_instance_ext_count;
     bool swapchain;
+    /* The instance and device are the application's (desc.adopt): the
+     * engine destroys its messenger and its own objects, never those. */
+    bool adopted;
     /* Info/verbose messages (about 90 loader lines per device) are logged
      * only with OB_LOG=debug; otherwise they would swamp log captures. */
     bool log_infos;
@@ -153,8 +159,53 @@ static void instance_destroy(ob_device *dev)
     if (dev->messenger) dev->destroy_messenger(dev->instance, dev->messenger, NULL);
     dev->messenger = VK_NULL_HANDLE;
     /* The messenger chained into VkInstanceCreateInfo still reports here. */
-    if (dev->instance) vkDestroyInstance(dev->instance, NULL);
+    if (dev->instance && !dev->adopted) vkDestroyInstance(dev->instance, NULL);
     dev->instance = VK_NULL_HANDLE;
+}
+
+static VkDebugUtilsMessengerCreateInfoEXT messenger_info(ob_device *dev)
+{
+    return (VkDebugUtilsMessengerCreateInfoEXT){
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_VERBOSE_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = validation_message,
+        .pUserData = dev,
+    };
+}
+
+/* The debug-utils entry points of dev->instance, and with validation the
+ * messenger that routes its messages into the log. On failure nothing is
+ * left to undo but the instance. */
+static ob_result messenger_create(ob_device *dev, bool debug_utils)
+{
+    if (debug_utils) {
+        dev->set_object_name = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetInstanceProcAddr(
+            dev->instance, "vkSetDebugUtilsObjectNameEXT");
+    }
+    if (!dev->validation) return OB_OK;
+    PFN_vkCreateDebugUtilsMessengerEXT pfn_vkCreateDebugUtilsMessengerEXT =
+        (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(dev->instance,
+                                                                  "vkCreateDebugUtilsMessengerEXT");
+    dev->destroy_messenger = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+        dev->instance, "vkDestroyDebugUtilsMessengerEXT");
+    if (!pfn_vkCreateDebugUtilsMessengerEXT || !dev->destroy_messenger) {
+        OB_LOG_E("device", "validation is on but vkCreateDebugUtilsMessengerEXT is missing: "
+                           "messages could not be captured");
+        return OB_ERR_UNSUPPORTED;
+    }
+    VkDebugUtilsMessengerCreateInfoEXT info = messenger_info(dev);
+    VkResult vr = OB_VK_CHECK_CREATE(pfn_vkCreateDebugUtilsMessengerEXT(dev->instance, &info, NULL, &dev->messenger));
+    if (vr < 0) {
+        dev->messenger = VK_NULL_HANDLE;
+        return ob_result_from_vk(vr);
+    }
+    return OB_OK;
 }
 
 static ob_result instance_create(ob_device *dev, const char *app_name)
@@ -210,23 +261,12 @@ static ob_result instance_create(ob_device *dev, const char *app_name)
     if (sync_validation) enabled_exts[enabled_count++] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
     const char *layers[] = {OB_VALIDATION_LAYER};
 
-    VkDebugUtilsMessengerCreateInfoEXT messenger_info = {
-        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_VERBOSE_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
-        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
-        .pfnUserCallback = validation_message,
-        .pUserData = dev,
-    };
+    VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(dev);
     const VkValidationFeatureEnableEXT enables[] = {
         VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
     VkValidationFeaturesEXT features = {
         .sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
-        .pNext = &messenger_info,
+        .pNext = &messenger,
         .enabledValidationFeatureCount = OB_ARRAY_COUNT(enables),
         .pEnabledValidationFeatures = enables,
     };
@@ -240,7 +280,7 @@ static ob_result instance_create(ob_device *dev, const char *app_name)
     };
     VkInstanceCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-        .pNext = dev->validation ? (sync_validation ? (const void *)&features : (const void *)&messenger_info)
+        .pNext = dev->validation ? (sync_validation ? (const void *)&features : (const void *)&messenger)
                                  : NULL,
         .pApplicationInfo = &app,
         .enabledLayerCount = dev->validation ? 1u : 0u,
@@ -253,39 +293,31 @@ static ob_result instance_create(ob_device *dev, const char *app_name)
         dev->instance = VK_NULL_HANDLE;
         return vr == VK_ERROR_INCOMPATIBLE_DRIVER ? OB_ERR_NO_DEVICE : ob_result_from_vk(vr);
     }
-    if (debug_utils) {
-        dev->set_object_name = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetInstanceProcAddr(
-            dev->instance, "vkSetDebugUtilsObjectNameEXT");
-    }
-    if (dev->validation) {
-        PFN_vkCreateDebugUtilsMessengerEXT pfn_vkCreateDebugUtilsMessengerEXT =
-            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(dev->instance,
-                                                                      "vkCreateDebugUtilsMessengerEXT");
-        dev->destroy_messenger = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
-            dev->instance, "vkDestroyDebugUtilsMessengerEXT");
-        if (!pfn_vkCreateDebugUtilsMessengerEXT || !dev->destroy_messenger) {
-            OB_LOG_E("device", "validation is on but vkCreateDebugUtilsMessengerEXT is missing: "
-                               "messages could not be captured");
-            instance_destroy(dev);
-            return OB_ERR_UNSUPPORTED;
-        }
-        vr = OB_VK_CHECK_CREATE(pfn_vkCreateDebugUtilsMessengerEXT(dev->instance, &messenger_info, NULL, &dev->messenger));
-        if (vr < 0) {
-            dev->messenger = VK_NULL_HANDLE;
-            instance_destroy(dev);
-            return ob_result_from_vk(vr);
-        }
-    }
-    return OB_OK;
+    r = messenger_create(dev, debug_utils);
+    if (r != OB_OK) instance_destroy(dev);
+    return r;
 }
 
 /* ------------------------------------------------------------ logical device */
 
 static void logical_destroy(ob_device *dev)
 {
-    if (dev->device) vkDestroyDevice(dev->device, NULL);
+    if (dev->device && !dev->adopted) vkDestroyDevice(dev->device, NULL);
     dev->device = VK_NULL_HANDLE;
     dev->queue = VK_NULL_HANDLE;
+}
+
+/* Device-level entry points of extensions the engine needs. */
+static ob_result logical_entry_points(ob_device *dev)
+{
+    dev->push_descriptor =
+        (PFN_vkCmdPushDescriptorSetKHR)vkGetDeviceProcAddr(dev->device, "vkCmdPushDescriptorSetKHR");
+    if (!dev->push_descriptor) {
+        OB_LOG_E("device", "'%s' advertises %s but has no vkCmdPushDescriptorSetKHR",
+                 dev->props.deviceName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+        return OB_ERR_UNSUPPORTED;
+    }
+    return OB_OK;
 }
 
 static ob_result logical_create(ob_device *dev)
@@ -342,17 +374,60 @@ static ob_result logical_create(ob_device *dev)
         return ob_result_from_vk(vr);
     }
     vkGetDeviceQueue(dev->device, dev->queue_family, 0, &dev->queue);
-    dev->push_descriptor =
-        (PFN_vkCmdPushDescriptorSetKHR)vkGetDeviceProcAddr(dev->device, "vkCmdPushDescriptorSetKHR");
-    if (!dev->push_descriptor) {
-        OB_LOG_E("device", "'%s' advertises %s but has no vkCmdPushDescriptorSetKHR",
-                 dev->props.deviceName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+    ob_result r = logical_entry_points(dev);
+    if (r != OB_OK) {
         logical_destroy(dev);
-        return OB_ERR_UNSUPPORTED;
+        return r;
     }
     ob_device_set_name(dev, VK_OBJECT_TYPE_DEVICE, (uint64_t)(uintptr_t)dev->device, "obelisk device");
     ob_device_set_name(dev, VK_OBJECT_TYPE_QUEUE, (uint64_t)(uintptr_t)dev->queue, "obelisk queue");
     return OB_OK;
+}
+
+/* The application's instance, physical device, device and queue, checked;
+ * the engine adds only its messenger. On failure the messenger is gone and
+ * the handles are untouched. */
+static ob_result adopt_create(ob_device *dev, const ob_vulkan_handles *a)
+{
+    ob_physical_choice choice;
+    ob_adopted_info info;
+    ob_result r = ob_device_check_adopted(a, &choice, &info);
+    if (r != OB_OK) return r;
+    dev->adopted = true;
+    dev->instance = a->instance;
+    dev->physical = choice.physical;
+    dev->props = choice.props;
+    dev->caps = choice.caps;
+    dev->queue_family = choice.queue_family;
+    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
+    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+    dev->device = a->device;
+    dev->queue = a->queue;
+    dev->swapchain = info.swapchain;
+    if (dev->validation && !info.debug_utils) {
+        /* The application decides what its instance enables: without debug
+         * utils nothing can be captured. Asked for in the desc, that is an
+         * error; asked for by $OB_VALIDATION alone, a warning. */
+        if (dev->validation_required) {
+            OB_LOG_E("device", "validation was requested (desc.validation) but the application's "
+                     "instance lacks %s: messages could not be captured", VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+            r = OB_ERR_UNSUPPORTED;
+            goto fail;
+        }
+        OB_LOG_W("device", "OB_VALIDATION is set but the application's instance lacks %s: "
+                 "validation messages are not captured", VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        dev->validation = false;
+    }
+    r = messenger_create(dev, info.debug_utils);
+    if (r != OB_OK) goto fail;
+    r = logical_entry_points(dev);
+    if (r != OB_OK) goto fail;
+    return OB_OK;
+fail:
+    instance_destroy(dev);
+    dev->device = VK_NULL_HANDLE;
+    dev->queue = VK_NULL_HANDLE;
+    return r;
 }
 
 /* ----------------------------------------------------------------- one-shot */
@@ -536,6 +611,39 @@ void ob_device_defer(ob_device *dev, ob_deferred_fn fn, void *payload)
     q->items[q->count++] = (defer_item){fn, payload};
 }
 
+/* Instance, physical device choice and logical device of the engine's own.
+ * On failure *stage names the step, and nothing of them is left. */
+static ob_result own_create(ob_device *dev, const ob_device_desc *desc, const char **stage)
+{
+    *stage = "instance";
+    dev->extra_instance_exts = desc->instance_extensions;
+    dev->extra_instance_ext_count = desc->instance_extensions ? desc->instance_extension_count : 0;
+    dev->swapchain = desc->swapchain;
+    ob_result r = instance_create(dev, desc->app_name ? desc->app_name : "obelisk");
+    if (r != OB_OK) return r;
+
+    const char *selector = desc->device ? desc->device : getenv("OB_DEVICE");
+    ob_physical_choice choice;
+    *stage = "device selection";
+    r = ob_device_select_physical(dev->instance, selector, &choice);
+    if (r != OB_OK) goto fail_destroy_instance;
+    dev->physical = choice.physical;
+    dev->props = choice.props;
+    dev->caps = choice.caps;
+    dev->queue_family = choice.queue_family;
+    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
+    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+
+    *stage = "logical device";
+    r = logical_create(dev);
+    if (r != OB_OK) goto fail_destroy_instance;
+    return OB_OK;
+
+fail_destroy_instance:
+    instance_destroy(dev);
+    return r;
+}
+
 /* ------------------------------------------------------- create and destroy */
 
 ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
@@ -554,34 +662,21 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     atomic_init(&dev->val_infos, 0);
     atomic_init(&dev->lost, false);
     dev->validation = validation_wanted(desc->validation);
+    dev->validation_required = desc->validation > 0;
     const char *log_env = getenv("OB_LOG");
     dev->log_infos = log_env && strcmp(log_env, "debug") == 0;
 
     stage = "frame slots";
     r = slots_create(dev, desc->frames_in_flight);
     if (r != OB_OK) goto fail_free_dev;
-    stage = "instance";
-    dev->extra_instance_exts = desc->instance_extensions;
-    dev->extra_instance_ext_count = desc->instance_extensions ? desc->instance_extension_count : 0;
-    dev->swapchain = desc->swapchain;
-    r = instance_create(dev, desc->app_name ? desc->app_name : "obelisk");
-    if (r != OB_OK) goto fail_destroy_slots;
-
-    const char *selector = desc->device ? desc->device : getenv("OB_DEVICE");
-    ob_physical_choice choice;
-    stage = "device selection";
-    r = ob_device_select_physical(dev->instance, selector, &choice);
-    if (r != OB_OK) goto fail_destroy_instance;
-    dev->physical = choice.physical;
-    dev->props = choice.props;
-    dev->caps = choice.caps;
-    dev->queue_family = choice.queue_family;
-    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
-    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
-
-    stage = "logical device";
-    r = logical_create(dev);
-    if (r != OB_OK) goto fail_destroy_instance;
+    if (desc->adopt) {
+        stage = "adopting the application's device";
+        r = adopt_create(dev, desc->adopt);
+        if (r != OB_OK) goto fail_destroy_slots;
+    } else {
+        r = own_create(dev, desc, &stage);
+        if (r != OB_OK) goto fail_destroy_slots;
+    }
     stage = "one-shot command pool";
     r = oneshot_create(dev);
     if (r != OB_OK) goto fail_destroy_logical;
@@ -589,10 +684,10 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     dev->registry = ob_resource_registry_create(&r);
     if (!dev->registry) goto fail_destroy_oneshot;
 
-    OB_LOG_I("device", "using #%u '%s' (%s), Vulkan %u.%u.%u, validation %s", dev->caps.device_index,
+    OB_LOG_I("device", "using #%u '%s' (%s), Vulkan %u.%u.%u, validation %s%s", dev->caps.device_index,
              dev->props.deviceName, dev->driver_info, VK_API_VERSION_MAJOR(dev->props.apiVersion),
              VK_API_VERSION_MINOR(dev->props.apiVersion), VK_API_VERSION_PATCH(dev->props.apiVersion),
-             dev->validation ? "on" : "off");
+             dev->validation ? "on" : "off", dev->adopted ? ", the application's device" : "");
     if (out_result) *out_result = OB_OK;
     return dev;
 
@@ -600,7 +695,6 @@ fail_destroy_oneshot:
     oneshot_destroy(dev);
 fail_destroy_logical:
     logical_destroy(dev);
-fail_destroy_instance:
     instance_destroy(dev);
 fail_destroy_slots:
     slots_destroy(dev);
@@ -646,6 +740,8 @@ bool ob_device_is_cpu(const ob_device *dev) { return dev->props.deviceType == VK
 PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev) { return dev->push_descriptor; }
 const ob_device_caps *ob_device_get_caps(const ob_device *dev) { return &dev->caps; }
 bool ob_device_validation_enabled(const ob_device *dev) { return dev->validation; }
+bool ob_device_is_adopted(const ob_device *dev) { return dev->adopted; }
+bool ob_device_has_swapchain(const ob_device *dev) { return dev->swapchain; }
 ob_resource_registry *ob_device_registry(const ob_device *dev) { return dev->registry; }
 
 double ob_device_timestamp_period_ns(const ob_device *dev)

@@ -68,6 +68,42 @@ ob_result ob_result_from_vk(VkResult res);
 
 typedef struct ob_device ob_device;
 
+/* Vulkan objects the application already owns, for ob_device_desc.adopt
+ * (programs that already use Vulkan). The engine creates its own objects on
+ * them and destroys only those: none of these handles is destroyed, and the
+ * application destroys them after ob_device_destroy / ob_renderer_destroy.
+ * Requirements, checked at creation (a missing one fails it with
+ * OB_ERR_UNSUPPORTED and a log line naming it): an instance created for
+ * Vulkan 1.3 (api_version), a 1.3 physical device, a queue family with
+ * graphics + compute, VK_KHR_push_descriptor enabled on the device, and
+ * dynamicRendering, synchronization2 and maintenance4 enabled (in a
+ * VkPhysicalDeviceVulkan13Features, or their own feature structs, in the
+ * `features` chain). VK_KHR_swapchain must be enabled to present
+ * (ob_renderer_attach_surface). Optional features (timeline semaphores,
+ * anisotropy, wireframe, ...) count as available only where the chain
+ * enabled them. The engine submits to `queue` from the render thread: the
+ * application must not use the queue at the same time (Vulkan's external
+ * synchronization rule). The strings and the chain are read during
+ * creation only. */
+typedef struct ob_vulkan_handles {
+    VkInstance instance;
+    VkPhysicalDevice physical;
+    VkDevice device;
+    uint32_t queue_family;
+    VkQueue queue;                        /* a queue of queue_family */
+    uint32_t api_version;                 /* VkApplicationInfo.apiVersion of the instance */
+    /* What the instance enabled: with VK_EXT_debug_utils (and the
+     * validation layer) the engine names its objects and captures
+     * validation messages with a messenger of its own. */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    const char *const *device_extensions; /* what vkCreateDevice enabled */
+    uint32_t device_extension_count;
+    /* The VkPhysicalDeviceFeatures2 chain given to vkCreateDevice (its
+     * pNext); NULL means no features were enabled, which fails the check. */
+    const VkPhysicalDeviceFeatures2 *features;
+} ob_vulkan_handles;
+
 typedef struct ob_device_desc {
     const char *app_name;     /* NULL → "obelisk" */
     const char *device;       /* NULL → $OB_DEVICE → auto ("lavapipe", "gpu" or an index) */
@@ -80,6 +116,11 @@ typedef struct ob_device_desc {
     const char *const *instance_extensions;
     uint32_t instance_extension_count;
     bool swapchain;
+    /* Non-NULL: use the application's instance, device and queue instead of
+     * creating them (app_name, device, instance_extensions and swapchain are
+     * then ignored; validation only captures messages, see
+     * ob_vulkan_handles). */
+    const ob_vulkan_handles *adopt;
 } ob_device_desc;
 
 typedef struct ob_validation_counts {
@@ -88,11 +129,19 @@ typedef struct ob_validation_counts {
     uint32_t infos;
 } ob_validation_counts;
 
-/* Creates the device. On failure returns NULL, sets *out_result
- * (OB_ERR_NO_DEVICE when no device meets the requirements) and logs why. */
+/* Creates the device, or adopts the application's (desc.adopt). On failure
+ * returns NULL, sets *out_result (OB_ERR_NO_DEVICE when no device meets the
+ * requirements, OB_ERR_UNSUPPORTED when an adopted device lacks one) and
+ * logs why. */
 ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result);
-/* Waits idle, runs every deferred deletion, destroys. NULL is a no-op. */
+/* Waits idle, runs every deferred deletion, destroys what the engine
+ * created (an adopted instance and device are left alive). NULL is a no-op. */
 void ob_device_destroy(ob_device *dev);
+/* True when the instance and device are the application's (desc.adopt). */
+bool ob_device_is_adopted(const ob_device *dev);
+/* Whether VK_KHR_swapchain is enabled on the device (desc.swapchain, or in
+ * the adopted device's extensions). */
+bool ob_device_has_swapchain(const ob_device *dev);
 
 VkInstance ob_device_vk_instance(const ob_device *dev);
 VkPhysicalDevice ob_device_vk_physical(const ob_device *dev);

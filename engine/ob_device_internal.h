@@ -4,7 +4,8 @@
  *
  * The device owns the resource registry so that ob_device_destroy can free
  * whatever the application leaked; the registry code lives with the
- * resources. Physical-device probing lives in ob_device_select.c.
+ * resources. Physical-device probing lives in ob_device_select.c, the
+ * checks of an application's own Vulkan objects in ob_device_adopt.c.
  */
 #ifndef OB_DEVICE_INTERNAL_H
 #define OB_DEVICE_INTERNAL_H
@@ -27,6 +28,30 @@ typedef struct ob_physical_choice {
  * OB_ERR_INVALID_ARGUMENT for a malformed selector). */
 ob_result ob_device_select_physical(VkInstance instance, const char *selector,
                                     ob_physical_choice *out_choice);
+
+/* Probes one physical device against the requirements of ob_device.h:
+ * fills *out_choice (the first graphics + compute family; caps = what the
+ * hardware supports) and *out_suitable; when unsuitable, `reason` says why.
+ * Only a host allocation failure is an error. */
+ob_result ob_device_probe_physical(VkPhysicalDevice pd, uint32_t index, ob_physical_choice *out_choice,
+                                   bool *out_suitable, char *reason, size_t reason_size);
+
+/* ---- adopted handles (ob_device_adopt.c) ---- */
+
+/* What an application's instance and device have enabled that the engine
+ * cares about beyond the requirements. */
+typedef struct ob_adopted_info {
+    bool debug_utils;   /* VK_EXT_debug_utils on the instance */
+    bool swapchain;     /* VK_KHR_swapchain on the device */
+} ob_adopted_info;
+
+/* Checks an application's handles against the engine's requirements (see
+ * ob_vulkan_handles) and fills *out_choice with the physical device, the
+ * application's queue family and caps = supported and enabled. On failure
+ * logs every requirement that is missing and returns OB_ERR_UNSUPPORTED
+ * (OB_ERR_INVALID_ARGUMENT for null or inconsistent handles). */
+ob_result ob_device_check_adopted(const ob_vulkan_handles *a, ob_physical_choice *out_choice,
+                                  ob_adopted_info *out_info);
 
 /* ---- resource registry (ob_resources.c) ---- */
 

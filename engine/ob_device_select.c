@@ -172,6 +172,17 @@ static ob_result probe(VkPhysicalDevice pd, uint32_t index, candidate *c)
     return OB_OK;
 }
 
+ob_result ob_device_probe_physical(VkPhysicalDevice pd, uint32_t index, ob_physical_choice *out_choice,
+                                   bool *out_suitable, char *reason, size_t reason_size)
+{
+    candidate c;
+    ob_result r = probe(pd, index, &c);
+    *out_choice = c.choice;
+    *out_suitable = r == OB_OK && c.suitable;
+    if (reason_size) snprintf(reason, reason_size, "%s", c.reason);
+    return r;
+}
+
 static bool matches(const candidate *c, selector_kind kind, uint32_t want_index, uint32_t index)
 {
     switch (kind) {

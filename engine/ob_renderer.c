@@ -140,7 +140,10 @@ fail:
 void ob_renderer_destroy(ob_renderer *r)
 {
     if (!r) return;
-    if (r->dev) vkDeviceWaitIdle(ob_device_vk(r->dev));
+    if (r->dev) {
+        OB_VK_CHECK(vkDeviceWaitIdle(ob_device_vk(r->dev)));
+        ob_renderer_detach_surface(r);
+    }
     ob_renderer_workers_stop(r);
     ob_pipeline_manager_destroy(r->immediate);
     for (uint32_t i = 0; i < OB_MAX_FRAMES_IN_FLIGHT; i++)
@@ -329,6 +332,14 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
         ob_pm_begin_frame(w->pm, r->slot, r->serial);
     }
     ob_pm_begin_frame(r->immediate, r->slot, r->serial);
+    /* The slot's fence also covers the submission that waited on its
+     * acquire semaphore, so the acquire may signal it again. */
+    ob_result pres = ob_renderer_present_acquire(r);
+    if (pres != OB_OK) {
+        OB_LOG_E("renderer", "frame %llu: no swapchain image: %s", (unsigned long long)r->serial,
+                 ob_result_name(pres));
+        return pres;
+    }
 
     r->mode = r->pending_mode;
     r->active = r->pending_active;
@@ -501,17 +512,15 @@ ob_result ob_renderer_process_views(ob_renderer *r)
 ob_result ob_renderer_end_frame(ob_renderer *r)
 {
     if (!r->in_frame) return OB_ERR_WRONG_STATE;
-    if (!r->submitted) {
-        ob_result res = ob_renderer_process_views(r);
-        if (res != OB_OK) {
-            r->in_frame = false;
-            return res;
-        }
-    }
+    ob_result res = r->submitted ? OB_OK : ob_renderer_process_views(r);
+    /* A frame submitted with errors (a view not recorded) still releases
+     * its swapchain image: the present waits on what was submitted. */
+    ob_result pres = ob_renderer_present_queue(r);
     r->in_frame = false;
+    if (res != OB_OK) return res;
     r->cur.frame_ns = ob_time_ns() - r->frame_start_ns + r->cur.update_ns;
     r->frames[r->slot].stats = r->cur;
-    return OB_OK;
+    return pres;
 }
 
 ob_result ob_renderer_wait_idle(ob_renderer *r)

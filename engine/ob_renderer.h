@@ -9,10 +9,24 @@
  * its own command pool (multi-threaded). The primary then executes every
  * view in order, with the barriers each needs, in one submission.
  *
- * Lifecycle: create → { begin_frame → (camera views' pre_draw) →
- * process_views → end_frame } * → destroy.
+ * Lifecycle: create → [attach_surface] → { begin_frame → (camera views'
+ * pre_draw) → process_views → end_frame } * → [detach_surface] → destroy.
  * Thread rule: every function is [render thread]; workers are internal.
  * The threading mode and the active worker count change only at begin_frame.
+ *
+ * Vulkan objects: by default the renderer creates its instance and device;
+ * with desc.device.adopt it runs on the application's (ob_vulkan_handles in
+ * ob_device.h) and destroys none of them.
+ *
+ * Presenting: without a surface the renderer is headless (the final image is
+ * read back). With one (ob_renderer_attach_surface) it owns a swapchain on
+ * it: begin_frame acquires an image, the frame's primary ends by copying the
+ * present image (a presenting composite view's target) into it, the frame's
+ * one submission waits for the acquire and signals the present, and
+ * end_frame presents. A swapchain out of date, suboptimal or of another
+ * size than the surface is rebuilt at the next begin_frame; a surface of
+ * size 0x0 (a minimised window) skips presenting, not the frame, and is no
+ * error.
  */
 #ifndef OB_RENDERER_H
 #define OB_RENDERER_H
@@ -144,8 +158,12 @@ typedef struct ob_frame_stats {
     uint64_t frame_hash;         /* all view hashes in order */
 } ob_frame_stats;
 
+/* Creates the device (or adopts the application's: desc.device.adopt), the
+ * parameter registry, the frame slots and the workers. Failure: NULL,
+ * *out_result set, the cause logged, everything created so far destroyed. */
 ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result);
-/* Waits idle, stops and joins the workers, destroys everything it created. NULL ok. */
+/* Waits idle, detaches the surface, stops and joins the workers, destroys
+ * everything it created (never adopted Vulkan objects). NULL ok. */
 void ob_renderer_destroy(ob_renderer *r);
 
 ob_device *ob_renderer_device(ob_renderer *r);
@@ -202,7 +220,10 @@ void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t varia
 typedef void (*ob_frame_stats_fn)(void *user, const ob_frame_stats *stats);
 void ob_renderer_set_stats_callback(ob_renderer *r, ob_frame_stats_fn fn, void *user);
 
-/* Completes the frame. */
+/* Completes the frame: records and submits it if process_views did not,
+ * then presents it when a surface is attached. A failure to record or
+ * submit is returned first; a present that fails for good (surface or
+ * device lost) returns its error; out of date is no error. */
 ob_result ob_renderer_end_frame(ob_renderer *r);
 /* Waits for all submitted frames; their stats (with GPU times) become final. */
 ob_result ob_renderer_wait_idle(ob_renderer *r);
@@ -210,5 +231,57 @@ ob_result ob_renderer_wait_idle(ob_renderer *r);
 const ob_frame_stats *ob_renderer_last_stats(const ob_renderer *r);
 /* Stats of the frame just submitted (CPU parts final, GPU times pending). */
 const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r);
+
+/* ---- presenting ------------------------------------------------------
+ * The application creates the window and its VkSurfaceKHR on the renderer's
+ * instance (ob_device_vk_instance; the instance needs the surface
+ * extensions: ob_device_desc.instance_extensions) and keeps owning it: it
+ * calls ob_renderer_detach_surface (or ob_renderer_destroy) before
+ * destroying the surface. The device needs VK_KHR_swapchain
+ * (ob_device_desc.swapchain). */
+typedef struct ob_surface_desc {
+    VkSurfaceKHR surface;
+    /* The window's size in pixels, used where the surface takes its size
+     * from the swapchain (Wayland); X11 and Win32 surfaces say their own.
+     * Keep it current with ob_renderer_surface_resized. */
+    uint32_t width, height;
+    /* false: FIFO (waits for vertical blank); true: MAILBOX, else
+     * IMMEDIATE, where the surface offers them. */
+    bool no_vsync;
+} ob_surface_desc;
+/* Checks that the device's queue can present to the surface and picks a
+ * format (B8G8R8A8 or R8G8B8A8 UNORM where offered) and mode; the
+ * swapchain comes with the next begin_frame. Failure: an error result
+ * (OB_ERR_UNSUPPORTED naming what is missing, OB_ERR_WRONG_STATE inside a
+ * frame or with a surface already attached), logged, nothing attached.
+ * [render thread, between frames] */
+ob_result ob_renderer_attach_surface(ob_renderer *r, const ob_surface_desc *desc);
+/* Waits idle and destroys the swapchain and its semaphores; the surface
+ * stays the application's. No-op without one. [render thread, between frames] */
+void ob_renderer_detach_surface(ob_renderer *r);
+/* The window was resized (to width x height pixels; 0x0 when minimised):
+ * the swapchain is rebuilt at the next begin_frame. Optional where the
+ * surface reports its size (it is queried every frame). [render thread] */
+void ob_renderer_surface_resized(ob_renderer *r, uint32_t width, uint32_t height);
+/* This frame presents `image` (a colour image with OB_IMAGE_TRANSFER_SRC
+ * usage): at the end of the primary it is blitted, scaled to the window if
+ * sizes differ, into the acquired swapchain image. A presenting composite
+ * view calls it from its pre_draw. No-op when headless or outside a frame;
+ * a frame with a swapchain image and nothing to present shows black (and
+ * logs a warning once). [render thread, during PreRender] */
+void ob_renderer_present_image(ob_renderer *r, ob_image image);
+/* The size of this frame's swapchain image; false (and 0x0) when headless,
+ * outside a frame, or when this frame is not presented (minimised). Views
+ * that follow the window size read it during PreRender. [render thread] */
+bool ob_renderer_present_extent(const ob_renderer *r, uint32_t *out_width, uint32_t *out_height);
+
+typedef struct ob_present_stats {
+    uint32_t presented;          /* frames shown */
+    uint32_t skipped;            /* frames not shown: minimised, out of date, not submitted */
+    uint32_t swapchains;         /* swapchains created (1 + rebuilds) */
+    uint32_t width, height;      /* of the current swapchain (0x0: none) */
+} ob_present_stats;
+/* Counts since the surface was attached; all zero when headless. */
+ob_present_stats ob_renderer_present_stats(const ob_renderer *r);
 
 #endif /* OB_RENDERER_H */

@@ -82,6 +82,8 @@ typedef struct ob_image_undo {
 } ob_image_undo;
 #define OB_MAX_FRAME_IMAGES (4 * OB_MAX_FRAME_VIEWS)
 
+typedef struct ob_present ob_present;
+
 typedef struct ob_attachment {
     uint32_t node_id;
     ob_view *view;
@@ -142,6 +144,8 @@ struct ob_renderer {
     atomic_uint next_job;
     bool quit;
 
+    ob_present *present;        /* the attached surface's swapchain; NULL = headless */
+
     ob_frame_stats_fn stats_fn;
     void *stats_user;
     ob_frame_stats cur;         /* being built */
@@ -153,5 +157,22 @@ struct ob_renderer {
 ob_result ob_renderer_workers_start(ob_renderer *r);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
+/* Keep img's tracked state from before this frame's first barrier on it, so
+ * a frame that is not submitted can put it back. */
+void ob_renderer_note_image_state(ob_renderer *r, ob_image img);
+
+/* ob_renderer_present.c — each a no-op without an attached surface.
+ * begin_frame: acquire this frame's image (none when minimised). */
+ob_result ob_renderer_present_acquire(ob_renderer *r);
+/* End of the primary: the present image into the acquired image, to PRESENT_SRC. */
+void ob_renderer_present_record(ob_renderer *r, VkCommandBuffer cmd);
+/* The frame's submission: the wait on the acquire and the signal for the
+ * present (returns 1, or 0 with nothing to add); then whether it was
+ * submitted. */
+uint32_t ob_renderer_present_sync(ob_renderer *r, VkSemaphoreSubmitInfo *out_wait,
+                                  VkSemaphoreSubmitInfo *out_signal);
+void ob_renderer_present_submitted(ob_renderer *r, bool submitted);
+/* end_frame: queue the present of a submitted frame. */
+ob_result ob_renderer_present_queue(ob_renderer *r);
 
 #endif /* OB_RENDERER_INTERNAL_H */

@@ -374,7 +374,7 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 #define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 2)
 
 /* Keep img's tracked state from before this frame's first barrier on it. */
-static void remember_state(ob_renderer *r, ob_image img)
+void ob_renderer_note_image_state(ob_renderer *r, ob_image img)
 {
     for (uint32_t i = 0; i < r->undo_count; i++)
         if (r->undo[i].img.id == img.id) return;
@@ -410,7 +410,7 @@ static void add_image_barrier(ob_renderer *r, ob_image img, VkImageLayout layout
 {
     if (!img.id || *n >= VIEW_MAX_BARRIERS) return;
     ob_image_state next = {layout, stages, access};
-    remember_state(r, img);
+    ob_renderer_note_image_state(r, img);
     if (ob_image_transition(r->dev, img, &next, &barriers[*n])) (*n)++;
 }
 
@@ -426,7 +426,7 @@ static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img
     VkImageMemoryBarrier2 b;
     ob_image_state dst = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
                           VK_ACCESS_2_TRANSFER_WRITE_BIT};
-    remember_state(r, img);
+    ob_renderer_note_image_state(r, img);
     if (!ob_image_transition(r->dev, img, &dst, &b)) return;
     VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
                             .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
@@ -725,6 +725,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         st->frame_hash = ob_hash_u64(ob_hash_u64(st->frame_hash, v->id), vs->hash.hash);
     }
     ob_free(by_view);
+    ob_renderer_present_record(r, cmd);
     if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 1);
     ob_param_registry_end_recording(r->reg);
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
@@ -752,10 +753,17 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     }
     VkCommandBufferSubmitInfo cbi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
                                      .commandBuffer = cmd};
+    VkSemaphoreSubmitInfo acquired = {0}, ready = {0};
+    uint32_t present_sync = ob_renderer_present_sync(r, &acquired, &ready);
     VkSubmitInfo2 si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
+                        .waitSemaphoreInfoCount = present_sync,
+                        .pWaitSemaphoreInfos = &acquired,
                         .commandBufferInfoCount = 1,
-                        .pCommandBufferInfos = &cbi};
+                        .pCommandBufferInfos = &cbi,
+                        .signalSemaphoreInfoCount = present_sync,
+                        .pSignalSemaphoreInfos = &ready};
     vr = OB_VK_CHECK(OB_VK_SUBMIT(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence)));
+    ob_renderer_present_submitted(r, vr == VK_SUCCESS);
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
         /* Nothing was submitted: the reset fence will not signal, so the

@@ -84,7 +84,17 @@ typedef struct ob_composite_view ob_composite_view;
 ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_result *out_result);
 void ob_composite_view_destroy(ob_views *ctx, ob_composite_view *v);
 ob_view *ob_composite_view_base(ob_composite_view *v);
+/* The final target. Its handle changes when a presenting composite follows
+ * a resized window: ask again after each frame. */
 ob_image ob_composite_view_target(const ob_composite_view *v);
+/* Presenting (off by default): every frame the view runs in, its target is
+ * what the renderer presents (ob_renderer_present_image), and when the
+ * frame's swapchain image has another size, the target — and the source's,
+ * when the source had the same size — are made again at the window's size
+ * before the source's PreRender. A failed resize is logged and the old size
+ * is scaled to the window. Without an attached surface this changes
+ * nothing. [render thread, between frames] */
+void ob_composite_view_set_presenting(ob_composite_view *v, bool presenting);
 
 /* -------------------------------------------------------- particle system */
 

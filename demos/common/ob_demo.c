@@ -26,7 +26,8 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --env-size N      environment map size (per paraboloid half)\n"
             "  --shadow-size N   shadow map size\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
-            "  --window          show the scene live (F1 toggles the mode)\n"
+            "  --window          show the scene live (F1 toggles the mode; resizable)\n"
+            "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
             "  --quiet           no per-frame lines\n"
             "  --malloc-threshold KIB  fix glibc's mmap and trim thresholds (steady RSS on\n"
             "                    long runs, slower frames on lavapipe; docs/soak.md)\n%s",
@@ -105,6 +106,11 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
         } else if (!strcmp(a, "--malloc-threshold")) {
             ok = parse_u32(v, &o->malloc_threshold_kib) && o->malloc_threshold_kib >= 1 &&
                  o->malloc_threshold_kib <= 32 * 1024;
+            i++;
+        } else if (!strcmp(a, "--window-resize")) {
+            ok = sscanf(v, "%u:%ux%u", &o->resize_frame, &o->resize_width, &o->resize_height) == 3 &&
+                 o->resize_width > 0 && o->resize_height > 0 && o->resize_width <= 8192 &&
+                 o->resize_height <= 8192;
             i++;
         } else if (!strcmp(a, "--shadow-size")) {
             ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= 16 && o->shadow_size <= 8192;
@@ -224,6 +230,10 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     ob_result r;
     const char *const *exts = NULL;
     uint32_t ext_count = 0;
+    if (o->resize_width && !o->window) {
+        fprintf(stderr, "--window-resize needs --window\n");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     if (o->window) {
         d->window = ob_window_open(o->width, o->height, "Obelisk", &exts, &ext_count);
         if (!d->window) return OB_ERR_UNSUPPORTED;
@@ -239,7 +249,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     d->r = ob_renderer_create(&rd, &r);
     if (!d->r) return r;
     ob_renderer_set_stats_callback(d->r, on_stats, d);
-    if (d->window && (r = ob_window_attach(d->window, ob_renderer_device(d->r))) != OB_OK) return r;
+    if (d->window && (r = ob_window_attach(d->window, d->r)) != OB_OK) return r;
     d->fx = ob_effect_context_create(ob_renderer_device(d->r), ob_renderer_registry(d->r), NULL, &r);
     if (!d->fx) return r;
     d->lib = ob_material_library_create(d->fx, NULL, &r);
@@ -264,6 +274,8 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     if (!d->main) return r;
     d->composite = ob_composite_view_create(d->views, ob_perspective_view_base(d->main), &r);
     if (!d->composite) return r;
+    /* The renderer presents the composite's target; main follows the window's size. */
+    if (d->window) ob_composite_view_set_presenting(d->composite, true);
     if (o->overlay) {
         d->overlay = ob_overlay_view_create(d->views, ob_composite_view_base(d->composite), &r);
         if (!d->overlay) return r;
@@ -502,6 +514,8 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     for (uint32_t f = 0; (!counted || f < d->opt.frames) && (!d->window || ob_window_poll(d->window));
          f++) {
         if (d->window && ob_window_take_toggle(d->window)) d->flipped = !d->flipped;
+        if (d->window && d->opt.resize_width && f == d->opt.resize_frame)
+            ob_window_request_size(d->window, d->opt.resize_width, d->opt.resize_height);
         ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
                                   d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
         uint64_t t0 = ob_time_ns();
@@ -518,8 +532,6 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
         overlay_text(d);
         ob_views_render(d->views, final);
         r = ob_renderer_end_frame(d->r);
-        if (r == OB_OK && d->window)
-            r = ob_window_present(d->window, ob_composite_view_target(d->composite));
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
             return 1;
@@ -534,9 +546,10 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
                "Obelisk's %.1f MiB\n", mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0,
                mem.heap_in_use_kb / 1024.0, mem.obelisk_heap_kb / 1024.0);
     if (d->window) {
-        uint32_t skipped, presented = ob_window_presented(d->window, &skipped);
-        printf("window: %u frames presented, %u skipped (swapchain out of date)\n", presented,
-               skipped);
+        ob_present_stats ps = ob_renderer_present_stats(d->r);
+        printf("window: %u frames presented, %u skipped (minimised or swapchain out of date), "
+               "%u swapchains, last %ux%u\n", ps.presented, ps.skipped, ps.swapchains, ps.width,
+               ps.height);
     }
     ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
     if (ob_device_validation_enabled(ob_renderer_device(d->r)))
@@ -548,7 +561,9 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
             fprintf(stderr, "cannot write '%s': %s\n", d->opt.out, ob_result_name(r));
             return 1;
         }
-        printf("wrote %s (%ux%u)\n", d->opt.out, d->opt.width, d->opt.height);
+        ob_image_info info = {0};
+        ob_image_get_info(ob_renderer_device(d->r), ob_composite_view_target(d->composite), &info);
+        printf("wrote %s (%ux%u)\n", d->opt.out, info.width, info.height);
     }
     if (ob_device_validation_enabled(ob_renderer_device(d->r)) && (vc.errors || vc.warnings))
         return 3;

@@ -29,6 +29,7 @@ typedef struct ob_demo_options {
     uint32_t shadow_size;     /* --shadow-size */
     bool overlay;             /* --overlay / --no-overlay */
     bool window;              /* --window */
+    uint32_t resize_frame, resize_width, resize_height; /* --window-resize F:WxH (0 = none) */
     bool quiet;               /* --quiet: no per-frame lines */
     uint32_t malloc_threshold_kib; /* --malloc-threshold: glibc's thresholds (0 = its own) */
     ob_gpu_timing gpu_timing; /* ob_renderer_desc.gpu_timing (obelisk-bench --gpu-timing) */

@@ -3,7 +3,13 @@
 #   - switching single/multi-threaded every frame, overlay off: exits 0 (3 =
 #     the validation layer spoke), says every frame was presented, and its
 #     final image is byte-identical to a headless single-threaded run's;
-#   - with the overlay (on by default with --window): exits 0, all presented.
+#   - with the overlay (on by default with --window): exits 0, all presented;
+#   - resized from 320x240 to 400x300 by the window system during the run
+#     (--window-resize): every frame still presented, the swapchain rebuilt
+#     once at the new size, and the final image (the composite's target,
+#     which follows the window) is 400x300.
+# The renderer presents (ob_renderer_end_frame, same submission as the
+# frame); the demo only hands it the window's surface.
 # Skipped (prints SKIP) when the build has no window support or xvfb-run is
 # missing; ./setup.sh installs both (libglfw3-dev, xvfb, xauth).
 # Run by ctest: cmake -DBIN=... -DSRC=... -DOUT=... -DWINDOW=ON|OFF -DXVFB_RUN=path -P mirror_window.cmake
@@ -27,6 +33,7 @@ set(common --objects 120 --size 320x240 --frames ${frames} --quiet)
 function(run name)
   execute_process(COMMAND ${ARGN} ${common} --out ${OUT}/${name}.png
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
+  set(last_out "${out}" PARENT_SCOPE)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${name}: exited with ${rc}\n${out}\n${err}")
   endif()
@@ -49,3 +56,10 @@ if(NOT same EQUAL 0)
   message(FATAL_ERROR "the windowed run's image differs from the headless single-threaded one")
 endif()
 run(window_overlay ${xvfb} ${BIN}/obelisk-mirror --window --threads 2 --toggle 2)
+
+run(window_resize ${xvfb} ${BIN}/obelisk-mirror --window --no-overlay --threads 2 --toggle 1
+    --window-resize 2:400x300)
+if(NOT last_out MATCHES "2 swapchains, last 400x300" OR NOT last_out MATCHES "wrote [^\n]* \\(400x300\\)")
+  message(FATAL_ERROR "window_resize: the swapchain and the final target did not follow the "
+          "window to 400x300\n${last_out}")
+endif()
