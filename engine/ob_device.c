@@ -524,7 +524,9 @@ ob_result ob_device_oneshot_submit(ob_device *dev, VkCommandBuffer cmd)
         if (vr >= 0) {
             vr = OB_VK_CHECK(OB_VK_WAIT(
                 vkWaitForFences(dev->device, 1, &dev->oneshot_fence, VK_TRUE, UINT64_MAX)));
-            OB_VK_CHECK(vkResetFences(dev->device, 1, &dev->oneshot_fence));
+            /* A fence left signalled would fail the next one-shot submission. */
+            VkResult reset = OB_VK_CHECK(vkResetFences(dev->device, 1, &dev->oneshot_fence));
+            if (vr >= 0 && reset < 0) vr = reset;
             if (vr < 0) {
                 /* Possibly still pending: the pool frees it at destroy. */
                 ob_device_note_result(dev, vr);

@@ -48,6 +48,10 @@ const char *ob_vk_result_name(VkResult res);
  * VK_ERROR_OUT_OF_DEVICE_MEMORY without making the call). */
 #define OB_VK_CREATE(call) \
     (ob_fault_should_fail(OB_FAULT_VK_OBJECT) ? VK_ERROR_OUT_OF_DEVICE_MEMORY : (call))
+/* OB_VK_CHECK for a result obtained earlier (a helper's return value, a
+ * result that needs a look first): logs `call_name`, the Vulkan command that
+ * produced it, never the variable's name. */
+#define OB_VK_CHECK_AS(res, call_name) ob_vk_check((res), (call_name), __FILE__, __LINE__)
 /* OB_VK_CHECK(OB_VK_CREATE(call)) that logs the call text without the wrapper. */
 #define OB_VK_CHECK_CREATE(call) ob_vk_check(OB_VK_CREATE(call), #call, __FILE__, __LINE__)
 /* Wrap every vkQueueSubmit* in OB_VK_SUBMIT: a test can make the Nth

@@ -183,8 +183,8 @@ static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
         .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
-    VkResult vr = OB_VK_CREATE(vkCreateBuffer(pm->vk, &bi, NULL, &c->vk));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail;
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(pm->vk, &bi, NULL, &c->vk));
+    if (vr != VK_SUCCESS) goto fail;
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(pm->vk, c->vk, &req);
     uint32_t type = ob_device_memory_type(pm->dev, req.memoryTypeBits,
@@ -199,8 +199,8 @@ static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
     VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
                                .allocationSize = req.size,
                                .memoryTypeIndex = type};
-    vr = OB_VK_CREATE(vkAllocateMemory(pm->vk, &ai, NULL, &c->memory));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) goto fail;
+    vr = OB_VK_CHECK_CREATE(vkAllocateMemory(pm->vk, &ai, NULL, &c->memory));
+    if (vr != VK_SUCCESS) goto fail;
     vr = OB_VK_CHECK(vkBindBufferMemory(pm->vk, c->vk, c->memory, 0));
     if (vr != VK_SUCCESS) goto fail;
     void *mapped = NULL;

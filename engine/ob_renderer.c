@@ -141,6 +141,8 @@ void ob_renderer_destroy(ob_renderer *r)
 {
     if (!r) return;
     if (r->dev) {
+        /* A failure (a lost device) is logged; destroying goes on, since
+         * nothing the device still runs can complete any more. */
         OB_VK_CHECK(vkDeviceWaitIdle(ob_device_vk(r->dev)));
         ob_renderer_detach_surface(r);
     }

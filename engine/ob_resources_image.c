@@ -133,7 +133,7 @@ static ob_result image_support_check(ob_device *dev, const char *name, const ob_
                  name, (int)desc->format, desc->usage, (unsigned)vk_usage, ob_device_name(dev));
         return OB_ERR_UNSUPPORTED;
     }
-    if (vr < 0) return ob_result_from_vk(OB_VK_CHECK(vr));
+    if (vr < 0) return ob_result_from_vk(OB_VK_CHECK_AS(vr, "vkGetPhysicalDeviceImageFormatProperties"));
     if (desc->width > ip.maxExtent.width || desc->height > ip.maxExtent.height || layers > ip.maxArrayLayers) {
         OB_LOG_E("resources", "image '%s': %ux%u with %u layers exceeds the limits for format %d "
                               "(%ux%u, %u layers)",

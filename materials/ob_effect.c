@@ -109,10 +109,10 @@ static ob_result create_pipeline_cache(ob_effect_context *ctx)
         .initialDataSize = accepted,
         .pInitialData = accepted ? blob : NULL,
     };
-    VkResult vr = OB_VK_CREATE(vkCreatePipelineCache(ob_device_vk(ctx->dev), &info, NULL,
-                                                     &ctx->cache));
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreatePipelineCache(ob_device_vk(ctx->dev), &info, NULL,
+                                                           &ctx->cache));
     ob_free(blob);
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) return ob_result_from_vk(vr);
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     ctx->cache_loaded_bytes = (uint32_t)accepted;
     if (accepted)
         OB_LOG_I("effect", "pipeline cache loaded from '%s' (%zu bytes)", ctx->cache_path, accepted);
@@ -185,7 +185,7 @@ ob_result ob_effect_context_save_cache(ob_effect_context *ctx)
     VkResult vr = vkGetPipelineCacheData(vk, ctx->cache, &size, data);
     ob_result r = OB_OK;
     if (vr != VK_SUCCESS && vr != VK_INCOMPLETE) {
-        OB_VK_CHECK(vr);
+        OB_VK_CHECK_AS(vr, "vkGetPipelineCacheData");
         r = ob_result_from_vk(vr);
         goto done;
     }
@@ -316,8 +316,8 @@ static ob_result create_module(ob_effect *e, const ob_shader *sh, VkShaderModule
         .codeSize = sh->spirv_words * sizeof(uint32_t),
         .pCode = sh->spirv,
     };
-    VkResult vr = OB_VK_CREATE(vkCreateShaderModule(ob_device_vk(e->ctx->dev), &info, NULL, out));
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) {
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateShaderModule(ob_device_vk(e->ctx->dev), &info, NULL, out));
+    if (vr != VK_SUCCESS) {
         OB_LOG_E("effect", "effect '%s': shader module for '%s' not created", e->name, sh->name);
         return ob_result_from_vk(vr);
     }
@@ -598,7 +598,8 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
                              : create_graphics(e, color, depth, &feedback, &pipeline);
     effect_pipeline *entry = &e->pipelines[count];
     *entry = (effect_pipeline){color, depth, VK_NULL_HANDLE, pipeline_id(e, color, depth)};
-    if (OB_VK_CHECK(vr) != VK_SUCCESS) {
+    if (OB_VK_CHECK_AS(vr, e->compute ? "vkCreateComputePipelines" : "vkCreateGraphicsPipelines") !=
+        VK_SUCCESS) {
         ob_device_note_result(e->ctx->dev, vr);
         atomic_fetch_add(&e->ctx->pipelines_failed, 1);
         bool transient = vr == VK_ERROR_OUT_OF_HOST_MEMORY || vr == VK_ERROR_OUT_OF_DEVICE_MEMORY;

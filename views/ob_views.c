@@ -1,6 +1,7 @@
 #include "ob_views_internal.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -327,22 +328,28 @@ static ob_result geometry_draw(const struct ob_geometry *g, ob_pipeline_manager 
 
 static uint32_t geometry_id(const struct ob_geometry *g) { return ob_geometry_id(g); }
 
+/* The standard layout as an effect's vertex input, made once: constant
+ * after that, so any thread may read it (pthread_once orders the write
+ * before every reader). */
+static ob_effect_vertex_input standard_input;
+static pthread_once_t standard_input_once = PTHREAD_ONCE_INIT;
+
+static void make_standard_input(void)
+{
+    const ob_vertex_layout *l = ob_vertex_layout_standard();
+    standard_input.stride = l->stride;
+    standard_input.attribute_count = l->attribute_count;
+    for (uint32_t i = 0; i < l->attribute_count; i++) {
+        standard_input.attributes[i].location = l->attributes[i].location;
+        standard_input.attributes[i].format = l->attributes[i].format;
+        standard_input.attributes[i].offset = l->attributes[i].offset;
+    }
+}
+
 const ob_effect_vertex_input *ob_views_standard_input(void)
 {
-    static ob_effect_vertex_input input;
-    static bool init;
-    if (!init) {
-        const ob_vertex_layout *l = ob_vertex_layout_standard();
-        input.stride = l->stride;
-        input.attribute_count = l->attribute_count;
-        for (uint32_t i = 0; i < l->attribute_count; i++) {
-            input.attributes[i].location = l->attributes[i].location;
-            input.attributes[i].format = l->attributes[i].format;
-            input.attributes[i].offset = l->attributes[i].offset;
-        }
-        init = true;
-    }
-    return &input;
+    pthread_once(&standard_input_once, make_standard_input);
+    return &standard_input;
 }
 
 /* ------------------------------------------------------------ context */

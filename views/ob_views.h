@@ -120,7 +120,8 @@ ob_node *ob_particle_system_node(ob_particle_system *ps);
  * last), which pre-draws what it needs. */
 void ob_views_render(ob_views *ctx, ob_view *final_view);
 
-/* Standard vertex layout of geometry, as an effect's vertex input. */
+/* Standard vertex layout of geometry, as an effect's vertex input: a
+ * constant the library owns, made on first use. [any thread] */
 const ob_effect_vertex_input *ob_views_standard_input(void);
 
 #endif /* OB_VIEWS_H */
