@@ -69,6 +69,9 @@ if(NOT OB_SANITIZE)
   # the executable, so their builds cannot ask for this).
   target_link_options(obelisk PRIVATE -Wl,--no-undefined)
 endif()
+# Only ob_* is exported (cmake/obelisk.map says why).
+target_link_options(obelisk PRIVATE -Wl,--version-script=${CMAKE_SOURCE_DIR}/cmake/obelisk.map)
+set_property(TARGET obelisk APPEND PROPERTY LINK_DEPENDS ${CMAKE_SOURCE_DIR}/cmake/obelisk.map)
 target_link_libraries(obelisk PUBLIC Vulkan::Vulkan PRIVATE ${OB_LIBRARY_PRIVATE_LINK})
 # The installed static library's link interface comes from the package's
 # own look-ups (cmake/ObeliskConfig.cmake.in); in the build tree nothing links it.
