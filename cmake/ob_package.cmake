@@ -17,6 +17,8 @@
 # structs) and materials/ob_shader_source.h (the shader compiler's include
 # expander). No installed header may include one of them: the package_headers
 # test compiles every installed header alone against the install tree.
+# views/ob_json_read.h (the scene-file parser's cJSON reader) is internal
+# too: cJSON stays a private dependency.
 # ob_reflect.h is public because ob_params.h, ob_program.h and ob_shader.h
 # take and return its plain structs (custom effects use the reflection).
 set(OB_PUBLIC_HEADERS
@@ -25,7 +27,7 @@ set(OB_PUBLIC_HEADERS
     engine/ob_renderer.h engine/ob_resources.h engine/ob_scene.h engine/ob_view.h
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h
-    views/ob_views.h views/ob_stack.h
+    views/ob_views.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h
     views/obelisk.h)
 
 # ------------------------------------------------------------------ shaders
@@ -53,7 +55,7 @@ endforeach()
 # What the engine's code links besides Vulkan (the headers' only third-party
 # include) and libc: private to the shared library, link-only for the static one.
 set(OB_LIBRARY_PRIVATE_LINK PkgConfig::GLSLANG glslang-default-resource-limits stdc++
-    ${SPIRV_CROSS_C} PkgConfig::ASSIMP Threads::Threads m ${CMAKE_DL_LIBS})
+    ${SPIRV_CROSS_C} PkgConfig::ASSIMP PkgConfig::CJSON Threads::Threads m ${CMAKE_DL_LIBS})
 
 add_library(obelisk SHARED ${OB_LIBRARY_OBJECTS})
 add_library(obelisk_static STATIC ${OB_LIBRARY_OBJECTS})

@@ -10,8 +10,11 @@
  *   materials  run-time shader compiler, render effects, materials
  *   geometry   meshes and generators, model loading, GPU geometry
  *   views      the standard views (perspective, shadow, env map, simulation,
- *              overlay, composite) and ob_stack, the usual set-up in one call
- * Only the Vulkan headers come along; cglm and stb stay inside the library.
+ *              overlay, composite); ob_stack, the usual set-up in one call;
+ *              scene files: parsing (ob_scene_file.h) and loading into a
+ *              scene (ob_scene_load.h)
+ * Only the Vulkan headers come along; cglm, stb and cJSON stay inside the
+ * library.
  */
 #ifndef OBELISK_H
 #define OBELISK_H
@@ -35,6 +38,8 @@
 #include "ob_geometry.h"
 #include "ob_mesh.h"
 
+#include "ob_scene_file.h"
+#include "ob_scene_load.h"
 #include "ob_stack.h"
 #include "ob_views.h"
 

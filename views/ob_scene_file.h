@@ -9,9 +9,9 @@
  * and, for a JSON syntax error, the line and column:
  *   scene.json:12:7: invalid JSON near '}, "camera"...'
  * Unknown keys are errors (with a suggestion when one is close), so a typo is
- * never silently ignored. Nothing here touches the GPU: turning the
- * description into a scene (materials, geometry, nodes) is the program's job
- * (obelisk-view), which can then report a model that fails to load and go on
+ * never silently ignored. Nothing here touches the GPU: ob_scene_load.h
+ * turns a description into a scene (materials, geometry, nodes, lights,
+ * camera, particles), reporting a model that fails to load and going on
  * with the rest.
  *
  * Lifecycle: ob_scene_file_parse / ob_scene_file_load fill a caller-provided
@@ -29,19 +29,27 @@
 #include <stdint.h>
 
 #include "ob_core.h"
-#include "ob_json_read.h"
 #include "ob_material.h"
 #include "ob_scene.h"
 #include "ob_views.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define OB_SCENE_FILE_NONE UINT32_MAX   /* "no index": no parent, default material */
 #define OB_SCENE_FILE_MAX_PARTICLES (1u << 20)
 
-/* The error of a failed parse: message, JSON path, syntax line/column. */
-typedef ob_json_error ob_scene_file_error;
+/* The error of a failed parse or load (ob_scene_load.h uses it too). */
+typedef struct ob_scene_file_error {
+    char message[1024];      /* "FILE: PATH: what was expected" (or "FILE:LINE:COL: ..." for syntax) */
+    char json_path[320];     /* "entities[3].transform.scale"; "" for syntax errors and the top level */
+    uint32_t line, column;   /* 1-based position of a syntax error; 0 otherwise */
+} ob_scene_file_error;
 
-/* "settings": each value overrides the program's default; a command-line
- * option overrides the file. */
+/* "settings": each value overrides the program's default (a program may let
+ * its own command line override the file, as obelisk-view does).
+ * ob_scene_load_settings puts them where they belong. */
 typedef struct ob_scene_file_settings {
     bool has_size;
     uint32_t width, height;       /* 1..8192 */
@@ -55,7 +63,8 @@ typedef struct ob_scene_file_settings {
     float ambient[4];             /* rgb, w = intensity > 0 (0 0 0 1 for "none") */
 } ob_scene_file_settings;
 
-/* "camera": without one the program frames the whole scene. */
+/* "camera": without one the program frames the whole scene (ob_scene_load
+ * does when asked to). */
 typedef struct ob_scene_file_camera {
     bool present;
     double position[3], target[3], up[3];
@@ -188,4 +197,7 @@ bool ob_scene_file_geometry_equal(const ob_scene_file_geometry *a, const ob_scen
 /* Stable lower-case names: "none", "box", ..., "model". */
 const char *ob_scene_file_geometry_kind_name(ob_scene_file_geometry_kind kind);
 
+#ifdef __cplusplus
+}
+#endif
 #endif /* OB_SCENE_FILE_H */

@@ -12,7 +12,9 @@
  * the key is absent, so the caller presets the default.
  *
  * Lifecycle: ob_json_reader_init → ob_json_parse → check and read →
- * cJSON_Delete(root). Thread rule: [any thread], one reader per thread;
+ * cJSON_Delete(root). Internal to the views layer (the scene-file parser
+ * uses it); not installed, so cJSON never reaches a program's include path.
+ * Thread rule: [any thread], one reader per thread;
  * cJSON's allocation hooks are set once (to ob_malloc) on first parse, and
  * cJSON's global error pointer is never used.
  */
@@ -25,12 +27,12 @@
 #include <stdint.h>
 
 #include "ob_core.h"
+#include "ob_scene_file.h"
 
-typedef struct ob_json_error {
-    char message[1024];      /* "FILE: PATH: what was expected" (or "FILE:LINE:COL: ..." for syntax) */
-    char json_path[320];     /* "entities[3].transform.scale"; "" for syntax errors and the top level */
-    uint32_t line, column;   /* 1-based position of a syntax error; 0 otherwise */
-} ob_json_error;
+/* The error report is the scene file's public one (ob_scene_file.h): this
+ * reader is internal to the views layer and not installed, so the struct a
+ * program reads must live in the installed header. */
+typedef ob_scene_file_error ob_json_error;
 
 typedef struct ob_json_reader {
     const char *file;        /* names the document in messages; not copied */
