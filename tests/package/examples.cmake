@@ -37,3 +37,19 @@ file(SHA256 ${OUT}/cube_static.png b)
 if(NOT a STREQUAL b)
   message(FATAL_ERROR "cube_png and cube_png_static wrote different images")
 endif()
+
+# scene_window (built where GLFW is): a scene file shown for 5 frames in a
+# window on a virtual X server, when xvfb-run is there (./setup.sh installs
+# it): exits 0 and logs no warning or error, validation on.
+find_program(XVFB_RUN xvfb-run)
+if(EXISTS ${OUT}/build/scene_window AND XVFB_RUN)
+  execute_process(COMMAND ${XVFB_RUN} -a -s "-screen 0 1024x768x24"
+                          ${OUT}/build/scene_window ${SRC}/tests/data/scenes/load_small.json 5
+                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+  if(NOT code EQUAL 0 OR err MATCHES "\\[(warn|error)\\]")
+    message(FATAL_ERROR "scene_window: exit ${code}\n${out}\n${err}")
+  endif()
+  message(STATUS "ok: scene_window showed load_small.json for 5 frames")
+else()
+  message(STATUS "scene_window not run (no GLFW or no xvfb-run)")
+endif()
