@@ -120,7 +120,7 @@ int main(int argc, char **argv)
         ob_scene_load_target t = {.renderer = d.r, .materials = d.lib, .views = d.views, .scene = d.scene};
         ob_scene_load_desc ld = {.file = &sf, .camera = d.camera,
                                  .frame_aspect = (double)opt.width / opt.height, .seed = opt.seed,
-                                 .first_geometry_id = d.geometry_count + 1};
+                                 .first_geometry_id = d.stack->geometry_count + 1};
         ob_scene_file_error err;
         if ((r = ob_scene_load(&t, &ld, &loaded, &err)) != OB_OK)
             fprintf(stderr, "obelisk-view: %s\n", err.message);

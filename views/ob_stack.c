@@ -7,7 +7,10 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     ob_stack_desc d = desc ? *desc : (ob_stack_desc){0};
     ob_result r = OB_ERR_OUT_OF_HOST_MEMORY;
     ob_stack *s = ob_calloc(1, sizeof *s);
-    if (!s) goto fail;
+    if (!s) {
+        OB_LOG_E("stack", "no memory for the stack");
+        goto fail;
+    }
 
     if (!(s->renderer = ob_renderer_create(&d.renderer, &r))) goto fail_destroy;
     s->device = ob_renderer_device(s->renderer);
@@ -74,6 +77,7 @@ ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char 
     ob_result r = ob_array_reserve((void **)&s->geometry, &s->geometry_cap,
                                    s->geometry_count + 1, sizeof *s->geometry);
     ob_geometry *g = NULL;
+    if (r != OB_OK) OB_LOG_E("stack", "geometry '%s': no memory to keep it", name ? name : "");
     if (r == OB_OK) {
         ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = s->geometry_count + 1};
         g = ob_geometry_create(s->device, &gd, &r);
@@ -105,7 +109,7 @@ out:
     return n;
 }
 
-ob_result ob_stack_frame(ob_stack *s, double dt)
+ob_result ob_stack_frame_begin(ob_stack *s, double dt)
 {
     double time = s->time;
     bool first = s->frames++ == 0;
@@ -117,6 +121,13 @@ ob_result ob_stack_frame(ob_stack *s, double dt)
     uint64_t update_ns = ob_time_ns() - t0;
     if ((r = ob_renderer_begin_frame(s->renderer, s->scene)) != OB_OK) return r;
     ob_renderer_note_update_ns(s->renderer, update_ns);
+    return OB_OK;
+}
+
+ob_result ob_stack_frame(ob_stack *s, double dt)
+{
+    ob_result r = ob_stack_frame_begin(s, dt);
+    if (r != OB_OK) return r;
     ob_views_render(s->views, s->final_view);
     return ob_renderer_end_frame(s->renderer);
 }

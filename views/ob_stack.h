@@ -9,8 +9,9 @@
  * point to.
  *
  * Lifecycle: ob_stack_create → [ob_stack_add_geometry, ob_stack_add_entity,
- * materials in s->materials, lights on nodes of s->scene] → ob_stack_frame*
- * → ob_stack_destroy. Views the program made itself on s->views (particle
+ * materials in s->materials, lights on nodes of s->scene] → frames
+ * (ob_stack_frame, or ob_stack_frame_begin + the program's own PreRender
+ * and end) → ob_stack_destroy. Views the program made itself on s->views (particle
  * systems, more perspective views) are destroyed by the program first.
  * Thread rule: [render thread] for every function (the renderer's rule).
  */
@@ -79,6 +80,16 @@ ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_
  * or a read-back such as ob_image_write_png does). s->time advances by dt
  * even when a step fails. Returns the first failure of those steps. */
 ob_result ob_stack_frame(ob_stack *s, double dt);
+
+/* The first half of ob_stack_frame, for a program that acts between the
+ * frame's start and its PreRender (overlay text, more views, a look at the
+ * frame before it is recorded): updates the scene (by dt; 0 on the first
+ * frame), sets the views' time and begins the frame. The program then runs
+ * the PreRender (ob_views_render(s->views, s->final_view), and any other
+ * view it queues) and ends the frame (ob_renderer_end_frame(s->renderer)).
+ * s->time advances by dt even when a step fails. Failure: the update's or
+ * begin_frame's result, and the frame is not begun (do not end it). */
+ob_result ob_stack_frame_begin(ob_stack *s, double dt);
 
 /* The final image: the composite's target (the overlay draws into it too). */
 ob_image ob_stack_final_image(const ob_stack *s);

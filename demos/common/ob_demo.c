@@ -238,48 +238,35 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
         d->window = ob_window_open(o->width, o->height, "Obelisk", &exts, &ext_count);
         if (!d->window) return OB_ERR_UNSUPPORTED;
     }
-    ob_renderer_desc rd = {
-        .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
-                   .instance_extension_count = ext_count, .swapchain = o->window},
-        .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
-        .threading = o->threads == 0 ? OB_THREADING_SINGLE
-                     : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
-        .gpu_timing = o->gpu_timing,
+    ob_stack_desc sd = {
+        .renderer = {
+            .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
+                       .instance_extension_count = ext_count, .swapchain = o->window},
+            .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
+            .threading = o->threads == 0 ? OB_THREADING_SINGLE
+                         : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
+            .gpu_timing = o->gpu_timing,
+        },
+        .width = o->width, .height = o->height,
+        .camera = {.fovy = 1.0f, .znear = 0.05f},
+        .env_map_size = o->env_size, .shadow_map_size = o->shadow_size,
+        .overlay = o->overlay,
     };
-    d->r = ob_renderer_create(&rd, &r);
-    if (!d->r) return r;
+    memcpy(sd.clear_color, o->clear_color, sizeof sd.clear_color);
+    memcpy(sd.ambient, o->ambient, sizeof sd.ambient);
+    if (!(d->stack = ob_stack_create(&sd, &r))) return r;
+    d->r = d->stack->renderer;
+    d->lib = d->stack->materials;
+    d->views = d->stack->views;
+    d->scene = d->stack->scene;
+    d->camera = d->stack->camera;
+    d->main = d->stack->main;
+    d->composite = d->stack->composite;
+    d->overlay = d->stack->overlay;
     ob_renderer_set_stats_callback(d->r, on_stats, d);
     if (d->window && (r = ob_window_attach(d->window, d->r)) != OB_OK) return r;
-    d->fx = ob_effect_context_create(ob_renderer_device(d->r), ob_renderer_registry(d->r), NULL, &r);
-    if (!d->fx) return r;
-    d->lib = ob_material_library_create(d->fx, NULL, &r);
-    if (!d->lib) return r;
-    ob_views_desc vd = {.renderer = d->r, .materials = d->lib, .effects = d->fx,
-                        .env_map_size = o->env_size, .shadow_map_size = o->shadow_size};
-    memcpy(vd.ambient, o->ambient, sizeof vd.ambient);
-    d->views = ob_views_create(&vd, &r);
-    if (!d->views) return r;
-    d->scene = ob_scene_create(&r);
-    if (!d->scene) return r;
-    d->camera = ob_node_create(d->scene, NULL, "camera", &r);
-    if (!d->camera) return r;
-    ob_camera_desc cam = {.fovy = 1.0f, .znear = 0.05f};
-    if ((r = ob_node_set_camera(d->camera, &cam)) != OB_OK) return r;
-    ob_perspective_desc pd = {.name = "main", .camera = d->camera, .width = o->width,
-                              .height = o->height, .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
-    static const float zero[4] = {0, 0, 0, 0};
-    if (memcmp(o->clear_color, zero, sizeof zero) != 0)
-        memcpy(pd.clear_color, o->clear_color, sizeof pd.clear_color);
-    d->main = ob_perspective_view_create(d->views, &pd, &r);
-    if (!d->main) return r;
-    d->composite = ob_composite_view_create(d->views, ob_perspective_view_base(d->main), &r);
-    if (!d->composite) return r;
     /* The renderer presents the composite's target; main follows the window's size. */
     if (d->window) ob_composite_view_set_presenting(d->composite, true);
-    if (o->overlay) {
-        d->overlay = ob_overlay_view_create(d->views, ob_composite_view_base(d->composite), &r);
-        if (!d->overlay) return r;
-    }
     if (o->stats_json) {
         d->json = fopen(o->stats_json, "w");
         if (!d->json) {
@@ -301,22 +288,13 @@ void ob_demo_shutdown(ob_demo *d)
 {
     if (d->r) ob_renderer_wait_idle(d->r);
     for (uint32_t i = 0; i < d->system_count; i++) ob_particle_system_destroy(d->views, d->systems[i]);
-    ob_overlay_view_destroy(d->views, d->overlay);
-    ob_composite_view_destroy(d->views, d->composite);
-    ob_perspective_view_destroy(d->views, d->main);
-    ob_scene_destroy(d->scene);
-    ob_views_destroy(d->views);
-    ob_material_library_destroy(d->lib);
-    for (uint32_t i = 0; i < d->geometry_count; i++)
-        ob_geometry_destroy(ob_renderer_device(d->r), d->geometries[i]);
-    ob_effect_context_destroy(d->fx);
+    /* The swapchain goes before the device it lives on. */
     ob_window_close(d->window);
-    ob_renderer_destroy(d->r);
+    ob_stack_destroy(d->stack);
     if (d->json) {
         fputs("\n]\n", d->json);
         fclose(d->json);
     }
-    ob_free(d->geometries);
     ob_free(d->systems);
     ob_free(d->history);
     memset(d, 0, sizeof *d);
@@ -324,30 +302,13 @@ void ob_demo_shutdown(ob_demo *d)
 
 ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name)
 {
-    ob_result r;
-    if (ob_array_reserve((void **)&d->geometries, &d->geometry_cap, d->geometry_count + 1,
-                         sizeof *d->geometries) != OB_OK)
-        return NULL;
-    ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = d->geometry_count + 1};
-    ob_geometry *g = ob_geometry_create(ob_renderer_device(d->r), &gd, &r);
-    if (g) d->geometries[d->geometry_count++] = g;
-    return g;
+    return ob_stack_add_geometry(d->stack, mesh, name, NULL);
 }
 
 ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
                         ob_material *m)
 {
-    ob_result r;
-    ob_node *n = ob_node_create(d->scene, parent, name, &r);
-    if (!n) return NULL;
-    const ob_bounds *b = ob_geometry_bounds(g);
-    ob_renderable rd = {.material = m, .geometry = g, .local_radius = b->radius};
-    memcpy(rd.local_center, b->center, sizeof rd.local_center);
-    if (ob_node_set_renderable(n, &rd) != OB_OK) {
-        ob_node_destroy(d->scene, n);
-        return NULL;
-    }
-    return n;
+    return ob_stack_add_entity(d->stack, parent, name, g, m, NULL);
 }
 
 ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc)
@@ -507,8 +468,6 @@ static void overlay_text(ob_demo *d)
 int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
 {
     const double dt = 1.0 / 60.0;
-    ob_view *final = d->overlay ? ob_overlay_view_base(d->overlay)
-                                : ob_composite_view_base(d->composite);
     /* F1 in the window flips the mode. */
     const bool counted = frames_bound_run(&d->opt);
     for (uint32_t f = 0; (!counted || f < d->opt.frames) && (!d->window || ob_window_poll(d->window));
@@ -518,25 +477,19 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
             ob_window_request_size(d->window, d->opt.resize_width, d->opt.resize_height);
         ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
                                   d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
-        uint64_t t0 = ob_time_ns();
-        if (update) update(d, f, d->time, user);
-        ob_scene_update(d->scene, f == 0 ? 0.0 : dt);
-        ob_views_set_time(d->views, d->time, dt);
-        uint64_t update_ns = ob_time_ns() - t0;
-        ob_result r = ob_renderer_begin_frame(d->r, d->scene);
+        if (update) update(d, f, d->stack->time, user);
+        ob_result r = ob_stack_frame_begin(d->stack, dt);
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: begin_frame failed: %s\n", f, ob_result_name(r));
             return 1;
         }
-        ob_renderer_note_update_ns(d->r, update_ns);
         overlay_text(d);
-        ob_views_render(d->views, final);
+        ob_views_render(d->views, d->stack->final_view);
         r = ob_renderer_end_frame(d->r);
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
             return 1;
         }
-        d->time += dt;
     }
     if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
     print_summary(d);

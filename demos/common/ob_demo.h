@@ -1,10 +1,13 @@
-/* ob_demo.h — what the demo programs share: options, the standard set-up
- * (renderer, effects, materials, views, scene, camera, final target), the
- * frame loop with its ST/MT toggling, per-frame lines, the JSON stats and the
- * summary of medians per mode.
+/* ob_demo.h — the demo runner the demo programs share: options, the
+ * standard set-up (an ob_stack from views/ob_stack.h, with the window when
+ * --window is given), the frame loop with its ST/MT toggling, per-frame
+ * lines, the JSON stats and the summary of medians per mode.
  *
  * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
- * ob_demo_run → ob_demo_shutdown. Thread rule: render thread only.
+ * ob_demo_run → ob_demo_shutdown (also after a failed init). Thread rule:
+ * [render thread] for every function (the renderer's and GLFW's rule).
+ * Failure: init returns the failing step's result (logged by the engine);
+ * the helpers that make things return NULL, the cause logged.
  */
 #ifndef OB_DEMO_H
 #define OB_DEMO_H
@@ -13,7 +16,7 @@
 
 #include "ob_geometry.h"
 #include "ob_mesh.h"
-#include "ob_views.h"
+#include "ob_stack.h"
 #include "ob_window.h"
 
 typedef struct ob_demo_options {
@@ -57,38 +60,44 @@ typedef struct ob_demo_frame_times {
 
 typedef struct ob_demo {
     ob_demo_options opt;
+    ob_stack *stack;          /* owns everything below but the window and the systems */
+    /* The stack's objects under their short names (borrowed, read-only). */
     ob_renderer *r;
-    ob_effect_context *fx;
     ob_material_library *lib;
     ob_views *views;
     ob_scene *scene;
     ob_node *camera;
     ob_perspective_view *main;
     ob_composite_view *composite;
-    ob_overlay_view *overlay;
-    ob_geometry **geometries;
-    uint32_t geometry_count, geometry_cap;
+    ob_overlay_view *overlay;        /* NULL unless --overlay (or --window) */
     ob_particle_system **systems;
     uint32_t system_count, system_cap;
     ob_demo_frame_times *history;  /* completed frames' times, in order */
     uint32_t history_count, history_cap;
     FILE *json;
-    double time;
     ob_window *window;        /* --window */
     bool flipped;             /* F1: the mode is the opposite of what the options say */
 } ob_demo;
 
-/* Renderer (worker count from --threads), effect context, material library,
- * views, an empty scene with a camera node, the main perspective view, the
- * composite (final target) and the overlay. */
+/* The window (--window), then the stack: renderer (worker count from
+ * --threads), effect context, material library, views, an empty scene with
+ * a camera node (fovy 1, near 0.05), the main perspective view, the
+ * composite (final target) and the overlay; then --stats-json is opened.
+ * Failure: the failing step's result; ob_demo_shutdown is still due. */
 ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o);
+/* Waits idle and destroys all (particle systems, window, stack), closes the
+ * JSON stats. A zeroed d is fine. */
 void ob_demo_shutdown(ob_demo *d);
 
-/* Upload a mesh; the demo keeps the geometry and destroys it at shutdown. */
+/* Uploads a mesh (the caller keeps and releases it) as geometry the stack
+ * owns. Failure: NULL, logged. */
 ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name);
-/* A node with geometry and material; local bounds from the geometry. */
+/* A node with geometry and material; local bounds from the geometry.
+ * Failure: NULL, logged, nothing left in the scene. */
 ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
                         ob_material *m);
+/* A particle system under parent that the demo destroys at shutdown.
+ * Failure: NULL, logged. */
 ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc);
 
 /* Frame callback: animate before the scene update. */

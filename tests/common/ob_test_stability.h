@@ -1,14 +1,27 @@
 /* ob_test_stability.h — the extreme-case tests run the stability cases of
- * demos/common/ob_bench_stab_*.c (the ones obelisk-bench reports) and assert
- * on their rows, so a case's scene, measurement and bound exist once.
+ * demos/stability (the ones obelisk-bench reports) and assert every bound
+ * themselves, so a case's scene and measurement exist once and its bound
+ * is checked by the test, not taken from the case's verdict.
  *
  * Each case is one cmocka test named by its label:
  *     const struct CMUnitTest tests[] = {OB_TEST_STABILITY_CASE("depth precision")};
- * The test passes when the case ran without error and every row it gave
- * passed (error within the bound and the case's other checks), with the
- * validation layer on and silent for every renderer the case made, and
- * Obelisk's heap back where it was once the case is done. The rows are
- * printed, so the measured numbers can be quoted.
+ * The test runs the case (a renderer, scene or allocation failure fails it)
+ * and then, for every row it gave:
+ *   - the case's other checks held, else it fails naming the case, the row
+ *     and the row's detail;
+ *   - a row with a bound: the measured error is a number and within the
+ *     bound, else it fails naming the case, the row, the measured value and
+ *     the bound;
+ *   - a row without a bound is measured only: printed, counted neither as a
+ *     pass nor as a fail;
+ *   - the verdict the benchmark reports for the row is the one the test
+ *     reached (pass, or measured only).
+ * A case must give at least one row with a bound. The validation layer must
+ * be on and silent for every renderer the case made, and Obelisk's heap back
+ * where it was once the case is done. Every row is printed, so the measured
+ * numbers can be quoted.
+ *
+ * Thread rule: the test's thread (the cases' [render thread]).
  */
 #ifndef OB_TEST_STABILITY_H
 #define OB_TEST_STABILITY_H

@@ -23,37 +23,33 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
         if (base && *base) strncat(s->cache_dir, "/stack", sizeof s->cache_dir - strlen(s->cache_dir) - 1);
     }
 
+    ob_stack_desc sd = {
+        .renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1},
+                     .worker_count = s->workers},
+        .cache_dir = s->cache_dir,
+        .width = s->width, .height = s->height,
+        .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
+        .camera = {.fovy = 1.0f, .znear = 0.1f},
+        .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size,
+    };
     ob_result r;
-    ob_renderer_desc rd = {.device = {.app_name = "obelisk-test-stack", .validation = 1},
-                           .worker_count = s->workers};
-    s->r = ob_renderer_create(&rd, &r);
-    if (!s->r) goto fail;
-    s->dev = ob_renderer_device(s->r);
-    s->fx = ob_effect_context_create(s->dev, ob_renderer_registry(s->r), s->cache_dir, &r);
-    if (!s->fx) goto fail;
-    s->lib = ob_material_library_create(s->fx, NULL, &r);
-    if (!s->lib) goto fail;
-    ob_views_desc vd = {.renderer = s->r, .materials = s->lib, .effects = s->fx,
-                        .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size};
-    s->views = ob_views_create(&vd, &r);
-    if (!s->views) goto fail;
+    if (!(s->stack = ob_stack_create(&sd, &r))) {
+        ob_test_stack_stop(s);
+        return r;
+    }
+    s->r = s->stack->renderer;
+    s->dev = s->stack->device;
     return OB_OK;
-
-fail:
-    ob_test_stack_stop(s);
-    return r;
 }
 
+/* Uploads the mesh `made` filled (a failed make passes its result on) and
+ * releases it. */
 static ob_result add_geometry(ob_test_stack *s, ob_result made, ob_mesh *m, const char *name,
                               ob_geometry **out)
 {
     *out = NULL;
     ob_result r = made;
-    if (r == OB_OK) {
-        ob_geometry_desc gd = {.mesh = m, .name = name, .id = s->geometry_count + 1};
-        *out = ob_geometry_create(s->dev, &gd, &r);
-        if (*out) s->geometry[s->geometry_count++] = *out;
-    }
+    if (r == OB_OK) *out = ob_stack_add_geometry(s->stack, m, name, &r);
     ob_mesh_release(m);
     return r;
 }
@@ -61,35 +57,18 @@ static ob_result add_geometry(ob_test_stack *s, ob_result made, ob_mesh *m, cons
 static ob_node *add_entity(ob_test_stack *s, const char *name, ob_geometry *g, ob_material *m,
                            double x, double y, double z, ob_result *out_result)
 {
-    ob_node *n = ob_node_create(s->scene, NULL, name, out_result);
-    if (!n) return NULL;
-    const ob_bounds *b = ob_geometry_bounds(g);
-    ob_renderable rd = {.material = m, .geometry = g, .local_radius = b->radius};
-    memcpy(rd.local_center, b->center, sizeof rd.local_center);
-    *out_result = ob_node_set_renderable(n, &rd);
-    if (*out_result != OB_OK) return NULL;
-    ob_node_set_position(n, (const double[3]){x, y, z});
+    ob_node *n = ob_stack_add_entity(s->stack, NULL, name, g, m, out_result);
+    if (n) ob_node_set_position(n, (const double[3]){x, y, z});
     return n;
 }
 
 ob_result ob_test_stack_build_scene(ob_test_stack *s)
 {
-    ob_result r;
-    s->scene = ob_scene_create(&r);
-    if (!s->scene) return r;
-    s->camera = ob_node_create(s->scene, NULL, "camera", &r);
-    if (!s->camera) return r;
-    if ((r = ob_node_set_camera(s->camera, &(ob_camera_desc){.fovy = 1.0f, .znear = 0.1f})) != OB_OK)
-        return r;
-    ob_node_set_position(s->camera, (const double[3]){0.0, 1.6, 4.0});
-    if ((r = ob_node_look_at(s->camera, (const double[3]){0.0, 0.4, 0.0}, (const double[3]){0, 1, 0})) != OB_OK)
-        return r;
-    ob_perspective_desc pd = {.name = "main", .camera = s->camera, .width = s->width,
-                              .height = s->height, .clear_color = {0.1f, 0.2f, 0.3f, 1.0f}};
-    s->main = ob_perspective_view_create(s->views, &pd, &r);
-    if (!s->main) return r;
-    s->composite = ob_composite_view_create(s->views, ob_perspective_view_base(s->main), &r);
-    if (!s->composite) return r;
+    ob_stack *st = s->stack;
+    ob_node_set_position(st->camera, (const double[3]){0.0, 1.6, 4.0});
+    ob_result r = ob_node_look_at(st->camera, (const double[3]){0.0, 0.4, 0.0},
+                                  (const double[3]){0, 1, 0});
+    if (r != OB_OK) return r;
 
     ob_geometry *box, *sphere, *plane;
     ob_mesh m = {0};
@@ -102,23 +81,23 @@ ob_result ob_test_stack_build_scene(ob_test_stack *s)
 
     ob_material_desc lit = {.name = "red", .kind = OB_MATERIAL_LIT, .diffuse = {0.9f, 0.3f, 0.2f, 1.0f},
                             .casts_shadows = true};
-    ob_material *red = ob_material_create(s->lib, &lit, &r);
+    ob_material *red = ob_material_create(st->materials, &lit, &r);
     if (!red) return r;
     ob_material_desc ground = {.name = "ground", .kind = OB_MATERIAL_LIT,
                                .diffuse = {0.6f, 0.6f, 0.55f, 1.0f}};
-    ob_material *grey = ob_material_create(s->lib, &ground, &r);
+    ob_material *grey = ob_material_create(st->materials, &ground, &r);
     if (!grey) return r;
     ob_material_desc mirror = {.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE,
                                .diffuse = {0.9f, 0.9f, 0.95f, 1.0f}, .reflectivity = 0.8f,
                                .casts_shadows = true};
-    ob_material *shiny = ob_material_create(s->lib, &mirror, &r);
+    ob_material *shiny = ob_material_create(st->materials, &mirror, &r);
     if (!shiny) return r;
 
     if (!add_entity(s, "ground", plane, grey, 0.0, 0.0, 0.0, &r)) return r;
     if (!add_entity(s, "box", box, red, -0.8, 0.4, 0.0, &r)) return r;
     if (!add_entity(s, "ball", sphere, shiny, 0.8, 0.45, 0.0, &r)) return r;
 
-    ob_node *sun = ob_node_create(s->scene, NULL, "sun", &r);
+    ob_node *sun = ob_node_create(st->scene, NULL, "sun", &r);
     if (!sun) return r;
     ob_light_desc ld = {.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 1.0f, 1.0f},
                         .intensity = 1.0f, .casts_shadows = true};
@@ -127,14 +106,14 @@ ob_result ob_test_stack_build_scene(ob_test_stack *s)
     if ((r = ob_node_look_at(sun, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0})) != OB_OK)
         return r;
 
-    ob_node *fountain = ob_node_create(s->scene, NULL, "fountain", &r);
+    ob_node *fountain = ob_node_create(st->scene, NULL, "fountain", &r);
     if (!fountain) return r;
     ob_node_set_position(fountain, (const double[3]){0.0, 1.2, 0.6});
     /* Shorter than a frame: every step respawns every particle from the
      * simulation time, so no frame's pixels depend on an earlier frame. */
     ob_particle_desc pdesc = {.name = "sparks", .count = 64, .seed = 7, .lifetime = 0.005f,
                               .speed = 1.0f, .size = 0.15f};
-    s->particles = ob_particle_system_create(s->views, s->scene, fountain, &pdesc, &r);
+    s->particles = ob_particle_system_create(st->views, st->scene, fountain, &pdesc, &r);
     if (!s->particles) return r;
     return OB_OK;
 }
@@ -147,16 +126,11 @@ ob_result ob_test_stack_frame(ob_test_stack *s, ob_threading mode, uint32_t work
 
 ob_result ob_test_stack_frame_begin(ob_test_stack *s, ob_threading mode, uint32_t workers)
 {
-    const double dt = 1.0 / 60.0;
-    double time = (double)s->frames * dt;
     s->frames++;
     ob_renderer_set_threading(s->r, mode, workers);
-    ob_result r = ob_scene_update(s->scene, time > 0.0 ? dt : 0.0);
+    ob_result r = ob_stack_frame_begin(s->stack, 1.0 / 60.0);
     if (r != OB_OK) return r;
-    ob_views_set_time(s->views, time, dt);
-    r = ob_renderer_begin_frame(s->r, s->scene);
-    if (r != OB_OK) return r;
-    ob_views_render(s->views, ob_composite_view_base(s->composite));
+    ob_views_render(s->stack->views, s->stack->final_view);
     for (int k = 0; k < OB_FAULT_KIND_COUNT; k++)
         s->fault_points_before_record[k] = ob_fault_count((ob_fault_kind)k);
     return OB_OK;
@@ -171,22 +145,13 @@ ob_result ob_test_stack_frame_end(ob_test_stack *s)
 
 ob_result ob_test_stack_read(ob_test_stack *s, uint8_t *out)
 {
-    return ob_image_read_rgba8(s->dev, ob_composite_view_target(s->composite), out);
+    return ob_image_read_rgba8(s->dev, ob_stack_final_image(s->stack), out);
 }
 
 void ob_test_stack_stop(ob_test_stack *s)
 {
     if (s->r) ob_renderer_wait_idle(s->r);
-    if (s->views) {
-        ob_particle_system_destroy(s->views, s->particles);
-        ob_composite_view_destroy(s->views, s->composite);
-        ob_perspective_view_destroy(s->views, s->main);
-    }
-    ob_scene_destroy(s->scene);
-    ob_views_destroy(s->views);
-    ob_material_library_destroy(s->lib);
-    for (uint32_t i = 0; i < s->geometry_count; i++) ob_geometry_destroy(s->dev, s->geometry[i]);
-    ob_effect_context_destroy(s->fx);
-    ob_renderer_destroy(s->r);
+    if (s->stack) ob_particle_system_destroy(s->stack->views, s->particles);
+    ob_stack_destroy(s->stack);
     memset(s, 0, sizeof *s);
 }

@@ -1,6 +1,7 @@
-/* ob_test_stack.h — the whole engine stack for tests that expect things to
- * fail: every step returns its ob_result instead of failing the test, and
- * ob_test_stack_stop destroys whatever exists after any failure.
+/* ob_test_stack.h — the whole engine stack (an ob_stack, views/ob_stack.h)
+ * for tests that expect things to fail: every step returns its ob_result
+ * instead of failing the test, and ob_test_stack_stop destroys whatever
+ * exists after any failure.
  *
  * ob_test_world (ob_test_world.h) is the harness for tests where every step
  * must succeed; this one is for fault injection and device loss, where a
@@ -22,10 +23,8 @@
 #ifndef OB_TEST_STACK_H
 #define OB_TEST_STACK_H
 
+#include "ob_stack.h"
 #include "ob_test.h"
-#include "ob_views.h"
-
-#define OB_TEST_STACK_MAX_GEOMETRY 4
 
 typedef struct ob_test_stack_desc {
     uint32_t workers;          /* 0 → 2 */
@@ -36,18 +35,11 @@ typedef struct ob_test_stack_desc {
 } ob_test_stack_desc;
 
 typedef struct ob_test_stack {
+    ob_stack *stack;           /* owns everything below but the particle system */
+    /* The stack's renderer and device under their short names (borrowed). */
     ob_renderer *r;
     ob_device *dev;
-    ob_effect_context *fx;
-    ob_material_library *lib;
-    ob_views *views;
-    ob_scene *scene;
-    ob_node *camera;
-    ob_perspective_view *main;
-    ob_composite_view *composite;
     ob_particle_system *particles;
-    ob_geometry *geometry[OB_TEST_STACK_MAX_GEOMETRY];
-    uint32_t geometry_count;
     uint32_t width, height, env_map_size, shadow_map_size, workers;
     uint64_t frames;           /* frames attempted (time = frames / 60 s) */
     /* ob_fault_count of each kind when the last frame's PreRender ended:
@@ -56,12 +48,14 @@ typedef struct ob_test_stack {
     char cache_dir[512];
 } ob_test_stack;
 
-/* Renderer (validation on), effect context, material library and views.
- * On failure everything created so far is destroyed and the error returned. */
+/* The ob_stack: renderer (validation on), effect context, material
+ * library, views, scene, camera (fovy 1, near 0.1), main perspective view
+ * and composite. On failure everything created so far is destroyed and the
+ * error returned. */
 ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc);
-/* Scene, camera, main perspective view, composite, geometry, materials,
- * entities, lights and the particle system. On failure the stack keeps what
- * it made (ob_test_stack_stop frees it) and returns the error. */
+/* The camera's place, geometry, materials, entities, lights and the
+ * particle system. On failure the stack keeps what it made
+ * (ob_test_stack_stop frees it) and returns the error. */
 ob_result ob_test_stack_build_scene(ob_test_stack *s);
 /* One frame in `mode` (workers active, 0 = all), waited for. The frame's
  * time advances even when a step fails, so frame k always shows time k/60.

@@ -17,34 +17,28 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     w->heap_at_create = ob_heap_stats_now();
     w->width = d.width ? d.width : 160;
     w->height = d.height ? d.height : 120;
+    ob_stack_desc sd = {
+        .renderer = {.device = {.app_name = "obelisk-test", .validation = 1},
+                     .worker_count = d.workers ? d.workers : 4, .chunk_draws = d.chunk_draws},
+        .width = w->width, .height = w->height,
+        .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
+        .camera = {.fovy = 1.0f, .znear = 0.1f},
+        .env_map_size = d.env_map_size ? d.env_map_size : 64,
+        .shadow_map_size = d.shadow_map_size ? d.shadow_map_size : 256,
+    };
+    if (d.clear_color[3] > 0.0f) memcpy(sd.clear_color, d.clear_color, sizeof sd.clear_color);
     ob_result r;
-    ob_renderer_desc rd = {.device = {.app_name = "obelisk-test", .validation = 1},
-                           .worker_count = d.workers ? d.workers : 4,
-                           .chunk_draws = d.chunk_draws};
-    w->r = ob_renderer_create(&rd, &r);
-    if (!w->r) fail_msg("renderer: %s", ob_result_name(r));
-    w->dev = ob_renderer_device(w->r);
-    w->fx = ob_effect_context_create(w->dev, ob_renderer_registry(w->r), NULL, &r);
-    if (!w->fx) fail_msg("effect context: %s", ob_result_name(r));
-    w->lib = ob_material_library_create(w->fx, NULL, &r);
-    if (!w->lib) fail_msg("material library: %s", ob_result_name(r));
-    ob_views_desc vd = {.renderer = w->r, .materials = w->lib, .effects = w->fx,
-                        .env_map_size = d.env_map_size ? d.env_map_size : 64,
-                        .shadow_map_size = d.shadow_map_size ? d.shadow_map_size : 256};
-    w->views = ob_views_create(&vd, &r);
-    if (!w->views) fail_msg("views: %s", ob_result_name(r));
-    w->scene = ob_scene_create(&r);
-    if (!w->scene) fail_msg("scene: %s", ob_result_name(r));
-    w->camera = ob_node_create(w->scene, NULL, "camera", &r);
-    if (!w->camera) fail_msg("camera: %s", ob_result_name(r));
-    CHECK(ob_node_set_camera(w->camera, &(ob_camera_desc){.fovy = 1.0f, .znear = 0.1f}), "camera");
-    ob_perspective_desc pd = {.name = "main", .camera = w->camera, .width = w->width,
-                              .height = w->height, .clear_color = {0.1f, 0.2f, 0.3f, 1.0f}};
-    if (d.clear_color[3] > 0.0f) memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
-    w->main = ob_perspective_view_create(w->views, &pd, &r);
-    if (!w->main) fail_msg("main view: %s", ob_result_name(r));
-    w->composite = ob_composite_view_create(w->views, ob_perspective_view_base(w->main), &r);
-    if (!w->composite) fail_msg("composite: %s", ob_result_name(r));
+    w->stack = ob_stack_create(&sd, &r);
+    if (!w->stack) fail_msg("stack: %s", ob_result_name(r));
+    w->r = w->stack->renderer;
+    w->dev = w->stack->device;
+    w->fx = w->stack->effects;
+    w->lib = w->stack->materials;
+    w->views = w->stack->views;
+    w->scene = w->stack->scene;
+    w->camera = w->stack->camera;
+    w->main = w->stack->main;
+    w->composite = w->stack->composite;
     w->pixels = malloc((size_t)w->width * w->height * 4);
     assert_non_null(w->pixels);
 
@@ -63,17 +57,10 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
 
 void ob_test_world_destroy(ob_test_world *w)
 {
-    if (!w->r) return;
+    if (!w->stack) return;
     ob_renderer_wait_idle(w->r);
     ob_validation_counts vc = ob_device_validation_counts(w->dev);
-    ob_composite_view_destroy(w->views, w->composite);
-    ob_perspective_view_destroy(w->views, w->main);
-    ob_scene_destroy(w->scene);
-    ob_views_destroy(w->views);
-    ob_material_library_destroy(w->lib);
-    for (uint32_t i = 0; i < w->geometry_count; i++) ob_geometry_destroy(w->dev, w->geometry[i]);
-    ob_effect_context_destroy(w->fx);
-    ob_renderer_destroy(w->r);
+    ob_stack_destroy(w->stack);
     free(w->pixels);
     ob_heap_stats before = w->heap_at_create, after = ob_heap_stats_now();
     memset(w, 0, sizeof *w);
@@ -89,12 +76,9 @@ void ob_test_world_destroy(ob_test_world *w)
 
 ob_geometry *ob_test_world_geometry(ob_test_world *w, const ob_mesh *mesh, const char *name)
 {
-    assert_true(w->geometry_count < OB_TEST_WORLD_MAX_GEOMETRY);
     ob_result r;
-    ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = w->geometry_count + 1};
-    ob_geometry *g = ob_geometry_create(w->dev, &gd, &r);
+    ob_geometry *g = ob_stack_add_geometry(w->stack, mesh, name, &r);
     if (!g) fail_msg("geometry '%s': %s", name, ob_result_name(r));
-    w->geometry[w->geometry_count++] = g;
     return g;
 }
 
@@ -113,12 +97,8 @@ ob_node *ob_test_world_entity(ob_test_world *w, ob_node *parent, const char *nam
                               ob_material *m, double x, double y, double z)
 {
     ob_result r;
-    ob_node *n = ob_node_create(w->scene, parent, name, &r);
+    ob_node *n = ob_stack_add_entity(w->stack, parent, name, g, m, &r);
     if (!n) fail_msg("entity '%s': %s", name, ob_result_name(r));
-    const ob_bounds *b = ob_geometry_bounds(g);
-    ob_renderable rd = {.material = m, .geometry = g, .local_radius = b->radius};
-    memcpy(rd.local_center, b->center, sizeof rd.local_center);
-    CHECK(ob_node_set_renderable(n, &rd), name);
     ob_node_set_position(n, (const double[3]){x, y, z});
     return n;
 }
@@ -155,16 +135,12 @@ const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mo
                                                uint32_t workers, ob_view *const *extra,
                                                uint32_t extra_count)
 {
-    const double dt = 1.0 / 60.0;
     ob_renderer_set_threading(w->r, mode, workers);
-    CHECK(ob_scene_update(w->scene, w->time > 0.0 ? dt : 0.0), "scene update");
-    ob_views_set_time(w->views, w->time, dt);
-    CHECK(ob_renderer_begin_frame(w->r, w->scene), "begin frame");
-    ob_views_render(w->views, ob_composite_view_base(w->composite));
+    CHECK(ob_stack_frame_begin(w->stack, 1.0 / 60.0), "frame begin");
+    ob_views_render(w->views, w->stack->final_view);
     for (uint32_t i = 0; i < extra_count; i++) ob_views_render(w->views, extra[i]);
     CHECK(ob_renderer_end_frame(w->r), "end frame");
     CHECK(ob_renderer_wait_idle(w->r), "wait idle");
-    w->time += dt;
     return ob_renderer_last_stats(w->r);
 }
 

@@ -1,19 +1,21 @@
-/* ob_test_world.h — a whole engine stack for gpu tests: renderer (validation
- * on), effects, materials, views, a scene with a camera, the main perspective
- * view and the composite final target; helpers to add entities and lights,
+/* ob_test_world.h — a whole engine stack for gpu tests, built on ob_stack
+ * (views/ob_stack.h): renderer (validation on), effects, materials, views, a
+ * scene with a camera, the main perspective view and the composite final
+ * target; a box, a sphere and a plane; helpers to add entities and lights,
  * run frames in a given threading mode and read the image back.
  *
  * Every helper fails the running cmocka test on error, so tests read as the
  * scenario they check. ob_test_world_destroy asserts the validation layer
- * stayed silent.
+ * stayed silent and Obelisk's heap is back where it was.
+ *
+ * Lifecycle: ob_test_world_create → helpers and frames →
+ * ob_test_world_destroy. Thread rule: the test's thread only.
  */
 #ifndef OB_TEST_WORLD_H
 #define OB_TEST_WORLD_H
 
+#include "ob_stack.h"
 #include "ob_test.h"
-#include "ob_views.h"
-
-#define OB_TEST_WORLD_MAX_GEOMETRY 32
 
 typedef struct ob_test_world_desc {
     uint32_t workers;          /* 0 → 4 */
@@ -25,6 +27,8 @@ typedef struct ob_test_world_desc {
 } ob_test_world_desc;
 
 typedef struct ob_test_world {
+    ob_stack *stack;           /* owns everything below but the pixels */
+    /* The stack's objects under their short names (borrowed, read-only). */
     ob_renderer *r;
     ob_device *dev;
     ob_effect_context *fx;
@@ -34,20 +38,16 @@ typedef struct ob_test_world {
     ob_node *camera;
     ob_perspective_view *main;
     ob_composite_view *composite;
-    ob_geometry *geometry[OB_TEST_WORLD_MAX_GEOMETRY];
-    uint32_t geometry_count;
     ob_geometry *box, *sphere, *plane;
     uint32_t width, height;
     uint8_t *pixels;           /* width * height * 4, filled by ob_test_world_read */
-    double time;
-    char cache_dir[256];
     ob_heap_stats heap_at_create;   /* destroy checks Obelisk's heap is back to it */
 } ob_test_world;
 
 void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc);
 void ob_test_world_destroy(ob_test_world *w);
 
-/* Geometry from a mesh (the world owns it). */
+/* Geometry from a mesh (the world owns it; the caller releases the mesh). */
 ob_geometry *ob_test_world_geometry(ob_test_world *w, const ob_mesh *mesh, const char *name);
 ob_material *ob_test_world_material(ob_test_world *w, ob_material_kind kind, float r, float g,
                                     float b, bool casts_shadows);

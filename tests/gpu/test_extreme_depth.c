@@ -1,12 +1,12 @@
 /* Numerical precision of rendering: reversed-Z depth ordering of nearly
  * coplanar surfaces far from the camera, and a whole lit, shadowed,
- * reflective scene moved 1e7 units from the origin (and, measured only, up
- * to 1e13).
+ * reflective scene moved 1e7 units from the origin (and, measured only, up to
+ * 1e13).
  *
  * The scenes, measurements and bounds are the stability cases of
- * demos/common/ob_bench_stab_precision.c, which obelisk-bench reports too;
- * each test runs one and asserts that every row passed (see
- * ob_test_stability.h). */
+ * demos/stability/ob_stab_precision.c, which obelisk-bench reports too; each
+ * test runs one and asserts every row's bound itself; rows without one are
+ * measured only (see ob_test_stability.h). */
 #include "ob_test_stability.h"
 
 int main(void)

@@ -6,8 +6,9 @@
  * printed, never asserted.
  *
  * The scenes, measurements and bounds are the stability cases of
- * demos/common/ob_bench_stab_load.c, which obelisk-bench reports too; each
- * test runs one and asserts that every row passed. */
+ * demos/stability/ob_stab_load.c, which obelisk-bench reports too; each test
+ * runs one and asserts every row's bound itself; rows without one are
+ * measured only. */
 #include "ob_test_stability.h"
 
 int main(void)

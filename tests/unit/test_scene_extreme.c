@@ -1,11 +1,11 @@
-/* Extreme scenes: very deep hierarchies, far-away coordinates, very long
- * runs of incremental rotation, zero scale and very many nodes. Bounds are
- * stated next to each check.
+/* Extreme scenes: very deep hierarchies, far-away coordinates, very long runs
+ * of incremental rotation, zero scale and very many nodes. Bounds are stated
+ * next to each check.
  *
  * The chains, the far scene's matrices and the long rotation run are the
- * stability cases of demos/common/ob_bench_stab_precision.c (obelisk-bench
- * reports them too): those tests run the case and assert that every row
- * passed (see ob_test_stability.h). */
+ * stability cases of demos/stability/ob_stab_precision.c (obelisk-bench
+ * reports them too): those tests run the case and assert every row's bound
+ * itself (see ob_test_stability.h). */
 #include "ob_test_stability.h"
 #include "ob_scene.h"
 

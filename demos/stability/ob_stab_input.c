@@ -5,9 +5,10 @@
  * run these cases and assert on their rows. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
-#include "ob_bench_stab_world.h"
+#include "ob_stab_world.h"
 
 #define W 128
 #define H 96
@@ -128,16 +129,16 @@ ob_result ob_stab_up_parallel(ob_stab_ctx *c)
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
     build_base(&w);
-    ob_stab_position(w.d.camera, 0, 6, 0);
+    ob_stab_position(w.s->camera, 0, 6, 0);
     ob_stab_expect(c, expect);
-    ob_result look = w.err == OB_OK ? ob_node_look_at(w.d.camera, (const double[3]){0, 0, 0},
+    ob_result look = w.err == OB_OK ? ob_node_look_at(w.s->camera, (const double[3]){0, 0, 0},
                                                       (const double[3]){0, 1, 0})
                                     : w.err;
     bool named = ob_stab_log_has(c, "'camera'", "parallel", NULL);
     ob_stab_expect(c, NULL);
     uint8_t *fallback = ob_stab_render(&w, NULL);
     if (w.err == OB_OK && look == OB_OK)
-        look = ob_node_look_at(w.d.camera, (const double[3]){0, 0, 0}, (const double[3]){0, 0, 1});
+        look = ob_node_look_at(w.s->camera, (const double[3]){0, 0, 0}, (const double[3]){0, 0, 1});
     uint8_t *explicit_up = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
     if (w.err == OB_OK) {
@@ -174,18 +175,18 @@ ob_result ob_stab_refused_views(ob_stab_ctx *c)
     for (size_t i = 0; i < OB_ARRAY_COUNT(sizes) && w.err == OB_OK; i++) {
         ob_stab_expect(c, expect);
         ob_result res = OB_OK;
-        ob_perspective_desc pd = {.name = "degenerate", .camera = w.d.camera,
+        ob_perspective_desc pd = {.name = "degenerate", .camera = w.s->camera,
                                   .width = sizes[i][0], .height = sizes[i][1]};
-        ob_perspective_view *v = ob_perspective_view_create(w.d.views, &pd, &res);
+        ob_perspective_view *v = ob_perspective_view_create(w.s->views, &pd, &res);
         if (v) {
             accepted++;
-            ob_perspective_view_destroy(w.d.views, v);
+            ob_perspective_view_destroy(w.s->views, v);
         }
         wrong_result += !v && res != OB_ERR_INVALID_ARGUMENT;
         unnamed += !ob_stab_log_has(c, "'degenerate'", "width and height", NULL);
     }
     ob_result res = OB_OK;
-    ob_node *bad = w.err == OB_OK ? ob_node_create(w.d.scene, NULL, "bad-camera", &res) : NULL;
+    ob_node *bad = w.err == OB_OK ? ob_node_create(w.s->scene, NULL, "bad-camera", &res) : NULL;
     if (!bad && w.err == OB_OK) w.err = res;
     for (size_t i = 0; i < OB_ARRAY_COUNT(bad_cams) && bad; i++) {
         ob_stab_expect(c, expect);
@@ -258,7 +259,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     const ob_frame_stats *st;
     uint8_t *off = ob_stab_render(&w, &st);
     bool absent = !ob_stab_view_stats(st, "shadow:sun");
-    if (lamp) ob_node_destroy(w.d.scene, lamp);
+    if (lamp) ob_node_destroy(w.s->scene, lamp);
     ob_stab_hide(b.sun, false);
     ob_result set = OB_OK;
     if (b.sun) {
@@ -269,7 +270,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     uint8_t *zero = ob_stab_render(&w, &st);
     absent &= !ob_stab_view_stats(st, "shadow:sun");
     ob_skip_reason skip = ob_stab_skip_reason(st, "shadow:sun");
-    if (b.sun) ob_node_destroy(w.d.scene, b.sun);
+    if (b.sun) ob_node_destroy(w.s->scene, b.sun);
     uint8_t *none = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
     if (w.err == OB_OK) {
@@ -382,16 +383,16 @@ ob_result ob_stab_non_finite_light_camera(ob_stab_ctx *c)
     uint8_t *no_sun = ob_stab_render(&w, NULL);
     ob_stab_hide(b.sun, false);
     ob_stab_position(b.sun, 3, 8, 4);
-    if (lamp) ob_node_destroy(w.d.scene, lamp);
+    if (lamp) ob_node_destroy(w.s->scene, lamp);
     double light_ms = ob_stab_take_ms(c);
 
     ob_stab_expect(c, expect);
     double eye[3] = {0, 2.5, 4.5};
-    if (w.d.camera) ob_node_get_position(w.d.camera, eye);
-    ob_stab_position(w.d.camera, eye[0], NAN, eye[2]);
+    if (w.s->camera) ob_node_get_position(w.s->camera, eye);
+    ob_stab_position(w.s->camera, eye[0], NAN, eye[2]);
     uint8_t *img_cam = ob_stab_render(&w, NULL);
     bool named = ob_stab_log_has(c, "'main'", "'camera'", NULL);
-    ob_stab_position(w.d.camera, eye[0], eye[1], eye[2]);
+    ob_stab_position(w.s->camera, eye[0], eye[1], eye[2]);
     uint8_t *fixed = ob_stab_render(&w, NULL);
     ob_stab_expect(c, NULL);
     ob_result r = OB_OK;
@@ -446,7 +447,7 @@ ob_result ob_stab_non_finite_material(ob_stab_ctx *c)
         errors = ob_stab_expected_errors(c) - errors;
         ob_result res = OB_OK;
         ob_material *m = ob_material_create(
-            w.d.lib, &(ob_material_desc){.name = "nan-material", .diffuse = {1, NAN, 1, 1}}, &res);
+            w.s->materials, &(ob_material_desc){.name = "nan-material", .diffuse = {1, NAN, 1, 1}}, &res);
         refused += !m && res == OB_ERR_NON_FINITE;
         named = ob_stab_log_has(c, "'stab-red'", "non-finite", NULL) &&
                 ob_stab_log_has(c, "'nan-material'", NULL);
@@ -478,8 +479,8 @@ ob_result ob_stab_non_finite_parameter(ob_stab_ctx *c)
     uint32_t refused = 0;
     bool kept = false, named = false, found = false;
     if (w.err == OB_OK) {
-        ob_param_registry *reg = ob_renderer_registry(w.d.r);
-        ob_params *params = ob_renderer_params(w.d.r);
+        ob_param_registry *reg = ob_renderer_registry(w.s->renderer);
+        ob_params *params = ob_renderer_params(w.s->renderer);
         ob_param ambient = ob_param_find(reg, "AmbientColor");
         ob_param world = ob_param_registry_builtins(reg)->world;
         const float good[4] = {0.5f, 0.25f, 0.125f, 1.0f};
@@ -530,7 +531,7 @@ ob_result ob_stab_beyond_float(ob_stab_ctx *c)
     ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
     ob_stab_look(&w, 0, 2.5, 4.5, 0, 0.4, 0);
     ob_result res = OB_OK;
-    ob_node *parent = w.err == OB_OK ? ob_node_create(w.d.scene, NULL, "giant-parent", &res) : NULL;
+    ob_node *parent = w.err == OB_OK ? ob_node_create(w.s->scene, NULL, "giant-parent", &res) : NULL;
     if (!parent && w.err == OB_OK) w.err = res;
     ob_node *far = ob_stab_entity(&w, parent, "beyond-float", w.box, red, 0, 0, 0);
     ob_stab_hide(far, true);

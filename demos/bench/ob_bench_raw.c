@@ -51,7 +51,7 @@ static ob_result make_module(ob_demo *d, const char *name, const char *source, o
 {
     ob_result r;
     ob_shader_desc sd = {.path = name, .source = source, .stage = stage};
-    const ob_shader *sh = ob_shader_get(ob_effect_context_compiler(d->fx), &sd, &r);
+    const ob_shader *sh = ob_shader_get(ob_effect_context_compiler(d->stack->effects), &sd, &r);
     if (!sh) return r;
     VkShaderModuleCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
                                    .codeSize = sh->spirv_words * 4, .pCode = sh->spirv};

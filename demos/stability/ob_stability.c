@@ -1,7 +1,8 @@
 #define _POSIX_C_SOURCE 200809L
-#include "ob_bench_stab_world.h"
+#include "ob_stab_world.h"
 
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 /* ------------------------------------------------------------ log sink */
@@ -78,9 +79,19 @@ static const struct {
     {"shadow map without casters", ob_stab_no_casters},
 };
 
-uint32_t ob_bench_stability_case_count(void) { return OB_ARRAY_COUNT(cases); }
+uint32_t ob_stability_case_count(void) { return OB_ARRAY_COUNT(cases); }
 
-ob_result ob_bench_stability_run(const ob_bench_stability_desc *desc, ob_bench_stability *out)
+const char *ob_stability_verdict_name(ob_stability_verdict v)
+{
+    switch (v) {
+    case OB_STABILITY_PASS: return "pass";
+    case OB_STABILITY_MEASURED: return "measured";
+    case OB_STABILITY_FAIL: break;
+    }
+    return "fail";
+}
+
+ob_result ob_stability_run(const ob_stability_desc *desc, ob_stability *out)
 {
     memset(out, 0, sizeof *out);
     out->quick = desc->quick;
@@ -103,10 +114,10 @@ ob_result ob_bench_stability_run(const ob_bench_stability_desc *desc, ob_bench_s
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(cases) && r == OB_OK; i++) {
         if (desc->only && strcmp(desc->only, cases[i].label) != 0) continue;
-        if (desc->progress) ob_bench_progress_label(desc->progress, "stability: %s", cases[i].label);
+        if (desc->on_case) desc->on_case(desc->on_case_user, cases[i].label, false);
         r = cases[i].run(c);
         out->cases++;
-        if (desc->progress) ob_bench_progress_tick(desc->progress);
+        if (desc->on_case) desc->on_case(desc->on_case_user, cases[i].label, true);
     }
     if (desc->only && out->cases == 0) {
         OB_LOG_E("bench", "stability: no case is called '%s'", desc->only);
@@ -126,7 +137,7 @@ ob_result ob_bench_stability_run(const ob_bench_stability_desc *desc, ob_bench_s
     return r;
 }
 
-void ob_bench_stability_release(ob_bench_stability *s)
+void ob_stability_release(ob_stability *s)
 {
     ob_free(s->rows);
     s->rows = NULL;

@@ -1,7 +1,7 @@
 /* ob_bench_report.h — what obelisk-bench measured, and its outputs: a
  * table on stdout, JSON, CSV, gnuplot charts. Either section may be left
  * out: the performance one (sweep, raw, scene200, quality: perf = false)
- * or the stability one (ob_bench_stability.h: stability = NULL).
+ * or the stability one (ob_stability.h: stability = NULL).
  *
  * Lifecycle: the program fills an ob_bench_report, then calls the writers.
  * Thread rule: any one thread. Writers report I/O failures as OB_ERR_IO
@@ -16,7 +16,7 @@
 #include "ob_bench_quality.h"
 #include "ob_bench_raw.h"
 #include "ob_bench_run.h"
-#include "ob_bench_stability.h"
+#include "ob_stability.h"
 
 
 /* One scene (views × objects) measured in every mode of the list. */
@@ -62,7 +62,7 @@ typedef struct ob_bench_summary {
 typedef struct ob_bench_report {
     bool quick;
     bool perf;                                     /* the performance sections ran */
-    const ob_bench_stability *stability;           /* NULL: that section did not run */
+    const ob_stability *stability;           /* NULL: that section did not run */
     uint32_t seed, cores, pool_workers;
     char device_name[256], driver_info[256];   /* ob_device_name / ob_device_driver_info */
     bool validation;
@@ -94,7 +94,7 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path);
 ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path);
 /* The stability section: header name,measure,error,unit,bound,pass,ms,detail,
  * one row a case (empty fields for NAN). */
-ob_result ob_bench_report_stability_csv(const ob_bench_stability *s, const char *path);
+ob_result ob_bench_report_stability_csv(const ob_stability *s, const char *path);
 /* Where the stability CSV of --csv FILE goes: FILE without a trailing
  * ".csv", then "-stability.csv". */
 void ob_bench_report_stability_csv_path(const char *csv, char *dest, size_t dest_size);

@@ -1,24 +1,25 @@
-/* ob_bench_stab_world.h — what the stability cases share (internal to
- * ob_bench_stability*.c): the run context (rows, expected log lines, frame
- * times), a small world on top of ob_demo (the tests' ob_test_world: camera,
- * main view, composite, box/sphere/plane, helpers to add entities and lights,
- * render a frame in a threading mode and read the image back), and image
- * comparisons.
+/* ob_stab_world.h — what the stability cases share (internal to
+ * demos/stability): the run context (rows, expected log lines, frame
+ * times), a small world on top of ob_stack (views/ob_stack.h; what the
+ * tests' ob_test_world is: camera, main view, composite, box/sphere/plane,
+ * helpers to add entities and lights, render a frame in a threading mode
+ * and read the image back), and image comparisons.
  *
  * Errors are sticky: the first failing call stores its ob_result in
  * w->err (logged by the engine or here, with the entity's name) and every
  * later helper does nothing and returns NULL / 0; the node setters accept
  * NULL. A case builds its scene, renders, then checks w->err once.
  *
- * Thread rule: render thread. The log sink the context installs may be called
+ * Thread rule: [render thread]. The log sink the context installs may be called
  * from any thread (workers, the validation callback); it locks.
  */
-#ifndef OB_BENCH_STAB_WORLD_H
-#define OB_BENCH_STAB_WORLD_H
+#ifndef OB_STAB_WORLD_H
+#define OB_STAB_WORLD_H
 
 #include <pthread.h>
 
-#include "ob_bench_stability.h"
+#include "ob_stability.h"
+#include "ob_stack.h"
 
 #define OB_STAB_MAX_NEEDLES 8
 #define OB_STAB_LOG_LINES 48
@@ -38,7 +39,7 @@ typedef struct ob_stab_log {
 } ob_stab_log;
 
 typedef struct ob_stab_ctx {
-    ob_bench_stability *out;
+    ob_stability *out;
     bool quick;
     uint32_t workers;
     ob_stab_log log;
@@ -46,11 +47,14 @@ typedef struct ob_stab_ctx {
     uint32_t first_count, steady_count;
 } ob_stab_ctx;
 
-/* Adds a row. pass = ok && error <= bound (a NAN bound: measured only, pass
- * = ok); a NAN error never passes. ms NAN: none. Failure: out of memory. */
+/* Adds a row; ok: the case's other checks held. Verdict: fail when !ok or
+ * the error is NAN, else measured only when the bound is NAN, else pass when
+ * error <= bound. ms NAN: none. Failure: out of memory (logged). */
 ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, double error,
                       const char *unit, double bound, bool ok, double ms, const char *detail_fmt,
                       ...) __attribute__((format(printf, 9, 10)));
+/* Median of v[0..n), NaNs left out (v is reordered); NAN if none is left. */
+double ob_stab_median(double *v, uint32_t n);
 /* Median wall time of the frames rendered since the last call (those after
  * each world's first frame when there are any, else all); NAN if none. */
 double ob_stab_take_ms(ob_stab_ctx *c);
@@ -72,12 +76,11 @@ typedef struct ob_stab_world_desc {
 } ob_stab_world_desc;
 
 typedef struct ob_stab_world {
-    ob_demo d;
+    ob_stack *s;                   /* the whole stack; NULL once destroyed */
     ob_stab_ctx *ctx;
     ob_geometry *box, *sphere, *plane;
     uint32_t width, height;
     uint8_t *pixels;               /* the last read image */
-    double time;
     uint32_t frames;
     ob_result err;
 } ob_stab_world;
@@ -150,4 +153,4 @@ ob_result ob_stab_env_recursion(ob_stab_ctx *c);
 ob_result ob_stab_many_objects(ob_stab_ctx *c);
 ob_result ob_stab_no_casters(ob_stab_ctx *c);
 
-#endif /* OB_BENCH_STAB_WORLD_H */
+#endif /* OB_STAB_WORLD_H */

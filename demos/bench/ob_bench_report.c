@@ -178,23 +178,28 @@ static void format_value(double v, char *buf, size_t n)
     else snprintf(buf, n, "%.3g", v);
 }
 
-static const char *row_verdict(const ob_bench_stability_row *row)
+static const char *row_verdict(const ob_stability_row *row)
 {
-    return !row->pass ? "FAIL" : isnan(row->bound) ? "-" : "ok";
+    switch (row->verdict) {
+    case OB_STABILITY_PASS: return "ok";
+    case OB_STABILITY_MEASURED: return "-";
+    case OB_STABILITY_FAIL: break;
+    }
+    return "FAIL";
 }
 
-static void print_stability(const ob_bench_stability *s, FILE *f)
+static void print_stability(const ob_stability *s, FILE *f)
 {
     fprintf(f, "\nnumerical stability and extreme cases%s: %u rows from %u cases, %u failed (over "
-               "the bound the test asserts, or a check of the case); bound '-' = measured only; "
-               "ms = median frame (after a renderer's first) or update time; renderers with %u "
-               "workers\n",
+               "the bound the test asserts, or a check of the case), %u measured only (bound "
+               "'-', pass '-': neither passed nor failed); ms = median frame (after a renderer's "
+               "first) or update time; renderers with %u workers\n",
             s->quick ? " (--quick: two cases shrunk, see their rows)" : "", s->count, s->cases,
-            s->failed, s->workers);
+            s->failed, s->measured, s->workers);
     fprintf(f, "  %-38s %10s %-11s %8s %-4s %9s  %s\n", "case", "error", "unit", "bound", "pass",
             "ms", "measure / detail");
     for (uint32_t i = 0; i < s->count; i++) {
-        const ob_bench_stability_row *row = &s->rows[i];
+        const ob_stability_row *row = &s->rows[i];
         char err[32], bound[32], ms[32];
         format_value(row->error, err, sizeof err);
         format_value(row->bound, bound, sizeof bound);
@@ -349,11 +354,11 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     fputs("}}", f);
 }
 
-static void json_stability(FILE *f, const ob_bench_stability *s)
+static void json_stability(FILE *f, const ob_stability *s)
 {
     fputs("\"stability\":[\n  ", f);
     for (uint32_t i = 0; i < s->count; i++) {
-        const ob_bench_stability_row *row = &s->rows[i];
+        const ob_stability_row *row = &s->rows[i];
         if (i) fputs(",\n  ", f);
         fputs("{\"name\":", f);
         json_str(f, row->name);
@@ -365,17 +370,22 @@ static void json_stability(FILE *f, const ob_bench_stability *s)
         json_str(f, row->unit);
         fputs(",\"bound\":", f);
         json_num(f, row->bound);
-        fprintf(f, ",\"pass\":%s,\"ms\":", row->pass ? "true" : "false");
+        /* pass: null for a measured-only row, which neither passed nor failed. */
+        fprintf(f, ",\"pass\":%s,\"verdict\":\"%s\",\"ms\":",
+                row->verdict == OB_STABILITY_MEASURED ? "null"
+                : row->verdict == OB_STABILITY_PASS   ? "true"
+                                                      : "false",
+                ob_stability_verdict_name(row->verdict));
         json_num(f, row->ms);
         fputs(",\"detail\":", f);
         json_str(f, row->detail);
         fputs("}", f);
     }
     fprintf(f, "],\n\"stability_info\":{\"quick\":%s,\"rows\":%u,\"cases\":%u,\"failed\":%u,"
-               "\"workers\":%u,\"validation\":%s,\"validation_messages\":%u,"
+               "\"measured_only\":%u,\"workers\":%u,\"validation\":%s,\"validation_messages\":%u,"
                "\"expected_log_errors\":%llu,\"expected_log_warnings\":%llu,\"seconds\":%.1f,"
                "\"device\":{\"name\":",
-            s->quick ? "true" : "false", s->count, s->cases, s->failed, s->workers,
+            s->quick ? "true" : "false", s->count, s->cases, s->failed, s->measured, s->workers,
             s->validation ? "true" : "false",
             s->validation_messages, (unsigned long long)s->expected_errors,
             (unsigned long long)s->expected_warnings, s->seconds);
@@ -546,13 +556,13 @@ static void csv_text(FILE *f, const char *s)
     fputc('"', f);
 }
 
-ob_result ob_bench_report_stability_csv(const ob_bench_stability *s, const char *path)
+ob_result ob_bench_report_stability_csv(const ob_stability *s, const char *path)
 {
     FILE *f = open_out(path);
     if (!f) return OB_ERR_IO;
-    fputs("name,measure,error,unit,bound,pass,ms,detail\n", f);
+    fputs("name,measure,error,unit,bound,pass,ms,detail,verdict\n", f);
     for (uint32_t i = 0; i < s->count; i++) {
-        const ob_bench_stability_row *row = &s->rows[i];
+        const ob_stability_row *row = &s->rows[i];
         csv_text(f, row->name);
         fputc(',', f);
         csv_text(f, row->measure);
@@ -560,11 +570,14 @@ ob_result ob_bench_report_stability_csv(const ob_bench_stability *s, const char 
         fputc(',', f);
         csv_text(f, row->unit);
         csv_num(f, row->bound);
-        fprintf(f, ",%s", row->pass ? "true" : "false");
+        /* pass: empty for a measured-only row, which neither passed nor failed. */
+        fprintf(f, ",%s", row->verdict == OB_STABILITY_MEASURED ? ""
+                          : row->verdict == OB_STABILITY_PASS   ? "true"
+                                                                : "false");
         csv_num(f, row->ms);
         fputc(',', f);
         csv_text(f, row->detail);
-        fputc('\n', f);
+        fprintf(f, ",%s\n", ob_stability_verdict_name(row->verdict));
     }
     return close_out(f, path);
 }

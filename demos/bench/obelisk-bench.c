@@ -2,7 +2,7 @@
  * per draw, and what quality costs.
  *
  *   sweep      views × objects × threading modes (ST, 1, 2, 4 workers,
- *              auto) on the sweep scene (demos/common/ob_bench_scene.h: a
+ *              auto) on the sweep scene (demos/bench/ob_bench_scene.h: a
  *              "view" is one more camera's perspective view of the whole
  *              scene): CPU time per phase and recording time with the device
  *              idle, frame time with frames in flight, GPU time, draws per
@@ -14,7 +14,7 @@
  *   quality    env-map and shadow-map sizes: image error against the
  *              highest-quality single-threaded image next to frame time; the
  *              threading modes must give that image byte for byte
- *   stability  numerical precision and extreme cases (ob_bench_stability.h):
+ *   stability  numerical precision and extreme cases (ob_stability.h):
  *              each case's error against the bound its test asserts, and its
  *              run time
  *
@@ -481,6 +481,14 @@ static void summarize(ob_bench_report *rep)
     s->threading_identical = s->threading_max_abs_diff == 0 && s->hash_mismatches == 0;
 }
 
+/* The progress bar through a stability run: labelled per case, a tick after. */
+static void stability_progress(void *user, const char *label, bool done)
+{
+    ob_bench_progress *prog = user;
+    if (done) ob_bench_progress_tick(prog);
+    else ob_bench_progress_label(prog, "stability: %s", label);
+}
+
 /* The 1-minute load average: other work on the machine skews every time. */
 static double load_average(void)
 {
@@ -540,7 +548,7 @@ static int run(const bench_options *o)
     }
     /* A stability case takes about as long as a dozen mirror-scene frames. */
     const uint64_t stability_unit = 12;
-    if (o->stability) total += ob_bench_stability_case_count() * stability_unit;
+    if (o->stability) total += ob_stability_case_count() * stability_unit;
     ob_bench_progress prog;
     ob_bench_progress_init(&prog, total, o->progress);
     qd.tick = ob_bench_progress_tick;
@@ -571,11 +579,12 @@ static int run(const bench_options *o)
         ob_bench_progress_label(&prog, "quality and threading check (mirror scene)");
         r = ob_bench_quality_run(&qd, &rep.quality, &rep.quality_count);
     }
-    ob_bench_stability stab = {0};
+    ob_stability stab = {0};
     if (r == OB_OK && o->stability) {
         prog.unit = stability_unit;
-        ob_bench_stability_desc sd = {.quick = o->quick, .progress = &prog};
-        r = ob_bench_stability_run(&sd, &stab);
+        ob_stability_desc sd = {.quick = o->quick, .on_case = stability_progress,
+                                .on_case_user = &prog};
+        r = ob_stability_run(&sd, &stab);
         rep.stability = &stab;
         if (!rep.device_name[0]) {
             snprintf(rep.device_name, sizeof rep.device_name, "%s", stab.device_name);
@@ -609,8 +618,8 @@ static int run(const bench_options *o)
             code = 4;
         }
         for (uint32_t i = 0; rep.stability && i < stab.count; i++) {
-            const ob_bench_stability_row *row = &stab.rows[i];
-            if (row->pass) continue;
+            const ob_stability_row *row = &stab.rows[i];
+            if (row->verdict != OB_STABILITY_FAIL) continue;
             fprintf(stderr, "obelisk-bench: stability case '%s' failed: error %.6g %s, bound %.6g "
                             "(%s)\n", row->name, row->error, row->unit, row->bound, row->detail);
             if (!code) code = 5;
@@ -622,7 +631,7 @@ static int run(const bench_options *o)
             if (!code) code = 3;
         }
     }
-    ob_bench_stability_release(&stab);
+    ob_stability_release(&stab);
     ob_free(rep.sweep);
     ob_free(rep.quality);
     return code;

@@ -1,9 +1,9 @@
 #define _POSIX_C_SOURCE 200809L
-#include "ob_bench_stab_world.h"
+#include "ob_stab_world.h"
 
-#include "ob_demo.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,12 +14,12 @@ ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, dou
                       const char *unit, double bound, bool ok, double ms, const char *detail_fmt,
                       ...)
 {
-    ob_bench_stability *s = c->out;
+    ob_stability *s = c->out;
     if (ob_array_reserve((void **)&s->rows, &s->cap, s->count + 1, sizeof *s->rows) != OB_OK) {
         OB_LOG_E("bench", "stability: no memory for the row '%s'", name);
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
-    ob_bench_stability_row *row = &s->rows[s->count++];
+    ob_stability_row *row = &s->rows[s->count++];
     memset(row, 0, sizeof *row);
     snprintf(row->name, sizeof row->name, "%s", name);
     snprintf(row->measure, sizeof row->measure, "%s", measure);
@@ -27,19 +27,39 @@ ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, dou
     row->error = error;
     row->bound = bound;
     row->ms = ms;
-    row->pass = ok && !isnan(error) && (isnan(bound) || error <= bound);
+    row->checks_ok = ok;
+    if (!ok || isnan(error)) row->verdict = OB_STABILITY_FAIL;
+    else if (isnan(bound)) row->verdict = OB_STABILITY_MEASURED;
+    else row->verdict = error <= bound ? OB_STABILITY_PASS : OB_STABILITY_FAIL;
     va_list ap;
     va_start(ap, detail_fmt);
     vsnprintf(row->detail, sizeof row->detail, detail_fmt, ap);
     va_end(ap);
-    if (!row->pass) s->failed++;
+    if (row->verdict == OB_STABILITY_FAIL) s->failed++;
+    if (row->verdict == OB_STABILITY_MEASURED) s->measured++;
     return OB_OK;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double ob_stab_median(double *v, uint32_t n)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (!isnan(v[i])) v[k++] = v[i];
+    if (!k) return NAN;
+    qsort(v, k, sizeof *v, compare_double);
+    return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
 double ob_stab_take_ms(ob_stab_ctx *c)
 {
-    double ms = c->steady_count ? ob_demo_median(c->steady_ms, c->steady_count)
-                                : ob_demo_median(c->first_ms, c->first_count);
+    double ms = c->steady_count ? ob_stab_median(c->steady_ms, c->steady_count)
+                                : ob_stab_median(c->first_ms, c->first_count);
     c->steady_count = c->first_count = 0;
     return ms;
 }
@@ -100,26 +120,27 @@ ob_result ob_stab_world_create(ob_stab_world *w, ob_stab_ctx *c, const ob_stab_w
     w->ctx = c;
     w->width = desc->width ? desc->width : 160;
     w->height = desc->height ? desc->height : 120;
-    ob_demo_options o = {.frames = 1, .threads = (int)c->workers, .width = w->width,
-                         .height = w->height, .seed = 1, .quiet = true,
-                         .env_size = desc->env_map_size ? desc->env_map_size : 64,
-                         .shadow_size = desc->shadow_map_size ? desc->shadow_map_size : 256,
-                         .clear_color = {0.1f, 0.2f, 0.3f, 1.0f}};
-    if (desc->clear_color[3] > 0.0f) memcpy(o.clear_color, desc->clear_color, sizeof o.clear_color);
-    ob_result r = ob_demo_init(&w->d, &o);
-    if (r != OB_OK) {
+    ob_stack_desc sd = {
+        .renderer = {.device = {.app_name = "obelisk-stability"}, .worker_count = c->workers,
+                     .threading = c->workers ? OB_THREADING_MULTI : OB_THREADING_SINGLE},
+        .width = w->width, .height = w->height,
+        .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
+        .camera = {.fovy = 1.0f, .znear = desc->znear > 0 ? desc->znear : 0.1f},
+        .env_map_size = desc->env_map_size ? desc->env_map_size : 64,
+        .shadow_map_size = desc->shadow_map_size ? desc->shadow_map_size : 256,
+    };
+    if (desc->clear_color[3] > 0.0f) memcpy(sd.clear_color, desc->clear_color, sizeof sd.clear_color);
+    ob_result r;
+    if (!(w->s = ob_stack_create(&sd, &r))) {
         fail(w, r, "renderer set-up", "");
         return r;
     }
+    ob_device *dev = w->s->device;
     if (!c->out->device_name[0]) {
-        ob_device *dev = ob_renderer_device(w->d.r);
         snprintf(c->out->device_name, sizeof c->out->device_name, "%s", ob_device_name(dev));
         snprintf(c->out->driver_info, sizeof c->out->driver_info, "%s", ob_device_driver_info(dev));
     }
-    c->out->validation |= ob_device_validation_enabled(ob_renderer_device(w->d.r));
-    r = ob_node_set_camera(w->d.camera, &(ob_camera_desc){
-                                            .fovy = 1.0f, .znear = desc->znear > 0 ? desc->znear : 0.1f});
-    if (r != OB_OK) fail(w, r, "camera", "camera");
+    c->out->validation |= ob_device_validation_enabled(dev);
     w->pixels = ob_malloc((size_t)w->width * w->height * 4);
     if (!w->pixels) fail(w, OB_ERR_OUT_OF_HOST_MEMORY, "image", "pixels");
     ob_mesh m = {0};
@@ -129,10 +150,7 @@ ob_result ob_stab_world_create(ob_stab_world *w, ob_stab_ctx *c, const ob_stab_w
         r = i == 0 ? ob_mesh_box((const float[3]){0.5f, 0.5f, 0.5f}, &m)
             : i == 1 ? ob_mesh_sphere(0.5f, 24, 16, &m)
                      : ob_mesh_plane(20.0f, 20.0f, 2, &m);
-        if (r == OB_OK) {
-            *shapes[i].dst = ob_demo_geometry(&w->d, &m, shapes[i].name);
-            if (!*shapes[i].dst) r = OB_ERR_OUT_OF_DEVICE_MEMORY;
-        }
+        if (r == OB_OK) *shapes[i].dst = ob_stack_add_geometry(w->s, &m, shapes[i].name, &r);
         ob_mesh_release(&m);
         if (r != OB_OK) fail(w, r, "geometry", shapes[i].name);
     }
@@ -142,12 +160,13 @@ ob_result ob_stab_world_create(ob_stab_world *w, ob_stab_ctx *c, const ob_stab_w
 
 void ob_stab_world_destroy(ob_stab_world *w)
 {
-    if (w->d.r) {
-        ob_renderer_wait_idle(w->d.r);
-        ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(w->d.r));
+    if (w->s) {
+        ob_renderer_wait_idle(w->s->renderer);
+        ob_validation_counts vc = ob_device_validation_counts(w->s->device);
         w->ctx->out->validation_messages += vc.errors + vc.warnings;
     }
-    ob_demo_shutdown(&w->d);
+    ob_stack_destroy(w->s);
+    w->s = NULL;
     ob_free(w->pixels);
     w->pixels = NULL;
 }
@@ -156,7 +175,7 @@ ob_material *ob_stab_material_desc(ob_stab_world *w, const ob_material_desc *md)
 {
     if (w->err != OB_OK) return NULL;
     ob_result r;
-    ob_material *m = ob_material_create(w->d.lib, md, &r);
+    ob_material *m = ob_material_create(w->s->materials, md, &r);
     if (!m) fail(w, r, "material", md->name);
     return m;
 }
@@ -173,9 +192,10 @@ ob_node *ob_stab_entity(ob_stab_world *w, ob_node *parent, const char *name, ob_
                         ob_material *m, double x, double y, double z)
 {
     if (w->err != OB_OK) return NULL;
-    ob_node *n = ob_demo_entity(&w->d, parent, name, g, m);
+    ob_result r;
+    ob_node *n = ob_stack_add_entity(w->s, parent, name, g, m, &r);
     if (!n) {
-        fail(w, OB_ERR_OUT_OF_HOST_MEMORY, "entity", name);
+        fail(w, r, "entity", name);
         return NULL;
     }
     ob_stab_position(n, x, y, z);
@@ -188,7 +208,7 @@ ob_node *ob_stab_light(ob_stab_world *w, ob_light_type type, bool shadows, float
     if (w->err != OB_OK) return NULL;
     const char *name = type == OB_LIGHT_DIRECTIONAL ? "sun" : "lamp";
     ob_result r;
-    ob_node *n = ob_node_create(w->d.scene, NULL, name, &r);
+    ob_node *n = ob_node_create(w->s->scene, NULL, name, &r);
     if (!n) {
         fail(w, r, "light", name);
         return NULL;
@@ -207,8 +227,8 @@ void ob_stab_look(ob_stab_world *w, double ex, double ey, double ez, double tx, 
                   double tz)
 {
     if (w->err != OB_OK) return;
-    ob_stab_position(w->d.camera, ex, ey, ez);
-    ob_result r = ob_node_look_at(w->d.camera, (const double[3]){tx, ty, tz},
+    ob_stab_position(w->s->camera, ex, ey, ez);
+    ob_result r = ob_node_look_at(w->s->camera, (const double[3]){tx, ty, tz},
                                   (const double[3]){0, 1, 0});
     if (r != OB_OK) fail(w, r, "camera aim", "camera");
 }
@@ -239,16 +259,13 @@ const ob_frame_stats *ob_stab_frame_with(ob_stab_world *w, ob_threading mode,
                                          ob_view *const *extra, uint32_t extra_count)
 {
     if (w->err != OB_OK) return NULL;
-    const double dt = 1.0 / 60.0;
-    ob_renderer *r = w->d.r;
+    ob_renderer *r = w->s->renderer;
     uint64_t t0 = ob_time_ns();
     ob_renderer_set_threading(r, mode, 0);
-    ob_result res = ob_scene_update(w->d.scene, w->time > 0.0 ? dt : 0.0);
-    ob_views_set_time(w->d.views, w->time, dt);
-    if (res == OB_OK) res = ob_renderer_begin_frame(r, w->d.scene);
+    ob_result res = ob_stack_frame_begin(w->s, 1.0 / 60.0);
     if (res == OB_OK) {
-        ob_views_render(w->d.views, ob_composite_view_base(w->d.composite));
-        for (uint32_t i = 0; i < extra_count; i++) ob_views_render(w->d.views, extra[i]);
+        ob_views_render(w->s->views, w->s->final_view);
+        for (uint32_t i = 0; i < extra_count; i++) ob_views_render(w->s->views, extra[i]);
         res = ob_renderer_end_frame(r);
     }
     if (res == OB_OK) res = ob_renderer_wait_idle(r);
@@ -262,15 +279,14 @@ const ob_frame_stats *ob_stab_frame_with(ob_stab_world *w, ob_threading mode,
     if (w->frames == 0 && c->first_count < OB_STAB_MAX_TIMES) c->first_ms[c->first_count++] = ms;
     else if (w->frames > 0 && c->steady_count < OB_STAB_MAX_TIMES) c->steady_ms[c->steady_count++] = ms;
     w->frames++;
-    w->time += dt;
     return ob_renderer_last_stats(r);
 }
 
 uint8_t *ob_stab_snapshot(ob_stab_world *w)
 {
     if (w->err != OB_OK) return NULL;
-    ob_result r = ob_image_read_rgba8(ob_renderer_device(w->d.r),
-                                      ob_composite_view_target(w->d.composite), w->pixels);
+    ob_result r = ob_image_read_rgba8(ob_renderer_device(w->s->renderer),
+                                      ob_composite_view_target(w->s->composite), w->pixels);
     if (r != OB_OK) {
         fail(w, r, "read back", "composite");
         return NULL;

@@ -12,10 +12,10 @@
  *           draws about a third of the objects and culls the rest): the
  *           demo's main view (shown by the composite) plus V-1 extra
  *           perspective views queued in the frame before it.
- *   mirror  obelisk-mirror's scene: three reflective spheres (dual-paraboloid
- *           environment maps that see each other), N orbiting objects, a
- *           shadow-casting sun, two point lights, a particle fountain; the
- *           camera circles slowly.
+ *   mirror  obelisk-mirror's scene itself (demos/scenes/ob_mirror_scene.h:
+ *           three reflective spheres whose dual-paraboloid environment maps
+ *           see each other, N orbiting objects, a shadow-casting sun, two
+ *           point lights, a particle fountain); the camera circles slowly.
  *
  * Lifecycle: ob_demo_init → ob_bench_scene_build → frames → (ob_renderer_wait_idle)
  * ob_bench_scene_release → ob_demo_shutdown.

@@ -5,10 +5,11 @@
  * judged. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "ob_bench_stab_world.h"
+#include "ob_stab_world.h"
 
 static int view_index(const ob_frame_stats *st, const char *name)
 {
@@ -70,15 +71,15 @@ ob_result ob_stab_views_64(ob_stab_ctx *c)
             ob_view *views[BALLS + 2];
             uint32_t n = 0;
             for (uint32_t i = 0; i < BALLS; i++) {
-                ob_view *v = ob_renderer_attached_view(w.d.r, spheres[i], OB_VIEW_PARABOLOID);
+                ob_view *v = ob_renderer_attached_view(w.s->renderer, spheres[i], OB_VIEW_PARABOLOID);
                 const ob_view_stats *vs = v ? ob_stab_view_stats(st, v->name) : NULL;
                 if (!vs || vs->skipped != OB_SKIP_NONE || vs->draws == 0) bad++;
                 if (v) views[n++] = v;
             }
             int main_at = view_index(st, "main");
             for (uint32_t i = 0; i < n; i++) bad += view_index(st, views[i]->name) >= main_at;
-            views[n++] = ob_perspective_view_base(w.d.main);
-            views[n++] = ob_composite_view_base(w.d.composite);
+            views[n++] = ob_perspective_view_base(w.s->main);
+            views[n++] = ob_composite_view_base(w.s->composite);
             edges = 0;
             bad += order_violations(st, views, n, &edges);
             ran = st->view_count;
@@ -129,10 +130,10 @@ ob_result ob_stab_view_cap(ob_stab_ctx *c)
     for (; made < EXTRA && w.err == OB_OK; made++) {
         char name[32];
         snprintf(name, sizeof name, "extra%03u", made);
-        ob_perspective_desc pd = {.name = name, .camera = w.d.camera, .width = 16, .height = 16,
+        ob_perspective_desc pd = {.name = name, .camera = w.s->camera, .width = 16, .height = 16,
                                   .clear_color = {0, 0, 0, 1}};
         ob_result res;
-        extra[made] = ob_perspective_view_create(w.d.views, &pd, &res);
+        extra[made] = ob_perspective_view_create(w.s->views, &pd, &res);
         if (!extra[made]) {
             w.err = res;
             break;
@@ -157,8 +158,8 @@ ob_result ob_stab_view_cap(ob_stab_ctx *c)
         }
         refused &= !ob_stab_view_stats(st, last) &&
                    ob_stab_skip_reason(st, last) == OB_SKIP_ERROR;
-        ob_view *order[2] = {ob_perspective_view_base(w.d.main),
-                             ob_composite_view_base(w.d.composite)};
+        ob_view *order[2] = {ob_perspective_view_base(w.s->main),
+                             ob_composite_view_base(w.s->composite)};
         uint32_t edges = 0;
         bad += order_violations(st, order, 2, &edges);
         uint8_t *img = ob_stab_snapshot(&w);
@@ -180,8 +181,8 @@ ob_result ob_stab_view_cap(ob_stab_ctx *c)
                         "%u views ran; the 129th refused with reason error: %s, named: %s; ran "
                         "the next frame: %s; %u views missing, empty or out of order", ran,
                         refused ? "yes" : "NO", named ? "yes" : "NO", later ? "yes" : "NO", bad);
-    if (w.d.r) ob_renderer_wait_idle(w.d.r);
-    for (uint32_t i = 0; i < made; i++) ob_perspective_view_destroy(w.d.views, extra[i]);
+    if (w.s->renderer) ob_renderer_wait_idle(w.s->renderer);
+    for (uint32_t i = 0; i < made; i++) ob_perspective_view_destroy(w.s->views, extra[i]);
     ob_free(alone);
     if (r == OB_OK) r = w.err;
     ob_stab_world_destroy(&w);
@@ -205,7 +206,7 @@ ob_result ob_stab_env_recursion(ob_stab_ctx *c)
     for (uint32_t depth = 0; depth <= 4 && r == OB_OK; depth++) {
         ob_stab_world w;
         ob_stab_world_create(&w, c, &(ob_stab_world_desc){.width = REC_W, .height = REC_H});
-        if (w.d.r) ob_renderer_set_max_recursion(w.d.r, depth);
+        if (w.s->renderer) ob_renderer_set_max_recursion(w.s->renderer, depth);
         ob_material *ground = ob_stab_material(&w, "ground", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.6f, false);
         ob_material *red = ob_stab_material(&w, "red", OB_MATERIAL_LIT, 0.9f, 0.2f, 0.1f, true);
         ob_material *mirror = ob_stab_material(&w, "mirror", OB_MATERIAL_REFLECTIVE, 0.9f, 0.9f,
@@ -273,9 +274,9 @@ ob_result ob_stab_many_objects(ob_stab_ctx *c)
     double build_ms = (double)(ob_time_ns() - t0) * 1e-6;
     ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 6, 4);
     /* Straight above, +Y of the image toward -Z: every cube in view. */
-    ob_stab_position(w.d.camera, -0.05, 34, -12.45);
+    ob_stab_position(w.s->camera, -0.05, 34, -12.45);
     if (w.err == OB_OK) {
-        ob_result res = ob_node_look_at(w.d.camera, (const double[3]){-0.05, 0, -12.45},
+        ob_result res = ob_node_look_at(w.s->camera, (const double[3]){-0.05, 0, -12.45},
                                         (const double[3]){0, 0, -1});
         if (res != OB_OK) w.err = res;
     }
