@@ -227,7 +227,7 @@ bool ob_param_mapping_reads_world(const ob_param_mapping *map);
 /* True when the block is exactly the standard per-draw block: 128 bytes,
  * WorldMatrix at 0 and NormalMatrix at 64 and nothing else (materials/
  * shaders/common.glsl's PerDraw). The pipeline manager fills such a block
- * from ob_pm_set_world directly. */
+ * from ob_pipeline_manager_set_world directly. */
 bool ob_param_mapping_is_world_normal(const ob_param_mapping *map);
 
 /* True when some mapped parameter's value id in pm's slot differs from the

@@ -97,7 +97,7 @@ struct ob_pipeline_manager {
     VkRect2D scissor;
     bool viewport_set, scissor_set;
 
-    const float *world;         /* ob_pm_set_world's world and normal, for the next draw */
+    const float *world;         /* ob_pipeline_manager_set_world's world and normal, for the next draw */
     bool world_pending;
 
     /* What the last full apply of uniforms and resources was made from: while
@@ -110,7 +110,7 @@ struct ob_pipeline_manager {
     uint32_t state_pipeline_id; /* the pipeline state_hash was made with */
 
     ob_cmd_hash hash;
-    ob_pm_stats stats;
+    ob_pipeline_manager_stats stats;
     bool logged_error;
 };
 
@@ -234,7 +234,7 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
     ob_free(pm);
 }
 
-void ob_pm_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial)
+void ob_pipeline_manager_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial)
 {
     pm->ring = &pm->rings[slot % MAX_FRAME_SLOTS];
     for (uint32_t i = 0; i < pm->ring->chunk_count; i++) pm->ring->chunks[i].used = 0;
@@ -243,7 +243,7 @@ void ob_pm_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_se
     pm->logged_error = false;
 }
 
-void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd)
+void ob_pipeline_manager_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd)
 {
     pm->cmd = cmd;
     memset(&pm->cur, 0, sizeof pm->cur);
@@ -256,7 +256,7 @@ void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd)
     pm->hash = ob_cmd_hash_empty();
 }
 
-ob_cmd_hash ob_pm_end(ob_pipeline_manager *pm)
+ob_cmd_hash ob_pipeline_manager_end(ob_pipeline_manager *pm)
 {
     ob_cmd_hash h = pm->hash;
     pm->cmd = VK_NULL_HANDLE;
@@ -264,12 +264,12 @@ ob_cmd_hash ob_pm_end(ob_pipeline_manager *pm)
     return h;
 }
 
-VkCommandBuffer ob_pm_command_buffer(const ob_pipeline_manager *pm) { return pm->cmd; }
-ob_params *ob_pm_params(ob_pipeline_manager *pm) { return &pm->params; }
+VkCommandBuffer ob_pipeline_manager_command_buffer(const ob_pipeline_manager *pm) { return pm->cmd; }
+ob_params *ob_pipeline_manager_params(ob_pipeline_manager *pm) { return &pm->params; }
 
 /* ------------------------------------------------------------ desired state */
 
-void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
+void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
                         const ob_program *program)
 {
     pm->pipeline = pipeline;
@@ -277,19 +277,19 @@ void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t p
     pm->program = program;
 }
 
-void ob_pm_set_world(ob_pipeline_manager *pm, const float world_normal[32])
+void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
     pm->world = world_normal;
     pm->world_pending = true;
 }
 
-void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
+void ob_pipeline_manager_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
 {
     pm->vb = buf;
     pm->vb_offset = offset;
 }
 
-void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
+void ob_pipeline_manager_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
                             VkIndexType type)
 {
     pm->ib = buf;
@@ -297,13 +297,13 @@ void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t off
     pm->index_type = type;
 }
 
-void ob_pm_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h)
+void ob_pipeline_manager_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h)
 {
     pm->viewport = (VkViewport){x, y, w, h, 0.0f, 1.0f};
     pm->viewport_set = true;
 }
 
-void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h)
+void ob_pipeline_manager_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h)
 {
     pm->scissor = (VkRect2D){{x, y}, {w, h}};
     pm->scissor_set = true;
@@ -632,7 +632,7 @@ static ob_result apply_resources(ob_pipeline_manager *pm, const ob_program *prog
 }
 
 /* The push block from parameters, or for the standard per-draw block
- * straight from ob_pm_set_world (world = true). */
+ * straight from ob_pipeline_manager_set_world (world = true). */
 static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog, bool world,
                                  uint64_t *h)
 {
@@ -797,7 +797,7 @@ static void fold(ob_pipeline_manager *pm, uint64_t h)
     pm->hash = ob_cmd_hash_concat(pm->hash, (ob_cmd_hash){h, OB_CMD_HASH_BASE, 1});
 }
 
-ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
+ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
                      uint32_t first_vertex, uint32_t first_instance)
 {
     uint64_t h;
@@ -810,7 +810,7 @@ ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t in
     return OB_OK;
 }
 
-ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
                              uint32_t instance_count, uint32_t first_index,
                              int32_t vertex_offset, uint32_t first_instance)
 {
@@ -827,7 +827,7 @@ ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
     return OB_OK;
 }
 
-ob_result ob_pm_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
                               uint32_t draw_count)
 {
     VkBuffer vk = ob_buffer_vk(pm->dev, args);
@@ -846,7 +846,7 @@ ob_result ob_pm_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t 
     return OB_OK;
 }
 
-ob_result ob_pm_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z)
+ob_result ob_pipeline_manager_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z)
 {
     uint64_t h;
     ob_result r = apply(pm, false, &h);
@@ -858,19 +858,19 @@ ob_result ob_pm_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32
     return OB_OK;
 }
 
-ob_pm_stats ob_pm_stats_take(ob_pipeline_manager *pm)
+ob_pipeline_manager_stats ob_pipeline_manager_stats_take(ob_pipeline_manager *pm)
 {
-    ob_pm_stats s = pm->stats;
+    ob_pipeline_manager_stats s = pm->stats;
     memset(&pm->stats, 0, sizeof pm->stats);
     return s;
 }
 
-void ob_pm_stats_add(ob_pm_stats *into, const ob_pm_stats *s)
+void ob_pipeline_manager_stats_add(ob_pipeline_manager_stats *into, const ob_pipeline_manager_stats *s)
 {
     /* Every field is a counter: add them as an array of the same layout. */
     uint32_t *a = (uint32_t *)into;
     const uint32_t *b = (const uint32_t *)s;
-    size_t n32 = offsetof(ob_pm_stats, uniform_bytes) / sizeof(uint32_t);
+    size_t n32 = offsetof(ob_pipeline_manager_stats, uniform_bytes) / sizeof(uint32_t);
     for (size_t i = 0; i < n32; i++) a[i] += b[i];
     into->uniform_bytes += s->uniform_bytes;
     into->skipped_draws += s->skipped_draws;

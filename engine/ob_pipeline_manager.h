@@ -56,7 +56,7 @@ static inline ob_cmd_hash ob_cmd_hash_concat(ob_cmd_hash a, ob_cmd_hash b)
     return (ob_cmd_hash){a.hash * b.scale + b.hash, a.scale * b.scale, a.draws + b.draws};
 }
 
-typedef struct ob_pm_stats {
+typedef struct ob_pipeline_manager_stats {
     uint32_t draws, dispatches;
     uint32_t pipeline_binds_requested, pipeline_binds_issued;
     uint32_t descriptor_binds_requested, descriptor_binds_issued;  /* set 0 (dynamic UBOs) */
@@ -67,7 +67,7 @@ typedef struct ob_pm_stats {
     uint32_t blocks_packed, blocks_reused;
     uint64_t uniform_bytes;
     uint32_t skipped_draws;     /* draws refused: invalid handles, no pipeline */
-} ob_pm_stats;
+} ob_pipeline_manager_stats;
 
 ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,
                                                 ob_result *out_result);
@@ -75,17 +75,17 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm);
 
 /* Start of a frame in frame slot `slot` (its previous use has completed):
  * rewinds the slot's uniform ring. frame_serial increases every frame. */
-void ob_pm_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial);
+void ob_pipeline_manager_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial);
 
 /* Wrap cmd (already begun by the caller) and forget all current state. */
-void ob_pm_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd);
+void ob_pipeline_manager_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd);
 /* Stop wrapping; returns the hash of what was drawn since begin. */
-ob_cmd_hash ob_pm_end(ob_pipeline_manager *pm);
-VkCommandBuffer ob_pm_command_buffer(const ob_pipeline_manager *pm);
-ob_params *ob_pm_params(ob_pipeline_manager *pm);
+ob_cmd_hash ob_pipeline_manager_end(ob_pipeline_manager *pm);
+VkCommandBuffer ob_pipeline_manager_command_buffer(const ob_pipeline_manager *pm);
+ob_params *ob_pipeline_manager_params(ob_pipeline_manager *pm);
 
 /* Desired state. The pipeline id is stable (for hashes). */
-void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
+void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t pipeline_id,
                         const ob_program *program);
 /* The per-draw transforms of the next draw only: world_normal[0..15] the
  * world matrix (column-major, camera-relative), [16..31] its normal matrix
@@ -97,32 +97,32 @@ void ob_pm_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeline, uint32_t p
  * stay valid from one draw to the next; any other program gets the world
  * matrix as the WorldMatrix parameter (which derives the rest) before the
  * draw. */
-void ob_pm_set_world(ob_pipeline_manager *pm, const float world_normal[32]);
-void ob_pm_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset);
-void ob_pm_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
+void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32]);
+void ob_pipeline_manager_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset);
+void ob_pipeline_manager_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset,
                             VkIndexType type);
-void ob_pm_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h);
-void ob_pm_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h);
+void ob_pipeline_manager_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h);
+void ob_pipeline_manager_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h);
 
 /* Draws apply the desired state, then record. Uniform blocks and resources
  * are applied again only when the program or some parameter of the slot
  * changed since the last draw. They return OB_ERR_WRONG_STATE (no pipeline),
  * OB_ERR_INVALID_HANDLE (a stale buffer/image parameter),
  * OB_ERR_OUT_OF_DEVICE_MEMORY (ring growth failed) or OB_ERR_NON_FINITE (a
- * matrix derived from the world matrix given with ob_pm_set_world is not
+ * matrix derived from the world matrix given with ob_pipeline_manager_set_world is not
  * finite; logged by the parameters, the caller names the entity) and skip
  * the draw. */
-ob_result ob_pm_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
+ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
                      uint32_t first_vertex, uint32_t first_instance);
-ob_result ob_pm_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
                              uint32_t instance_count, uint32_t first_index,
                              int32_t vertex_offset, uint32_t first_instance);
-ob_result ob_pm_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
                               uint32_t draw_count);
-ob_result ob_pm_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z);
+ob_result ob_pipeline_manager_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z);
 
-/* Stats since the last ob_pm_stats_take (which resets them). */
-ob_pm_stats ob_pm_stats_take(ob_pipeline_manager *pm);
-void ob_pm_stats_add(ob_pm_stats *into, const ob_pm_stats *s);
+/* Stats since the last ob_pipeline_manager_stats_take (which resets them). */
+ob_pipeline_manager_stats ob_pipeline_manager_stats_take(ob_pipeline_manager *pm);
+void ob_pipeline_manager_stats_add(ob_pipeline_manager_stats *into, const ob_pipeline_manager_stats *s);
 
 #endif /* OB_PIPELINE_MANAGER_H */

@@ -331,9 +331,9 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
             if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
             w->pool_recorded[r->slot] = false;
         }
-        ob_pm_begin_frame(w->pm, r->slot, r->serial);
+        ob_pipeline_manager_begin_frame(w->pm, r->slot, r->serial);
     }
-    ob_pm_begin_frame(r->immediate, r->slot, r->serial);
+    ob_pipeline_manager_begin_frame(r->immediate, r->slot, r->serial);
     /* The slot's fence also covers the submission that waited on its
      * acquire semaphore, so the acquire may signal it again. */
     ob_result pres = ob_renderer_present_acquire(r);
@@ -372,7 +372,7 @@ static int32_t queue_index(const ob_renderer *r, const ob_view *v)
 bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
 {
     if (!r->in_frame || !v) return false;
-    /* The stack top is v itself (ob_renderer_pre_draw pushed it); the view
+    /* The stack top is v itself (ob_renderer_pre_render pushed it); the view
      * below it is the consumer that asked for v. */
     ob_view *consumer = NULL;
     uint32_t depth = 0;
@@ -410,16 +410,16 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     return true;
 }
 
-void ob_renderer_pre_draw(ob_renderer *r, ob_view *v)
+void ob_renderer_pre_render(ob_renderer *r, ob_view *v)
 {
-    if (!r->in_frame || !v || !v->vtbl || !v->vtbl->pre_draw) return;
+    if (!r->in_frame || !v || !v->vtbl || !v->vtbl->pre_render) return;
     if (r->stack_depth >= OB_MAX_VIEW_STACK) {
         ob_renderer_note_skipped(r, v->name, OB_SKIP_RECURSION);
         return;
     }
     uint64_t t0 = r->stack_depth == 0 ? ob_time_ns() : 0;
     r->stack[r->stack_depth++] = v;
-    v->vtbl->pre_draw(v, r);
+    v->vtbl->pre_render(v, r);
     r->stack_depth--;
     if (t0) r->cur.pre_render_ns += ob_time_ns() - t0;
 }

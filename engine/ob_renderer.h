@@ -10,7 +10,7 @@
  * view in order, with the barriers each needs, in one submission.
  *
  * Lifecycle: create → [attach_surface] → { begin_frame → (camera views'
- * pre_draw) → process_views → end_frame } * → [detach_surface] → destroy.
+ * pre_render) → process_views → end_frame } * → [detach_surface] → destroy.
  * Thread rule: every function is [render thread]; workers are internal.
  * The threading mode and the active worker count change only at begin_frame.
  *
@@ -145,7 +145,7 @@ typedef struct ob_frame_stats {
     uint32_t skipped_count;
     struct { char name[48]; ob_skip_reason reason; } skipped[OB_MAX_FRAME_VIEWS];
     uint32_t draws, culled;
-    ob_pm_stats pm;              /* summed over every manager */
+    ob_pipeline_manager_stats pm;              /* summed over every manager */
     /* CPU time (CLOCK_THREAD_CPUTIME_ID) each thread spent recording this
      * frame: [0] the render thread (inline recording or its share of the
      * jobs, plus assembling the primary), [i] pool worker i. Shows the work
@@ -189,16 +189,16 @@ uint64_t ob_renderer_frame_serial(const ob_renderer *r);
 
 /* Queue v for this frame. Returns false (and records why in the stats) when v
  * is already queued or the PreRender chain is deeper than max_recursion. The
- * current recursion depth rises while a queued view runs its pre_draw. */
+ * current recursion depth rises while a queued view runs its pre_render. */
 bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
-/* Run v's pre_draw with v as the current view (so views it queues become
+/* Run v's pre_render with v as the current view (so views it queues become
  * its dependencies and the recursion depth is known). Everyone starts a
- * view's PreRender through this, never by calling pre_draw directly. */
-void ob_renderer_pre_draw(ob_renderer *r, ob_view *v);
+ * view's PreRender through this, never by calling pre_render directly. */
+void ob_renderer_pre_render(ob_renderer *r, ob_view *v);
 void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
 void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
 uint32_t ob_renderer_recursion_depth(const ob_renderer *r);
-/* The view whose pre_draw is running (NULL outside PreRender). */
+/* The view whose pre_render is running (NULL outside PreRender). */
 ob_view *ob_renderer_current_view(const ob_renderer *r);
 
 /* Views attached to an entity for this frame (its environment map): set by
@@ -266,7 +266,7 @@ void ob_renderer_surface_resized(ob_renderer *r, uint32_t width, uint32_t height
 /* This frame presents `image` (a colour image with OB_IMAGE_TRANSFER_SRC
  * usage): at the end of the primary it is blitted, scaled to the window if
  * sizes differ, into the acquired swapchain image. A presenting composite
- * view calls it from its pre_draw. No-op when headless or outside a frame;
+ * view calls it from its pre_render. No-op when headless or outside a frame;
  * a frame with a swapchain image and nothing to present shows black (and
  * logs a warning once). [render thread, during PreRender] */
 void ob_renderer_present_image(ob_renderer *r, ob_image image);

@@ -21,7 +21,7 @@ typedef struct ob_job {
     uint64_t predicted_ns;
     VkCommandBuffer cmd;        /* secondary, filled by the worker */
     ob_cmd_hash hash;
-    ob_pm_stats stats;
+    ob_pipeline_manager_stats stats;
     uint64_t record_ns;
     int32_t worker;
 } ob_job;

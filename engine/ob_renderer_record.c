@@ -99,15 +99,15 @@ static VkFormat image_format(ob_device *dev, ob_image img)
 /* The per-view parameters a recording of v needs in a manager's slot. */
 static void set_view_params(ob_renderer *r, ob_view *v, ob_pipeline_manager *pm)
 {
-    ob_params *params = ob_pm_params(pm);
+    ob_params *params = ob_pipeline_manager_params(pm);
     if (v->vtbl->set_render_params) v->vtbl->set_render_params(v, r, params);
     for (uint32_t i = 0; i < v->dep_count; i++) {
         ob_view *d = v->deps[i];
         if (d->vtbl->set_usage_params) d->vtbl->set_usage_params(d, r, params, v);
     }
     if (v->layer_count > 0) {
-        ob_pm_set_viewport(pm, 0.0f, 0.0f, (float)v->width, (float)v->height);
-        ob_pm_set_scissor(pm, 0, 0, v->width, v->height);
+        ob_pipeline_manager_set_viewport(pm, 0.0f, 0.0f, (float)v->width, (float)v->height);
+        ob_pipeline_manager_set_scissor(pm, 0, 0, v->width, v->height);
     }
 }
 
@@ -149,11 +149,11 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
         job->cmd = VK_NULL_HANDLE;
         return;
     }
-    ob_pm_begin(w->pm, job->cmd);
+    ob_pipeline_manager_begin(w->pm, job->cmd);
     set_view_params(r, v, w->pm);
     v->vtbl->record(v, r, w->pm, job->layer, job->first, job->count);
-    job->hash = ob_pm_end(w->pm);
-    job->stats = ob_pm_stats_take(w->pm);
+    job->hash = ob_pipeline_manager_end(w->pm);
+    job->stats = ob_pipeline_manager_stats_take(w->pm);
     if (OB_VK_CHECK(vkEndCommandBuffer(job->cmd)) != VK_SUCCESS) {
         w->error = OB_ERR_VULKAN;
         job->cmd = VK_NULL_HANDLE;
@@ -655,7 +655,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         vkCmdResetQueryPool(cmd, fs->queries, 0, view_stamps ? 2 * count + 2 : 2);
         vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 0);
     }
-    if (!multi) ob_pm_begin(r->immediate, cmd);
+    if (!multi) ob_pipeline_manager_begin(r->immediate, cmd);
 
     /* Jobs are sorted by cost; walk them per view in (layer, first) order. */
     ob_job **by_view = NULL;
@@ -694,26 +694,26 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
                         ns = 0;
                     }
                     vs->hash = ob_cmd_hash_concat(vs->hash, job->hash);
-                    ob_pm_stats_add(&st->pm, &job->stats);
+                    ob_pipeline_manager_stats_add(&st->pm, &job->stats);
                     vs->draws += job->stats.draws;
                     vs->record_ns += job->record_ns;
                     if (vs->chunks++ == 0) vs->worker = job->worker;
                 }
                 if (ns) vkCmdExecuteCommands(cmd, ns, secs);
             } else if (v->layer_count == 0 || v->custom_record || v->item_count > 0) {
-                ob_pm_begin(r->immediate, cmd);
+                ob_pipeline_manager_begin(r->immediate, cmd);
                 set_view_params(r, v, r->immediate);
                 v->vtbl->record(v, r, r->immediate, l, 0, v->item_count);
-                ob_cmd_hash h = ob_pm_end(r->immediate);
+                ob_cmd_hash h = ob_pipeline_manager_end(r->immediate);
                 vs->hash = ob_cmd_hash_concat(vs->hash, h);
                 vs->chunks++;
             }
             if (v->layer_count > 0) vkCmdEndRendering(cmd);
         }
         if (!multi) {
-            ob_pm_stats s = ob_pm_stats_take(r->immediate);
+            ob_pipeline_manager_stats s = ob_pipeline_manager_stats_take(r->immediate);
             vs->draws = s.draws;
-            ob_pm_stats_add(&st->pm, &s);
+            ob_pipeline_manager_stats_add(&st->pm, &s);
             vs->record_ns = ob_time_ns() - tv;
         }
         v->cost_ns = vs->record_ns;

@@ -219,7 +219,7 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
         /* A refused matrix is not drawn (a stale one would put this entity
          * where the previous one was). */
         bool finite = ob_render_proxy_per_draw(p, v->origin, m);
-        if (finite) ob_pm_set_world(pm, m);
+        if (finite) ob_pipeline_manager_set_world(pm, m);
         if (!finite || gi->draw(p->geometry, pm) == OB_ERR_NON_FINITE)
             OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
                      "(or its derived matrices); not drawn", v->name, ob_node_name(p->node),

@@ -5,7 +5,7 @@
  * views/ and embed ob_view as their first member.
  *
  * Frame life of a view:
- *   pre_draw   [render thread]  queue itself (ob_renderer_queue_view), cull the
+ *   pre_render   [render thread]  queue itself (ob_renderer_queue_view), cull the
  *                               scene into its draw list (ob_view_cull), and let
  *                               visible entities' materials queue the views they
  *                               need (ob_renderer_pre_render_entities)
@@ -63,7 +63,7 @@ typedef struct ob_draw_item {
 
 typedef struct ob_view_vtbl {
     const char *type_name;
-    void (*pre_draw)(ob_view *v, ob_renderer *r);
+    void (*pre_render)(ob_view *v, ob_renderer *r);
     /* Per-view parameters (matrices, lights) into a manager's slot. */
     void (*set_render_params)(ob_view *v, ob_renderer *r, ob_params *params);
     /* What a consumer samples (e.g. the env map texture, the shadow map and
@@ -103,7 +103,7 @@ struct ob_view {
     ob_buffer storage_written;        /* compute views: buffer written (consumers
                                          read it in their vertex stage) */
 
-    /* Per frame, filled during pre_draw; owned by the view. */
+    /* Per frame, filled during pre_render; owned by the view. */
     ob_draw_item *items;
     uint32_t item_count, item_cap;
     const ob_render_proxy *proxies; /* the snapshot culled from (items index it) */

@@ -684,9 +684,9 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
     uint32_t pipeline_id;
     VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
     if (!pipeline) return OB_APPLY_SKIP;
-    ob_pm_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
+    ob_pipeline_manager_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
 
-    ob_params *params = ob_pm_params(pm);
+    ob_params *params = ob_pipeline_manager_params(pm);
     const ob_material_library *lib = m->lib;
     ob_params_set_vec4(params, lib->diffuse, m->diffuse);
     ob_params_set_vec4(params, lib->specular, m->specular);

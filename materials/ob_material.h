@@ -156,7 +156,7 @@ ob_effect *ob_material_library_find_effect(const ob_material_library *lib, ob_st
 
 /* Make sure every effect variant and pipeline the materials of v's draw list
  * need exists (for entities whose PreRender ran before v's shadow views were
- * queued, say). The views layer calls it at the end of a view's pre_draw.
+ * queued, say). The views layer calls it at the end of a view's pre_render.
  * [render thread, not while recording] */
 void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v);
 

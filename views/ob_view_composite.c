@@ -67,7 +67,7 @@ static ob_effect *composite_effect(ob_views *ctx)
     return ctx->composite_effect;
 }
 
-static void composite_pre_draw(ob_view *v, ob_renderer *r)
+static void composite_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_composite_view *cv = (ob_composite_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
@@ -75,7 +75,7 @@ static void composite_pre_draw(ob_view *v, ob_renderer *r)
         follow_window(cv, r);
         ob_renderer_present_image(r, v->color);
     }
-    ob_renderer_pre_draw(r, cv->source);
+    ob_renderer_pre_render(r, cv->source);
     composite_effect(cv->ctx);
 }
 
@@ -88,14 +88,14 @@ static void composite_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm
     (void)first;
     (void)count;
     if (!ob_views_bind_effect(cv->ctx, cv->ctx->composite_effect, v, pm)) return;
-    ob_params_set_texture(ob_pm_params(pm), cv->source_image, cv->source->color);
-    ob_pm_set_vertex_buffer(pm, (ob_buffer){0}, 0);
-    ob_pm_draw(pm, 3, 1, 0, 0);
+    ob_params_set_texture(ob_pipeline_manager_params(pm), cv->source_image, cv->source->color);
+    ob_pipeline_manager_set_vertex_buffer(pm, (ob_buffer){0}, 0);
+    ob_pipeline_manager_draw(pm, 3, 1, 0, 0);
 }
 
 static const ob_view_vtbl composite_vtbl = {
     .type_name = "composite",
-    .pre_draw = composite_pre_draw,
+    .pre_render = composite_pre_render,
     .record = composite_record,
 };
 

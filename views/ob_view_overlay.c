@@ -16,7 +16,7 @@
 
 /* Text drawn last over the final target. Glyph quads come from stb_easy_font
  * (16-byte vertices: position + RGBA8) into a host-visible buffer per frame
- * slot, built on the render thread in pre_draw and drawn by one indexed draw. */
+ * slot, built on the render thread in pre_render and drawn by one indexed draw. */
 
 #define OVERLAY_TEXT_MAX 4096
 #define OVERLAY_MAX_QUADS 8192
@@ -62,11 +62,11 @@ static ob_effect *text_effect(ob_views *ctx)
     return ctx->text_effect;
 }
 
-static void overlay_pre_draw(ob_view *v, ob_renderer *r)
+static void overlay_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_overlay_view *ov = (ob_overlay_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
-    ob_renderer_pre_draw(r, ov->source);
+    ob_renderer_pre_render(r, ov->source);
     v->color = ov->source->color;
     v->width = ov->source->width;
     v->height = ov->source->height;
@@ -107,16 +107,16 @@ static void overlay_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, 
     (void)first;
     (void)count;
     if (ov->quad_count == 0 || !ob_views_bind_effect(ov->ctx, ov->ctx->text_effect, v, pm)) return;
-    ob_params *params = ob_pm_params(pm);
+    ob_params *params = ob_pipeline_manager_params(pm);
     float scale[16];
     ob_mat4_identity(scale);
     scale[0] = scale[5] = OVERLAY_SCALE;
     ob_params_set_mat4(params, ob_param_registry_builtins(params->reg)->world, scale);
     static const float white[4] = {1, 1, 1, 1};
     ob_params_set_vec4(params, ov->diffuse, white);
-    ob_pm_set_vertex_buffer(pm, ov->vertices[ov->slot], 0);
-    ob_pm_set_index_buffer(pm, ov->indices, 0, VK_INDEX_TYPE_UINT32);
-    ob_pm_draw_indexed(pm, ov->quad_count * 6, 1, 0, 0, 0);
+    ob_pipeline_manager_set_vertex_buffer(pm, ov->vertices[ov->slot], 0);
+    ob_pipeline_manager_set_index_buffer(pm, ov->indices, 0, VK_INDEX_TYPE_UINT32);
+    ob_pipeline_manager_draw_indexed(pm, ov->quad_count * 6, 1, 0, 0, 0);
 }
 
 static void overlay_render_params(ob_view *v, ob_renderer *r, ob_params *params)
@@ -130,7 +130,7 @@ static void overlay_render_params(ob_view *v, ob_renderer *r, ob_params *params)
 
 static const ob_view_vtbl overlay_vtbl = {
     .type_name = "overlay",
-    .pre_draw = overlay_pre_draw,
+    .pre_render = overlay_pre_render,
     .set_render_params = overlay_render_params,
     .record = overlay_record,
 };

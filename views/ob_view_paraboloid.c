@@ -14,7 +14,7 @@ struct ob_paraboloid_view {
     ob_node *owner;
     ob_param direction, env_map, env_matrix;
     /* Per item of this frame's draw list: bit L set when its bound reaches
-     * layer L's hemisphere (filled in pre_draw, read by the recording). */
+     * layer L's hemisphere (filled in pre_render, read by the recording). */
     uint8_t *reach;
     uint32_t reach_cap;
     bool reach_valid;      /* false: no memory for it this frame, draw all */
@@ -50,7 +50,7 @@ static void paraboloid_reach(ob_paraboloid_view *pv)
     }
 }
 
-static void paraboloid_pre_draw(ob_view *v, ob_renderer *r)
+static void paraboloid_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
@@ -93,7 +93,7 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
     ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
     float side = layer == 0 ? 1.0f : -1.0f;
     float dir[4] = {side, PARABOLOID_NEAR, 0.0f, 0.0f};
-    ob_params_set_vec4(ob_pm_params(pm), pv->direction, dir);
+    ob_params_set_vec4(ob_pipeline_manager_params(pm), pv->direction, dir);
     /* Runs of items this layer draws are recorded together. */
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     uint32_t run = first;
@@ -108,7 +108,7 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
 
 static const ob_view_vtbl paraboloid_vtbl = {
     .type_name = "paraboloid",
-    .pre_draw = paraboloid_pre_draw,
+    .pre_render = paraboloid_pre_render,
     .set_render_params = paraboloid_render_params,
     .set_usage_params = paraboloid_usage_params,
     .record = paraboloid_record,

@@ -11,7 +11,7 @@ struct ob_perspective_view {
     bool warned_degenerate;
 };
 
-static void perspective_pre_draw(ob_view *v, ob_renderer *r)
+static void perspective_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_perspective_view *pv = (ob_perspective_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
@@ -54,7 +54,7 @@ static void perspective_render_params(ob_view *v, ob_renderer *r, ob_params *par
 
 static const ob_view_vtbl perspective_vtbl = {
     .type_name = "perspective",
-    .pre_draw = perspective_pre_draw,
+    .pre_render = perspective_pre_render,
     .set_render_params = perspective_render_params,
     .record = ob_view_record_draw_list,
 };

@@ -64,7 +64,7 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
     return true;
 }
 
-static void shadow_pre_draw(ob_view *v, ob_renderer *r)
+static void shadow_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_shadow_view *sv = (ob_shadow_view *)v;
     if (!sv->consumer || !fit_to_casters(sv, r)) {
@@ -105,7 +105,7 @@ static void shadow_usage_params(ob_view *v, ob_renderer *r, ob_params *params,
 
 static const ob_view_vtbl shadow_vtbl = {
     .type_name = "shadow",
-    .pre_draw = shadow_pre_draw,
+    .pre_render = shadow_pre_render,
     .set_render_params = shadow_render_params,
     .set_usage_params = shadow_usage_params,
     .record = ob_view_record_draw_list,

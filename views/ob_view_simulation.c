@@ -29,7 +29,7 @@ struct ob_particle_system {
     ob_param particles, step, emitter, force;
 };
 
-static void sim_pre_draw(ob_view *v, ob_renderer *r)
+static void sim_pre_render(ob_view *v, ob_renderer *r)
 {
     if (!ob_renderer_queue_view(r, v)) return;
     sim_view *sv = (sim_view *)v;
@@ -63,11 +63,11 @@ static void sim_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint
     uint32_t id = 0;
     VkPipeline p = ob_effect_pipeline(e, VK_FORMAT_UNDEFINED, VK_FORMAT_UNDEFINED, &id);
     if (!p) return;
-    ob_pm_set_pipeline(pm, p, id, ob_effect_program(e));
-    sim_params(ps, ob_pm_params(pm));
+    ob_pipeline_manager_set_pipeline(pm, p, id, ob_effect_program(e));
+    sim_params(ps, ob_pipeline_manager_params(pm));
     uint32_t local[3];
     ob_effect_local_size(e, local);
-    ob_pm_dispatch(pm, (ps->desc.count + local[0] - 1) / local[0], 1, 1);
+    ob_pipeline_manager_dispatch(pm, (ps->desc.count + local[0] - 1) / local[0], 1, 1);
 }
 
 /* The drawing side reads the same parameters (size, lifetime, buffer). */
@@ -80,7 +80,7 @@ static void sim_usage_params(ob_view *v, ob_renderer *r, ob_params *params, cons
 
 static const ob_view_vtbl sim_vtbl = {
     .type_name = "simulation",
-    .pre_draw = sim_pre_draw,
+    .pre_render = sim_pre_render,
     .set_usage_params = sim_usage_params,
     .record = sim_record,
 };

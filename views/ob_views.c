@@ -179,7 +179,7 @@ bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipe
     uint32_t id = 0;
     VkPipeline p = ob_effect_pipeline(e, color, depth, &id);
     if (!p) return false;
-    ob_pm_set_pipeline(pm, p, id, ob_effect_program(e));
+    ob_pipeline_manager_set_pipeline(pm, p, id, ob_effect_program(e));
     return true;
 }
 
@@ -230,7 +230,7 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             }
             e = &ctx->envs[ctx->env_count - 1];
         }
-        ob_renderer_pre_draw(r, e->view);
+        ob_renderer_pre_render(r, e->view);
         /* Only a map that renders this frame is sampled: one left out (past
          * the recursion bound, say) was never written, so the entity is
          * drawn without its reflection instead. */
@@ -283,7 +283,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             e = &ctx->shadows[ctx->shadow_count - 1];
         }
         ob_shadow_view_set_consumer(e->owner_object, consumer);
-        ob_renderer_pre_draw(r, e->view);
+        ob_renderer_pre_render(r, e->view);
     }
 }
 
@@ -308,7 +308,7 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
     for (uint32_t i = 0; i < consumer->item_count; i++) {
         ob_views_entry *e = find_entry(ctx->systems, ctx->system_count,
                                        ob_node_id(consumer->items[i].node));
-        if (e) ob_renderer_pre_draw(r, e->view);
+        if (e) ob_renderer_pre_render(r, e->view);
     }
 }
 
@@ -317,13 +317,13 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
 static ob_result geometry_draw(const struct ob_geometry *g, ob_pipeline_manager *pm)
 {
     if (ob_geometry_index_count(g) > 0) {
-        ob_pm_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
-        ob_pm_set_index_buffer(pm, ob_geometry_index_buffer(g), 0, VK_INDEX_TYPE_UINT32);
-        return ob_pm_draw_indexed(pm, ob_geometry_index_count(g), 1, 0, 0, 0);
+        ob_pipeline_manager_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
+        ob_pipeline_manager_set_index_buffer(pm, ob_geometry_index_buffer(g), 0, VK_INDEX_TYPE_UINT32);
+        return ob_pipeline_manager_draw_indexed(pm, ob_geometry_index_count(g), 1, 0, 0, 0);
     }
     /* Procedural geometry (no index buffer): vertex pulling, instanced. */
-    ob_pm_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
-    return ob_pm_draw(pm, ob_geometry_vertex_count(g), ob_geometry_instance_count(g), 0, 0);
+    ob_pipeline_manager_set_vertex_buffer(pm, ob_geometry_vertex_buffer(g), 0);
+    return ob_pipeline_manager_draw(pm, ob_geometry_vertex_count(g), ob_geometry_instance_count(g), 0, 0);
 }
 
 static uint32_t geometry_id(const struct ob_geometry *g) { return ob_geometry_id(g); }
@@ -427,7 +427,7 @@ void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
 
 void ob_views_render(ob_views *ctx, ob_view *final_view)
 {
-    ob_renderer_pre_draw(ctx->r, final_view);
+    ob_renderer_pre_render(ctx->r, final_view);
     /* Variants and pipelines are created on first need during PreRender
      * (and rarely while recording): report what this frame added. */
     ob_effect_counters now = ob_effect_context_counters(ctx->effects);

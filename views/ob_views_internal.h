@@ -45,7 +45,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer);
 ob_shadow_view *ob_shadow_view_create(ob_views *ctx, ob_node *light, ob_result *out_result);
 void ob_shadow_view_destroy(ob_views *ctx, ob_shadow_view *v);
 ob_view *ob_shadow_view_base(ob_shadow_view *v);
-/* Set the consumer whose visible casters the next pre_draw fits. */
+/* Set the consumer whose visible casters the next pre_render fits. */
 void ob_shadow_view_set_consumer(ob_shadow_view *v, ob_view *consumer);
 
 ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);

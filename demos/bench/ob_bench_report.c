@@ -266,7 +266,7 @@ static void json_result(FILE *f, const ob_bench_result *r)
         fprintf(f, ",\"%s\":", names[i]);
         json_num(f, values[i]);
     }
-    const ob_pm_stats *p = &r->pm;
+    const ob_pipeline_manager_stats *p = &r->pm;
     fputs(",\"binds\":{", f);
     json_pair(f, "pipeline", p->pipeline_binds_requested, p->pipeline_binds_issued, false);
     json_pair(f, "descriptor", p->descriptor_binds_requested, p->descriptor_binds_issued, false);
@@ -478,7 +478,7 @@ static void json_perf(FILE *f, const ob_bench_report *rep)
 static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t objects,
                        const ob_bench_result *r)
 {
-    const ob_pm_stats *p = &r->pm;
+    const ob_pipeline_manager_stats *p = &r->pm;
     fprintf(f, "%s,%u,%u,,,%s,%u", section, views, objects, r->mode.name, r->mode.workers);
     const double v[] = {r->workers_used, r->draws, r->update_ms, r->pre_render_ms, r->record_ms,
                         r->assemble_ms, r->submit_ms, r->record_total_ms, r->cpu_frame_ms,

@@ -16,7 +16,7 @@ typedef struct sample {
     double draws, views;
     double cpu_render_ms, cpu_workers_ms, cpu_max_worker_ms, host_allocs_per_object;
     uint32_t workers;
-    ob_pm_stats pm;
+    ob_pipeline_manager_stats pm;
     uint64_t hash;
 } sample;
 
@@ -296,7 +296,7 @@ static void summarize(const ob_bench_run_desc *desc, const collector *c, double 
         o->record_cpu_workers_ms = MEDIAN(m, SAMPLE_IDLE, cpu_workers_ms);
         o->record_cpu_max_worker_ms = MEDIAN(m, SAMPLE_IDLE, cpu_max_worker_ms);
         o->cmd_host_allocs_per_object = MEDIAN(m, SAMPLE_IDLE, host_allocs_per_object);
-        const ob_pm_stats *p = &o->pm;
+        const ob_pipeline_manager_stats *p = &o->pm;
         uint64_t commands = (uint64_t)p->draws + p->dispatches + p->pipeline_binds_issued +
                             p->descriptor_binds_issued + p->push_descriptor_issued +
                             p->push_constant_issued + p->vertex_binds_issued + p->index_binds_issued;

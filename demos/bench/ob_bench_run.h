@@ -117,7 +117,7 @@ typedef struct ob_bench_result {
     /* Estimate of vkCmd calls the pipeline manager made per draw: (every
      * *_issued counter + draws + dispatches) / draws, last measured frame. */
     double commands_per_object;
-    ob_pm_stats pm;            /* bind counters of the last measured frame */
+    ob_pipeline_manager_stats pm;            /* bind counters of the last measured frame */
     uint64_t frame_hash;       /* of the last measured frame */
     uint32_t hash_mismatches;  /* measured frames whose hash differed from the reference mode's */
 } ob_bench_result;

@@ -354,7 +354,7 @@ static void test_apply_and_prepare_view(void **state)
 
     mi->pre_render(red, NULL, NULL, &persp);
     assert_true(mi->apply(red, NULL, NULL, pm, &persp));
-    ob_params *params = ob_pm_params(pm);
+    ob_params *params = ob_pipeline_manager_params(pm);
     float got[4];
     assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "DiffuseColor"), got), OB_OK);
     assert_true(got[0] == 1 && got[1] == 0 && got[2] == 0 && got[3] == 1);
@@ -471,11 +471,11 @@ static void test_hundred_entities_one_pipeline(void **state)
         .pDepthAttachment = &depth_att,
     };
     vkCmdBeginRendering(cmd, &ri);
-    ob_pm_begin_frame(pm, 0, 1);
-    ob_pm_begin(pm, cmd);
-    ob_pm_set_viewport(pm, 0, 0, SIZE, SIZE);
-    ob_pm_set_scissor(pm, 0, 0, SIZE, SIZE);
-    ob_params *params = ob_pm_params(pm);
+    ob_pipeline_manager_begin_frame(pm, 0, 1);
+    ob_pipeline_manager_begin(pm, cmd);
+    ob_pipeline_manager_set_viewport(pm, 0, 0, SIZE, SIZE);
+    ob_pipeline_manager_set_scissor(pm, 0, 0, SIZE, SIZE);
+    ob_params *params = ob_pipeline_manager_params(pm);
     ob_param world = ob_param_registry_builtins(f->reg)->world;
     for (int i = 0; i < 100; i++) {
         /* A 10 x 10 grid of triangles across the target. */
@@ -483,14 +483,14 @@ static void test_hundred_entities_one_pipeline(void **state)
                        -0.9f + 0.2f * (float)(i % 10), -0.9f + 0.2f * (float)(i / 10), 0, 1};
         assert_int_equal(ob_params_set_mat4(params, world, m), OB_OK);
         assert_true(mi->apply(green, NULL, NULL, pm, &persp));
-        ob_pm_set_vertex_buffer(pm, vb, 0);
-        assert_int_equal(ob_pm_draw(pm, 3, 1, 0, 0), OB_OK);
+        ob_pipeline_manager_set_vertex_buffer(pm, vb, 0);
+        assert_int_equal(ob_pipeline_manager_draw(pm, 3, 1, 0, 0), OB_OK);
     }
-    ob_cmd_hash h = ob_pm_end(pm);
+    ob_cmd_hash h = ob_pipeline_manager_end(pm);
     vkCmdEndRendering(cmd);
     assert_int_equal(ob_device_oneshot_submit(f->dev, cmd), OB_OK);
 
-    ob_pm_stats s = ob_pm_stats_take(pm);
+    ob_pipeline_manager_stats s = ob_pipeline_manager_stats_take(pm);
     assert_int_equal(h.draws, 100);
     assert_int_equal(s.draws, 100);
     assert_int_equal(s.pipeline_binds_requested, 100);
@@ -577,7 +577,7 @@ static void test_reflective_uses_attached_env_map(void **state)
     assert_int_equal(env.calls, 1);
     assert_ptr_equal(env.consumer, &persp);
     float got[4];
-    ob_params_get_vec4(ob_pm_params(pm), ob_param_find(ob_renderer_registry(rd), "Reflectivity"), got);
+    ob_params_get_vec4(ob_pipeline_manager_params(pm), ob_param_find(ob_renderer_registry(rd), "Reflectivity"), got);
     assert_true(got[0] == 0.6f);   /* the REFLECTIVE default */
 
     /* Another entity with the same reflective material has no map: plain lit. */

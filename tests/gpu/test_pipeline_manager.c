@@ -31,8 +31,8 @@ static void add_grid(ob_test_world *w, uint32_t count, ob_material **materials,
 
 static void frame_camera(ob_test_world *w) { ob_test_world_look(w, 0, 12, 8, 0, 0, -5); }
 
-/* a - b, field by field (every field of ob_pm_stats is a counter). */
-static ob_pm_stats pm_minus(ob_pm_stats a, const ob_pm_stats *b)
+/* a - b, field by field (every field of ob_pipeline_manager_stats is a counter). */
+static ob_pipeline_manager_stats pm_minus(ob_pipeline_manager_stats a, const ob_pipeline_manager_stats *b)
 {
     a.draws -= b->draws;
     a.dispatches -= b->dispatches;
@@ -56,7 +56,7 @@ static ob_pm_stats pm_minus(ob_pm_stats a, const ob_pm_stats *b)
 }
 
 /* The manager stats of the composite alone (main view empty). */
-static ob_pm_stats composite_only(ob_test_world *w, ob_threading mode, uint32_t workers)
+static ob_pipeline_manager_stats composite_only(ob_test_world *w, ob_threading mode, uint32_t workers)
 {
     const ob_frame_stats *st = ob_test_world_frame(w, mode, workers);
     const ob_view_stats *main = ob_test_view_stats(st, "main");
@@ -90,14 +90,14 @@ static void shared_state_bound_once_single_threaded(void **state)
     ob_test_world_create(&w, NULL);
     frame_camera(&w);
     ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
-    ob_pm_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
+    ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
 
     ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint32_t per_view, per_material;
     lit_block_sizes(&w, &per_view, &per_material);
-    ob_pm_stats s = pm_minus(st->pm, &base);
+    ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
     const ob_view_stats *main = ob_test_view_stats(st, "main");
     assert_int_equal(main->draws, 100);
     assert_int_equal(main->chunks, 1);
@@ -131,14 +131,14 @@ static void shared_state_bound_once_per_secondary(void **state)
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 25});
     frame_camera(&w);
     ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
-    ob_pm_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
+    ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
     ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
     uint32_t per_view, per_material;
     for (int frame = 0; frame < 3; frame++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 4);
         if (frame == 0) lit_block_sizes(&w, &per_view, &per_material);
-        ob_pm_stats s = pm_minus(st->pm, &base);
+        ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
         const ob_view_stats *main = ob_test_view_stats(st, "main");
         assert_int_equal(st->workers, 4);
         assert_int_equal(main->draws, 100);
@@ -170,14 +170,14 @@ static void uniforms_packed_only_after_a_change(void **state)
 {
     (void)state;
     enum { SHARED_50, SHARED_100, SAME_VALUES, DISTINCT, CASES };
-    ob_pm_stats got[CASES];
+    ob_pipeline_manager_stats got[CASES];
     uint32_t per_view = 0, per_material = 0;
     for (int c = 0; c < CASES; c++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
         frame_camera(&w);
         ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
-        ob_pm_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
+        ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
         ob_material *mats[100];
         uint32_t nm = c == SHARED_50 || c == SHARED_100 ? 1 : 100;
         for (uint32_t i = 0; i < nm; i++) {

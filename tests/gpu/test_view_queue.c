@@ -72,15 +72,15 @@ typedef struct graph_view {
     ob_view base;
     struct graph_view *needs[4];
     uint32_t need_count;
-    uint32_t pre_draws;
+    uint32_t pre_renders;
 } graph_view;
 
-static void graph_pre_draw(ob_view *v, ob_renderer *r)
+static void graph_pre_render(ob_view *v, ob_renderer *r)
 {
     graph_view *g = (graph_view *)v;
-    g->pre_draws++;
+    g->pre_renders++;
     if (!ob_renderer_queue_view(r, v)) return;
-    for (uint32_t i = 0; i < g->need_count; i++) ob_renderer_pre_draw(r, &g->needs[i]->base);
+    for (uint32_t i = 0; i < g->need_count; i++) ob_renderer_pre_render(r, &g->needs[i]->base);
 }
 
 static void graph_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t layer,
@@ -89,7 +89,7 @@ static void graph_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, ui
     (void)v, (void)r, (void)pm, (void)layer, (void)first, (void)count;
 }
 
-static const ob_view_vtbl graph_vtbl = {.type_name = "graph", .pre_draw = graph_pre_draw,
+static const ob_view_vtbl graph_vtbl = {.type_name = "graph", .pre_render = graph_pre_render,
                                         .record = graph_record};
 
 static void graph_init(graph_view *g, const char *name)
@@ -293,14 +293,14 @@ static void view_cycle_is_queued_once(void **state)
     ob_test_world_create(&w, NULL);
     ob_view *root = &g[0].base;
     for (int f = 0; f < 2; f++) {
-        for (int i = 0; i < 3; i++) g[i].pre_draws = 0;
+        for (int i = 0; i < 3; i++) g[i].pre_renders = 0;
         const ob_frame_stats *st = frame_from_roots(&w, &root, 1, f ? OB_THREADING_MULTI
                                                                     : OB_THREADING_SINGLE);
         assert_int_equal(st->view_count, 3);
         assert_each_view_once(st);
-        assert_int_equal(g[0].pre_draws, 2);
-        assert_int_equal(g[1].pre_draws, 2);
-        assert_int_equal(g[2].pre_draws, 1);
+        assert_int_equal(g[0].pre_renders, 2);
+        assert_int_equal(g[1].pre_renders, 2);
+        assert_int_equal(g[2].pre_renders, 1);
         /* Deepest first; a, the cycle's start, last. */
         assert_string_equal(st->views[0].name, "c");
         assert_string_equal(st->views[1].name, "b");
