@@ -2,6 +2,7 @@
 #include "ob_core.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -381,6 +382,22 @@ uint64_t ob_hash_block(uint64_t h, const void *data, size_t size)
         h = ob_hash_u64(h, w);
     }
     return size < 32 ? ob_hash_u64(h, size) : h;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double ob_median(double *v, uint32_t n)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (!isnan(v[i])) v[k++] = v[i];
+    if (!k) return NAN;
+    qsort(v, k, sizeof *v, compare_double);
+    return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
 uint64_t ob_time_ns(void)

@@ -200,6 +200,9 @@ static inline uint64_t ob_hash_str(uint64_t h, const char *s);
 
 /* Monotonic time in nanoseconds. */
 uint64_t ob_time_ns(void);
+/* Median of v[0..n), NaNs left out (v is reordered); NAN if none is left.
+ * [any thread] */
+double ob_median(double *v, uint32_t n);
 /* CPU time the calling thread has used, in nanoseconds. */
 uint64_t ob_thread_cpu_ns(void);
 

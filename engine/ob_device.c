@@ -384,6 +384,18 @@ static ob_result logical_create(ob_device *dev)
     return OB_OK;
 }
 
+/* The chosen physical device, its queue family and properties, into dev. */
+static void take_physical(ob_device *dev, const ob_physical_choice *choice)
+{
+    dev->physical = choice->physical;
+    dev->props = choice->props;
+    dev->caps = choice->caps;
+    dev->queue_family = choice->queue_family;
+    memcpy(dev->driver_info, choice->driver_info, sizeof dev->driver_info);
+    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+}
+
+
 /* The application's instance, physical device, device and queue, checked;
  * the engine adds only its messenger. On failure the messenger is gone and
  * the handles are untouched. */
@@ -395,12 +407,7 @@ static ob_result adopt_create(ob_device *dev, const ob_vulkan_handles *a)
     if (r != OB_OK) return r;
     dev->adopted = true;
     dev->instance = a->instance;
-    dev->physical = choice.physical;
-    dev->props = choice.props;
-    dev->caps = choice.caps;
-    dev->queue_family = choice.queue_family;
-    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
-    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+    take_physical(dev, &choice);
     dev->device = a->device;
     dev->queue = a->queue;
     dev->swapchain = info.swapchain;
@@ -629,12 +636,7 @@ static ob_result own_create(ob_device *dev, const ob_device_desc *desc, const ch
     *stage = "device selection";
     r = ob_device_select_physical(dev->instance, selector, &choice);
     if (r != OB_OK) goto fail_destroy_instance;
-    dev->physical = choice.physical;
-    dev->props = choice.props;
-    dev->caps = choice.caps;
-    dev->queue_family = choice.queue_family;
-    memcpy(dev->driver_info, choice.driver_info, sizeof dev->driver_info);
-    vkGetPhysicalDeviceMemoryProperties(dev->physical, &dev->mem_props);
+    take_physical(dev, &choice);
 
     *stage = "logical device";
     r = logical_create(dev);

@@ -161,7 +161,7 @@ static double field_median(const collector *c, uint32_t mode, sample_kind kind, 
         const sample *p = &c->samples[i];
         if (p->mode == mode && p->kind == kind) memcpy(&buf[n++], (const char *)p + offset, sizeof *buf);
     }
-    return ob_demo_median(buf, n);
+    return ob_median(buf, n);
 }
 
 void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out)
@@ -173,8 +173,8 @@ void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out)
         *out = (ob_bench_spread){NAN, NAN, NAN};
         return;
     }
-    /* ob_demo_median sorts; its median is the 0.5 quantile below. */
-    out->median = ob_demo_median(values, k);
+    /* ob_median sorts; its median is the 0.5 quantile below. */
+    out->median = ob_median(values, k);
     double at[2] = {0.25 * (k - 1), 0.75 * (k - 1)};
     double q[2];
     for (int i = 0; i < 2; i++) {
@@ -210,7 +210,7 @@ static void round_ratios(const ob_bench_run_desc *desc, const collector *c, doub
             const sample *p = idle_sample(c, m, desc->warmup + k);
             buf[k] = p ? p->record_total_ms : NAN;
         }
-        double med = ob_demo_median(buf, desc->rounds);
+        double med = ob_median(buf, desc->rounds);
         if (med < best_median) best_median = med, best_mode = m;
     }
     double *round_min = buf + desc->rounds;

@@ -324,12 +324,6 @@ ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_part
 
 /* ------------------------------------------------------------ stats */
 
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* mode: 0 = single-threaded frames, 1 = multi-threaded frames, -1 = all. */
 double ob_demo_median_ms(const ob_demo *d, int mode, size_t phase_offset)
 {
@@ -348,19 +342,9 @@ double ob_demo_median_ms(const ob_demo *d, int mode, size_t phase_offset)
             v[n++] = (double)ns * 1e-6;
         }
     }
-    double m = ob_demo_median(v, n);
+    double m = ob_median(v, n);
     ob_free(v);
     return m;
-}
-
-double ob_demo_median(double *v, uint32_t n)
-{
-    uint32_t k = 0;
-    for (uint32_t i = 0; i < n; i++)
-        if (!isnan(v[i])) v[k++] = v[i];
-    if (!k) return NAN;
-    qsort(v, k, sizeof *v, compare_double);
-    return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
 void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_memory *mem)

@@ -112,8 +112,6 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user);
  * phase_offset is offsetof(ob_demo_frame_times, <phase>). */
 double ob_demo_median_ms(const ob_demo *d, int mode_workers_filter, size_t phase_offset);
 
-/* Median of v[0..n), NaNs left out (v is reordered); NAN if nothing is left. */
-double ob_demo_median(double *v, uint32_t n);
 
 /* The process's memory: resident set and its peak (/proc/self/status, 0
  * where there is none), what the C heap holds live (glibc's mallinfo2, 0

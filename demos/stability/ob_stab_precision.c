@@ -402,7 +402,7 @@ ob_result ob_stab_scene_matrices(ob_stab_ctx *c)
                        "max relative element difference of the camera-relative view and world "
                        "matrices at 1e7 vs the origin",
                        worst, "relative", 1e-6, naive_worst > 0.01 && culled == 0,
-                       ob_stab_median(ms, 3),
+                       ob_median(ms, 3),
                        "3 offsets; hierarchy with scale, controllers, camera; float world "
                        "matrices would be off by %.3g units (must be > 0.01); items culled %u "
                        "(must be 0); ms = build + 31 updates", naive_worst, culled);
@@ -574,7 +574,7 @@ ob_result ob_stab_deep_hierarchy(ob_stab_ctx *c, uint32_t levels)
     ob_dquat_from_axis_angle(u, levels * th, q);
     ob_dquat_to_mat3(q, rot);
     for (int i = 0; i < 9; i++) rot_err = fmax(rot_err, fabs(wa.m[i] - rot[i]));
-    double update_ms = ob_stab_median(ms, 3);
+    double update_ms = ob_median(ms, 3);
     /* Edits on the deep chain stay iterative too: the cycle check walks every
      * ancestor, destroy frees the whole chain. */
     static const char *const expect[] = {"would make a cycle", NULL};

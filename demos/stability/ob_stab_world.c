@@ -40,26 +40,10 @@ ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, dou
     return OB_OK;
 }
 
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-double ob_stab_median(double *v, uint32_t n)
-{
-    uint32_t k = 0;
-    for (uint32_t i = 0; i < n; i++)
-        if (!isnan(v[i])) v[k++] = v[i];
-    if (!k) return NAN;
-    qsort(v, k, sizeof *v, compare_double);
-    return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
-}
-
 double ob_stab_take_ms(ob_stab_ctx *c)
 {
-    double ms = c->steady_count ? ob_stab_median(c->steady_ms, c->steady_count)
-                                : ob_stab_median(c->first_ms, c->first_count);
+    double ms = c->steady_count ? ob_median(c->steady_ms, c->steady_count)
+                                : ob_median(c->first_ms, c->first_count);
     c->steady_count = c->first_count = 0;
     return ms;
 }

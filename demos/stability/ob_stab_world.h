@@ -53,8 +53,6 @@ typedef struct ob_stab_ctx {
 ob_result ob_stab_add(ob_stab_ctx *c, const char *name, const char *measure, double error,
                       const char *unit, double bound, bool ok, double ms, const char *detail_fmt,
                       ...) __attribute__((format(printf, 9, 10)));
-/* Median of v[0..n), NaNs left out (v is reordered); NAN if none is left. */
-double ob_stab_median(double *v, uint32_t n);
 /* Median wall time of the frames rendered since the last call (those after
  * each world's first frame when there are any, else all); NAN if none. */
 double ob_stab_take_ms(ob_stab_ctx *c);
