@@ -58,7 +58,7 @@ typedef struct bound_state {
     uint32_t offsets[OB_PROGRAM_MAX_UBOS];
     uint32_t resource_ids[OB_PROGRAM_MAX_RESOURCES * 2];
     bool resources_valid;
-    uint8_t push[128];
+    uint8_t push[OB_PUSH_CONSTANT_MAX];
     bool push_valid;
     VkBuffer vb, ib;
     uint32_t vb_id, ib_id;      /* handles of vb and ib: an equal id needs no lookup */
@@ -648,7 +648,7 @@ static void apply_push_constants(ob_pipeline_manager *pm, const ob_program *prog
         pm->stats.push_constant_issued++;
         return;
     }
-    _Alignas(16) uint8_t bytes[128];
+    _Alignas(16) uint8_t bytes[OB_PUSH_CONSTANT_MAX];
     ob_params_pack(&pm->params, prog->push_mapping, bytes, true);
     *h = ob_hash_block(*h, bytes, prog->push_size);
     if (!pm->cur.push_valid || memcmp(pm->cur.push, bytes, prog->push_size) != 0) {

@@ -171,10 +171,12 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         if (!prog->push_mapping) goto fail_free;
         prog->push_size = (pb->size + 3u) & ~3u;
         prog->push_stages = stages;
-        if (prog->push_size > ob_device_properties(dev)->limits.maxPushConstantsSize) {
-            OB_LOG_E("program", "program '%s': push constants of %u bytes exceed the device limit %u",
-                     prog->name, prog->push_size,
-                     ob_device_properties(dev)->limits.maxPushConstantsSize);
+        uint32_t limit = OB_MIN(ob_device_properties(dev)->limits.maxPushConstantsSize,
+                                OB_PUSH_CONSTANT_MAX);
+        if (prog->push_size > limit) {
+            OB_LOG_E("program", "program '%s': push constants of %u bytes exceed the limit %u "
+                     "(the device's %u, the engine's %u)", prog->name, prog->push_size, limit,
+                     ob_device_properties(dev)->limits.maxPushConstantsSize, OB_PUSH_CONSTANT_MAX);
             r = OB_ERR_UNSUPPORTED;
             goto fail_free;
         }

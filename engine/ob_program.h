@@ -28,6 +28,11 @@
 
 #define OB_PROGRAM_MAX_UBOS 8
 #define OB_PROGRAM_MAX_RESOURCES 8
+/* The largest push-constant block a program may declare: the pipeline
+ * manager packs and compares push data in buffers of this size (lavapipe's
+ * limit; Vulkan guarantees 128). A bigger block fails ob_program_create even
+ * where the device allows more. */
+#define OB_PUSH_CONSTANT_MAX 128u
 
 typedef enum ob_program_set {
     OB_PROGRAM_SET_UNIFORMS = 0,

@@ -393,6 +393,12 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
         ob_renderer_note_skipped(r, v->name, OB_SKIP_RECURSION);
         return false;
     }
+    if (v->input_count > OB_VIEW_MAX_INPUTS) {
+        OB_LOG_E("renderer", "view '%s' not queued: %u inputs, at most %u", v->name, v->input_count,
+                 OB_VIEW_MAX_INPUTS);
+        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        return false;
+    }
     if (r->queue_count >= OB_MAX_FRAME_VIEWS) {
         OB_LOG_E("renderer", "view '%s' not queued: more than %u views this frame", v->name,
                  OB_MAX_FRAME_VIEWS);

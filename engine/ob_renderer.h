@@ -18,8 +18,8 @@
  * with desc.device.adopt it runs on the application's (ob_vulkan_handles in
  * ob_device.h) and destroys none of them.
  *
- * Presenting: without a surface the renderer is headless (the final image is
- * read back). With one (ob_renderer_attach_surface) it owns a swapchain on
+ * Presenting: without a surface the renderer is headless (a program reads
+ * the final image back itself, e.g. ob_image_write_png). With one (ob_renderer_attach_surface) it owns a swapchain on
  * it: begin_frame acquires an image, the frame's primary ends by copying the
  * present image (a presenting composite view's target) into it, the frame's
  * one submission waits for the acquire and signals the present, and
@@ -117,7 +117,8 @@ typedef enum ob_skip_reason {
     OB_SKIP_RECURSION,           /* queued deeper than the recursion bound */
     OB_SKIP_NO_CASTERS,          /* shadow view with no caster in range */
     OB_SKIP_NOT_NEEDED,          /* nobody visible asked for it */
-    OB_SKIP_DUPLICATE,           /* already queued this frame */
+    OB_SKIP_DUPLICATE,           /* already queued this frame (not reported by the renderer
+                                    today: a second queueing only adds a dependency) */
     OB_SKIP_ERROR,               /* failed (see log) */
 } ob_skip_reason;
 const char *ob_skip_reason_name(ob_skip_reason r);
@@ -187,8 +188,12 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene);
 ob_scene *ob_renderer_scene(ob_renderer *r);
 uint64_t ob_renderer_frame_serial(const ob_renderer *r);
 
-/* Queue v for this frame. Returns false (and records why in the stats) when v
- * is already queued or the PreRender chain is deeper than max_recursion. The
+/* Queue v for this frame. Returns false when v is already queued (the
+ * consumer then depends on the earlier queueing; nothing is recorded in the
+ * stats), when the PreRender chain is deeper than max_recursion
+ * (OB_SKIP_RECURSION in the stats), or when v has more inputs than
+ * OB_VIEW_MAX_INPUTS or the frame more views than OB_MAX_FRAME_VIEWS
+ * (OB_SKIP_ERROR, logged). The
  * current recursion depth rises while a queued view runs its pre_render. */
 bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
 /* Run v's pre_render with v as the current view (so views it queues become

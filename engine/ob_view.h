@@ -8,9 +8,10 @@
  *   pre_render   [render thread]  queue itself (ob_renderer_queue_view), cull the
  *                               scene into its draw list (ob_view_cull), and let
  *                               visible entities' materials queue the views they
- *                               need (ob_renderer_pre_render_entities)
- *   begin      [render thread]  before recording: fill per-view parameters
- *                               (set_render_params into the recording slots)
+ *                               need (ob_view_pre_render_items)
+ *   set_render_params [the recording thread] at the start of each job (chunk)
+ *                               of the view: fill the per-view parameters of
+ *                               the slot that records it
  *   record     [any one thread] record draw-list items [first, first+count) through
  *                               a pipeline manager; may run as several chunks on
  *                               several workers, each into its own secondary
