@@ -19,15 +19,19 @@
 # test compiles every installed header alone against the install tree.
 # views/ob_json_read.h (the scene-file parser's cJSON reader) is internal
 # too: cJSON stays a private dependency.
+# The extension headers ob_renderer_layer.h and ob_views_layer.h are
+# installed (custom views and materials need them, docs/extending.md) but
+# obelisk.h includes neither: a program that only renders never sees the hooks.
 # ob_reflect.h is public because ob_params.h, ob_program.h and ob_shader.h
 # take and return its plain structs (custom effects use the reflection).
 set(OB_PUBLIC_HEADERS
     engine/ob_core.h engine/ob_device.h engine/ob_math.h engine/ob_params.h
     engine/ob_pipeline_manager.h engine/ob_program.h engine/ob_reflect.h
-    engine/ob_renderer.h engine/ob_resources.h engine/ob_scene.h engine/ob_view.h
+    engine/ob_renderer.h engine/ob_renderer_layer.h engine/ob_resources.h engine/ob_scene.h
+    engine/ob_view.h
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h
-    views/ob_views.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h
+    views/ob_views.h views/ob_views_layer.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h
     views/obelisk.h)
 
 # ------------------------------------------------------------------ shaders

@@ -1,16 +1,17 @@
 /* ob_renderer.h — the frame: view queue, worker pool, submission, stats.
  *
  * Hieroglyph 3's RendererDX11 with its multithreaded task processing, on
- * Vulkan. During PreRender views queue themselves (ob_renderer_queue_view);
- * ob_renderer_process_views records them — dependencies first — either
+ * Vulkan. During PreRender views queue themselves (ob_renderer_queue_view,
+ * in the extension header ob_renderer_layer.h); ob_renderer_process_views records them — dependencies first — either
  * inline into the primary command buffer through the immediate pipeline
  * manager (single-threaded), or as jobs handed all at once to a pool of
  * workers, worker i recording with pipeline manager i into secondaries from
  * its own command pool (multi-threaded). The primary then executes every
  * view in order, with the barriers each needs, in one submission.
  *
- * Lifecycle: create → [attach_surface] → { begin_frame → (camera views'
- * pre_render) → process_views → end_frame } * → [detach_surface] → destroy.
+ * Lifecycle: create → [attach_surface] → { begin_frame → PreRender (the
+ * views layer's ob_views_render per root view) → [process_views] →
+ * end_frame } * → [detach_surface] → destroy.
  * Thread rule: every function is [render thread]; workers are internal.
  * The threading mode and the active worker count change only at begin_frame.
  *
@@ -41,41 +42,12 @@
 #define OB_MAX_WORKERS 16
 #define OB_MAX_FRAME_VIEWS 128
 
-/* The engine calls up into materials and geometry through these (filled by
- * the higher layers: see ob_views_install in views/ob_views.h). */
-/* What a material's apply did. */
-typedef enum ob_apply_result {
-    OB_APPLY_SKIP = 0,      /* not drawn in this view */
-    OB_APPLY_ENTITY = 1,    /* applied, for this entity only: apply again for the next */
-    OB_APPLY_MATERIAL = 2,  /* applied, and the same for every entity with this
-                             * material in this view: the next one of those may
-                             * be drawn without applying again */
-} ob_apply_result;
-
-typedef struct ob_material_iface {
-    /* Render flag for the view type (Hieroglyph's Params[type].bRender). */
-    bool (*renders)(const struct ob_material *m, ob_view_type type);
-    /* Sort class: 0 opaque, 1 blended; priority orders within a class;
-     * state groups draws that bind the same pipeline and parameters (a
-     * dense id: its low 16 bits go into the sort key). */
-    void (*sort_info)(const struct ob_material *m, ob_view_type type,
-                      uint32_t *out_class, uint32_t *out_priority, uint32_t *out_state);
-    /* An entity with this material is visible to view v: queue what it needs
-     * (env maps, ...), and make the pipeline for v's targets exist (render thread). */
-    void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
-    /* Set the pipeline and the material's parameters for v. Views draw the
-     * entities of a state group one after another and apply once per run of
-     * the same material when it answers OB_APPLY_MATERIAL. */
-    ob_apply_result (*apply)(struct ob_material *m, ob_node *entity, ob_renderer *r,
-                             ob_pipeline_manager *pm, const ob_view *v);
-} ob_material_iface;
-
-typedef struct ob_geometry_iface {
-    /* Bind buffers and draw. */
-    ob_result (*draw)(const struct ob_geometry *g, ob_pipeline_manager *pm);
-    /* Stable id for sorting and hashing. */
-    uint32_t (*id)(const struct ob_geometry *g);
-} ob_geometry_iface;
+/* The interfaces through which the engine calls up into materials and
+ * geometry, and the hooks views and materials call during a frame, are the
+ * extension API: engine/ob_renderer_layer.h (<obelisk/ob_renderer_layer.h>),
+ * which this header does not include. Here they are opaque. */
+typedef struct ob_material_iface ob_material_iface;
+typedef struct ob_geometry_iface ob_geometry_iface;
 
 typedef enum ob_threading {
     OB_THREADING_SINGLE = 0,   /* immediate: record everything into the primary */
@@ -173,11 +145,6 @@ ob_param_registry *ob_renderer_registry(ob_renderer *r);
 ob_params *ob_renderer_params(ob_renderer *r);
 uint32_t ob_renderer_worker_count(const ob_renderer *r);
 
-void ob_renderer_set_material_iface(ob_renderer *r, const ob_material_iface *iface);
-void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *iface);
-const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r);
-const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r);
-
 /* Takes effect at the next begin_frame. active_workers 0 → all. */
 void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
 ob_threading ob_renderer_threading(const ob_renderer *r);
@@ -188,37 +155,17 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene);
 ob_scene *ob_renderer_scene(ob_renderer *r);
 uint64_t ob_renderer_frame_serial(const ob_renderer *r);
 
-/* Queue v for this frame. Returns false when v is already queued (the
- * consumer then depends on the earlier queueing; nothing is recorded in the
- * stats), when the PreRender chain is deeper than max_recursion
- * (OB_SKIP_RECURSION in the stats), or when v has more inputs than
- * OB_VIEW_MAX_INPUTS or the frame more views than OB_MAX_FRAME_VIEWS
- * (OB_SKIP_ERROR, logged). The
- * current recursion depth rises while a queued view runs its pre_render. */
-bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
-/* Run v's pre_render with v as the current view (so views it queues become
- * its dependencies and the recursion depth is known). Everyone starts a
- * view's PreRender through this, never by calling pre_render directly. */
-void ob_renderer_pre_render(ob_renderer *r, ob_view *v);
-void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
-void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
-uint32_t ob_renderer_recursion_depth(const ob_renderer *r);
-/* The view whose pre_render is running (NULL outside PreRender). */
-ob_view *ob_renderer_current_view(const ob_renderer *r);
-
-/* Views attached to an entity for this frame (its environment map): set by
- * the views layer during PreRender [render thread], read by materials while
- * recording [any thread]. Attachments are cleared at begin_frame. */
-ob_result ob_renderer_attach_view(ob_renderer *r, const ob_node *entity, ob_view *v);
-ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, ob_view_type type);
-
 /* Record every queued view (dependencies first) and submit. */
 ob_result ob_renderer_process_views(ob_renderer *r);
 
+/* Deepest PreRender nesting queued (a view pre-rendered by a view ...
+ * `depth` levels down); deeper views are left out with OB_SKIP_RECURSION in
+ * the stats. Default 4; at most OB_MAX_VIEW_STACK - 2 (30, engine/
+ * ob_renderer_internal.h), larger values are clamped. [render thread] */
+void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
+
 /* Time the application spent updating the scene, for the stats. */
 void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns);
-/* Pipelines and shader variants the higher layers created this frame. */
-void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants);
 
 /* Called with each frame's final stats (GPU times included) once the frame
  * is known complete, in frame order. [render thread] */
@@ -268,18 +215,6 @@ void ob_renderer_detach_surface(ob_renderer *r);
  * the swapchain is rebuilt at the next begin_frame. Optional where the
  * surface reports its size (it is queried every frame). [render thread] */
 void ob_renderer_surface_resized(ob_renderer *r, uint32_t width, uint32_t height);
-/* This frame presents `image` (a colour image with OB_IMAGE_TRANSFER_SRC
- * usage): at the end of the primary it is blitted, scaled to the window if
- * sizes differ, into the acquired swapchain image. A presenting composite
- * view calls it from its pre_render. No-op when headless or outside a frame;
- * a frame with a swapchain image and nothing to present shows black (and
- * logs a warning once). [render thread, during PreRender] */
-void ob_renderer_present_image(ob_renderer *r, ob_image image);
-/* The size of this frame's swapchain image; false (and 0x0) when headless,
- * outside a frame, or when this frame is not presented (minimised). Views
- * that follow the window size read it during PreRender. [render thread] */
-bool ob_renderer_present_extent(const ob_renderer *r, uint32_t *out_width, uint32_t *out_height);
-
 typedef struct ob_present_stats {
     uint32_t presented;          /* frames shown */
     uint32_t skipped;            /* frames not shown: minimised, out of date, not submitted */

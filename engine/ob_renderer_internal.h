@@ -8,7 +8,7 @@
 #include <semaphore.h>
 #include <stdatomic.h>
 
-#include "ob_renderer.h"
+#include "ob_renderer_layer.h"
 
 #define OB_MAX_FRAMES_IN_FLIGHT 4
 #define OB_MAX_VIEW_STACK 32

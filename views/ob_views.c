@@ -163,12 +163,12 @@ void ob_views_free_view(ob_views *ctx, ob_view *base)
     ob_free(base);
 }
 
-void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, VkFormat *depth)
+void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_color, VkFormat *out_depth)
 {
     ob_image_info info;
-    *color = *depth = VK_FORMAT_UNDEFINED;
-    if (v->color.id && ob_image_get_info(ctx->dev, v->color, &info) == OB_OK) *color = info.format;
-    if (v->depth.id && ob_image_get_info(ctx->dev, v->depth, &info) == OB_OK) *depth = info.format;
+    *out_color = *out_depth = VK_FORMAT_UNDEFINED;
+    if (v->color.id && ob_image_get_info(ctx->dev, v->color, &info) == OB_OK) *out_color = info.format;
+    if (v->depth.id && ob_image_get_info(ctx->dev, v->depth, &info) == OB_OK) *out_depth = info.format;
 }
 
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)

@@ -21,6 +21,10 @@
  * views → ob_views_destroy (after ob_renderer_wait_idle).
  * Thread rule: [render thread] for everything here; the views' record and
  * set_*_params callbacks run on workers and only read view state.
+ *
+ * Writing a view of one's own: ob_views_layer.h (not included here) has what
+ * the standard views use — queueing shadows and simulations, targets, the
+ * PerView parameters — and docs/extending.md §5 says how.
  */
 #ifndef OB_VIEWS_H
 #define OB_VIEWS_H
@@ -116,8 +120,11 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
 void ob_particle_system_destroy(ob_views *ctx, ob_particle_system *ps);
 ob_node *ob_particle_system_node(ob_particle_system *ps);
 
-/* Start a frame's PreRender: the final view first (queued first, executed
- * last), which pre-draws what it needs. */
+/* Start a frame's PreRender of a root view (the final view, or another
+ * camera view the program renders: each root view queued first is executed
+ * last), which pre-renders what it needs, and report the pipelines and
+ * shader variants this created to the frame's stats. [render thread, between
+ * begin_frame and end_frame] */
 void ob_views_render(ob_views *ctx, ob_view *final_view);
 
 /* Standard vertex layout of geometry, as an effect's vertex input: a

@@ -1,9 +1,10 @@
-/* ob_views_internal.h — shared between the files of the views layer. */
+/* ob_views_internal.h — shared between the files of the views layer; not
+ * installed. What custom views may use is in ob_views_layer.h. */
 #ifndef OB_VIEWS_INTERNAL_H
 #define OB_VIEWS_INTERNAL_H
 
 #include "ob_math.h"
-#include "ob_views.h"
+#include "ob_views_layer.h"
 
 typedef struct ob_shadow_view ob_shadow_view;
 typedef struct ob_paraboloid_view ob_paraboloid_view;
@@ -34,14 +35,6 @@ struct ob_views {
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };
 
-/* Parameters every camera-like view sets: projection, lights relative to the
- * view's origin, ambient, screen size. */
-void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *params,
-                                const float view[16], const float proj[16]);
-
-/* Shadow views of the lights that cast shadows on what `consumer` sees. */
-void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer);
-
 ob_shadow_view *ob_shadow_view_create(ob_views *ctx, ob_node *light, ob_result *out_result);
 void ob_shadow_view_destroy(ob_views *ctx, ob_shadow_view *v);
 ob_view *ob_shadow_view_base(ob_shadow_view *v);
@@ -53,29 +46,15 @@ void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v);
 ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v);
 
 /* Particle systems by emitter node: the perspective view queues the
- * simulation of every emitter it sees. */
+ * simulation of every emitter it sees (ob_views_queue_simulations). */
 ob_result ob_views_add_system(ob_views *ctx, ob_node *emitter, ob_view *sim, ob_particle_system *ps);
 void ob_views_remove_system(ob_views *ctx, ob_particle_system *ps);
-void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer);
 
 /* Simulation view of a particle system (ob_view_simulation.c). */
 ob_view *ob_particle_system_sim_view(ob_particle_system *ps);
 
-/* Image + view for a view's target. */
-ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height,
-                               uint32_t layers, VkFormat color, VkFormat depth);
-void ob_views_release_target(ob_views *ctx, ob_view *v);
-
 /* Frees a view made by this layer: its targets, its draw list and the
  * object itself (whose first member is the base). NULL ok. */
 void ob_views_free_view(ob_views *ctx, ob_view *base);
-
-/* Formats of a view's targets (VK_FORMAT_UNDEFINED when absent). */
-void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, VkFormat *depth);
-/* Bind an effect's pipeline for v's targets on pm; false if unavailable. */
-bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm);
-
-#define OB_VIEWS_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
-#define OB_VIEWS_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 
 #endif /* OB_VIEWS_INTERNAL_H */

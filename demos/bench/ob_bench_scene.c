@@ -131,7 +131,7 @@ ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt)
     ob_result r = ob_renderer_begin_frame(d->r, d->scene);
     if (r != OB_OK) return r;
     ob_renderer_note_update_ns(d->r, update_ns);
-    for (uint32_t k = 1; k < s->view_count; k++) ob_renderer_pre_render(d->r, s->views[k]);
+    for (uint32_t k = 1; k < s->view_count; k++) ob_views_render(d->views, s->views[k]);
     ob_views_render(d->views, ob_composite_view_base(d->composite));
     return ob_renderer_end_frame(d->r);
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "ob_stab_world.h"
+#include "ob_renderer_layer.h"
 
 static int view_index(const ob_frame_stats *st, const char *name)
 {

@@ -10,7 +10,7 @@
 #include "ob_material.h"
 #include "ob_params.h"
 #include "ob_pipeline_manager.h"
-#include "ob_renderer.h"
+#include "ob_renderer_layer.h"
 #include "ob_resources.h"
 #include "ob_scene.h"
 #include "ob_view.h"

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "ob_test_world.h"
+#include "ob_renderer_layer.h"
 
 /* ------------------------------------------------------------ helpers */
 

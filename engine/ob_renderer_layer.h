@@ -1,0 +1,134 @@
+/* ob_renderer_layer.h — the renderer's extension API: what the layers above
+ * the engine (views, materials, geometry) and people writing a custom view or
+ * material call. A program that only uses the standard views, materials and
+ * ob_stack never needs it, and neither ob_renderer.h nor obelisk/obelisk.h
+ * includes it: #include <obelisk/ob_renderer_layer.h> explicitly
+ * (docs/extending.md says when).
+ *
+ * Contents:
+ *   - the interfaces the engine calls up through (ob_material_iface,
+ *     ob_geometry_iface), installed by ob_views_create;
+ *   - PreRender: queueing a view, starting another view's PreRender, the
+ *     current view and nesting depth, views attached to an entity;
+ *   - what a view or the views layer reports into the frame's stats;
+ *   - the present image of a frame (a presenting composite view).
+ *
+ * Thread rule: [render thread] unless a function says otherwise; the PreRender
+ * functions only between ob_renderer_begin_frame and the frame's
+ * process_views/end_frame (outside a frame they do nothing or return
+ * false/NULL, as each says).
+ */
+#ifndef OB_RENDERER_LAYER_H
+#define OB_RENDERER_LAYER_H
+
+#include "ob_renderer.h"
+
+/* ---- interfaces into materials and geometry ----------------------------- */
+
+/* What a material's apply did. */
+typedef enum ob_apply_result {
+    OB_APPLY_SKIP = 0,      /* not drawn in this view */
+    OB_APPLY_ENTITY = 1,    /* applied, for this entity only: apply again for the next */
+    OB_APPLY_MATERIAL = 2,  /* applied, and the same for every entity with this
+                             * material in this view: the next one of those may
+                             * be drawn without applying again */
+} ob_apply_result;
+
+struct ob_material_iface {
+    /* Render flag for the view type (Hieroglyph's Params[type].bRender). [any thread] */
+    bool (*renders)(const struct ob_material *m, ob_view_type type);
+    /* Sort class: 0 opaque, 1 blended; priority orders within a class;
+     * state groups draws that bind the same pipeline and parameters (a
+     * dense id: its low 16 bits go into the sort key). [any thread] */
+    void (*sort_info)(const struct ob_material *m, ob_view_type type,
+                      uint32_t *out_class, uint32_t *out_priority, uint32_t *out_state);
+    /* An entity with this material is visible to view v: queue what it needs
+     * (env maps, ...), and make the pipeline for v's targets exist.
+     * [render thread, PreRender] */
+    void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
+    /* Set the pipeline and the material's parameters for v. Views draw the
+     * entities of a state group one after another and apply once per run of
+     * the same material when it answers OB_APPLY_MATERIAL. [recording thread:
+     * writes only pm's slot] */
+    ob_apply_result (*apply)(struct ob_material *m, ob_node *entity, ob_renderer *r,
+                             ob_pipeline_manager *pm, const ob_view *v);
+};
+
+struct ob_geometry_iface {
+    /* Bind buffers and draw. [recording thread] */
+    ob_result (*draw)(const struct ob_geometry *g, ob_pipeline_manager *pm);
+    /* Stable id for sorting and hashing. [any thread] */
+    uint32_t (*id)(const struct ob_geometry *g);
+};
+
+/* Install the interface the renderer calls for every renderable's material
+ * (geometry). The renderer keeps a copy; NULL uninstalls (nothing is drawn
+ * then: ob_view_cull fails with OB_ERR_WRONG_STATE). ob_views_create installs
+ * the library's; a program that wraps it (docs/extending.md §4.2) installs
+ * its copy afterwards. Cannot fail.
+ * [render thread, between frames] */
+void ob_renderer_set_material_iface(ob_renderer *r, const ob_material_iface *iface);
+void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *iface);
+/* The installed copy, NULL when none. Valid until the next set_*_iface.
+ * [any thread, while no set_*_iface runs] */
+const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r);
+const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r);
+
+/* ---- PreRender ----------------------------------------------------------- */
+
+/* Queue v for this frame. Returns false when v is already queued (the
+ * consumer then depends on the earlier queueing; nothing is recorded in the
+ * stats), when the PreRender chain is deeper than max_recursion
+ * (OB_SKIP_RECURSION in the stats), or when v has more inputs than
+ * OB_VIEW_MAX_INPUTS or the frame more views than OB_MAX_FRAME_VIEWS
+ * (OB_SKIP_ERROR, logged). A view's pre_render calls it first and returns
+ * when it is false. The view running its pre_render (if any) becomes a
+ * consumer of v: v is recorded before it. [render thread, PreRender] */
+bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
+/* Run v's pre_render with v as the current view (so views it queues become
+ * its dependencies and the recursion depth is known). Everyone starts a
+ * view's PreRender through this, never by calling pre_render directly; a
+ * program's root views start through ob_views_render. No-op outside a frame
+ * or for NULL; nested deeper than OB_MAX_VIEW_STACK it records
+ * OB_SKIP_RECURSION and does not run v. [render thread, PreRender] */
+void ob_renderer_pre_render(ob_renderer *r, ob_view *v);
+/* Nesting of the running pre_render: 0 for a root view, 1 for a view it
+ * started, ... (0 outside PreRender). [render thread] */
+uint32_t ob_renderer_recursion_depth(const ob_renderer *r);
+/* The view whose pre_render is running (NULL outside PreRender). [render thread] */
+ob_view *ob_renderer_current_view(const ob_renderer *r);
+
+/* Views attached to an entity for this frame (its environment map): set by
+ * the views layer during PreRender, read by materials while recording.
+ * Attachments are cleared at begin_frame. attach replaces an attachment of
+ * the same view type; it fails only with OB_ERR_OUT_OF_MEMORY (nothing
+ * attached). [attach: render thread, PreRender; get: any thread, while no
+ * attach runs] */
+ob_result ob_renderer_attach_view(ob_renderer *r, const ob_node *entity, ob_view *v);
+/* NULL when none of that type is attached. */
+ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, ob_view_type type);
+
+/* ---- reporting into the frame's stats ------------------------------------ */
+
+/* A view left out this frame, and why (once per name and reason; beyond
+ * OB_MAX_FRAME_VIEWS entries the rest are dropped). [render thread] */
+void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
+/* Pipelines and shader variants the higher layers created this frame
+ * (added to the frame's stats). [render thread] */
+void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants);
+
+/* ---- the present image --------------------------------------------------- */
+
+/* This frame presents `image` (a colour image with OB_IMAGE_TRANSFER_SRC
+ * usage): at the end of the primary it is blitted, scaled to the window if
+ * sizes differ, into the acquired swapchain image. A presenting composite
+ * view calls it from its pre_render. No-op when headless or outside a frame;
+ * a frame with a swapchain image and nothing to present shows black (and
+ * logs a warning once). [render thread, PreRender] */
+void ob_renderer_present_image(ob_renderer *r, ob_image image);
+/* The size of this frame's swapchain image; false (and 0x0) when headless,
+ * outside a frame, or when this frame is not presented (minimised). Views
+ * that follow the window size read it during PreRender. [render thread] */
+bool ob_renderer_present_extent(const ob_renderer *r, uint32_t *out_width, uint32_t *out_height);
+
+#endif /* OB_RENDERER_LAYER_H */

@@ -1,0 +1,72 @@
+/* ob_views_layer.h — the views layer's extension API: what a custom view
+ * (docs/extending.md §5) uses to behave like the standard ones. Not included
+ * by ob_views.h nor by obelisk/obelisk.h: #include <obelisk/ob_views_layer.h>
+ * explicitly. It brings the renderer's extension API (ob_renderer_layer.h).
+ *
+ * Thread rule: [render thread] unless a function says otherwise. The
+ * PreRender functions run inside a view's pre_render (started through
+ * ob_renderer_pre_render); set_common_params runs on a recording thread from
+ * a view's set_render_params.
+ */
+#ifndef OB_VIEWS_LAYER_H
+#define OB_VIEWS_LAYER_H
+
+#include "ob_renderer_layer.h"
+#include "ob_views.h"
+
+/* The standard views' target formats. */
+#define OB_VIEWS_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define OB_VIEWS_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
+
+/* ---- PreRender ----------------------------------------------------------- */
+
+/* Pre-render the shadow view of every directional light that casts shadows
+ * (made on first need, one per light, owned by ctx), fitted to the casters
+ * `consumer` sees: call it after ob_view_cull of the consumer. The consumer
+ * then depends on them and samples the map through their set_usage_params
+ * (ShadowMap, ShadowMatrix). A light of zero intensity is left out
+ * (OB_SKIP_NOT_NEEDED); a shadow view that cannot be made is logged and left
+ * out (OB_SKIP_ERROR) and the rest goes on. [render thread, PreRender] */
+void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer);
+/* Pre-render the simulation of every particle system whose emitter is among
+ * `consumer`'s culled items (after ob_view_cull), so it runs before the
+ * consumer draws the particles. [render thread, PreRender] */
+void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer);
+
+/* ---- targets ------------------------------------------------------------- */
+
+/* Make v's targets: a colour image of format `color` (colour target, sampled,
+ * transfer source and destination) and a depth image of format `depth`
+ * (depth target, sampled, transfer destination), width x height with
+ * `layers` layers, named "<view>.color" / "<view>.depth"; either format may
+ * be VK_FORMAT_UNDEFINED (none). Sets v->color, depth, width, height and
+ * layer_count. Failure: the image's error, v's targets left empty (the colour
+ * image made first is destroyed again), logged by the resources. [render
+ * thread] */
+ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height,
+                               uint32_t layers, VkFormat color, VkFormat depth);
+/* Destroy v's targets (deferred until the frames using them are done) and
+ * zero v->color and v->depth. Empty targets are fine. [render thread] */
+void ob_views_release_target(ob_views *ctx, ob_view *v);
+/* Formats of v's targets (VK_FORMAT_UNDEFINED where absent). [any thread,
+ * while no resource is created or destroyed] */
+void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_color,
+                             VkFormat *out_depth);
+
+/* ---- recording ----------------------------------------------------------- */
+
+/* Bind e's pipeline for v's target formats on pm. false (nothing bound) when
+ * e is NULL or its pipeline for those formats cannot be made. [recording
+ * thread] */
+bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm);
+/* Write the PerView block every camera-like view sets into `params`: View and
+ * Projection, ScreenSize from v's size, the ambient colour given to
+ * ob_views_create, the scene's first directional light and first four point
+ * lights relative to v->origin, and defaults for ShadowMatrix (identity) and
+ * ParaboloidDirection (zero) that dependencies override. Call it from
+ * set_render_params with the slot given. Cannot fail. [recording thread:
+ * writes only `params`] */
+void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *params,
+                                const float view[16], const float proj[16]);
+
+#endif /* OB_VIEWS_LAYER_H */
