@@ -17,7 +17,6 @@
 #include <string.h>
 
 #define OB_VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
-#define OB_MAX_FRAMES_IN_FLIGHT 16u
 
 typedef struct defer_item {
     ob_deferred_fn fn;

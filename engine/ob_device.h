@@ -108,11 +108,17 @@ typedef struct ob_vulkan_handles {
     const VkPhysicalDeviceFeatures2 *features;
 } ob_vulkan_handles;
 
+/* The most frame slots a device (and so a renderer) has: ob_device_create
+ * refuses more (OB_ERR_INVALID_ARGUMENT, logged); ob_renderer_create clamps
+ * ob_renderer_desc.device.frames_in_flight to it. */
+#define OB_MAX_FRAMES_IN_FLIGHT 4u
+
 typedef struct ob_device_desc {
     const char *app_name;     /* NULL → "obelisk" */
     const char *device;       /* NULL → $OB_DEVICE → auto ("lavapipe", "gpu" or an index) */
     int validation;           /* 0 → $OB_VALIDATION; >0 on; <0 off */
-    uint32_t frames_in_flight;/* 0 → 2; the number of frame slots for deferred deletion */
+    uint32_t frames_in_flight;/* 0 → 2; the number of frame slots for deferred deletion
+                               * (at most OB_MAX_FRAMES_IN_FLIGHT) */
     /* Presentation (windowed demos): extra instance extensions (e.g. what
      * glfwGetRequiredInstanceExtensions returns; the strings must outlive
      * creation) and VK_KHR_swapchain on the device. Missing ones fail

@@ -10,7 +10,6 @@
 
 #include "ob_renderer_layer.h"
 
-#define OB_MAX_FRAMES_IN_FLIGHT 4
 #define OB_MAX_VIEW_STACK 32
 
 /* One unit of recording: a chunk of one layer of one view. */

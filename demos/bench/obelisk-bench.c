@@ -21,7 +21,9 @@
  * Medians of repeated frames after warm-up; every ratio comes from one run.
  * Fixed seeds. A program, not a test: it never judges a time; it fails
  * when a threading mode's image or command hashes differ (exit 4) or a
- * stability case exceeds its bound (exit 5).
+ * stability case exceeds its bound (exit 5). It stops before measuring
+ * anything when the standard effects do not compile (exit 6: the shader
+ * folder is wrong, say), since every frame would then draw nothing.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -501,6 +503,32 @@ static double load_average(void)
     return load;
 }
 
+/* Every standard effect compiles, on a throwaway stack: without them the
+ * frames draw nothing and every figure would be noise. The measured stacks
+ * are made afterwards, as before. */
+static ob_result check_effects(const bench_options *o, uint32_t pool)
+{
+    /* In ob_std_effect's order (materials/ob_material.h). */
+    static const char *const names[] = {"lit", "depth", "paraboloid", "unlit", "overlay",
+                                        "fullscreen", "particles-sim", "particles-draw"};
+    _Static_assert(OB_ARRAY_COUNT(names) == OB_STD_EFFECT_COUNT, "one name per standard effect");
+    ob_demo_options dopt = demo_options(o, pool, 64, 64, 0);
+    ob_demo d;
+    ob_result r = ob_demo_init(&d, &dopt);
+    if (r != OB_OK)
+        fprintf(stderr, "obelisk-bench: cannot set up the renderer: %s (%s)\n", ob_result_name(r),
+                ob_result_text(r));
+    for (uint32_t k = 0; r == OB_OK && k < OB_STD_EFFECT_COUNT; k++) {
+        if (ob_material_library_effect(d.lib, (ob_std_effect)k, 0, &r)) continue;
+        fprintf(stderr, "obelisk-bench: the standard effect '%s' does not compile: %s (%s); "
+                        "nothing measured. Are the shaders where the library looks "
+                        "($OB_SHADER_DIR, else share/obelisk/shaders beside the library)?\n",
+                names[k], ob_result_name(r), ob_result_text(r));
+    }
+    ob_demo_shutdown(&d);
+    return r;
+}
+
 static int run(const bench_options *o)
 {
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
@@ -512,6 +540,7 @@ static int run(const bench_options *o)
                            .image_width = o->image_width, .image_height = o->image_height,
                            .image_frames = o->quick ? 3 : 4};
     rep.pool_workers = pool_size(o, rep.cores);
+    if (check_effects(o, rep.pool_workers) != OB_OK) return 6;
     /* Unknown until the raw configuration has run (it may not be in the lists). */
     rep.engine_vs_raw = (ob_bench_spread){NAN, NAN, NAN};
     rep.raw = (ob_bench_raw_result){.record_ms = NAN, .ns_per_draw = NAN,
