@@ -67,6 +67,7 @@ struct ob_device {
     VkFence oneshot_fence;
 
     ob_resource_registry *registry;
+    char *shader_dir;        /* desc.shader_dir copied; NULL when not given */
 };
 
 /* -------------------------------------------------------- validation capture */
@@ -668,6 +669,10 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     dev->validation_required = desc->validation > 0;
     const char *log_env = getenv("OB_LOG");
     dev->log_infos = log_env && strcmp(log_env, "debug") == 0;
+    if (desc->shader_dir && !(dev->shader_dir = ob_strdup(desc->shader_dir))) {
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail_free_dev;
+    }
 
     stage = "frame slots";
     r = slots_create(dev, desc->frames_in_flight);
@@ -702,6 +707,7 @@ fail_destroy_logical:
 fail_destroy_slots:
     slots_destroy(dev);
 fail_free_dev:
+    ob_free(dev->shader_dir);
     ob_free(dev);
 fail:
     OB_LOG_E("device", "device creation failed at %s: %s", stage, ob_result_name(r));
@@ -726,6 +732,7 @@ void ob_device_destroy(ob_device *dev)
     logical_destroy(dev);
     instance_destroy(dev);
     slots_destroy(dev);
+    ob_free(dev->shader_dir);
     ob_free(dev);
 }
 
@@ -738,6 +745,7 @@ VkQueue ob_device_vk_queue(const ob_device *dev) { return dev->queue; }
 uint32_t ob_device_queue_family(const ob_device *dev) { return dev->queue_family; }
 const VkPhysicalDeviceProperties *ob_device_properties(const ob_device *dev) { return &dev->props; }
 const char *ob_device_name(const ob_device *dev) { return dev->props.deviceName; }
+const char *ob_device_shader_dir(const ob_device *dev) { return dev->shader_dir; }
 const char *ob_device_driver_info(const ob_device *dev) { return dev->driver_info; }
 bool ob_device_is_cpu(const ob_device *dev) { return dev->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
 PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev) { return dev->push_descriptor; }

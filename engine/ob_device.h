@@ -131,6 +131,14 @@ typedef struct ob_device_desc {
      * then ignored; validation only captures messages, see
      * ob_vulkan_handles). */
     const ob_vulkan_handles *adopt;
+    /* The folder of the library's shaders for everything built on this
+     * device: every effect context made on it (ob_effect_context_create,
+     * and so ob_stack, the material library and the standard views) compiles
+     * from here. Copied. NULL → $OB_SHADER_DIR → share/obelisk/shaders
+     * beside the binary holding the engine (ob_shader_compiler_desc). For a
+     * program that keeps its own copy of the shaders, or a static program
+     * outside the install prefix. */
+    const char *shader_dir;
 } ob_device_desc;
 
 typedef struct ob_validation_counts {
@@ -162,6 +170,8 @@ const VkPhysicalDeviceProperties *ob_device_properties(const ob_device *dev);
 /* "llvmpipe (LLVM 15.0.6, 256 bits)" and "Mesa 22.3.6 (LLVM 15.0.6)". */
 const char *ob_device_name(const ob_device *dev);
 const char *ob_device_driver_info(const ob_device *dev);
+/* desc.shader_dir as given (a copy owned by the device), NULL when none was. */
+const char *ob_device_shader_dir(const ob_device *dev);
 bool ob_device_is_cpu(const ob_device *dev);
 /* Nanoseconds per timestamp tick (0 if timestamps are unsupported). */
 double ob_device_timestamp_period_ns(const ob_device *dev);

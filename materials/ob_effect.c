@@ -136,7 +136,10 @@ ob_effect_context *ob_effect_context_create(ob_device *dev, ob_param_registry *r
     }
     ctx->dev = dev;
     ctx->reg = reg;
-    ctx->compiler = ob_shader_compiler_create(&(ob_shader_compiler_desc){.cache_dir = cache_dir}, &r);
+    /* The device's shader folder (ob_device_desc.shader_dir) reaches every
+     * effect made through this context; NULL lets the compiler choose. */
+    ctx->compiler = ob_shader_compiler_create(&(ob_shader_compiler_desc){
+        .shader_dir = ob_device_shader_dir(dev), .cache_dir = cache_dir}, &r);
     if (!ctx->compiler) goto fail_free;
     /* One cache folder for SPIR-V and pipelines; "" means the compiler could
      * not create it, and then pipelines are not persisted either. */

@@ -91,8 +91,9 @@ typedef struct ob_effect_counters {
     uint32_t cache_loaded_bytes;        /* bytes of pipelines.bin accepted at create, 0 = none */
 } ob_effect_counters;
 
-/* Creates the shared pieces: a shader compiler (SPIR-V cached under
- * cache_dir), and the VkPipelineCache, seeded from <cache_dir>/pipelines.bin
+/* Creates the shared pieces: a shader compiler (shaders read from the
+ * device's folder, ob_device_desc.shader_dir, else the compiler's default;
+ * SPIR-V cached under cache_dir), and the VkPipelineCache, seeded from <cache_dir>/pipelines.bin
  * when the file's VkPipelineCacheHeaderVersionOne matches this device (vendor,
  * device, pipelineCacheUUID); a missing file is normal, a mismatched or
  * corrupt one is ignored with a log line. cache_dir NULL → the shader

@@ -59,7 +59,10 @@ typedef struct ob_shader_compiler_desc {
     /* NULL → $OB_SHADER_DIR → share/obelisk/shaders beside the binary holding
      * the engine: <libobelisk.so's folder>/../share/obelisk/shaders installed,
      * build/share/obelisk/shaders in the build tree (then the configured
-     * install folder, for static programs outside the prefix). */
+     * install folder, for static programs outside the prefix). The effect
+     * context passes ob_device_desc.shader_dir here, so one field points a
+     * whole renderer (ob_renderer_desc.device, ob_stack_desc.renderer.device)
+     * at a folder. */
     const char *shader_dir;
     /* NULL → $OB_CACHE_DIR → $XDG_CACHE_HOME/obelisk → $HOME/.cache/obelisk.
      * Created if missing; SPIR-V goes in <cache_dir>/spirv/. If it cannot be
