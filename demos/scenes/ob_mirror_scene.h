@@ -17,6 +17,8 @@
 #ifndef OB_MIRROR_SCENE_H
 #define OB_MIRROR_SCENE_H
 
+#include <stdio.h>
+
 #include "ob_demo.h"
 
 typedef struct ob_mirror_scene_desc {
@@ -51,6 +53,15 @@ ob_result ob_mirror_scene_objects(ob_demo *d, uint32_t objects, uint32_t seed, d
                                   ob_material *const palette[OB_MIRROR_SCENE_COLOURS]);
 /* The sun (shadows as asked) and the red and blue point lights. */
 ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows);
+
+/* Writes the scene as a scene file (docs/scene-format.md) that loads
+ * (ob_scene_load, seed desc->seed) into the same entities, transforms,
+ * controllers, materials, lights, particles and camera (its pose at time 0)
+ * as ob_mirror_scene_build — demos/scenes/mirror.json is this output for
+ * obelisk-mirror's defaults (200 objects, seed 1). The palette's materials,
+ * all named "diffuse" here, are "diffuse0".."diffuse7" there. Needs no
+ * device. Failure: OB_ERR_IO when writing fails. [any thread] */
+ob_result ob_mirror_scene_write_json(const ob_mirror_scene_desc *desc, FILE *out);
 
 /* Places camera on its circle around the mirrors at scene time `time`
  * (seconds), looking at their centre. */
