@@ -52,50 +52,66 @@ ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, V
     return OB_OK;
 }
 
-void ob_staging_destroy(ob_device *dev, ob_staging *staging)
+void ob_res_vk_buffer_free(ob_device *dev, ob_res_vk_buffer *b)
 {
     VkDevice vk = ob_device_vk(dev);
-    if (staging->buffer) vkDestroyBuffer(vk, staging->buffer, NULL);
-    if (staging->memory) vkFreeMemory(vk, staging->memory, NULL);   /* unmaps too */
-    memset(staging, 0, sizeof *staging);
+    if (b->buffer) vkDestroyBuffer(vk, b->buffer, NULL);
+    if (b->memory) vkFreeMemory(vk, b->memory, NULL);   /* unmaps too */
+    memset(b, 0, sizeof *b);
 }
 
-ob_result ob_staging_create(ob_device *dev, uint64_t size, const char *owner_name, ob_staging *out_staging)
+ob_result ob_res_vk_buffer_make(ob_device *dev, VkDeviceSize size, VkBufferUsageFlags usage,
+                                VkMemoryPropertyFlags flags, bool map, const char *what,
+                                const char *name, ob_res_vk_buffer *out)
 {
-    memset(out_staging, 0, sizeof *out_staging);
+    memset(out, 0, sizeof *out);
     VkDevice vk = ob_device_vk(dev);
     VkBufferCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
         .size = size,
-        .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        .usage = usage,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
-    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(vk, &info, NULL, &out_staging->buffer));
+    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(vk, &info, NULL, &out->buffer));
     if (vr < 0) {
-        out_staging->buffer = VK_NULL_HANDLE;
+        out->buffer = VK_NULL_HANDLE;
         ob_device_note_result(dev, vr);
-        OB_LOG_E("resources", "staging for '%s': cannot create a %llu-byte buffer", owner_name,
+        OB_LOG_E("resources", "%s '%s': cannot create a %llu-byte buffer", what, name,
                  (unsigned long long)size);
         return ob_result_from_vk(vr);
     }
     VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(vk, out_staging->buffer, &req);
-    ob_result r = ob_res_memory_alloc(dev, &req,
-                                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                      "staging for", owner_name, &out_staging->memory);
-    if (r != OB_OK) goto fail_destroy;
-    vr = OB_VK_CHECK(vkBindBufferMemory(vk, out_staging->buffer, out_staging->memory, 0));
-    if (vr >= 0) vr = OB_VK_CHECK(vkMapMemory(vk, out_staging->memory, 0, VK_WHOLE_SIZE, 0, &out_staging->mapped));
+    vkGetBufferMemoryRequirements(vk, out->buffer, &req);
+    ob_result r = ob_res_memory_alloc(dev, &req, flags, what, name, &out->memory);
+    if (r != OB_OK) goto fail_free_buffer;
+    out->mem_size = req.size;
+    vr = OB_VK_CHECK(vkBindBufferMemory(vk, out->buffer, out->memory, 0));
+    if (vr >= 0 && map) vr = OB_VK_CHECK(vkMapMemory(vk, out->memory, 0, VK_WHOLE_SIZE, 0, &out->mapped));
     if (vr < 0) {
         ob_device_note_result(dev, vr);
         r = ob_result_from_vk(vr);
-        goto fail_destroy;
+        goto fail_free_buffer;
     }
-    ob_res_set_name(dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)(uintptr_t)out_staging->buffer, owner_name, " (staging)");
     return OB_OK;
 
-fail_destroy:
-    ob_staging_destroy(dev, out_staging);
+fail_free_buffer:
+    ob_res_vk_buffer_free(dev, out);
+    return r;
+}
+
+void ob_staging_destroy(ob_device *dev, ob_staging *staging)
+{
+    ob_res_vk_buffer_free(dev, staging);
+}
+
+ob_result ob_staging_create(ob_device *dev, uint64_t size, const char *owner_name, ob_staging *out_staging)
+{
+    ob_result r = ob_res_vk_buffer_make(dev, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                        true, "staging for", owner_name, out_staging);
+    if (r == OB_OK)
+        ob_res_set_name(dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)(uintptr_t)out_staging->buffer, owner_name,
+                        " (staging)");
     return r;
 }
 
@@ -241,7 +257,6 @@ ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result
     r = buffer_desc_check(desc, name, &data_size);
     if (r != OB_OK) goto fail;
 
-    VkDevice vk = ob_device_vk(dev);
     ob_buffer_rec *rec = ob_calloc(1, sizeof *rec);
     if (!rec) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
@@ -255,35 +270,17 @@ ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto fail_free_rec;
     }
-    VkBufferCreateInfo info = {
-        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
-        .size = desc->size,
-        .usage = buffer_vk_usage(desc->usage, desc->host_visible),
-        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
-    };
-    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(vk, &info, NULL, &rec->buffer));
-    if (vr < 0) {
-        rec->buffer = VK_NULL_HANDLE;
-        ob_device_note_result(dev, vr);
-        r = ob_result_from_vk(vr);
-        goto fail_free_rec;
-    }
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(vk, rec->buffer, &req);
     VkMemoryPropertyFlags flags = desc->host_visible
                                       ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    r = ob_res_memory_alloc(dev, &req, flags, "buffer", name, &rec->memory);
+    ob_res_vk_buffer made;
+    r = ob_res_vk_buffer_make(dev, desc->size, buffer_vk_usage(desc->usage, desc->host_visible), flags,
+                              desc->host_visible, "buffer", name, &made);
     if (r != OB_OK) goto fail_free_rec;
-    rec->mem_size = req.size;
-    vr = OB_VK_CHECK(vkBindBufferMemory(vk, rec->buffer, rec->memory, 0));
-    if (vr >= 0 && desc->host_visible)
-        vr = OB_VK_CHECK(vkMapMemory(vk, rec->memory, 0, VK_WHOLE_SIZE, 0, &rec->mapped));
-    if (vr < 0) {
-        ob_device_note_result(dev, vr);
-        r = ob_result_from_vk(vr);
-        goto fail_free_rec;
-    }
+    rec->buffer = made.buffer;
+    rec->memory = made.memory;
+    rec->mapped = made.mapped;
+    rec->mem_size = made.mem_size;
     ob_res_set_name(dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)(uintptr_t)rec->buffer, name, NULL);
     ob_res_set_name(dev, VK_OBJECT_TYPE_DEVICE_MEMORY, (uint64_t)(uintptr_t)rec->memory, name, " (memory)");
 

@@ -44,13 +44,29 @@ struct ob_resource_registry {
     uint64_t device_bytes;
 };
 
-/* A host-visible, coherent, mapped scratch buffer for one upload or
- * read-back; destroyed right after its one-shot has completed. */
-typedef struct ob_staging {
+/* A VkBuffer with its own memory: what ob_res_vk_buffer_make gives. */
+typedef struct ob_res_vk_buffer {
     VkBuffer buffer;
     VkDeviceMemory memory;
-    void *mapped;
-} ob_staging;
+    void *mapped;                /* with map; NULL otherwise */
+    VkDeviceSize mem_size;       /* bytes of memory allocated */
+} ob_res_vk_buffer;
+
+/* The engine's one path to a VkBuffer and its memory (buffers, staging):
+ * creates it (exclusive, `usage`), allocates memory of `flags` for it
+ * (ob_res_memory_alloc), binds it and, with map, maps all of it. Failure:
+ * the error (the VkResult noted on the device), logged as "<what> '<name>'
+ * ...", *out zeroed with nothing left behind. [render thread] */
+ob_result ob_res_vk_buffer_make(ob_device *dev, VkDeviceSize size, VkBufferUsageFlags usage,
+                                VkMemoryPropertyFlags flags, bool map, const char *what,
+                                const char *name, ob_res_vk_buffer *out);
+/* Destroys the buffer and frees (so unmaps) its memory; zeroes *b. A zeroed
+ * *b is a no-op. */
+void ob_res_vk_buffer_free(ob_device *dev, ob_res_vk_buffer *b);
+
+/* A host-visible, coherent, mapped scratch buffer for one upload or
+ * read-back; destroyed right after its one-shot has completed. */
+typedef ob_res_vk_buffer ob_staging;
 
 ob_result ob_staging_create(ob_device *dev, uint64_t size, const char *owner_name, ob_staging *out_staging);
 void ob_staging_destroy(ob_device *dev, ob_staging *staging);
