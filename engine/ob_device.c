@@ -419,18 +419,18 @@ static ob_result adopt_create(ob_device *dev, const ob_vulkan_handles *a)
             OB_LOG_E("device", "validation was requested (desc.validation) but the application's "
                      "instance lacks %s: messages could not be captured", VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
             r = OB_ERR_UNSUPPORTED;
-            goto fail;
+            goto fail_destroy_instance;
         }
         OB_LOG_W("device", "OB_VALIDATION is set but the application's instance lacks %s: "
                  "validation messages are not captured", VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
         dev->validation = false;
     }
     r = messenger_create(dev, info.debug_utils);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_instance;
     r = logical_entry_points(dev);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_instance;
     return OB_OK;
-fail:
+fail_destroy_instance:
     instance_destroy(dev);
     dev->device = VK_NULL_HANDLE;
     dev->queue = VK_NULL_HANDLE;
@@ -659,7 +659,7 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     ob_device *dev = ob_calloc(1, sizeof *dev);
     if (!dev) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     atomic_init(&dev->val_errors, 0);
     atomic_init(&dev->val_warnings, 0);
@@ -709,7 +709,7 @@ fail_destroy_slots:
 fail_free_dev:
     ob_free(dev->shader_dir);
     ob_free(dev);
-fail:
+fail_log:
     OB_LOG_E("device", "device creation failed at %s: %s", stage, ob_result_name(r));
     if (out_result) *out_result = r;
     return NULL;

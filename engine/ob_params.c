@@ -245,7 +245,7 @@ ob_param_registry *ob_param_registry_create(const ob_param_registry_desc *desc,
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     for (uint32_t role = OB_PARAM_ROLE_WORLD; role < OB_PARAM_ROLE_COUNT; role++) {
         *role_handle[role] = ob_param_register(reg, builtin_names[role], OB_PARAM_MAT4, 1, &r);
-        if (r != OB_OK) goto fail_destroy;
+        if (r != OB_OK) goto fail_destroy_registry;
         ob_param_info *info = ob_param_info_get(reg, *role_handle[role]);
         info->derive_role = role;
         reg->role_info[role] = info;
@@ -255,7 +255,7 @@ ob_param_registry *ob_param_registry_create(const ob_param_registry_desc *desc,
     }
     goto done;
 
-fail_destroy:
+fail_destroy_registry:
     OB_LOG_E("params", "registry: cannot register built-in parameters: %s", ob_result_text(r));
     ob_param_registry_destroy(reg);
     reg = NULL;

@@ -113,7 +113,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
     ob_program *prog = ob_calloc(1, sizeof *prog);
     if (!prog) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_report;
     }
     snprintf(prog->name, sizeof prog->name, "%s", name ? name : "program");
     prog->id = (uint32_t)ob_hash_str(OB_HASH_SEED, prog->name);
@@ -130,14 +130,14 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
                      "in set %u and not an array", prog->name, b->name, b->set, b->binding,
                      b->count, want_set);
             r = OB_ERR_UNSUPPORTED;
-            goto fail_free;
+            goto fail_destroy_program;
         }
         if (is_ubo) {
             if (prog->ubo_count >= OB_PROGRAM_MAX_UBOS) {
                 OB_LOG_E("program", "program '%s': more than %u uniform blocks", prog->name,
                          OB_PROGRAM_MAX_UBOS);
                 r = OB_ERR_UNSUPPORTED;
-                goto fail_free;
+                goto fail_destroy_program;
             }
             const ob_block_layout *layout = &refl->blocks[b->block];
             register_block_params(reg, layout);
@@ -145,7 +145,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
             u->binding = b->binding;
             u->size = (layout->size + 15u) & ~15u;
             u->mapping = ob_param_mapping_create(reg, layout, prog->name, &r);
-            if (!u->mapping) goto fail_free;
+            if (!u->mapping) goto fail_destroy_program;
             ubo_bindings[prog->ubo_count] = (VkDescriptorSetLayoutBinding){
                 .binding = b->binding,
                 .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC,
@@ -155,7 +155,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
             prog->ubo_count++;
         } else {
             r = add_resource(prog, reg, b);
-            if (r != OB_OK) goto fail_free;
+            if (r != OB_OK) goto fail_destroy_program;
             res_bindings[prog->resource_count - 1] = (VkDescriptorSetLayoutBinding){
                 .binding = b->binding,
                 .descriptorType = descriptor_type(b->kind),
@@ -168,7 +168,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         const ob_block_layout *pb = &refl->blocks[refl->push_block];
         register_block_params(reg, pb);
         prog->push_mapping = ob_param_mapping_create(reg, pb, prog->name, &r);
-        if (!prog->push_mapping) goto fail_free;
+        if (!prog->push_mapping) goto fail_destroy_program;
         prog->push_size = (pb->size + 3u) & ~3u;
         prog->push_stages = stages;
         uint32_t limit = OB_MIN(ob_device_properties(dev)->limits.maxPushConstantsSize,
@@ -178,7 +178,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
                      "(the device's %u, the engine's %u)", prog->name, prog->push_size, limit,
                      ob_device_properties(dev)->limits.maxPushConstantsSize, OB_PUSH_CONSTANT_MAX);
             r = OB_ERR_UNSUPPORTED;
-            goto fail_free;
+            goto fail_destroy_program;
         }
         prog->push_world_normal = ob_param_mapping_is_world_normal(prog->push_mapping);
         for (uint32_t i = 0; i < prog->ubo_count; i++)
@@ -191,7 +191,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         .pBindings = ubo_bindings,
     };
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateDescriptorSetLayout(vk, &set0, NULL, &prog->set_layouts[0]));
-    if (vr != VK_SUCCESS) goto fail_vk;
+    if (vr != VK_SUCCESS) goto fail_note_vk;
     VkDescriptorSetLayoutCreateInfo set1 = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
         .flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR,
@@ -199,7 +199,7 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         .pBindings = res_bindings,
     };
     vr = OB_VK_CHECK_CREATE(vkCreateDescriptorSetLayout(vk, &set1, NULL, &prog->set_layouts[1]));
-    if (vr != VK_SUCCESS) goto fail_vk;
+    if (vr != VK_SUCCESS) goto fail_note_vk;
     VkPushConstantRange push = {.stageFlags = prog->push_stages, .size = prog->push_size};
     VkPipelineLayoutCreateInfo pl = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
@@ -209,17 +209,17 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         .pPushConstantRanges = &push,
     };
     vr = OB_VK_CHECK_CREATE(vkCreatePipelineLayout(vk, &pl, NULL, &prog->layout));
-    if (vr != VK_SUCCESS) goto fail_vk;
+    if (vr != VK_SUCCESS) goto fail_note_vk;
     ob_device_set_name(dev, VK_OBJECT_TYPE_PIPELINE_LAYOUT, (uint64_t)prog->layout, prog->name);
     if (out_result) *out_result = OB_OK;
     return prog;
 
-fail_vk:
+fail_note_vk:
     r = ob_result_from_vk(vr);
-fail_free:
+fail_destroy_program:
     ob_program_destroy(dev, prog);
     prog = NULL;
-fail:
+fail_report:
     if (out_result) *out_result = r;
     return NULL;
 }

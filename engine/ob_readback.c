@@ -61,7 +61,7 @@ ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_
     ob_staging staging;
     VkCommandBuffer cmd;
     ob_result r = readback_begin(dev, rec->host_visible ? 0 : size, rec->name, &staging, &cmd);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
     if (!rec->host_visible) {
         VkMemoryBarrier2 to_copy = {
             .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
@@ -80,7 +80,7 @@ ob_result ob_buffer_read(ob_device *dev, ob_buffer buf, uint64_t offset, uint64_
         memcpy(out, rec->host_visible ? (const char *)rec->mapped + offset : staging.mapped, (size_t)size);
     ob_staging_destroy(dev, &staging);
     if (r == OB_OK) return OB_OK;
-fail:
+fail_log:
     OB_LOG_E("resources", "buffer '%s': read-back failed: %s", rec->name, ob_result_name(r));
     return r;
 }
@@ -162,7 +162,7 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
     ob_staging staging;
     VkCommandBuffer cmd;
     r = readback_begin(dev, pixels * 4, rec->name, &staging, &cmd);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
     ob_image_state saved = rec->state;
     record_image_copy(cmd, rec, layer, staging.buffer);
     r = ob_device_oneshot_submit(dev, cmd);
@@ -184,7 +184,7 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
 done:
     ob_staging_destroy(dev, &staging);
     if (r == OB_OK) return OB_OK;
-fail:
+fail_log:
     OB_LOG_E("resources", "image '%s': read-back failed: %s", rec->name, ob_result_name(r));
     return r;
 }

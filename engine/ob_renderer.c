@@ -81,7 +81,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     ob_renderer *r = ob_calloc(1, sizeof *r);
     if (!r) {
         res = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     if (d.worker_count == 0) {
         long n = sysconf(_SC_NPROCESSORS_ONLN);
@@ -101,14 +101,14 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     r->frames_in_flight = d.device.frames_in_flight;
 
     r->dev = ob_device_create(&d.device, &res);
-    if (!r->dev) goto fail_free;
+    if (!r->dev) goto fail_free_renderer;
     r->reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 1 + r->worker_count}, &res);
-    if (!r->reg) goto fail_destroy;
+    if (!r->reg) goto fail_destroy_renderer;
     res = ob_params_manager(r->reg, 0, &r->params0);
-    if (res != OB_OK) goto fail_destroy;
+    if (res != OB_OK) goto fail_destroy_renderer;
     for (uint32_t i = 0; i < r->frames_in_flight; i++) {
         res = create_frame_slot(r, &r->frames[i], i);
-        if (res != OB_OK) goto fail_destroy;
+        if (res != OB_OK) goto fail_destroy_renderer;
     }
     ob_pipeline_manager_desc pmd = {
         .device = r->dev,
@@ -118,20 +118,20 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
         .name = "immediate",
     };
     r->immediate = ob_pipeline_manager_create(&pmd, &res);
-    if (!r->immediate) goto fail_destroy;
+    if (!r->immediate) goto fail_destroy_renderer;
     res = ob_renderer_workers_start(r);
-    if (res != OB_OK) goto fail_destroy;
+    if (res != OB_OK) goto fail_destroy_renderer;
     if (out_result) *out_result = OB_OK;
     return r;
 
-fail_destroy:
+fail_destroy_renderer:
     ob_renderer_destroy(r);
     r = NULL;
-    goto fail;
-fail_free:
+    goto fail_log;
+fail_free_renderer:
     ob_free(r);
     r = NULL;
-fail:
+fail_log:
     OB_LOG_E("renderer", "renderer not created: %s", ob_result_name(res));
     if (out_result) *out_result = res;
     return NULL;

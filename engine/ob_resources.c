@@ -248,19 +248,19 @@ ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result
     if (!desc) {
         OB_LOG_E("resources", "ob_buffer_create: desc is NULL");
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     if (ob_device_is_lost(dev)) {
         r = OB_ERR_DEVICE_LOST;
-        goto fail;
+        goto fail_log;
     }
     r = buffer_desc_check(desc, name, &data_size);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
 
     ob_buffer_rec *rec = ob_calloc(1, sizeof *rec);
     if (!rec) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     rec->size = desc->size;
     rec->usage = desc->usage;
@@ -297,7 +297,7 @@ ob_buffer ob_buffer_create(ob_device *dev, const ob_buffer_desc *desc, ob_result
 
 fail_free_rec:
     buffer_rec_free(dev, rec);
-fail:
+fail_log:
     OB_LOG_E("resources", "buffer '%s' not created: %s", name, ob_result_name(r));
     if (out_result) *out_result = r;
     return handle;
@@ -378,7 +378,7 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
     const char *name = desc->name ? desc->name : "(unnamed)";
     if (ob_device_is_lost(dev)) {
         r = OB_ERR_DEVICE_LOST;
-        goto fail;
+        goto fail_log;
     }
     if ((unsigned)desc->filter > VK_FILTER_LINEAR ||
         (unsigned)desc->address > VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER ||
@@ -386,12 +386,12 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
         OB_LOG_E("resources", "sampler '%s': filter %d, address mode %d or compare op %d is out of range", name,
                  (int)desc->filter, (int)desc->address, (int)desc->compare_op);
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     ob_sampler_rec *rec = ob_calloc(1, sizeof *rec);
     if (!rec) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     rec->name = ob_strdup(name);
     if (!rec->name) {
@@ -431,7 +431,7 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
 
 fail_free_rec:
     sampler_rec_free(dev, rec);
-fail:
+fail_log:
     OB_LOG_E("resources", "sampler '%s' not created: %s", name, ob_result_name(r));
     if (out_result) *out_result = r;
     return handle;

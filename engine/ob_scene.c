@@ -720,9 +720,9 @@ ob_result ob_node_look_at(ob_node *n, const double target[3], const double up[3]
     ob_daffine world, local;
     double parent_q[4], q[4];
     ob_dquat_identity(parent_q);
-    if (node_local(n, &world, q) != LOCAL_OK) goto fail_transform;
+    if (node_local(n, &world, q) != LOCAL_OK) goto fail_log_non_finite;
     for (const ob_node *p = n->parent; p; p = p->parent) {
-        if (node_local(p, &local, q) != LOCAL_OK) goto fail_transform;
+        if (node_local(p, &local, q) != LOCAL_OK) goto fail_log_non_finite;
         ob_daffine_mul(&local, &world, &world);
         ob_dquat_mul(q, parent_q, parent_q);
     }
@@ -749,7 +749,7 @@ ob_result ob_node_look_at(ob_node *n, const double target[3], const double up[3]
     ob_dquat_normalize(n->rotation, n->rotation);
     return OB_OK;
 
-fail_transform:
+fail_log_non_finite:
     OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): look_at on a non-finite transform (its own or an "
              "ancestor's); rotation unchanged", n->name, n->id);
     return OB_ERR_NON_FINITE;

@@ -127,12 +127,12 @@ ob_effect_context *ob_effect_context_create(ob_device *dev, ob_param_registry *r
     if (!dev || !reg) {
         OB_LOG_E("effect", "effect context needs a device and a parameter registry");
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     ctx = ob_calloc(1, sizeof *ctx);
     if (!ctx) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     ctx->dev = dev;
     ctx->reg = reg;
@@ -140,7 +140,7 @@ ob_effect_context *ob_effect_context_create(ob_device *dev, ob_param_registry *r
      * effect made through this context; NULL lets the compiler choose. */
     ctx->compiler = ob_shader_compiler_create(&(ob_shader_compiler_desc){
         .shader_dir = ob_device_shader_dir(dev), .cache_dir = cache_dir}, &r);
-    if (!ctx->compiler) goto fail_free;
+    if (!ctx->compiler) goto fail_free_context;
     /* One cache folder for SPIR-V and pipelines; "" means the compiler could
      * not create it, and then pipelines are not persisted either. */
     const char *dir = cache_dir ? cache_dir : ob_shader_compiler_cache_dir(ctx->compiler);
@@ -149,22 +149,22 @@ ob_effect_context *ob_effect_context_create(ob_device *dev, ob_param_registry *r
         ctx->cache_path = ctx->cache_dir ? path_join(ctx->cache_dir, "pipelines.bin") : NULL;
         if (!ctx->cache_path) {
             r = OB_ERR_OUT_OF_HOST_MEMORY;
-            goto fail_free;
+            goto fail_free_context;
         }
     } else {
         OB_LOG_W("effect", "no cache folder: pipelines will not be saved across runs");
     }
     r = create_pipeline_cache(ctx);
-    if (r != OB_OK) goto fail_free;
+    if (r != OB_OK) goto fail_free_context;
     if (out_result) *out_result = OB_OK;
     return ctx;
 
-fail_free:
+fail_free_context:
     ob_shader_compiler_destroy(ctx->compiler);
     ob_free(ctx->cache_path);
     ob_free(ctx->cache_dir);
     ob_free(ctx);
-fail:
+fail_log:
     OB_LOG_E("effect", "effect context creation failed: %s", ob_result_name(r));
     if (out_result) *out_result = r;
     return NULL;
@@ -360,12 +360,12 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
     if (desc->name) snprintf(name, sizeof name, "%s", desc->name);
     else default_name(desc, name, sizeof name);
     r = check_desc(desc, name);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
 
     e = ob_calloc(1, sizeof *e);
     if (!e) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     e->ctx = ctx;
     memcpy(e->name, name, sizeof name);
@@ -375,7 +375,7 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
     if (pthread_mutex_init(&e->lock, NULL) != 0) {
         ob_free(e);
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
 
     stage_source wanted[2];
@@ -398,7 +398,7 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
         if (!shaders[i]) {
             OB_LOG_E("effect", "effect '%s': %s shader '%s' failed: %s", e->name,
                      ob_shader_stage_name(wanted[i].stage), wanted[i].path, ob_result_text(r));
-            goto fail_destroy;
+            goto fail_destroy_effect;
         }
     }
 
@@ -409,7 +409,7 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
     if (r != OB_OK) {
         OB_LOG_E("effect", "effect '%s': the stages' interfaces do not merge: %s", e->name,
                  ob_result_text(r));
-        goto fail_destroy;
+        goto fail_destroy_effect;
     }
     if (e->compute) memcpy(e->local_size, shaders[0]->reflection.local_size, sizeof e->local_size);
     else r = resolve_vertex_input(e, desc, &shaders[0]->reflection);
@@ -419,21 +419,21 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
             OB_LOG_E("effect", "effect '%s': program not created: %s", e->name, ob_result_text(r));
     }
     ob_reflection_release(&merged);
-    if (r != OB_OK) goto fail_destroy;
+    if (r != OB_OK) goto fail_destroy_effect;
 
     for (uint32_t i = 0; i < n; i++) {
         e->stages[i] = ob_shader_stage_vk(wanted[i].stage);
         r = create_module(e, shaders[i], &e->modules[i]);
-        if (r != OB_OK) goto fail_destroy;
+        if (r != OB_OK) goto fail_destroy_effect;
         e->stage_count = i + 1;
     }
     atomic_fetch_add(&ctx->variants_compiled, 1);
     if (out_result) *out_result = OB_OK;
     return e;
 
-fail_destroy:
+fail_destroy_effect:
     ob_effect_destroy(e);
-fail:
+fail_log:
     OB_LOG_E("effect", "effect '%s' not created: %s", name, ob_result_name(r));
     if (out_result) *out_result = r;
     return NULL;

@@ -142,20 +142,20 @@ ob_shader_compiler *ob_shader_compiler_create(const ob_shader_compiler_desc *des
     if (!glslang_ready) {
         OB_LOG_E("shader", "glslang failed to initialise");
         r = OB_ERR_UNSUPPORTED;
-        goto fail;
+        goto fail_log;
     }
     ob_shader_compiler *c = ob_calloc(1, sizeof *c);
-    if (!c) goto fail;
+    if (!c) goto fail_log;
     const char *env_shaders = getenv("OB_SHADER_DIR");
     c->shader_dir = d.shader_dir                    ? ob_strdup(d.shader_dir)
                     : env_shaders && env_shaders[0] ? ob_strdup(env_shaders)
                                                     : ob_shader_dir_default();
-    if (!c->shader_dir) goto fail_free;
+    if (!c->shader_dir) goto fail_free_compiler;
 
     if (!d.no_disk_cache) {
         bool oom = false;
         char *dir = d.cache_dir ? ob_strdup(d.cache_dir) : default_cache_dir(&oom);
-        if (!dir && (d.cache_dir || oom)) goto fail_free;
+        if (!dir && (d.cache_dir || oom)) goto fail_free_compiler;
         if (!dir) {
             OB_LOG_I("shader", "no cache folder ($OB_CACHE_DIR, $XDG_CACHE_HOME, $HOME unset): "
                      "shaders are cached in memory only");
@@ -163,7 +163,7 @@ ob_shader_compiler *ob_shader_compiler_create(const ob_shader_compiler_desc *des
             c->spirv_dir = ob_shader_path_join(dir, "spirv");
             if (!c->spirv_dir) {
                 ob_free(dir);
-                goto fail_free;
+                goto fail_free_compiler;
             }
             if (ob_dir_make(c->spirv_dir) != OB_OK) {
                 OB_LOG_W("shader", "cannot create shader cache folder '%s': shaders are cached "
@@ -176,25 +176,25 @@ ob_shader_compiler *ob_shader_compiler_create(const ob_shader_compiler_desc *des
             }
         }
     }
-    if (!c->cache_dir && !(c->cache_dir = ob_strdup(""))) goto fail_free;
+    if (!c->cache_dir && !(c->cache_dir = ob_strdup(""))) goto fail_free_compiler;
 
     c->bucket_count = INITIAL_BUCKETS;
     c->buckets = ob_calloc(c->bucket_count, sizeof *c->buckets);
-    if (!c->buckets) goto fail_free;
-    if (pthread_mutex_init(&c->lock, NULL) != 0) goto fail_free;
-    if (pthread_cond_init(&c->finished, NULL) != 0) goto fail_mutex;
+    if (!c->buckets) goto fail_free_compiler;
+    if (pthread_mutex_init(&c->lock, NULL) != 0) goto fail_free_compiler;
+    if (pthread_cond_init(&c->finished, NULL) != 0) goto fail_destroy_mutex;
     if (out_result) *out_result = OB_OK;
     return c;
 
-fail_mutex:
+fail_destroy_mutex:
     pthread_mutex_destroy(&c->lock);
-fail_free:
+fail_free_compiler:
     ob_free(c->buckets);
     ob_free(c->spirv_dir);
     ob_free(c->cache_dir);
     ob_free(c->shader_dir);
     ob_free(c);
-fail:
+fail_log:
     if (r == OB_ERR_OUT_OF_HOST_MEMORY) OB_LOG_E("shader", "out of host memory creating the shader compiler");
     if (out_result) *out_result = r;
     return NULL;

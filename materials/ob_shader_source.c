@@ -575,7 +575,7 @@ ob_result ob_shader_variant_describe(const ob_shader_desc *desc, char **out_name
         if (i > 0 && strcmp(sorted[i]->name, sorted[i - 1]->name) == 0) {
             OB_LOG_E("shader", "'%s': define %s is given twice", desc->path, sorted[i]->name);
             r = OB_ERR_INVALID_ARGUMENT;
-            goto fail;
+            goto fail_free_text;
         }
         buf_str(&name, i == 0 ? " [" : ", ");
         buf_str(&name, sorted[i]->name);
@@ -590,13 +590,13 @@ ob_result ob_shader_variant_describe(const ob_shader_desc *desc, char **out_name
     if (count) buf_str(&name, "]");
     if (name.oom || pre.oom) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_free_text;
     }
     ob_free(sorted);
     *out_name = name.data;
     *out_preamble = pre.data;
     return OB_OK;
-fail:
+fail_free_text:
     ob_free(sorted);
     ob_free(name.data);
     ob_free(pre.data);

@@ -148,7 +148,7 @@ ob_overlay_view *ob_overlay_view_create(ob_views *ctx, ob_view *source, ob_resul
     idx = ob_malloc(sizeof *idx * 6 * OVERLAY_MAX_QUADS);
     if (!ov || !idx) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_destroy_overlay;
     }
     ob_view_init(&ov->base, &overlay_vtbl, OB_VIEW_OVERLAY, "overlay");
     ov->ctx = ctx;
@@ -166,17 +166,17 @@ ob_overlay_view *ob_overlay_view_create(ob_views *ctx, ob_view *source, ob_resul
     ob_buffer_desc ib = {.size = sizeof *idx * 6 * OVERLAY_MAX_QUADS, .usage = OB_BUFFER_INDEX,
                          .data = idx, .name = "overlay.indices"};
     ov->indices = ob_buffer_create(ctx->dev, &ib, &r);
-    if (!ov->indices.id) goto fail;
+    if (!ov->indices.id) goto fail_destroy_overlay;
     for (uint32_t s = 0; s < OVERLAY_SLOTS; s++) {
         ob_buffer_desc vb = {.size = sizeof(overlay_vertex) * 4 * OVERLAY_MAX_QUADS,
                              .usage = OB_BUFFER_VERTEX, .host_visible = true,
                              .name = "overlay.vertices"};
         ov->vertices[s] = ob_buffer_create(ctx->dev, &vb, &r);
-        if (!ov->vertices[s].id) goto fail;
+        if (!ov->vertices[s].id) goto fail_destroy_overlay;
     }
     ob_free(idx);
     goto done;
-fail:
+fail_destroy_overlay:
     ob_free(idx);
     ob_overlay_view_destroy(ctx, ov);
     ov = NULL;

@@ -104,7 +104,7 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     particle *init = NULL;
     if (!ps) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_destroy_system;
     }
     ps->ctx = ctx;
     ps->scene = scene;
@@ -128,7 +128,7 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     init = ob_malloc(sizeof *init * d->count);
     if (!init) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_destroy_system;
     }
     seed_particles(init, d);
     ob_buffer_desc bd = {.size = sizeof *init * d->count, .usage = OB_BUFFER_STORAGE,
@@ -136,19 +136,19 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     ps->buffer = ob_buffer_create(ctx->dev, &bd, &r);
     ob_free(init);
     init = NULL;
-    if (!ps->buffer.id) goto fail;
+    if (!ps->buffer.id) goto fail_destroy_system;
 
     ob_geometry_desc gd = {.name = name, .vertex_count = 6, .instance_count = d->count};
     ps->quads = ob_geometry_create(ctx->dev, &gd, &r);
-    if (!ps->quads) goto fail;
+    if (!ps->quads) goto fail_destroy_system;
     ob_effect *draw = ob_material_library_effect(ctx->materials, OB_STD_PARTICLES_DRAW, 0, &r);
-    if (!draw) goto fail;
+    if (!draw) goto fail_destroy_system;
     ob_material_desc md = {.name = name, .kind = OB_MATERIAL_CUSTOM, .blended = true};
     memcpy(md.diffuse, d->color, sizeof md.diffuse);
     ps->material = ob_material_create(ctx->materials, &md, &r);
-    if (!ps->material) goto fail;
+    if (!ps->material) goto fail_destroy_system;
     r = ob_material_set_view_effect(ps->material, OB_VIEW_PERSPECTIVE, draw);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_system;
 
     ob_view_init(&ps->sim.base, &sim_vtbl, OB_VIEW_SIMULATION, name);
     ps->sim.ps = ps;
@@ -156,20 +156,20 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     ps->sim.base.storage_written = ps->buffer;
 
     ps->node = ob_node_create(scene, parent, name, &r);
-    if (!ps->node) goto fail;
+    if (!ps->node) goto fail_destroy_system;
     /* The particles stay within speed * lifetime of the emitter. */
     float reach = d->speed * d->lifetime +
                   0.5f * sqrtf(d->gravity[0] * d->gravity[0] + d->gravity[1] * d->gravity[1] +
                                d->gravity[2] * d->gravity[2]) * d->lifetime * d->lifetime;
     ob_renderable rd = {.material = ps->material, .geometry = ps->quads, .local_radius = reach};
     r = ob_node_set_renderable(ps->node, &rd);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_system;
     r = ob_views_add_system(ctx, ps->node, &ps->sim.base, ps);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_system;
     if (out_result) *out_result = OB_OK;
     return ps;
 
-fail:
+fail_destroy_system:
     OB_LOG_E("views", "particle system '%s' not created: %s",
              desc && desc->name ? desc->name : "particles", ob_result_name(r));
     ob_free(init);

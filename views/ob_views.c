@@ -377,7 +377,7 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
     ctx->dt = 1.0 / 60.0;
     r = register_params(ob_renderer_registry(ctx->r));
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_views;
     /* Samplers (ShadowMapSampler, EnvMapSampler, SourceImageSampler) are
      * the material library's defaults. */
     ob_renderer_set_material_iface(ctx->r, ob_material_iface_get());
@@ -385,7 +385,7 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ob_material_library_set_queue_hook(ctx->materials, queue_hook, ctx);
     goto done;
 
-fail:
+fail_destroy_views:
     ob_views_destroy(ctx);
     ctx = NULL;
 done:
