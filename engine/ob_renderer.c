@@ -176,12 +176,12 @@ void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *ifa
     if (iface) r->geometry_iface = *iface;
 }
 
-const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r)
+const ob_material_iface *ob_renderer_get_material_iface(const ob_renderer *r)
 {
     return r->has_material_iface ? &r->material_iface : NULL;
 }
 
-const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r)
+const ob_geometry_iface *ob_renderer_get_geometry_iface(const ob_renderer *r)
 {
     return r->has_geometry_iface ? &r->geometry_iface : NULL;
 }
@@ -193,7 +193,7 @@ void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t activ
     r->pending_active = active_workers;
 }
 
-ob_threading ob_renderer_threading(const ob_renderer *r) { return r->mode; }
+ob_threading ob_renderer_get_threading(const ob_renderer *r) { return r->mode; }
 
 void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth)
 {

@@ -147,7 +147,7 @@ uint32_t ob_renderer_worker_count(const ob_renderer *r);
 
 /* Takes effect at the next begin_frame. active_workers 0 → all. */
 void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
-ob_threading ob_renderer_threading(const ob_renderer *r);
+ob_threading ob_renderer_get_threading(const ob_renderer *r);
 
 /* Waits for this frame slot's fence, collects its GPU timings, resets its
  * pools and rings, applies a pending mode change. */

@@ -71,8 +71,8 @@ void ob_renderer_set_material_iface(ob_renderer *r, const ob_material_iface *ifa
 void ob_renderer_set_geometry_iface(ob_renderer *r, const ob_geometry_iface *iface);
 /* The installed copy, NULL when none. Valid until the next set_*_iface.
  * [any thread, while no set_*_iface runs] */
-const ob_material_iface *ob_renderer_material_iface(const ob_renderer *r);
-const ob_geometry_iface *ob_renderer_geometry_iface(const ob_renderer *r);
+const ob_material_iface *ob_renderer_get_material_iface(const ob_renderer *r);
+const ob_geometry_iface *ob_renderer_get_geometry_iface(const ob_renderer *r);
 
 /* ---- PreRender ----------------------------------------------------------- */
 

@@ -436,7 +436,7 @@ ob_result ob_node_set_parent(ob_scene *s, ob_node *n, ob_node *parent)
 
 uint32_t ob_node_id(const ob_node *n) { return n->id; }
 const char *ob_node_name(const ob_node *n) { return n->name; }
-ob_node *ob_node_parent(const ob_node *n) { return n->parent; }
+ob_node *ob_node_get_parent(const ob_node *n) { return n->parent; }
 ob_node *ob_node_first_child(const ob_node *n) { return n->first_child; }
 ob_node *ob_node_next_sibling(const ob_node *n) { return n->next_sibling; }
 
@@ -502,13 +502,13 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
     return OB_OK;
 }
 
-const ob_renderable *ob_node_renderable(const ob_node *n)
+const ob_renderable *ob_node_get_renderable(const ob_node *n)
 {
     return n->has_renderable ? &n->renderable : NULL;
 }
 
 void ob_node_set_user(ob_node *n, void *user) { n->user = user; }
-void *ob_node_user(const ob_node *n) { return n->user; }
+void *ob_node_get_user(const ob_node *n) { return n->user; }
 
 /* --------------------------------------------------------------- transform */
 
@@ -801,7 +801,7 @@ ob_result ob_node_set_camera(ob_node *n, const ob_camera_desc *d)
     return OB_OK;
 }
 
-const ob_camera_desc *ob_node_camera(const ob_node *n) { return n->has_camera ? &n->camera : NULL; }
+const ob_camera_desc *ob_node_get_camera(const ob_node *n) { return n->has_camera ? &n->camera : NULL; }
 
 ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d)
 {
@@ -826,4 +826,4 @@ ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d)
     return OB_OK;
 }
 
-const ob_light_desc *ob_node_light(const ob_node *n) { return n->has_light ? &n->light : NULL; }
+const ob_light_desc *ob_node_get_light(const ob_node *n) { return n->has_light ? &n->light : NULL; }

@@ -149,7 +149,7 @@ ob_result ob_node_set_parent(ob_scene *s, ob_node *n, ob_node *parent);
 
 uint32_t ob_node_id(const ob_node *n);
 const char *ob_node_name(const ob_node *n);
-ob_node *ob_node_parent(const ob_node *n);          /* NULL for the root */
+ob_node *ob_node_get_parent(const ob_node *n);          /* NULL for the root */
 ob_node *ob_node_first_child(const ob_node *n);     /* children in the order attached */
 ob_node *ob_node_next_sibling(const ob_node *n);
 
@@ -181,10 +181,10 @@ bool ob_node_is_hidden(const ob_node *n);   /* n's own flag */
 /* Copies r (NULL clears). A negative or non-finite bound is refused
  * (OB_ERR_INVALID_ARGUMENT, logged, nothing changed). */
 ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r);
-const ob_renderable *ob_node_renderable(const ob_node *n);   /* NULL if none */
+const ob_renderable *ob_node_get_renderable(const ob_node *n);   /* NULL if none */
 
 void ob_node_set_user(ob_node *n, void *user);
-void *ob_node_user(const ob_node *n);
+void *ob_node_get_user(const ob_node *n);
 
 /* ------------------------------------------- world queries (after update) */
 
@@ -249,7 +249,7 @@ typedef struct ob_camera_desc {
 /* Copies d with defaults filled in (NULL removes the camera). Refuses fovy
  * outside (0, pi), negative or non-finite values (OB_ERR_INVALID_ARGUMENT). */
 ob_result ob_node_set_camera(ob_node *n, const ob_camera_desc *d);
-const ob_camera_desc *ob_node_camera(const ob_node *n);   /* NULL if none */
+const ob_camera_desc *ob_node_get_camera(const ob_node *n);   /* NULL if none */
 
 typedef enum ob_light_type { OB_LIGHT_DIRECTIONAL, OB_LIGHT_POINT } ob_light_type;
 
@@ -266,7 +266,7 @@ typedef struct ob_light_desc {
 /* Copies d with defaults filled in (NULL removes the light). Refuses unknown
  * types, negative or non-finite values (OB_ERR_INVALID_ARGUMENT). */
 ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d);
-const ob_light_desc *ob_node_light(const ob_node *n);     /* NULL if none */
+const ob_light_desc *ob_node_get_light(const ob_node *n);     /* NULL if none */
 
 #ifdef __cplusplus
 }

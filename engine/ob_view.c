@@ -105,8 +105,8 @@ static void sort_items(ob_draw_item *items, ob_draw_item *scratch, uint32_t n)
 
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
 {
-    const ob_material_iface *mi = ob_renderer_material_iface(r);
-    const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
+    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
+    const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
     const ob_render_proxy *proxies = ob_scene_render_proxies(scene, &count);
@@ -180,12 +180,12 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
 
 void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
 {
-    const ob_material_iface *mi = ob_renderer_material_iface(r);
+    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     if (!mi || !mi->pre_render) return;
     /* Items can be appended to other views during this loop, never to v. */
     for (uint32_t i = 0; i < v->item_count; i++) {
         ob_node *n = v->items[i].node;
-        mi->pre_render(ob_node_renderable(n)->material, n, r, v);
+        mi->pre_render(ob_node_get_renderable(n)->material, n, r, v);
     }
 }
 
@@ -195,8 +195,8 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                           uint32_t first, uint32_t count)
 {
-    const ob_material_iface *mi = ob_renderer_material_iface(r);
-    const ob_geometry_iface *gi = ob_renderer_geometry_iface(r);
+    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
+    const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     /* Items are sorted by state: a run of one material is applied once. */
     const struct ob_material *applied = NULL;
     _Alignas(16) float m[32];

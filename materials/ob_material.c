@@ -588,7 +588,7 @@ static ob_effect *resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
     return e;
 }
 
-ob_effect *ob_material_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
+ob_effect *ob_material_get_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
                                    const ob_view *v, bool create, ob_result *out_result)
 {
     uint32_t variant;
@@ -633,7 +633,7 @@ void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, 
     view_formats(lib->dev, v, &color, &depth);
     for (uint32_t i = 0; i < v->item_count; i++) {
         ob_node *n = v->items[i].node;
-        const ob_renderable *rd = n ? ob_node_renderable(n) : NULL;
+        const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
         if (!rd || !rd->material || rd->material->lib != lib) continue;
         prepare(rd->material, r, n, v, color, depth);
     }

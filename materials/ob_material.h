@@ -185,7 +185,7 @@ ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity);
  * missing variant is compiled [render thread]; without, falls back as apply
  * does [any thread]. NULL when the material does not render in v->type or
  * the effect failed (logged). */
-ob_effect *ob_material_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
+ob_effect *ob_material_get_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
                                    const ob_view *v, bool create, ob_result *out_result);
 
 /* The engine interface: renders, sort_info, pre_render, apply. Static data. */

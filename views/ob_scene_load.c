@@ -349,8 +349,8 @@ typedef struct camera_state {
 
 static camera_state camera_save(const ob_node *n)
 {
-    camera_state s = {.had_camera = ob_node_camera(n) != NULL};
-    if (s.had_camera) s.desc = *ob_node_camera(n);
+    camera_state s = {.had_camera = ob_node_get_camera(n) != NULL};
+    if (s.had_camera) s.desc = *ob_node_get_camera(n);
     ob_node_get_position(n, s.position);
     ob_node_get_rotation(n, s.rotation);
     return s;

@@ -16,7 +16,7 @@ static void perspective_pre_render(ob_view *v, ob_renderer *r)
     ob_perspective_view *pv = (ob_perspective_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
     ob_scene *scene = ob_renderer_scene(r);
-    const ob_camera_desc *cam = pv->camera ? ob_node_camera(pv->camera) : NULL;
+    const ob_camera_desc *cam = pv->camera ? ob_node_get_camera(pv->camera) : NULL;
     if (!scene || !cam || !ob_node_transform_is_valid(pv->camera)) {
         /* Nothing sensible to render: the view still clears its target. */
         if (!pv->warned_degenerate)

@@ -21,7 +21,7 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
 {
     ob_view *v = &sv->base;
     ob_view *c = sv->consumer;
-    const ob_material_iface *mi = ob_renderer_material_iface(r);
+    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     float right[3], up[3], fwd[3];
     ob_node_world_axes(sv->light, right, up, fwd);
     double dir[3] = {fwd[0], fwd[1], fwd[2]}, upd[3] = {0.0, 1.0, 0.0}, axes[9];
@@ -33,7 +33,7 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
     uint32_t casters = 0;
     for (uint32_t i = 0; i < c->item_count; i++) {
         ob_node *n = c->items[i].node;
-        const ob_renderable *rd = ob_node_renderable(n);
+        const ob_renderable *rd = ob_node_get_renderable(n);
         if (!mi->renders(rd->material, OB_VIEW_SHADOW)) continue;
         double wc[3];
         float radius;

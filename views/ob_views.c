@@ -82,7 +82,7 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
     ob_scene *scene = ob_renderer_scene(ctx->r);
     ob_node *const *lights = scene ? ob_scene_lights(scene, &count) : NULL;
     for (uint32_t i = 0; i < count; i++) {
-        const ob_light_desc *l = ob_node_light(lights[i]);
+        const ob_light_desc *l = ob_node_get_light(lights[i]);
         if (l->type == OB_LIGHT_DIRECTIONAL && !have_dir) {
             float right[3], up[3], fwd[3];
             ob_node_world_axes(lights[i], right, up, fwd);
@@ -253,7 +253,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
     uint32_t count = 0;
     ob_node *const *lights = ob_scene_lights(ob_renderer_scene(r), &count);
     for (uint32_t i = 0; i < count; i++) {
-        const ob_light_desc *l = ob_node_light(lights[i]);
+        const ob_light_desc *l = ob_node_get_light(lights[i]);
         if (l->type != OB_LIGHT_DIRECTIONAL || !l->casts_shadows) continue;
         char name[64];
         snprintf(name, sizeof name, "shadow:%s", ob_node_name(lights[i]));

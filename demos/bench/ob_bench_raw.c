@@ -146,7 +146,7 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
     if (!s->draws || !s->push) return OB_ERR_OUT_OF_HOST_MEMORY;
     for (uint32_t i = 0; i < v->item_count; i++) {
         const ob_node *n = v->items[i].node;
-        const ob_renderable *rd = ob_node_renderable(n);
+        const ob_renderable *rd = ob_node_get_renderable(n);
         const ob_geometry *g = rd ? (const ob_geometry *)rd->geometry : NULL;
         if (!g || ob_geometry_index_count(g) == 0) continue;
         float *world = &s->push[32 * s->count], *normal = world + 16;

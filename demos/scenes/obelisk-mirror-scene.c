@@ -85,7 +85,7 @@ static void check_node(checker *c, const ob_node *a)
             differ(c, "world orientation", name);
             break;
         }
-    const ob_renderable *xa = ob_node_renderable(a), *xb = ob_node_renderable(b);
+    const ob_renderable *xa = ob_node_get_renderable(a), *xb = ob_node_get_renderable(b);
     if (!xa != !xb) {
         differ(c, "being drawn", name);
     } else if (xa) {
@@ -98,12 +98,12 @@ static void check_node(checker *c, const ob_node *a)
             differ(c, "bounds", name);
         if (!same_material(c, xa->material, xb->material)) differ(c, "material", name);
     }
-    const ob_light_desc *la = ob_node_light(a), *lb = ob_node_light(b);
+    const ob_light_desc *la = ob_node_get_light(a), *lb = ob_node_get_light(b);
     if (!la != !lb || (la && (la->type != lb->type || la->intensity != lb->intensity ||
                               la->range != lb->range || la->casts_shadows != lb->casts_shadows ||
                               memcmp(la->color, lb->color, sizeof la->color) != 0)))
         differ(c, "light", name);
-    const ob_camera_desc *ca = ob_node_camera(a), *cb = ob_node_camera(b);
+    const ob_camera_desc *ca = ob_node_get_camera(a), *cb = ob_node_get_camera(b);
     if (!ca != !cb || (ca && (fabsf(ca->fovy - cb->fovy) > 1e-6f || ca->znear != cb->znear)))
         differ(c, "camera", name);
     for (const ob_node *k = ob_node_first_child(a); k; k = ob_node_next_sibling(k)) check_node(c, k);

@@ -196,7 +196,7 @@ ob_result ob_stab_refused_views(ob_stab_ctx *c)
         unnamed += !ob_stab_log_has(c, "'bad-camera'", NULL);
     }
     ob_stab_expect(c, NULL);
-    bool no_camera = bad && !ob_node_camera(bad);
+    bool no_camera = bad && !ob_node_get_camera(bad);
     uint8_t *after = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
     if (w.err == OB_OK) {
@@ -263,7 +263,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     ob_stab_hide(b.sun, false);
     ob_result set = OB_OK;
     if (b.sun) {
-        ob_light_desc dark = *ob_node_light(b.sun);
+        ob_light_desc dark = *ob_node_get_light(b.sun);
         dark.intensity = 0.0f;
         set = ob_node_set_light(b.sun, &dark);
     }

@@ -341,7 +341,7 @@ ob_result ob_stab_no_casters(ob_stab_ctx *c)
     uint8_t *without = ob_stab_snapshot(&w);
     ob_result set = OB_OK;
     if (sun) {
-        ob_light_desc ld = *ob_node_light(sun);
+        ob_light_desc ld = *ob_node_get_light(sun);
         ld.casts_shadows = false;
         set = ob_node_set_light(sun, &ld);
     }

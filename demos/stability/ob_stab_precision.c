@@ -40,7 +40,7 @@ static ob_material *unlit(ob_stab_world *w, const char *name, const float rgb[3]
 static void set_material(ob_stab_world *w, ob_node *n, ob_material *m)
 {
     if (w->err != OB_OK || !n) return;
-    ob_renderable rd = *ob_node_renderable(n);
+    ob_renderable rd = *ob_node_get_renderable(n);
     rd.material = m;
     ob_result r = ob_node_set_renderable(n, &rd);
     if (r != OB_OK) {

@@ -168,7 +168,7 @@ static void test_no_effect_not_drawn(void **state)
     assert_false(mi->renders(lit, OB_VIEW_OVERLAY));
     mi->pre_render(lit, NULL, NULL, &overlay);
     assert_false(mi->apply(lit, NULL, NULL, pm, &overlay));
-    assert_null(ob_material_view_effect(lit, NULL, NULL, &overlay, true, &r));
+    assert_null(ob_material_get_view_effect(lit, NULL, NULL, &overlay, true, &r));
     assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 0);
 
     ob_material *custom = make_material(lib, OB_MATERIAL_CUSTOM, false, false, 0);
@@ -250,7 +250,7 @@ static void test_variants_compiled_only_when_used(void **state)
     ob_view_add_dependency(&persp, &shadow);
     mi->pre_render(lit, NULL, NULL, &persp);
     assert_int_equal(ob_effect_context_counters(f->ctx).variants_compiled, 3);
-    assert_ptr_equal(ob_material_view_effect(lit, NULL, NULL, &persp, false, NULL),
+    assert_ptr_equal(ob_material_get_view_effect(lit, NULL, NULL, &persp, false, NULL),
                      ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_SHADOWS));
 
     /* Environment map views use the paraboloid generation effect. */
@@ -315,7 +315,7 @@ static void test_reflective_queues_env_map(void **state)
     mi->pre_render(mirror, ball, NULL, &env);   /* drawn in others' maps, asks nothing */
     assert_int_equal(log.calls, 1);
     /* With no map attached the mirror falls back to plain lit shading. */
-    assert_ptr_equal(ob_material_view_effect(mirror, NULL, ball, &persp, false, NULL),
+    assert_ptr_equal(ob_material_get_view_effect(mirror, NULL, ball, &persp, false, NULL),
                      ob_material_library_find_effect(lib, OB_STD_LIT, 0));
     ob_scene_destroy(scene);
     destroy_library(f, lib);
@@ -373,7 +373,7 @@ static void test_apply_and_prepare_view(void **state)
      * wants lit+SHADOWS, which does not exist yet, so apply uses lit. */
     ob_view_add_dependency(&persp, &shadow);
     assert_true(mi->apply(red, NULL, NULL, pm, &persp));
-    assert_ptr_equal(ob_material_view_effect(red, NULL, NULL, &persp, false, NULL),
+    assert_ptr_equal(ob_material_get_view_effect(red, NULL, NULL, &persp, false, NULL),
                      ob_material_library_find_effect(lib, OB_STD_LIT, 0));
     /* prepare_view builds what the draw list needs. */
     ob_scene *scene = ob_scene_create(&r);
@@ -389,7 +389,7 @@ static void test_apply_and_prepare_view(void **state)
     ob_effect *shadowed = ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_SHADOWS);
     assert_non_null(shadowed);
     assert_int_equal(ob_effect_pipeline_count(shadowed), 1);
-    assert_ptr_equal(ob_material_view_effect(red, NULL, NULL, &persp, false, NULL), shadowed);
+    assert_ptr_equal(ob_material_get_view_effect(red, NULL, NULL, &persp, false, NULL), shadowed);
 
     ob_scene_destroy(scene);
     ob_pipeline_manager_destroy(pm);
@@ -564,7 +564,7 @@ static void test_reflective_uses_attached_env_map(void **state)
     ob_material *plain = make_material(lib, OB_MATERIAL_LIT, false, false, 0);
 
     mi->pre_render(mirror, ball, rd, &persp);   /* nothing attached: plain lit */
-    assert_ptr_equal(ob_material_view_effect(mirror, rd, ball, &persp, false, NULL),
+    assert_ptr_equal(ob_material_get_view_effect(mirror, rd, ball, &persp, false, NULL),
                      ob_material_library_find_effect(lib, OB_STD_LIT, 0));
     assert_null(ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_ENVMAP));
 
@@ -572,7 +572,7 @@ static void test_reflective_uses_attached_env_map(void **state)
     mi->pre_render(mirror, ball, rd, &persp);
     ob_effect *lookup = ob_material_library_find_effect(lib, OB_STD_LIT, OB_VARIANT_ENVMAP);
     assert_non_null(lookup);
-    assert_ptr_equal(ob_material_view_effect(mirror, rd, ball, &persp, false, NULL), lookup);
+    assert_ptr_equal(ob_material_get_view_effect(mirror, rd, ball, &persp, false, NULL), lookup);
     assert_true(mi->apply(mirror, ball, rd, pm, &persp));
     assert_int_equal(env.calls, 1);
     assert_ptr_equal(env.consumer, &persp);

@@ -52,7 +52,7 @@ static double rendered_share(ob_stack *s)
 
 static ob_material *material_of(ob_node *n)
 {
-    const ob_renderable *rd = ob_node_renderable(n);
+    const ob_renderable *rd = ob_node_get_renderable(n);
     assert_non_null(rd);
     return rd->material;
 }
@@ -81,7 +81,7 @@ static void test_load_small_scene(void **state)
     ob_result r = ob_scene_load_stack(s, &(ob_scene_load_desc){.file = &sf, .seed = 7}, &l, &err);
     if (r != OB_OK) fail_msg("load failed: %s", err.message);
     assert_string_equal(err.message, "");
-    assert_int_equal(ob_renderer_threading(s->renderer), OB_THREADING_MULTI);
+    assert_int_equal(ob_renderer_get_threading(s->renderer), OB_THREADING_MULTI);
 
     /* Entities in the file's order, with their parents. */
     static const char *const names[] = {"floor", "crate", "ball", "pyramid", "crate-twin"};
@@ -90,8 +90,8 @@ static void test_load_small_scene(void **state)
         assert_string_equal(ob_node_name(l.entities[i]), names[i]);
         assert_true(ob_node_is_renderable(l.entities[i]));
     }
-    assert_ptr_equal(ob_node_parent(l.entities[3]), l.entities[1]);
-    assert_ptr_equal(ob_node_parent(l.entities[1]), ob_scene_root(s->scene));
+    assert_ptr_equal(ob_node_get_parent(l.entities[3]), l.entities[1]);
+    assert_ptr_equal(ob_node_get_parent(l.entities[1]), ob_scene_root(s->scene));
     double p[3];
     ob_node_get_position(l.entities[2], p);
     assert_near(p[0], 1.5, 1e-12);
@@ -113,18 +113,18 @@ static void test_load_small_scene(void **state)
 
     /* Geometry: plane, box (shared by the two crates), sphere, the model. */
     assert_int_equal(l.geometry_count, 4);
-    assert_ptr_equal(ob_node_renderable(l.entities[1])->geometry, ob_node_renderable(l.entities[4])->geometry);
-    const ob_bounds *pyramid = ob_geometry_bounds(ob_node_renderable(l.entities[3])->geometry);
+    assert_ptr_equal(ob_node_get_renderable(l.entities[1])->geometry, ob_node_get_renderable(l.entities[4])->geometry);
+    const ob_bounds *pyramid = ob_geometry_bounds(ob_node_get_renderable(l.entities[3])->geometry);
     assert_near(pyramid->max[1] - pyramid->min[1], 1.0, 1e-6);
 
     /* Lights as the file says. */
     assert_int_equal(l.light_count, 2);
     assert_string_equal(ob_node_name(l.lights[0]), "sun");
-    const ob_light_desc *sun = ob_node_light(l.lights[0]);
+    const ob_light_desc *sun = ob_node_get_light(l.lights[0]);
     assert_non_null(sun);
     assert_int_equal(sun->type, OB_LIGHT_DIRECTIONAL);
     assert_true(sun->casts_shadows);
-    const ob_light_desc *lamp = ob_node_light(l.lights[1]);
+    const ob_light_desc *lamp = ob_node_get_light(l.lights[1]);
     assert_non_null(lamp);
     assert_int_equal(lamp->type, OB_LIGHT_POINT);
     assert_near(lamp->intensity, 2.0, 1e-6);
@@ -137,7 +137,7 @@ static void test_load_small_scene(void **state)
     assert_ptr_equal(l.camera, s->camera);
     assert_false(l.camera_created);
     assert_false(l.framed);
-    const ob_camera_desc *cam = ob_node_camera(s->camera);
+    const ob_camera_desc *cam = ob_node_get_camera(s->camera);
     assert_non_null(cam);
     assert_near(cam->fovy, 50.0 * DEG, 1e-6);
     assert_near(cam->znear, 0.05, 1e-6);
@@ -146,7 +146,7 @@ static void test_load_small_scene(void **state)
 
     /* Particles under their entity; bounds around the floor. */
     assert_int_equal(l.particle_count, 1);
-    assert_ptr_equal(ob_node_parent(ob_particle_system_node(l.particles[0])), l.entities[2]);
+    assert_ptr_equal(ob_node_get_parent(ob_particle_system_node(l.particles[0])), l.entities[2]);
     assert_true(l.has_bounds);
     assert_true(l.min[0] <= -4.0 && l.max[0] >= 4.0 && l.radius >= 4.0);
 
@@ -192,7 +192,7 @@ static void test_load_missing_model(void **state)
     assert_int_equal(l.entity_count, 6);
     assert_false(ob_node_is_renderable(l.entities[2]));
     assert_true(ob_node_is_renderable(l.entities[3]));
-    assert_ptr_equal(ob_node_parent(l.entities[3]), l.entities[2]);
+    assert_ptr_equal(ob_node_get_parent(l.entities[3]), l.entities[2]);
     assert_int_equal(l.geometry_count, 3);   /* plane, box, sphere */
     assert_int_equal(l.light_count, 1);      /* no "lights": the default sun */
     assert_string_equal(ob_node_name(l.lights[0]), "sun");

@@ -417,7 +417,7 @@ static void switched_off_light_no_shadow_view(void **state)
     ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_non_null(ob_test_view_stats(st, "shadow:sun"));
-    ob_light_desc dark = *ob_node_light(sun);
+    ob_light_desc dark = *ob_node_get_light(sun);
     dark.intensity = 0.0f;
     assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);

@@ -115,7 +115,7 @@ static void threading_change_takes_effect_at_next_frame(void **state)
         /* This frame still ran as set before it began. */
         assert_int_equal(st->mode, mode);
         assert_int_equal(st->workers, active);
-        assert_int_equal(ob_renderer_threading(w.r), mode);
+        assert_int_equal(ob_renderer_get_threading(w.r), mode);
         mode = steps[i].mode;
         active = steps[i].active;
     }

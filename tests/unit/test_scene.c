@@ -127,7 +127,7 @@ static void reparenting_moves_subtree(void **state)
     assert_near(p[2], 5, 1e-12);
 
     assert_int_equal(ob_node_set_parent(s, c, b), OB_OK);
-    assert_ptr_equal(ob_node_parent(c), b);
+    assert_ptr_equal(ob_node_get_parent(c), b);
     assert_null(ob_node_first_child(a));
     ob_scene_update(s, 0.0);
     ob_node_world_position(d, p); /* local kept: b * (1,0,0) + (0,0,5) rotated */
@@ -168,9 +168,9 @@ static void cycles_and_foreign_nodes_refused(void **state)
     ob_node_destroy(s, ob_scene_root(s)); /* refused, logged */
     assert_true(ob_test_log_has("root", "cannot be destroyed", NULL));
     /* Structure unchanged. */
-    assert_ptr_equal(ob_node_parent(c), b);
-    assert_ptr_equal(ob_node_parent(b), a);
-    assert_ptr_equal(ob_node_parent(a), ob_scene_root(s));
+    assert_ptr_equal(ob_node_get_parent(c), b);
+    assert_ptr_equal(ob_node_get_parent(b), a);
+    assert_ptr_equal(ob_node_get_parent(a), ob_scene_root(s));
     assert_int_equal(ob_scene_node_count(s), 4);
     assert_int_equal(ob_scene_update(s, 0.0), OB_OK);
     ob_scene_destroy(s);
@@ -215,8 +215,8 @@ static void hidden_subtree_leaves_snapshot(void **state)
     ob_scene_update(s, 0.0);
     assert_true(snapshot_has(s, leaf));
     assert_false(snapshot_has(s, inner));
-    assert_null(ob_node_renderable(inner));
-    assert_non_null(ob_node_renderable(leaf));
+    assert_null(ob_node_get_renderable(inner));
+    assert_non_null(ob_node_get_renderable(leaf));
     ob_scene_destroy(s);
 }
 
@@ -375,7 +375,7 @@ static void structure_changes_refused_inside_controllers(void **state)
     assert_int_equal(m.parent_r, OB_ERR_WRONG_STATE);
     assert_int_equal(m.update_r, OB_ERR_WRONG_STATE);
     assert_int_equal(ob_scene_node_count(s), 4);
-    assert_ptr_equal(ob_node_parent(m.victim), g);
+    assert_ptr_equal(ob_node_get_parent(m.victim), g);
     assert_true(ob_test_log_has("'victim'", "not allowed inside a controller", NULL));
     ob_scene_destroy(s);
 }
@@ -555,7 +555,7 @@ static void bad_update_arguments_refused(void **state)
     assert_int_equal(ob_node_set_renderable(n, &(ob_renderable){.local_center = {NAN, 0, 0}}),
                      OB_ERR_INVALID_ARGUMENT);
     assert_true(ob_test_log_has("'boxy'", "renderable", NULL));
-    assert_null(ob_node_renderable(n));
+    assert_null(ob_node_get_renderable(n));
     ob_scene_destroy(s);
 }
 
@@ -564,31 +564,31 @@ static void cameras_and_lights(void **state)
     (void)state;
     ob_scene *s = new_scene();
     ob_node *cam = new_node(s, NULL, "cam");
-    assert_null(ob_node_camera(cam));
+    assert_null(ob_node_get_camera(cam));
     assert_int_equal(ob_node_set_camera(cam, &(ob_camera_desc){0}), OB_OK);
-    const ob_camera_desc *cd = ob_node_camera(cam);
+    const ob_camera_desc *cd = ob_node_get_camera(cam);
     assert_non_null(cd);
     assert_near(cd->fovy, OB_PI / 3, 1e-6);
     assert_near(cd->znear, 0.1, 1e-7);
     assert_near(cd->aspect, 0, 0);
     assert_int_equal(ob_node_set_camera(cam, &(ob_camera_desc){.fovy = 4}), OB_ERR_INVALID_ARGUMENT);
     assert_int_equal(ob_node_set_camera(cam, &(ob_camera_desc){.znear = -1}), OB_ERR_INVALID_ARGUMENT);
-    assert_near(ob_node_camera(cam)->fovy, OB_PI / 3, 1e-6); /* unchanged */
+    assert_near(ob_node_get_camera(cam)->fovy, OB_PI / 3, 1e-6); /* unchanged */
     ob_node_set_camera(cam, NULL);
-    assert_null(ob_node_camera(cam));
+    assert_null(ob_node_get_camera(cam));
 
     ob_node *sun = new_node(s, NULL, "sun"), *lamp = new_node(s, NULL, "lamp");
     ob_node *off = new_node(s, NULL, "off"), *broken = new_node(s, NULL, "broken");
     assert_int_equal(ob_node_set_light(sun, &(ob_light_desc){.type = OB_LIGHT_DIRECTIONAL,
                                                              .casts_shadows = true}), OB_OK);
-    const ob_light_desc *ld = ob_node_light(sun);
+    const ob_light_desc *ld = ob_node_get_light(sun);
     assert_near(ld->color[1], 1, 0);
     assert_near(ld->intensity, 0, 0); /* literal: a light faded to 0 stays off */
     assert_true(ld->casts_shadows);
     assert_int_equal(ob_node_set_light(lamp, &(ob_light_desc){.type = OB_LIGHT_POINT,
                                                               .color = {1, 0.5f, 0},
                                                               .intensity = 3, .range = 10}), OB_OK);
-    assert_near(ob_node_light(lamp)->color[1], 0.5, 0);
+    assert_near(ob_node_get_light(lamp)->color[1], 0.5, 0);
     assert_int_equal(ob_node_set_light(off, &(ob_light_desc){.intensity = -1}), OB_ERR_INVALID_ARGUMENT);
     assert_int_equal(ob_node_set_light(off, &(ob_light_desc){.type = (ob_light_type)7}),
                      OB_ERR_INVALID_ARGUMENT);
@@ -609,7 +609,7 @@ static void cameras_and_lights(void **state)
     ob_node_world_axes(sun, NULL, NULL, fwd);
     assert_near(fwd[1], -1, 1e-6);
     ob_node_set_light(lamp, NULL);
-    assert_null(ob_node_light(lamp));
+    assert_null(ob_node_get_light(lamp));
     ob_scene_destroy(s);
 }
 
@@ -694,8 +694,8 @@ static void find_names_and_user_data(void **state)
     assert_string_equal(ob_node_name(anon), "");
     int tag;
     ob_node_set_user(b, &tag);
-    assert_ptr_equal(ob_node_user(b), &tag);
-    assert_null(ob_node_user(a));
+    assert_ptr_equal(ob_node_get_user(b), &tag);
+    assert_null(ob_node_get_user(a));
     assert_int_equal(ob_scene_node_count(s), 4);
     uint32_t count = 99;
     ob_node *const *items = ob_scene_renderables(s, &count);
