@@ -89,13 +89,6 @@ static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *
     return w->cmds[f][w->cmd_used++];
 }
 
-static VkFormat image_format(ob_device *dev, ob_image img)
-{
-    ob_image_info info;
-    if (!img.id || ob_image_get_info(dev, img, &info) != OB_OK) return VK_FORMAT_UNDEFINED;
-    return info.format;
-}
-
 /* The per-view parameters a recording of v needs in a manager's slot. */
 static void set_view_params(ob_renderer *r, ob_view *v, ob_pipeline_manager *pm)
 {
@@ -125,13 +118,15 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
         w->error = res;
         return;
     }
-    VkFormat color = image_format(r->dev, v->color);
+    VkFormat color, depth;
+    uint32_t samples;
+    ob_view_attachment_formats(v, r->dev, &color, &depth, &samples);
     VkCommandBufferInheritanceRenderingInfo rendering = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO,
-        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .colorAttachmentCount = color != VK_FORMAT_UNDEFINED ? 1u : 0u,
         .pColorAttachmentFormats = &color,
-        .depthAttachmentFormat = image_format(r->dev, v->depth),
-        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+        .depthAttachmentFormat = depth,
+        .rasterizationSamples = (VkSampleCountFlagBits)samples,
     };
     bool graphics = v->layer_count > 0;
     VkCommandBufferInheritanceInfo inherit = {
@@ -370,8 +365,9 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 
 /* ------------------------------------------------------------ primary */
 
-/* Colour and depth of each dependency, the inputs, the view's own two targets. */
-#define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 2)
+/* Colour and depth of each dependency, the inputs, the view's own targets
+ * (colour, depth, and with MSAA the two multisampled ones). */
+#define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 4)
 
 /* Keep img's tracked state from before this frame's first barrier on it. */
 void ob_renderer_note_image_state(ob_renderer *r, ob_image img)
@@ -465,11 +461,20 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
     }
     if (v->layer_count > 0) {
+        /* With MSAA `color` is the resolve target: the resolve writes it in
+         * the colour-attachment-output stage, like a colour attachment. */
+        bool ms = v->samples > 1;
         add_image_barrier(r, v->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                           VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                           barriers, &n);
-        add_image_barrier(r, v->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        if (ms)
+            add_image_barrier(r, v->msaa_color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                              VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
+                                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                              barriers, &n);
+        add_image_barrier(r, ms ? v->msaa_depth : v->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
                               VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
@@ -507,9 +512,51 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+/* A multisampled view (one layer): draws into msaa_color / msaa_depth,
+ * which nothing reads afterwards (not stored), and resolves the colour into
+ * v->color with the samples' average at the end of the scope. */
+static void begin_rendering_multisampled(ob_renderer *r, VkCommandBuffer cmd, ob_view *v,
+                                         bool secondaries)
+{
+    VkRenderingAttachmentInfo color = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(r->dev, v->msaa_color),
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT,
+        .resolveImageView = ob_image_view(r->dev, v->color),
+        .resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = v->load_color ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = v->load_color ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue.color = {{v->clear_color[0], v->clear_color[1], v->clear_color[2],
+                              v->clear_color[3]}},
+    };
+    VkRenderingAttachmentInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(r->dev, v->msaa_depth),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue.depthStencil = {v->clear_depth, 0},
+    };
+    VkRenderingInfo ri = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .flags = secondaries ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0u,
+        .renderArea = {{0, 0}, {v->width, v->height}},
+        .layerCount = 1,
+        .colorAttachmentCount = v->msaa_color.id ? 1u : 0u,
+        .pColorAttachments = &color,
+        .pDepthAttachment = v->msaa_depth.id ? &depth : NULL,
+    };
+    vkCmdBeginRendering(cmd, &ri);
+}
+
 static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uint32_t layer,
                             bool secondaries)
 {
+    if (v->samples > 1) {
+        begin_rendering_multisampled(r, cmd, v, secondaries);
+        return;
+    }
     VkRenderingAttachmentInfo color = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
         .imageView = v->color.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->color, layer)

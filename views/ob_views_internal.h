@@ -61,10 +61,23 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
 /* Simulation view of a particle system (ob_view_simulation.c). */
 ob_view *ob_particle_system_sim_view(ob_particle_system *ps);
 
-/* Image + view for a view's target. */
+/* Images for a view's targets (colour, depth; with v->samples > 1 and one
+ * layer also the multisampled colour and depth, the depth then only
+ * multisampled). On failure nothing is made and v is unchanged. */
 ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height,
                                uint32_t layers, VkFormat color, VkFormat depth);
 void ob_views_release_target(ob_views *ctx, ob_view *v);
+/* v's targets again at width x height (same formats, layers, samples); the
+ * old images are destroyed deferred. On failure v keeps its targets, logged. */
+ob_result ob_views_resize_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height);
+/* Applies v's pending ob_view_resize, if any; true when the size changed.
+ * Views call it at the start of their PreRender. */
+bool ob_views_apply_resize(ob_views *ctx, ob_view *v);
+/* The sample count to use for `wanted` (1, 2, 4, 8...): the largest the
+ * device offers for both formats up to wanted; a lower count is logged as
+ * a warning naming the view. */
+uint32_t ob_views_supported_samples(ob_views *ctx, const char *view_name, uint32_t wanted,
+                                    VkFormat color, VkFormat depth);
 
 /* Frees a view made by this layer: its targets, its draw list and the
  * object itself (whose first member is the base). NULL ok. */
@@ -76,6 +89,12 @@ void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *color, V
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm);
 
 #define OB_VIEWS_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+/* Environment maps: they only feed shading (sampled by reflective
+ * materials), so 8-bit linear is kept there; lit values above 1 clip. */
 #define OB_VIEWS_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
+/* Camera views render linear HDR colour; the composite tone maps it into an
+ * sRGB target (what is read back, written as PNG and presented). */
+#define OB_VIEWS_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
+#define OB_VIEWS_OUTPUT_FORMAT VK_FORMAT_R8G8B8A8_SRGB
 
 #endif /* OB_VIEWS_INTERNAL_H */
