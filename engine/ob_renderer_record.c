@@ -512,70 +512,43 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
-/* A multisampled view (one layer): draws into msaa_color / msaa_depth,
- * which nothing reads afterwards (not stored), and resolves the colour into
- * v->color with the samples' average at the end of the scope. */
-static void begin_rendering_multisampled(ob_renderer *r, VkCommandBuffer cmd, ob_view *v,
-                                         bool secondaries)
+/* The attachment view of img for one layer of v. */
+static VkImageView attachment_view(ob_renderer *r, const ob_view *v, ob_image img, uint32_t layer)
 {
-    VkRenderingAttachmentInfo color = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(r->dev, v->msaa_color),
-        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT,
-        .resolveImageView = ob_image_view(r->dev, v->color),
-        .resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .loadOp = v->load_color ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = v->load_color ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .clearValue.color = {{v->clear_color[0], v->clear_color[1], v->clear_color[2],
-                              v->clear_color[3]}},
-    };
-    VkRenderingAttachmentInfo depth = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(r->dev, v->msaa_depth),
-        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .clearValue.depthStencil = {v->clear_depth, 0},
-    };
-    VkRenderingInfo ri = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-        .flags = secondaries ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0u,
-        .renderArea = {{0, 0}, {v->width, v->height}},
-        .layerCount = 1,
-        .colorAttachmentCount = v->msaa_color.id ? 1u : 0u,
-        .pColorAttachments = &color,
-        .pDepthAttachment = v->msaa_depth.id ? &depth : NULL,
-    };
-    vkCmdBeginRendering(cmd, &ri);
+    if (!img.id) return VK_NULL_HANDLE;
+    return v->layer_count > 1 ? ob_image_layer_view(r->dev, img, layer) : ob_image_view(r->dev, img);
 }
 
+/* A multisampled view (one layer) draws into msaa_color / msaa_depth, which
+ * nothing reads afterwards (not stored unless the colour is loaded next
+ * time), and resolves the colour into v->color with the samples' average
+ * at the end of the scope. */
 static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uint32_t layer,
                             bool secondaries)
 {
-    if (v->samples > 1) {
-        begin_rendering_multisampled(r, cmd, v, secondaries);
-        return;
-    }
+    bool ms = v->samples > 1;
+    ob_image color_img = ms ? v->msaa_color : v->color, depth_img = ms ? v->msaa_depth : v->depth;
     VkRenderingAttachmentInfo color = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = v->color.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->color, layer)
-                                                       : ob_image_view(r->dev, v->color))
-                                 : VK_NULL_HANDLE,
+        .imageView = attachment_view(r, v, color_img, layer),
         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
         .loadOp = v->load_color ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .storeOp = ms && !v->load_color ? VK_ATTACHMENT_STORE_OP_DONT_CARE
+                                        : VK_ATTACHMENT_STORE_OP_STORE,
         .clearValue.color = {{v->clear_color[0], v->clear_color[1], v->clear_color[2],
                               v->clear_color[3]}},
     };
+    if (ms) {
+        color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
+        color.resolveImageView = ob_image_view(r->dev, v->color);
+        color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    }
     VkRenderingAttachmentInfo depth = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = v->depth.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->depth, layer)
-                                                       : ob_image_view(r->dev, v->depth))
-                                 : VK_NULL_HANDLE,
+        .imageView = attachment_view(r, v, depth_img, layer),
         .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .storeOp = ms ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE,
         .clearValue.depthStencil = {v->clear_depth, 0},
     };
     VkRenderingInfo ri = {
@@ -583,9 +556,9 @@ static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uin
         .flags = secondaries ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0u,
         .renderArea = {{0, 0}, {v->width, v->height}},
         .layerCount = 1,
-        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .colorAttachmentCount = color_img.id ? 1u : 0u,
         .pColorAttachments = &color,
-        .pDepthAttachment = v->depth.id ? &depth : NULL,
+        .pDepthAttachment = depth_img.id ? &depth : NULL,
     };
     vkCmdBeginRendering(cmd, &ri);
 }
