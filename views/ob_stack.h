@@ -44,7 +44,8 @@ typedef struct ob_stack_desc {
     bool overlay;                /* also an overlay view, drawn last over the composite */
     uint32_t msaa;               /* main view's samples per pixel: 0 or 1 → none; 2, 4, 8
                                     (lowered to what the device offers, logged) */
-    float exposure;              /* the composite's exposure; 0 → OB_COMPOSITE_DEFAULT_EXPOSURE */
+    float exposure;              /* the composite's exposure; 0 → OB_COMPOSITE_DEFAULT_EXPOSURE;
+                                    negative or not finite: creation fails (logged) */
 } ob_stack_desc;
 
 typedef struct ob_stack {

@@ -201,6 +201,34 @@ static void msaa_4x_gives_quarter_coverage_levels(void **state)
     assert_true(four.levels[0] > 1000 && four.levels[4] > 1000);
 }
 
+/* The sample count is part of the pipeline's key: a 4x pipeline is another
+ * pipeline with another id, and a single-sampled one keeps the id (and so
+ * the command hashes) it had before counts were part of the key. */
+static void sample_count_is_part_of_the_pipeline_key(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_result r;
+    ob_effect *e = ob_effect_create(
+        w.fx, &(ob_effect_desc){.name = "keyed", .vertex = "unlit.vert", .fragment = "unlit.frag",
+                                .layout = ob_views_standard_input(), .depth_test = true},
+        &r);
+    assert_non_null(e);
+    uint32_t id1 = 0, id1b = 0, id4 = 0;
+    VkPipeline one = ob_effect_pipeline(e, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT, &id1);
+    VkPipeline one_b = ob_effect_pipeline_for(
+        e, &(ob_effect_targets){VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT, 1}, &id1b);
+    VkPipeline four = ob_effect_pipeline_for(
+        e, &(ob_effect_targets){VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT, 4}, &id4);
+    assert_true(one != VK_NULL_HANDLE && four != VK_NULL_HANDLE);
+    assert_true(one == one_b && id1 == id1b);
+    assert_true(four != one && id4 != id1);
+    assert_int_equal(ob_effect_pipeline_count(e), 2);
+    ob_effect_destroy(e);
+    ob_test_world_destroy(&w);
+}
+
 /* A count the device cannot do is lowered, and the log says so. */
 static void msaa_is_clamped_with_a_message(void **state)
 {
@@ -327,6 +355,7 @@ int main(void)
         cmocka_unit_test(linear_half_reads_back_as_188),
         cmocka_unit_test(tone_map_follows_the_documented_formula),
         cmocka_unit_test(msaa_4x_gives_quarter_coverage_levels),
+        cmocka_unit_test(sample_count_is_part_of_the_pipeline_key),
         cmocka_unit_test(msaa_is_clamped_with_a_message),
         cmocka_unit_test(resize_mid_run_renders_the_new_size),
         cmocka_unit_test(msaa_4x_same_in_st_and_mt),
