@@ -1,7 +1,8 @@
 /* ob_views.h — the concrete render views and the glue that installs them.
  *
  * View types (engine/ob_view.h is the interface):
- *   perspective  a camera's colour + depth; queues the shadow views of the
+ *   perspective  a camera's linear HDR colour + depth (optionally
+ *                multisampled and resolved); queues the shadow views of the
  *                lights that cast shadows onto what it sees
  *   shadow       a directional light's depth, fitted to the casters the
  *                consumer sees; left out with no caster or zero intensity
@@ -11,7 +12,8 @@
  *   simulation   compute only: a particle system in a storage buffer that the
  *                perspective view then draws
  *   overlay      text (stb_easy_font) drawn last over the final target
- *   composite    full-screen copy of a view's colour into the final target
+ *   composite    full-screen pass tone mapping a view's colour into the
+ *                final target (sRGB); its size follows its source's
  *
  * ob_views is the context that owns per-entity and per-light views (created
  * on first need, reused every frame), fills the renderer's material and
