@@ -81,6 +81,7 @@ static void apply_settings(ob_demo_options *o, const ob_scene_file_settings *s)
     if (s->shadow_map_size && !o->shadow_size) o->shadow_size = s->shadow_map_size;
     if (s->has_clear_color) memcpy(o->clear_color, s->clear_color, sizeof o->clear_color);
     if (s->has_ambient) memcpy(o->ambient, s->ambient, sizeof o->ambient);
+    if (s->exposure > 0.0f && !o->exposure_given) o->exposure = s->exposure;
 }
 
 int main(int argc, char **argv)

@@ -360,3 +360,13 @@ bool ob_frustum_test_sphere(const ob_frustum *f, const float center[3], float ra
     }
     return true;
 }
+
+float ob_srgb_to_linear(float encoded)
+{
+    return encoded <= 0.04045f ? encoded / 12.92f : powf((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+float ob_linear_to_srgb(float linear)
+{
+    return linear <= 0.0031308f ? linear * 12.92f : 1.055f * powf(linear, 1.0f / 2.4f) - 0.055f;
+}

@@ -200,6 +200,13 @@ void ob_frustum_from_matrix(const float view_proj[16], ob_frustum *dest);
  * visible. Points are in the same (camera-relative) space as the matrix. */
 bool ob_frustum_test_sphere(const ob_frustum *f, const float center[3], float radius);
 
+/* The sRGB transfer function (IEC 61966-2-1) for one colour channel:
+ * encoded (what a colour picker or an 8-bit sRGB image holds) to linear
+ * light, and back. Scene files and authored palettes are sRGB; the engine
+ * shades in linear light. [any thread] */
+float ob_srgb_to_linear(float encoded);
+float ob_linear_to_srgb(float linear);
+
 #ifdef __cplusplus
 }
 #endif

@@ -8,6 +8,7 @@
 #include "ob_resources_internal.h"
 
 #include <stb_image_write.h>
+#include <math.h>
 #include <string.h>
 
 static const VkMemoryBarrier2 to_host = {
@@ -91,7 +92,32 @@ static bool rgba8_format(VkFormat f, bool *out_bgra)
 {
     *out_bgra = f == VK_FORMAT_B8G8R8A8_UNORM || f == VK_FORMAT_B8G8R8A8_SRGB;
     return *out_bgra || f == VK_FORMAT_R8G8B8A8_UNORM || f == VK_FORMAT_R8G8B8A8_SRGB ||
-           f == VK_FORMAT_R8G8B8A8_UINT;
+           f == VK_FORMAT_R8G8B8A8_UINT || f == VK_FORMAT_R16G16B16A16_SFLOAT;
+}
+
+/* IEEE half to float (normals, subnormals, infinities, NaN). */
+static float half_to_float(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h >> 15) << 31, exp = (h >> 10) & 0x1fu, mant = h & 0x3ffu;
+    float f;
+    if (exp == 0) {
+        f = ldexpf((float)mant, -24);
+    } else if (exp == 31) {
+        f = mant ? NAN : INFINITY;
+    } else {
+        f = ldexpf((float)(mant | 0x400u), (int)exp - 25);
+    }
+    return sign ? -f : f;
+}
+
+/* A linear half-float value as an 8-bit UNORM byte: clamped, rounded, not
+ * encoded (what a blit to R8G8B8A8_UNORM would write). */
+static uint8_t half_to_unorm8(uint16_t h)
+{
+    float f = half_to_float(h);
+    if (!(f > 0.0f)) return 0;   /* also NaN */
+    if (f >= 1.0f) return 255;
+    return (uint8_t)(f * 255.0f + 0.5f);
 }
 
 static ob_result image_read_check(const ob_image_rec *rec, uint32_t layer, const uint8_t *out, bool *out_bgra)
@@ -101,7 +127,7 @@ static ob_result image_read_check(const ob_image_rec *rec, uint32_t layer, const
         return OB_ERR_INVALID_ARGUMENT;
     }
     if (!rgba8_format(rec->info.format, out_bgra)) {
-        OB_LOG_E("resources", "image '%s': read-back to RGBA8 needs an R8G8B8A8 or B8G8R8A8 format, not format %d",
+        OB_LOG_E("resources", "image '%s': read-back to RGBA8 needs an R8G8B8A8, B8G8R8A8 or R16G16B16A16_SFLOAT format, not format %d",
                  rec->name, (int)rec->info.format);
         return OB_ERR_UNSUPPORTED;
     }
@@ -159,9 +185,10 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
     ob_result r = image_read_check(rec, layer, out, &bgra);
     if (r != OB_OK) return r;
     size_t pixels = (size_t)rec->info.width * rec->info.height;
+    bool half = rec->info.format == VK_FORMAT_R16G16B16A16_SFLOAT;
     ob_staging staging;
     VkCommandBuffer cmd;
-    r = readback_begin(dev, pixels * 4, rec->name, &staging, &cmd);
+    r = readback_begin(dev, pixels * (half ? 8 : 4), rec->name, &staging, &cmd);
     if (r != OB_OK) goto fail_log;
     ob_image_state saved = rec->state;
     record_image_copy(cmd, rec, layer, staging.buffer);
@@ -171,7 +198,13 @@ ob_result ob_image_read_layer_rgba8(ob_device *dev, ob_image img, uint32_t layer
         goto done;
     }
     const uint8_t *src = staging.mapped;
-    if (!bgra) {
+    if (half) {
+        for (size_t i = 0; i < pixels * 4; i++) {
+            uint16_t h;
+            memcpy(&h, src + 2 * i, sizeof h);
+            out[i] = half_to_unorm8(h);
+        }
+    } else if (!bgra) {
         memcpy(out, src, pixels * 4);
     } else {
         for (size_t i = 0; i < pixels; i++) {

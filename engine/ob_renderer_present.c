@@ -213,13 +213,26 @@ static ob_result choose_format(ob_renderer *r, ob_present *p)
         if (n == 0) OB_LOG_E("present", "the surface offers no image format");
         return vr < 0 ? ob_result_from_vk(vr) : OB_ERR_UNSUPPORTED;
     }
-    /* UNORM like the engine's targets: the window shows the bytes the
-     * headless image holds. */
+    /* sRGB, like the composite's target: a blit between two sRGB formats
+     * decodes and encodes again, so the window shows the bytes the headless
+     * image holds. Into a UNORM image the blit would write the decoded
+     * (linear) values and the picture would come out too dark: that
+     * fallback is said in the log. */
     p->format = formats[0];
-    for (uint32_t i = n; i-- > 0;)
-        if (formats[i].format == VK_FORMAT_B8G8R8A8_UNORM || formats[i].format == VK_FORMAT_R8G8B8A8_UNORM)
+    bool srgb = false;
+    for (uint32_t i = n; i-- > 0;) {
+        VkFormat f = formats[i].format;
+        bool is_srgb = (f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_R8G8B8A8_SRGB) &&
+                       formats[i].colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR;
+        if (is_srgb || (!srgb && (f == VK_FORMAT_B8G8R8A8_UNORM || f == VK_FORMAT_R8G8B8A8_UNORM))) {
             p->format = formats[i];
+            srgb = srgb || is_srgb;
+        }
+    }
     ob_free(formats);
+    if (!srgb)
+        OB_LOG_W("present", "the surface offers no B8G8R8A8/R8G8B8A8 sRGB format; format %d is used and "
+                 "the window shows the sRGB image darker than the PNG output", (int)p->format.format);
     VkFormatProperties fp;
     vkGetPhysicalDeviceFormatProperties(phys, p->format.format, &fp);
     if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT)) {

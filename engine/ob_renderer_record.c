@@ -89,13 +89,6 @@ static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *
     return w->cmds[f][w->cmd_used++];
 }
 
-static VkFormat image_format(ob_device *dev, ob_image img)
-{
-    ob_image_info info;
-    if (!img.id || ob_image_get_info(dev, img, &info) != OB_OK) return VK_FORMAT_UNDEFINED;
-    return info.format;
-}
-
 /* The per-view parameters a recording of v needs in a manager's slot. */
 static void set_view_params(ob_renderer *r, ob_view *v, ob_pipeline_manager *pm)
 {
@@ -125,13 +118,15 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
         w->error = res;
         return;
     }
-    VkFormat color = image_format(r->dev, v->color);
+    VkFormat color, depth;
+    uint32_t samples;
+    ob_view_attachment_formats(v, r->dev, &color, &depth, &samples);
     VkCommandBufferInheritanceRenderingInfo rendering = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO,
-        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .colorAttachmentCount = color != VK_FORMAT_UNDEFINED ? 1u : 0u,
         .pColorAttachmentFormats = &color,
-        .depthAttachmentFormat = image_format(r->dev, v->depth),
-        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+        .depthAttachmentFormat = depth,
+        .rasterizationSamples = (VkSampleCountFlagBits)samples,
     };
     bool graphics = v->layer_count > 0;
     VkCommandBufferInheritanceInfo inherit = {
@@ -370,8 +365,9 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
 
 /* ------------------------------------------------------------ primary */
 
-/* Colour and depth of each dependency, the inputs, the view's own two targets. */
-#define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 2)
+/* Colour and depth of each dependency, the inputs, the view's own targets
+ * (colour, depth, and with MSAA the two multisampled ones). */
+#define VIEW_MAX_BARRIERS (2 * OB_VIEW_MAX_DEPS + OB_VIEW_MAX_INPUTS + 4)
 
 /* Keep img's tracked state from before this frame's first barrier on it. */
 void ob_renderer_note_image_state(ob_renderer *r, ob_image img)
@@ -465,11 +461,20 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, barriers, &n);
     }
     if (v->layer_count > 0) {
+        /* With MSAA `color` is the resolve target: the resolve writes it in
+         * the colour-attachment-output stage, like a colour attachment. */
+        bool ms = v->samples > 1;
         add_image_barrier(r, v->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                           VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                           barriers, &n);
-        add_image_barrier(r, v->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        if (ms)
+            add_image_barrier(r, v->msaa_color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                              VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
+                                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                              barriers, &n);
+        add_image_barrier(r, ms ? v->msaa_depth : v->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
                               VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
@@ -507,28 +512,43 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+/* The attachment view of img for one layer of v. */
+static VkImageView attachment_view(ob_renderer *r, const ob_view *v, ob_image img, uint32_t layer)
+{
+    if (!img.id) return VK_NULL_HANDLE;
+    return v->layer_count > 1 ? ob_image_layer_view(r->dev, img, layer) : ob_image_view(r->dev, img);
+}
+
+/* A multisampled view (one layer) draws into msaa_color / msaa_depth, which
+ * nothing reads afterwards (not stored unless the colour is loaded next
+ * time), and resolves the colour into v->color with the samples' average
+ * at the end of the scope. */
 static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uint32_t layer,
                             bool secondaries)
 {
+    bool ms = v->samples > 1;
+    ob_image color_img = ms ? v->msaa_color : v->color, depth_img = ms ? v->msaa_depth : v->depth;
     VkRenderingAttachmentInfo color = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = v->color.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->color, layer)
-                                                       : ob_image_view(r->dev, v->color))
-                                 : VK_NULL_HANDLE,
+        .imageView = attachment_view(r, v, color_img, layer),
         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
         .loadOp = v->load_color ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .storeOp = ms && !v->load_color ? VK_ATTACHMENT_STORE_OP_DONT_CARE
+                                        : VK_ATTACHMENT_STORE_OP_STORE,
         .clearValue.color = {{v->clear_color[0], v->clear_color[1], v->clear_color[2],
                               v->clear_color[3]}},
     };
+    if (ms) {
+        color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
+        color.resolveImageView = ob_image_view(r->dev, v->color);
+        color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    }
     VkRenderingAttachmentInfo depth = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = v->depth.id ? (v->layer_count > 1 ? ob_image_layer_view(r->dev, v->depth, layer)
-                                                       : ob_image_view(r->dev, v->depth))
-                                 : VK_NULL_HANDLE,
+        .imageView = attachment_view(r, v, depth_img, layer),
         .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .storeOp = ms ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE,
         .clearValue.depthStencil = {v->clear_depth, 0},
     };
     VkRenderingInfo ri = {
@@ -536,9 +556,9 @@ static void begin_rendering(ob_renderer *r, VkCommandBuffer cmd, ob_view *v, uin
         .flags = secondaries ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0u,
         .renderArea = {{0, 0}, {v->width, v->height}},
         .layerCount = 1,
-        .colorAttachmentCount = v->color.id ? 1u : 0u,
+        .colorAttachmentCount = color_img.id ? 1u : 0u,
         .pColorAttachments = &color,
-        .pDepthAttachment = v->depth.id ? &depth : NULL,
+        .pDepthAttachment = depth_img.id ? &depth : NULL,
     };
     vkCmdBeginRendering(cmd, &ri);
 }

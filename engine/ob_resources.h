@@ -75,6 +75,10 @@ typedef struct ob_image_desc {
     uint32_t layers;         /* 0 → 1; >1 makes a 2D array (paraboloid maps use 2) */
     VkFormat format;         /* must support the usage on this device, else OB_ERR_UNSUPPORTED */
     uint32_t usage;          /* ob_image_usage bits */
+    uint32_t samples;        /* 0 or 1 → single-sampled; 2, 4, 8...: a multisampled
+                                attachment (one layer, no data, no sampling or
+                                transfers), OB_ERR_UNSUPPORTED where the format
+                                and usage do not offer that count */
     const void *data;        /* optional tightly packed texels for every layer (colour,
                                 D16/D32 or BC formats); staged, leaving the image in
                                 SHADER_READ_ONLY_OPTIMAL (TRANSFER_DST is implied) */
@@ -94,6 +98,7 @@ typedef struct ob_image_info {
     VkFormat format;
     uint32_t usage;
     VkImageAspectFlags aspect;
+    uint32_t samples;        /* 1 unless made multisampled */
 } ob_image_info;
 ob_result ob_image_get_info(const ob_device *dev, ob_image img, ob_image_info *out_info);
 
@@ -122,7 +127,9 @@ bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *nex
 ob_result ob_image_set_state(ob_device *dev, ob_image img, const ob_image_state *state);
 
 /* Reads the image (layer 0) back as tightly packed RGBA8 (colour formats
- * R8G8B8A8/B8G8R8A8 UNORM/SRGB and R8G8B8A8_UINT, swizzled to RGBA). Waits
+ * R8G8B8A8/B8G8R8A8 UNORM/SRGB and R8G8B8A8_UINT, swizzled to RGBA, bytes as
+ * stored — sRGB-encoded for the SRGB formats; R16G16B16A16_SFLOAT as linear
+ * values clamped to [0, 1] and scaled to 0..255, not encoded). Waits
  * for the device to be idle, so everything recorded for the image must have
  * been submitted. Needs OB_IMAGE_TRANSFER_SRC usage and defined contents
  * (OB_ERR_WRONG_STATE while the layout is UNDEFINED). The tracked state is

@@ -134,6 +134,14 @@ static ob_result image_support_check(ob_device *dev, const char *name, const ob_
         return OB_ERR_UNSUPPORTED;
     }
     if (vr < 0) return ob_result_from_vk(OB_VK_CHECK_AS(vr, "vkGetPhysicalDeviceImageFormatProperties"));
+    uint32_t samples = desc->samples > 1 ? desc->samples : 1;
+    if (!(ip.sampleCounts & samples)) {
+        OB_LOG_E("resources", "image '%s': format %d with usage 0x%x offers no %u samples per pixel "
+                              "on '%s' (sample counts 0x%x)",
+                 name, (int)desc->format, desc->usage, samples, ob_device_name(dev),
+                 (unsigned)ip.sampleCounts);
+        return OB_ERR_UNSUPPORTED;
+    }
     if (desc->width > ip.maxExtent.width || desc->height > ip.maxExtent.height || layers > ip.maxArrayLayers) {
         OB_LOG_E("resources", "image '%s': %ux%u with %u layers exceeds the limits for format %d "
                               "(%ux%u, %u layers)",
@@ -163,6 +171,16 @@ static ob_result image_desc_check(const ob_image_desc *desc, const char *name, u
     if ((desc->usage & OB_IMAGE_COLOR_TARGET) && (desc->usage & OB_IMAGE_DEPTH_TARGET)) {
         OB_LOG_E("resources", "image '%s': usage 0x%x asks for both a colour and a depth target", name, desc->usage);
         return OB_ERR_INVALID_ARGUMENT;
+    }
+    if (desc->samples > 1) {
+        bool pow2 = (desc->samples & (desc->samples - 1)) == 0 && desc->samples <= 64;
+        uint32_t attachment_only = OB_IMAGE_COLOR_TARGET | OB_IMAGE_DEPTH_TARGET;
+        if (!pow2 || (desc->usage & ~attachment_only) || desc->data || (desc->layers > 1)) {
+            OB_LOG_E("resources", "image '%s': %u samples per pixel need a power of two up to 64, "
+                     "one layer, no initial data and only target usage (usage 0x%x)", name,
+                     desc->samples, desc->usage);
+            return OB_ERR_INVALID_ARGUMENT;
+        }
     }
     if (!desc->data) return OB_OK;
     uint32_t bytes, dim;
@@ -316,7 +334,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
         goto fail;
     }
     rec->info = (ob_image_info){desc->width, desc->height, layers, desc->format, desc->usage,
-                                format_aspect(desc->format)};
+                                format_aspect(desc->format), desc->samples > 1 ? desc->samples : 1};
     rec->state = (ob_image_state){VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
     rec->name = ob_strdup(name);
     if (!rec->name) {
@@ -330,7 +348,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
         .extent = {desc->width, desc->height, 1},
         .mipLevels = 1,
         .arrayLayers = layers,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .samples = (VkSampleCountFlagBits)rec->info.samples,
         .tiling = VK_IMAGE_TILING_OPTIMAL,
         .usage = vk_usage,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,

@@ -25,6 +25,43 @@ void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const
     v->layer_count = 1;
 }
 
+static VkFormat image_format(const ob_device *dev, ob_image img)
+{
+    ob_image_info info;
+    if (!img.id || ob_image_get_info(dev, img, &info) != OB_OK) return VK_FORMAT_UNDEFINED;
+    return info.format;
+}
+
+void ob_view_attachment_formats(const ob_view *v, const ob_device *dev, VkFormat *out_color,
+                                VkFormat *out_depth, uint32_t *out_samples)
+{
+    bool ms = v->samples > 1;
+    *out_color = image_format(dev, ms && v->msaa_color.id ? v->msaa_color : v->color);
+    *out_depth = image_format(dev, ms ? v->msaa_depth : v->depth);
+    *out_samples = ms ? v->samples : 1;
+}
+
+bool ob_view_resize(ob_view *v, uint32_t width, uint32_t height)
+{
+    if (!v || width == 0 || height == 0) {
+        OB_LOG_E("view", "view '%s': resize to %ux%u refused (a side is zero)", v ? v->name : "?",
+                 width, height);
+        return false;
+    }
+    v->resize_width = width;
+    v->resize_height = height;
+    return true;
+}
+
+bool ob_view_take_resize(ob_view *v, uint32_t *out_width, uint32_t *out_height)
+{
+    if (!v->resize_width || !v->resize_height) return false;
+    *out_width = v->resize_width;
+    *out_height = v->resize_height;
+    v->resize_width = v->resize_height = 0;
+    return true;
+}
+
 void ob_view_release(ob_view *v)
 {
     if (!v) return;

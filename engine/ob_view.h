@@ -91,6 +91,16 @@ struct ob_view {
     ob_image color, depth;
     uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
     uint32_t width, height;
+    /* Multisampling. With samples > 1 (one layer only) the view draws into
+     * msaa_color / msaa_depth and each rendering scope ends by resolving
+     * msaa_color into `color` (the average of the samples), which is what
+     * consumers sample; `depth` is then absent (the multisampled depth is
+     * not resolved: no consumer reads a camera's depth). */
+    uint32_t samples;                 /* 0 or 1 → single-sampled */
+    ob_image msaa_color, msaa_depth;
+    /* A size asked for by ob_view_resize, 0 when none: the owner of the view
+     * makes its targets again at its next PreRender. */
+    uint32_t resize_width, resize_height;
     float clear_color[4];
     float clear_depth;                /* 0 with reversed-Z */
     bool load_color;                  /* keep previous contents (overlay on final target) */
@@ -122,6 +132,25 @@ struct ob_view {
     bool range_reported;              /* an entity beyond float range was logged
                                          and has not gone away since */
 };
+
+/* The colour and depth formats (VK_FORMAT_UNDEFINED when absent) and the
+ * sample count of what v's rendering scopes draw into: what a pipeline
+ * drawing in v must be made for. [any thread: only reads v] */
+void ob_view_attachment_formats(const ob_view *v, const ob_device *dev, VkFormat *out_color,
+                                VkFormat *out_depth, uint32_t *out_samples);
+
+/* Asks for v's targets at width x height. Nothing changes now: the view's
+ * owner makes the targets again at the
+ * view's next PreRender, before anything of that frame is recorded, and the
+ * old images go through the device's deferred deletion, so work already
+ * recorded keeps its images. The views layer does it for perspective and
+ * composite views (shadow and environment maps take their sizes from the
+ * views' settings). A zero side is refused (logged, false).
+ * [render thread] */
+bool ob_view_resize(ob_view *v, uint32_t width, uint32_t height);
+/* The pending resize of v, if any, and clears it (for the view's owner).
+ * [render thread] */
+bool ob_view_take_resize(ob_view *v, uint32_t *out_width, uint32_t *out_height);
 
 /* Initialise the base part (name copied, id = hash of name). */
 void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const char *name);

@@ -11,6 +11,7 @@
  * serialises creators (double-checked under it). */
 typedef struct effect_pipeline {
     VkFormat color, depth;
+    uint32_t samples;        /* rasterizationSamples: part of the key */
     VkPipeline pipeline;     /* VK_NULL_HANDLE when creation failed */
     uint32_t id;
 } effect_pipeline;
@@ -455,7 +456,7 @@ static VkPipelineShaderStageCreateInfo stage_info(const ob_effect *e, uint32_t i
     };
 }
 
-static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth,
+static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, uint32_t samples,
                                 const void *feedback, VkPipeline *out)
 {
     VkPipelineShaderStageCreateInfo stages[2];
@@ -490,7 +491,7 @@ static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth,
     };
     VkPipelineMultisampleStateCreateInfo ms = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+        .rasterizationSamples = (VkSampleCountFlagBits)samples,
     };
     bool has_depth = depth != VK_FORMAT_UNDEFINED;
     VkPipelineDepthStencilStateCreateInfo ds = {
@@ -562,25 +563,29 @@ static VkResult create_compute(ob_effect *e, const void *feedback, VkPipeline *o
 }
 
 static const effect_pipeline *find_pipeline(const ob_effect *e, uint32_t count, VkFormat color,
-                                            VkFormat depth)
+                                            VkFormat depth, uint32_t samples)
 {
     for (uint32_t i = 0; i < count; i++)
-        if (e->pipelines[i].color == color && e->pipelines[i].depth == depth)
+        if (e->pipelines[i].color == color && e->pipelines[i].depth == depth &&
+            e->pipelines[i].samples == samples)
             return &e->pipelines[i];
     return NULL;
 }
 
-static uint32_t pipeline_id(const ob_effect *e, VkFormat color, VkFormat depth)
+static uint32_t pipeline_id(const ob_effect *e, VkFormat color, VkFormat depth, uint32_t samples)
 {
     uint64_t h = ob_hash_str(OB_HASH_SEED, e->name);
     h = ob_hash_u64(h, ((uint64_t)(uint32_t)color << 32) | (uint32_t)depth);
+    /* Single-sampled pipelines keep the ids they had before sample counts
+     * were part of the key (command hashes stay comparable). */
+    if (samples > 1) h = ob_hash_u64(h, samples);
     uint32_t id = (uint32_t)(h ^ (h >> 32));
     return id ? id : 1u;
 }
 
 /* Called with e->lock held and the pair known to be missing. */
 static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkFormat color,
-                                           VkFormat depth)
+                                           VkFormat depth, uint32_t samples)
 {
     if (count >= OB_EFFECT_MAX_PIPELINES) {
         OB_LOG_E("effect", "effect '%s': more than %u target format pairs; no pipeline for "
@@ -598,17 +603,19 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
     };
     VkPipeline pipeline = VK_NULL_HANDLE;
     VkResult vr = e->compute ? create_compute(e, &feedback, &pipeline)
-                             : create_graphics(e, color, depth, &feedback, &pipeline);
+                             : create_graphics(e, color, depth, samples, &feedback, &pipeline);
     effect_pipeline *entry = &e->pipelines[count];
-    *entry = (effect_pipeline){color, depth, VK_NULL_HANDLE, pipeline_id(e, color, depth)};
+    *entry = (effect_pipeline){color, depth, samples, VK_NULL_HANDLE,
+                               pipeline_id(e, color, depth, samples)};
     if (OB_VK_CHECK_AS(vr, e->compute ? "vkCreateComputePipelines" : "vkCreateGraphicsPipelines") !=
         VK_SUCCESS) {
         ob_device_note_result(e->ctx->dev, vr);
         atomic_fetch_add(&e->ctx->pipelines_failed, 1);
         bool transient = vr == VK_ERROR_OUT_OF_HOST_MEMORY || vr == VK_ERROR_OUT_OF_DEVICE_MEMORY;
-        OB_LOG_E("effect", "effect '%s': pipeline for colour format %d, depth format %d not "
-                 "created (%s); its draws are skipped%s", e->name, (int)color, (int)depth,
-                 ob_vk_result_name(vr), transient ? " until a later try succeeds" : "");
+        OB_LOG_E("effect", "effect '%s': pipeline for colour format %d, depth format %d, %u "
+                 "sample(s) not created (%s); its draws are skipped%s", e->name, (int)color,
+                 (int)depth, samples, ob_vk_result_name(vr),
+                 transient ? " until a later try succeeds" : "");
         /* Memory may come back: leave the pair unpublished so the next
          * request tries again (a frame that failed must not stay broken). */
         if (transient) return NULL;
@@ -619,7 +626,7 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
             (whole.flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT))
             atomic_fetch_add(&e->ctx->pipelines_from_cache_hint, 1);
         char label[96];
-        snprintf(label, sizeof label, "%s/%d/%d", e->name, (int)color, (int)depth);
+        snprintf(label, sizeof label, "%s/%d/%d/%ux", e->name, (int)color, (int)depth, samples);
         ob_device_set_name(e->ctx->dev, VK_OBJECT_TYPE_PIPELINE, (uint64_t)pipeline, label);
     }
     /* Failed pairs are published too, so later draws fail fast and quietly. */
@@ -630,16 +637,27 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
 VkPipeline ob_effect_pipeline(ob_effect *e, VkFormat color, VkFormat depth,
                               uint32_t *out_pipeline_id)
 {
+    return ob_effect_pipeline_for(e, &(ob_effect_targets){color, depth, 1}, out_pipeline_id);
+}
+
+VkPipeline ob_effect_pipeline_for(ob_effect *e, const ob_effect_targets *targets,
+                                  uint32_t *out_pipeline_id)
+{
     if (out_pipeline_id) *out_pipeline_id = 0;
-    if (!e) return VK_NULL_HANDLE;
-    if (e->compute) color = depth = VK_FORMAT_UNDEFINED;
+    if (!e || !targets) return VK_NULL_HANDLE;
+    VkFormat color = targets->color, depth = targets->depth;
+    uint32_t samples = targets->samples > 1 ? targets->samples : 1;
+    if (e->compute) {
+        color = depth = VK_FORMAT_UNDEFINED;
+        samples = 1;
+    }
     uint32_t count = atomic_load_explicit(&e->pipeline_count, memory_order_acquire);
-    const effect_pipeline *p = find_pipeline(e, count, color, depth);
+    const effect_pipeline *p = find_pipeline(e, count, color, depth, samples);
     if (!p) {
         pthread_mutex_lock(&e->lock);
         count = atomic_load_explicit(&e->pipeline_count, memory_order_acquire);
-        p = find_pipeline(e, count, color, depth);
-        if (!p) p = create_entry(e, count, color, depth);
+        p = find_pipeline(e, count, color, depth, samples);
+        if (!p) p = create_entry(e, count, color, depth, samples);
         pthread_mutex_unlock(&e->lock);
         if (!p) return VK_NULL_HANDLE;
     }

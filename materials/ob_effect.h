@@ -140,6 +140,20 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
 VkPipeline ob_effect_pipeline(ob_effect *e, VkFormat color, VkFormat depth,
                               uint32_t *out_pipeline_id);
 
+/* What a pipeline is made for: the target formats (VK_FORMAT_UNDEFINED =
+ * none) and the rasterization sample count (0 or 1 → one sample). */
+typedef struct ob_effect_targets {
+    VkFormat color, depth;
+    uint32_t samples;
+} ob_effect_targets;
+
+/* ob_effect_pipeline for any targets, multisampled ones included: the
+ * sample count is part of the key and of the id (single-sampled pipelines
+ * have the ids ob_effect_pipeline gives them). Same failure rule.
+ * [any thread] */
+VkPipeline ob_effect_pipeline_for(ob_effect *e, const ob_effect_targets *targets,
+                                  uint32_t *out_pipeline_id);
+
 /* Number of pipelines this effect holds. [any thread] */
 uint32_t ob_effect_pipeline_count(const ob_effect *e);
 const ob_program *ob_effect_program(const ob_effect *e);

@@ -609,33 +609,31 @@ ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_vie
     return p;
 }
 
-static void view_formats(ob_device *dev, const ob_view *v, VkFormat *out_color,
-                         VkFormat *out_depth)
+/* What pipelines drawing in v are made for (formats and sample count). */
+static ob_effect_targets view_targets(ob_device *dev, const ob_view *v)
 {
-    ob_image_info info;
-    *out_color = *out_depth = VK_FORMAT_UNDEFINED;
-    if (v->color.id && ob_image_get_info(dev, v->color, &info) == OB_OK) *out_color = info.format;
-    if (v->depth.id && ob_image_get_info(dev, v->depth, &info) == OB_OK) *out_depth = info.format;
+    ob_effect_targets t;
+    ob_view_attachment_formats(v, dev, &t.color, &t.depth, &t.samples);
+    return t;
 }
 
 static void prepare(ob_material *m, ob_renderer *r, ob_node *entity, const ob_view *v,
-                    VkFormat color, VkFormat depth)
+                    const ob_effect_targets *targets)
 {
     uint32_t variant;
     ob_effect *e = resolve(m, r, entity, v, true, &variant, NULL);
-    if (e) ob_effect_pipeline(e, color, depth, NULL);
+    if (e) ob_effect_pipeline_for(e, targets, NULL);
 }
 
 void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v)
 {
     if (!lib || !v) return;
-    VkFormat color, depth;
-    view_formats(lib->dev, v, &color, &depth);
+    ob_effect_targets targets = view_targets(lib->dev, v);
     for (uint32_t i = 0; i < v->item_count; i++) {
         ob_node *n = v->items[i].node;
         const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
         if (!rd || !rd->material || rd->material->lib != lib) continue;
-        prepare(rd->material, r, n, v, color, depth);
+        prepare(rd->material, r, n, v, &targets);
     }
 }
 
@@ -662,9 +660,8 @@ static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer
     if (m->kind == OB_MATERIAL_REFLECTIVE && !m->custom[v->type] &&
         v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
         lib->queue_fn(lib->queue_user, entity, r, v, OB_VIEW_PARABOLOID);
-    VkFormat color, depth;
-    view_formats(lib->dev, v, &color, &depth);
-    prepare(m, r, entity, v, color, depth);
+    ob_effect_targets targets = view_targets(lib->dev, v);
+    prepare(m, r, entity, v, &targets);
 }
 
 static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
@@ -679,10 +676,9 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
                      ob_view_type_name(v->type), v->name);
         return OB_APPLY_SKIP;
     }
-    VkFormat color, depth;
-    view_formats(m->lib->dev, v, &color, &depth);
+    ob_effect_targets targets = view_targets(m->lib->dev, v);
     uint32_t pipeline_id;
-    VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
+    VkPipeline pipeline = ob_effect_pipeline_for(e, &targets, &pipeline_id);
     if (!pipeline) return OB_APPLY_SKIP;
     ob_pipeline_manager_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
 

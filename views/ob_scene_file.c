@@ -47,12 +47,28 @@ static char *name_or_default(sf_ctx *c, const cJSON *obj, const char *section, u
     return dup_or_oom(c, buf);
 }
 
+/* ------------------------------------------------------------ colours */
+
+/* Colours in a scene file are written sRGB-encoded, as a colour picker
+ * shows them; the engine shades in linear light, so the red, green and blue
+ * read here are decoded (the sRGB transfer function, IEC 61966-2-1). Alpha
+ * and the w of a specular colour (a power) are not colours and stay as
+ * written; emissive, which may exceed 1, is read as linear. A key that is
+ * absent leaves out[] as it was. */
+static bool opt_srgb_color(sf_ctx *c, const cJSON *j, const char *key, float w, float out[4])
+{
+    bool present = ob_json_member(j, key) != NULL;
+    if (!ob_json_opt_color(&c->rd, j, key, w, out)) return false;
+    for (int i = 0; present && i < 3; i++) out[i] = ob_srgb_to_linear(out[i]);
+    return true;
+}
+
 /* ------------------------------------------------------------ settings & camera */
 
 static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
 {
     static const char *const keys[] = {"size", "env_map_size", "shadow_map_size", "threads",
-                                       "clear_color", "ambient"};
+                                       "clear_color", "ambient", "exposure"};
     if (!ob_json_check_object(&c->rd, j, "an object", keys, OB_ARRAY_COUNT(keys))) return false;
     const cJSON *size = ob_json_member(j, "size");
     if (size) {
@@ -83,13 +99,16 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
         }
         ob_json_pop(&c->rd, mark);
     }
+    if (ob_json_member(j, "exposure")) {
+        if (!ob_json_opt_float(&c->rd, j, "exposure", OB_JSON_POSITIVE, &s->exposure)) return false;
+    }
     if (ob_json_member(j, "clear_color")) {
         s->has_clear_color = true;
-        if (!ob_json_opt_color(&c->rd, j, "clear_color", 1.0f, s->clear_color)) return false;
+        if (!opt_srgb_color(c, j, "clear_color", 1.0f, s->clear_color)) return false;
     }
     if (ob_json_member(j, "ambient")) {
         s->has_ambient = true;
-        if (!ob_json_opt_color(&c->rd, j, "ambient", 1.0f, s->ambient)) return false;
+        if (!opt_srgb_color(c, j, "ambient", 1.0f, s->ambient)) return false;
         if (s->ambient[3] == 0.0f) {   /* the engine reads intensity 0 as "default" */
             s->ambient[0] = s->ambient[1] = s->ambient[2] = 0.0f;
             s->ambient[3] = 1.0f;
@@ -156,7 +175,7 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
     l->desc.intensity = 1.0f;
     l->direction[0] = -1.0, l->direction[1] = -2.0, l->direction[2] = -1.0;
     ob_json_normalize(l->direction, 3);
-    if (!ob_json_opt_vec3d(&c->rd, j, "position", OB_JSON_ANY, l->position) || !ob_json_opt_color(&c->rd, j, "color", 1.0f, color) ||
+    if (!ob_json_opt_vec3d(&c->rd, j, "position", OB_JSON_ANY, l->position) || !opt_srgb_color(c, j, "color", 1.0f, color) ||
         !ob_json_opt_float(&c->rd, j, "intensity", OB_JSON_NON_NEGATIVE, &l->desc.intensity) ||
         !ob_json_opt_float(&c->rd, j, "range", OB_JSON_NON_NEGATIVE, &l->desc.range) ||
         !ob_json_opt_bool(&c->rd, j, "shadows", &l->desc.casts_shadows))
@@ -222,7 +241,7 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
     float diffuse[4] = {1, 1, 1, 1}, specular[4] = {0.25f, 0.25f, 0.25f, 32.0f}, emissive[4] = {0};
     d->reflectivity = d->kind == OB_MATERIAL_REFLECTIVE ? 0.6f : 0.0f;
     d->casts_shadows = true;
-    if (!ob_json_opt_color(&c->rd, j, "diffuse", 1.0f, diffuse) || !ob_json_opt_color(&c->rd, j, "specular", 32.0f, specular))
+    if (!opt_srgb_color(c, j, "diffuse", 1.0f, diffuse) || !opt_srgb_color(c, j, "specular", 32.0f, specular))
         return false;
     const cJSON *em = ob_json_member(j, "emissive");
     if (em) {
@@ -590,7 +609,7 @@ static bool parse_particle_system(sf_ctx *c, const cJSON *j, uint32_t i, ob_scen
     if (!ob_json_opt_u32(&c->rd, j, "count", 1, OB_SCENE_FILE_MAX_PARTICLES, &d->count) ||
         !ob_json_opt_float(&c->rd, j, "lifetime", OB_JSON_POSITIVE, &d->lifetime) ||
         !ob_json_opt_float(&c->rd, j, "speed", OB_JSON_POSITIVE, &d->speed) || !ob_json_opt_float(&c->rd, j, "size", OB_JSON_POSITIVE, &d->size) ||
-        !ob_json_opt_vec3f(&c->rd, j, "gravity", OB_JSON_ANY, d->gravity) || !ob_json_opt_color(&c->rd, j, "color", 1.0f, d->color))
+        !ob_json_opt_vec3f(&c->rd, j, "gravity", OB_JSON_ANY, d->gravity) || !opt_srgb_color(c, j, "color", 1.0f, d->color))
         return false;
     if (!(d->color[3] > 0.0f && d->color[3] <= 1.0f)) {
         ob_json_push_key(&c->rd, "color");

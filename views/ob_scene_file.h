@@ -61,6 +61,7 @@ typedef struct ob_scene_file_settings {
     float clear_color[4];         /* rgba (alpha 1 when 3 numbers were given) */
     bool has_ambient;
     float ambient[4];             /* rgb, w = intensity > 0 (0 0 0 1 for "none") */
+    float exposure;               /* the composite's exposure; 0 = not given, else > 0 */
 } ob_scene_file_settings;
 
 /* "camera": without one the program frames the whole scene (ob_scene_load

@@ -516,6 +516,7 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *s, ob_stack_desc *de
     if (s->shadow_map_size) desc->shadow_map_size = s->shadow_map_size;
     if (s->has_clear_color) memcpy(desc->clear_color, s->clear_color, sizeof desc->clear_color);
     if (s->has_ambient) memcpy(desc->ambient, s->ambient, sizeof desc->ambient);
+    if (s->exposure > 0.0f) desc->exposure = s->exposure;
 }
 
 void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views, const ob_scene_file_settings *s)

@@ -30,13 +30,19 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     ob_perspective_desc pd = {.name = "main", .camera = s->camera,
                               .width = d.width ? d.width : 640,
                               .height = d.height ? d.height : 480,
-                              .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
+                              .clear_color = {OB_STACK_CLEAR_R, OB_STACK_CLEAR_G,
+                                              OB_STACK_CLEAR_B, 1.0f},
+                              .samples = d.msaa};
     static const float no_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     if (memcmp(d.clear_color, no_color, sizeof no_color) != 0)
         memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
     if (!(s->main = ob_perspective_view_create(s->views, &pd, &r))) goto fail_destroy;
     s->composite = ob_composite_view_create(s->views, ob_perspective_view_base(s->main), &r);
     if (!s->composite) goto fail_destroy;
+    if (d.exposure != 0.0f && !ob_composite_view_set_exposure(s->composite, d.exposure)) {
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail_destroy;
+    }
     s->final_view = ob_composite_view_base(s->composite);
     if (d.overlay) {
         if (!(s->overlay = ob_overlay_view_create(s->views, s->final_view, &r))) goto fail_destroy;
@@ -135,4 +141,9 @@ ob_result ob_stack_frame(ob_stack *s, double dt)
 ob_image ob_stack_final_image(const ob_stack *s)
 {
     return s ? ob_composite_view_target(s->composite) : (ob_image){0};
+}
+
+bool ob_stack_resize(ob_stack *s, uint32_t width, uint32_t height)
+{
+    return ob_view_resize(ob_perspective_view_base(s->main), width, height);
 }

@@ -24,16 +24,28 @@
 extern "C" {
 #endif
 
+/* The default clear colour, in linear scene units: after the composite's
+ * tone map (at the default exposure) and sRGB encode it shows as the dark
+ * blue-grey (0.08, 0.09, 0.12) the stack cleared to before rendering was
+ * linear. */
+#define OB_STACK_CLEAR_R 0.0149f
+#define OB_STACK_CLEAR_G 0.0166f
+#define OB_STACK_CLEAR_B 0.0220f
+
 typedef struct ob_stack_desc {
     ob_renderer_desc renderer;   /* zero → defaults (worker count = cores, headless) */
     const char *cache_dir;       /* pipeline cache folder; NULL → the effect context's default */
     uint32_t width, height;      /* main view and final target; 0 → 640 x 480 */
-    float clear_color[4];        /* all zero → opaque (0.08, 0.09, 0.12) */
+    float clear_color[4];        /* linear; all zero → opaque OB_STACK_CLEAR_R/G/B */
     ob_camera_desc camera;       /* zero → ob_node_set_camera's defaults */
     uint32_t env_map_size;       /* 0 → the views' default (256) */
     uint32_t shadow_map_size;    /* 0 → the views' default (1024) */
     float ambient[4];            /* rgb, w = intensity; zero → the views' default */
     bool overlay;                /* also an overlay view, drawn last over the composite */
+    uint32_t msaa;               /* main view's samples per pixel: 0 or 1 → none; 2, 4, 8
+                                    (lowered to what the device offers, logged) */
+    float exposure;              /* the composite's exposure; 0 → OB_COMPOSITE_DEFAULT_EXPOSURE;
+                                    negative or not finite: creation fails (logged) */
 } ob_stack_desc;
 
 typedef struct ob_stack {
@@ -90,6 +102,10 @@ ob_result ob_stack_frame(ob_stack *s, double dt);
  * s->time advances by dt even when a step fails. Failure: the update's or
  * begin_frame's result, and the frame is not begun (do not end it). */
 ob_result ob_stack_frame_begin(ob_stack *s, double dt);
+
+/* Resizes the main view and with it the final image, from the next frame
+ * on (ob_view_resize). A zero side is refused: logged, false. */
+bool ob_stack_resize(ob_stack *s, uint32_t width, uint32_t height);
 
 /* The final image: the composite's target (the overlay draws into it too). */
 ob_image ob_stack_final_image(const ob_stack *s);

@@ -15,6 +15,7 @@ static void perspective_pre_render(ob_view *v, ob_renderer *r)
 {
     ob_perspective_view *pv = (ob_perspective_view *)v;
     if (!ob_renderer_queue_view(r, v)) return;
+    ob_views_apply_resize(pv->ctx, v);
     ob_scene *scene = ob_renderer_scene(r);
     const ob_camera_desc *cam = pv->camera ? ob_node_get_camera(pv->camera) : NULL;
     if (!scene || !cam || !ob_node_transform_is_valid(pv->camera)) {
@@ -82,8 +83,10 @@ ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspect
     pv->camera = desc->camera;
     memcpy(pv->base.clear_color, desc->clear_color, sizeof pv->base.clear_color);
     pv->base.clear_depth = 0.0f;
-    r = ob_views_make_target(ctx, &pv->base, desc->width, desc->height, 1,
-                             desc->color_format ? desc->color_format : OB_VIEWS_COLOR_FORMAT,
+    VkFormat color = desc->color_format ? desc->color_format : OB_VIEWS_HDR_FORMAT;
+    pv->base.samples = ob_views_supported_samples(ctx, pv->base.name, desc->samples, color,
+                                                  OB_VIEWS_DEPTH_FORMAT);
+    r = ob_views_make_target(ctx, &pv->base, desc->width, desc->height, 1, color,
                              OB_VIEWS_DEPTH_FORMAT);
     if (r != OB_OK) {
         ob_free(pv);
@@ -104,3 +107,4 @@ void ob_perspective_view_destroy(ob_views *ctx, ob_perspective_view *v)
 
 ob_view *ob_perspective_view_base(ob_perspective_view *v) { return &v->base; }
 ob_image ob_perspective_view_color(const ob_perspective_view *v) { return v->base.color; }
+uint32_t ob_perspective_view_samples(const ob_perspective_view *v) { return v->base.samples > 1 ? v->base.samples : 1; }

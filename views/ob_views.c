@@ -38,7 +38,7 @@ static ob_result register_params(ob_param_registry *reg)
         "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "PointLight0Position",
         "PointLight1Position", "PointLight2Position", "PointLight3Position", "PointLight0Color",
         "PointLight1Color", "PointLight2Color", "PointLight3Color", "ParaboloidDirection",
-        "SimStep", "SimEmitter", "SimForce", "DiffuseColor",
+        "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
     };
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
@@ -116,32 +116,52 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
 
 /* ------------------------------------------------------------ targets */
 
+/* One image of a view's targets, named "<view>.<what>". */
+static ob_image make_image(ob_views *ctx, const ob_view *v, const char *what, uint32_t width,
+                           uint32_t height, uint32_t layers, VkFormat format, uint32_t usage,
+                           uint32_t samples, ob_result *out_result)
+{
+    char name[64];
+    snprintf(name, sizeof name, "%s.%s", v->name, what);
+    ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = format,
+                       .usage = usage, .samples = samples, .name = name};
+    return ob_image_create(ctx->dev, &d, out_result);
+}
+
 ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height,
                                uint32_t layers, VkFormat color, VkFormat depth)
 {
     ob_result r = OB_OK;
-    char name[64];
+    /* Multisampled: colour and depth are drawn at v->samples, colour is
+     * resolved into the single-sampled `color` consumers read. */
+    uint32_t samples = layers == 1 && v->samples > 1 ? v->samples : 1;
+    ob_image img[4] = {{0}};   /* color, depth, msaa_color, msaa_depth */
     if (color != VK_FORMAT_UNDEFINED) {
-        snprintf(name, sizeof name, "%s.color", v->name);
-        ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = color,
-                           .usage = OB_IMAGE_COLOR_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC |
-                                    OB_IMAGE_TRANSFER_DST,
-                           .name = name};
-        v->color = ob_image_create(ctx->dev, &d, &r);
-        if (!v->color.id) return r;
+        img[0] = make_image(ctx, v, "color", width, height, layers, color,
+                            OB_IMAGE_COLOR_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC |
+                                OB_IMAGE_TRANSFER_DST, 1, &r);
+        if (r == OB_OK && samples > 1)
+            img[2] = make_image(ctx, v, "color.msaa", width, height, 1, color,
+                                OB_IMAGE_COLOR_TARGET, samples, &r);
     }
-    if (depth != VK_FORMAT_UNDEFINED) {
-        snprintf(name, sizeof name, "%s.depth", v->name);
-        ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = depth,
-                           .usage = OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
-                           .name = name};
-        v->depth = ob_image_create(ctx->dev, &d, &r);
-        if (!v->depth.id) {
-            ob_image_destroy(ctx->dev, v->color);
-            v->color = (ob_image){0};
-            return r;
-        }
+    if (r == OB_OK && depth != VK_FORMAT_UNDEFINED) {
+        if (samples > 1)
+            img[3] = make_image(ctx, v, "depth.msaa", width, height, 1, depth,
+                                OB_IMAGE_DEPTH_TARGET, samples, &r);
+        else
+            img[1] = make_image(ctx, v, "depth", width, height, layers, depth,
+                                OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
+                                1, &r);
     }
+    if (r != OB_OK) {
+        for (int i = 0; i < 4; i++) ob_image_destroy(ctx->dev, img[i]);
+        return r;
+    }
+    v->color = img[0];
+    v->depth = img[1];
+    v->msaa_color = img[2];
+    v->msaa_depth = img[3];
+    v->samples = samples;
     v->width = width;
     v->height = height;
     v->layer_count = layers;
@@ -152,7 +172,60 @@ void ob_views_release_target(ob_views *ctx, ob_view *v)
 {
     ob_image_destroy(ctx->dev, v->color);
     ob_image_destroy(ctx->dev, v->depth);
-    v->color = v->depth = (ob_image){0};
+    ob_image_destroy(ctx->dev, v->msaa_color);
+    ob_image_destroy(ctx->dev, v->msaa_depth);
+    v->color = v->depth = v->msaa_color = v->msaa_depth = (ob_image){0};
+}
+
+ob_result ob_views_resize_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height)
+{
+    if (width == v->width && height == v->height) return OB_OK;
+    VkFormat color, depth;
+    ob_views_target_formats(ctx, v, &color, &depth);
+    ob_view old = *v;
+    ob_result r = ob_views_make_target(ctx, v, width, height, v->layer_count, color, depth);
+    if (r != OB_OK) {
+        OB_LOG_E("views", "view '%s': cannot resize from %ux%u to %ux%u (%s); it keeps its size",
+                 v->name, old.width, old.height, width, height, ob_result_name(r));
+        return r;
+    }
+    /* Deferred: frames in flight still use the old images. */
+    ob_views_release_target(ctx, &old);
+    OB_LOG_I("views", "view '%s': targets now %ux%u (were %ux%u)", v->name, width, height,
+             old.width, old.height);
+    return OB_OK;
+}
+
+bool ob_views_apply_resize(ob_views *ctx, ob_view *v)
+{
+    uint32_t w, h;
+    return ob_view_take_resize(v, &w, &h) && ob_views_resize_target(ctx, v, w, h) == OB_OK;
+}
+
+uint32_t ob_views_supported_samples(ob_views *ctx, const char *view_name, uint32_t wanted,
+                                    VkFormat color, VkFormat depth)
+{
+    if (wanted <= 1) return 1;
+    const VkPhysicalDeviceLimits *lim = &ob_device_properties(ctx->dev)->limits;
+    VkSampleCountFlags counts = lim->framebufferColorSampleCounts & lim->framebufferDepthSampleCounts;
+    VkPhysicalDevice pd = ob_device_vk_physical(ctx->dev);
+    VkImageFormatProperties ip;
+    if (vkGetPhysicalDeviceImageFormatProperties(pd, color, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL,
+                                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, 0, &ip) == VK_SUCCESS)
+        counts &= ip.sampleCounts;
+    if (depth != VK_FORMAT_UNDEFINED &&
+        vkGetPhysicalDeviceImageFormatProperties(pd, depth, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL,
+                                                 VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0,
+                                                 &ip) == VK_SUCCESS)
+        counts &= ip.sampleCounts;
+    uint32_t got = 1;
+    for (uint32_t s = 2; s <= 64 && s <= wanted; s <<= 1)
+        if (counts & s) got = s;
+    if (got != wanted)
+        OB_LOG_W("views", "view '%s': MSAA %ux asked for; '%s' offers at most %ux for colour format "
+                 "%d with depth format %d (sample counts 0x%x): using %ux", view_name, wanted,
+                 ob_device_name(ctx->dev), got, (int)color, (int)depth, (unsigned)counts, got);
+    return got;
 }
 
 void ob_views_free_view(ob_views *ctx, ob_view *base)
@@ -168,16 +241,17 @@ void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_colo
     ob_image_info info;
     *out_color = *out_depth = VK_FORMAT_UNDEFINED;
     if (v->color.id && ob_image_get_info(ctx->dev, v->color, &info) == OB_OK) *out_color = info.format;
-    if (v->depth.id && ob_image_get_info(ctx->dev, v->depth, &info) == OB_OK) *out_depth = info.format;
+    ob_image d = v->depth.id ? v->depth : v->msaa_depth;
+    if (d.id && ob_image_get_info(ctx->dev, d, &info) == OB_OK) *out_depth = info.format;
 }
 
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)
 {
     if (!e) return false;
-    VkFormat color, depth;
-    ob_views_target_formats(ctx, v, &color, &depth);
+    ob_effect_targets t;
+    ob_view_attachment_formats(v, ctx->dev, &t.color, &t.depth, &t.samples);
     uint32_t id = 0;
-    VkPipeline p = ob_effect_pipeline(e, color, depth, &id);
+    VkPipeline p = ob_effect_pipeline_for(e, &t, &id);
     if (!p) return false;
     ob_pipeline_manager_set_pipeline(pm, p, id, ob_effect_program(e));
     return true;

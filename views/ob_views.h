@@ -1,7 +1,8 @@
 /* ob_views.h — the concrete render views and the glue that installs them.
  *
  * View types (engine/ob_view.h is the interface):
- *   perspective  a camera's colour + depth; queues the shadow views of the
+ *   perspective  a camera's linear HDR colour + depth (optionally
+ *                multisampled and resolved); queues the shadow views of the
  *                lights that cast shadows onto what it sees
  *   shadow       a directional light's depth, fitted to the casters the
  *                consumer sees; left out with no caster or zero intensity
@@ -11,7 +12,8 @@
  *   simulation   compute only: a particle system in a storage buffer that the
  *                perspective view then draws
  *   overlay      text (stb_easy_font) drawn last over the final target
- *   composite    full-screen copy of a view's colour into the final target
+ *   composite    full-screen pass tone mapping a view's colour into the
+ *                final target (sRGB); its size follows its source's
  *
  * ob_views is the context that owns per-entity and per-light views (created
  * on first need, reused every frame), fills the renderer's material and
@@ -61,15 +63,29 @@ typedef struct ob_perspective_desc {
     const char *name;
     ob_node *camera;             /* a node with a camera component */
     uint32_t width, height;
-    VkFormat color_format;       /* 0 → R8G8B8A8_UNORM */
-    float clear_color[4];
+    VkFormat color_format;       /* 0 → R16G16B16A16_SFLOAT (linear HDR) */
+    float clear_color[4];        /* linear, like everything the view draws */
+    uint32_t samples;            /* MSAA: 0 or 1 → none; 2, 4, 8: drawn multisampled and
+                                    resolved (average) into the colour target consumers
+                                    read. Lowered to what the device offers for the
+                                    formats, with a warning in the log. */
 } ob_perspective_desc;
 
 ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspective_desc *desc,
                                                 ob_result *out_result);
 void ob_perspective_view_destroy(ob_views *ctx, ob_perspective_view *v);
 ob_view *ob_perspective_view_base(ob_perspective_view *v);
+/* The (single-sampled, resolved) colour target. Its handle changes when
+ * the view is resized: ask again after each frame. */
 ob_image ob_perspective_view_color(const ob_perspective_view *v);
+/* Samples per pixel the view renders with (1 without MSAA). */
+uint32_t ob_perspective_view_samples(const ob_perspective_view *v);
+
+/* Resizing: ob_view_resize(base, w, h) (engine/ob_view.h) on a perspective
+ * or composite view takes effect at the view's next PreRender: its targets are
+ * made again (same formats and samples) before anything of that frame is
+ * recorded, the old ones destroyed deferred. A composite follows its
+ * source's size in the same frame. */
 
 /* --------------------------------------------------------------- overlay */
 
@@ -84,7 +100,13 @@ ob_view *ob_overlay_view_base(ob_overlay_view *v);
 /* ------------------------------------------------------------- composite */
 
 typedef struct ob_composite_view ob_composite_view;
-/* Copies `source`'s colour into a final target of the same size. */
+/* The exposure a composite starts with: scales the linear scene colour
+ * before the tone map. */
+#define OB_COMPOSITE_DEFAULT_EXPOSURE 1.0f
+/* Tone maps `source`'s linear (HDR) colour into a final target of the same
+ * size, format R8G8B8A8_SRGB: the colour pipeline is scene (linear, 16-bit
+ * float) → exposure → ACES fit (Narkowicz; formula in
+ * materials/shaders/composite.frag) → sRGB encode by the target's format. */
 ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_result *out_result);
 void ob_composite_view_destroy(ob_views *ctx, ob_composite_view *v);
 ob_view *ob_composite_view_base(ob_composite_view *v);
@@ -99,6 +121,23 @@ ob_image ob_composite_view_target(const ob_composite_view *v);
  * is scaled to the window. Without an attached surface this changes
  * nothing. [render thread, between frames] */
 void ob_composite_view_set_presenting(ob_composite_view *v, bool presenting);
+/* Exposure: a linear scale of the scene colour before the tone map
+ * (default OB_COMPOSITE_DEFAULT_EXPOSURE; 2 is one stop brighter). Takes
+ * effect in the next frame recorded. A negative or non-finite value is
+ * refused: logged, false, the old value kept. [render thread, between
+ * frames] */
+bool ob_composite_view_set_exposure(ob_composite_view *v, float exposure);
+float ob_composite_view_exposure(const ob_composite_view *v);
+/* Tone mapping on (default) or off: off, the exposed colour is only clamped
+ * to [0, 1] before the sRGB encode (a linear 0.5 reads back as 188).
+ * [render thread, between frames] */
+void ob_composite_view_set_tonemap(ob_composite_view *v, bool tonemap);
+/* The 8-bit sRGB level the composite writes for a linear colour channel
+ * value with its current exposure and tone map, computed on the CPU the way
+ * composite.frag does (then encoded and rounded to nearest): for tools and
+ * tests that look for a known colour in the output. The GPU's arithmetic
+ * may land one level away. [any thread: only reads v] */
+uint8_t ob_composite_view_output_level(const ob_composite_view *v, float linear);
 
 /* -------------------------------------------------------- particle system */
 

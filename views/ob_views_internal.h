@@ -53,6 +53,18 @@ void ob_views_remove_system(ob_views *ctx, ob_particle_system *ps);
 /* Simulation view of a particle system (ob_view_simulation.c). */
 ob_view *ob_particle_system_sim_view(ob_particle_system *ps);
 
+/* v's targets again at width x height (same formats, layers, samples); the
+ * old images are destroyed deferred. On failure v keeps its targets, logged. */
+ob_result ob_views_resize_target(ob_views *ctx, ob_view *v, uint32_t width, uint32_t height);
+/* Applies v's pending ob_view_resize, if any; true when the size changed.
+ * Views call it at the start of their PreRender. */
+bool ob_views_apply_resize(ob_views *ctx, ob_view *v);
+/* The sample count to use for `wanted` (1, 2, 4, 8...): the largest the
+ * device offers for both formats up to wanted; a lower count is logged as
+ * a warning naming the view. */
+uint32_t ob_views_supported_samples(ob_views *ctx, const char *view_name, uint32_t wanted,
+                                    VkFormat color, VkFormat depth);
+
 /* Frees a view made by this layer: its targets, its draw list and the
  * object itself (whose first member is the base). NULL ok. */
 void ob_views_free_view(ob_views *ctx, ob_view *base);

@@ -16,7 +16,13 @@
 
 /* The standard views' target formats. */
 #define OB_VIEWS_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+/* Environment maps: they only feed shading (sampled by reflective
+ * materials), so 8-bit linear is kept there; lit values above 1 clip. */
 #define OB_VIEWS_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
+/* Camera views render linear HDR colour; the composite tone maps it into an
+ * sRGB target (what is read back, written as PNG and presented). */
+#define OB_VIEWS_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
+#define OB_VIEWS_OUTPUT_FORMAT VK_FORMAT_R8G8B8A8_SRGB
 
 /* ---- PreRender ----------------------------------------------------------- */
 
@@ -39,7 +45,9 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
  * transfer source and destination) and a depth image of format `depth`
  * (depth target, sampled, transfer destination), width x height with
  * `layers` layers, named "<view>.color" / "<view>.depth"; either format may
- * be VK_FORMAT_UNDEFINED (none). Sets v->color, depth, width, height and
+ * be VK_FORMAT_UNDEFINED (none). With v->samples > 1 and one layer, also
+ * the multisampled colour and depth (v->msaa_color, msaa_depth; the depth is
+ * then only multisampled). Sets v->color, depth, width, height and
  * layer_count. Failure: the image's error, v's targets left empty (the colour
  * image made first is destroyed again), logged by the resources. [render
  * thread] */

@@ -25,6 +25,10 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --seed S          scene seed\n"
             "  --env-size N      environment map size (per paraboloid half)\n"
             "  --shadow-size N   shadow map size\n"
+            "  --msaa N          samples per pixel of the main view: 1, 2, 4 or 8 (default 1;\n"
+            "                    lowered to what the device offers, said in the log)\n"
+            "  --exposure F      linear scale of the scene colour before the tone map\n"
+            "                    (default 1; 2 = one stop brighter)\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
             "  --window          show the scene live (F1 toggles the mode; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
@@ -111,6 +115,16 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             ok = sscanf(v, "%u:%ux%u", &o->resize_frame, &o->resize_width, &o->resize_height) == 3 &&
                  o->resize_width > 0 && o->resize_height > 0 && o->resize_width <= 8192 &&
                  o->resize_height <= 8192;
+            i++;
+        } else if (!strcmp(a, "--msaa")) {
+            ok = parse_u32(v, &o->msaa) && (o->msaa == 1 || o->msaa == 2 || o->msaa == 4 ||
+                                            o->msaa == 8);
+            i++;
+        } else if (!strcmp(a, "--exposure")) {
+            char *end;
+            o->exposure = strtof(v, &end);
+            ok = *v && !*end && isfinite(o->exposure) && o->exposure > 0.0f && o->exposure <= 1e6f;
+            o->exposure_given = true;
             i++;
         } else if (!strcmp(a, "--shadow-size")) {
             ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= 16 && o->shadow_size <= 8192;
@@ -251,6 +265,8 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
         .camera = {.fovy = 1.0f, .znear = 0.05f},
         .env_map_size = o->env_size, .shadow_map_size = o->shadow_size,
         .overlay = o->overlay,
+        .msaa = o->msaa,
+        .exposure = o->exposure,
     };
     memcpy(sd.clear_color, o->clear_color, sizeof sd.clear_color);
     memcpy(sd.ambient, o->ambient, sizeof sd.ambient);

@@ -30,6 +30,8 @@ typedef struct ob_demo_options {
     uint32_t objects;         /* --objects N (obelisk-mirror) */
     uint32_t env_size;        /* --env-size (paraboloid map size) */
     uint32_t shadow_size;     /* --shadow-size */
+    uint32_t msaa;            /* --msaa 1|2|4|8 (main view; 0 = not given → 1) */
+    float exposure;           /* --exposure F (> 0; 0 = not given → the default) */
     bool overlay;             /* --overlay / --no-overlay */
     bool window;              /* --window */
     uint32_t resize_frame, resize_width, resize_height; /* --window-resize F:WxH (0 = none) */
@@ -40,7 +42,7 @@ typedef struct ob_demo_options {
     /* Set by the parser when --size / --threads were given, so that settings
      * from a scene file do not override the command line; frames_given makes
      * a windowed run stop after --frames. */
-    bool size_given, threads_given, frames_given;
+    bool size_given, threads_given, frames_given, exposure_given;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
 } ob_demo_options;

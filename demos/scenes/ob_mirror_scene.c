@@ -27,6 +27,22 @@ static const struct { float radius, height; uint32_t slices; } shape_cone = {0.3
 static const struct { float radius; uint32_t slices, stacks; } ball = {1.5f, 48, 32};
 static const struct { float width, depth; uint32_t subdivisions; } ground = {60.0f, 60.0f, 8};
 
+/* Colours are authored sRGB-encoded, as a scene file writes them (the
+ * generated mirror.json holds these numbers), and decoded to linear light
+ * where materials and lights are made. */
+static void linear3(const float srgb[3], float out[3])
+{
+    for (int i = 0; i < 3; i++) out[i] = ob_srgb_to_linear(srgb[i]);
+}
+
+static ob_material_desc linear_material(const ob_material_desc *authored)
+{
+    ob_material_desc d = *authored;
+    linear3(authored->diffuse, d.diffuse);
+    linear3(authored->specular, d.specular);
+    return d;
+}
+
 static const float palette_colors[OB_MIRROR_SCENE_COLOURS][3] = {
     {0.9f, 0.3f, 0.25f}, {0.25f, 0.7f, 0.35f}, {0.3f, 0.45f, 0.9f}, {0.95f, 0.8f, 0.3f},
     {0.8f, 0.4f, 0.85f}, {0.3f, 0.85f, 0.85f}, {0.95f, 0.55f, 0.2f}, {0.85f, 0.85f, 0.85f},
@@ -143,7 +159,8 @@ ob_result ob_mirror_scene_palette(ob_demo *d, bool casts_shadows,
     for (int i = 0; i < OB_MIRROR_SCENE_COLOURS; i++) {
         const float *c = palette_colors[i];
         ob_material_desc md = {.name = "diffuse", .kind = OB_MATERIAL_LIT,
-                               .casts_shadows = casts_shadows, .diffuse = {c[0], c[1], c[2], 1.0f}};
+                               .casts_shadows = casts_shadows, .diffuse = {0, 0, 0, 1.0f}};
+        linear3(c, md.diffuse);
         if (!(out[i] = ob_material_create(d->lib, &md, &r))) return r;
     }
     return OB_OK;
@@ -151,7 +168,8 @@ ob_result ob_mirror_scene_palette(ob_demo *d, bool casts_shadows,
 
 ob_material *ob_mirror_scene_ground_material(ob_demo *d, ob_result *out_result)
 {
-    return ob_material_create(d->lib, &ground_material, out_result);
+    ob_material_desc md = linear_material(&ground_material);
+    return ob_material_create(d->lib, &md, out_result);
 }
 
 ob_result ob_mirror_scene_objects(ob_demo *d, uint32_t objects, uint32_t seed, double spread_to,
@@ -180,6 +198,7 @@ ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows)
     if (!sun_node) return r;
     ob_light_desc ld = sun.desc;
     ld.casts_shadows = sun_shadows;
+    linear3(sun.desc.color, ld.color);
     if ((r = ob_node_set_light(sun_node, &ld)) != OB_OK) return r;
     double origin[3] = {0, 0, 0}, up[3] = {0, 1, 0};
     ob_node_set_position(sun_node, sun.position);
@@ -188,7 +207,9 @@ ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows)
     for (int i = 0; i < 2; i++) {
         ob_node *pl = ob_node_create(d->scene, NULL, points[i].name, &r);
         if (!pl) return r;
-        if ((r = ob_node_set_light(pl, &points[i].desc)) != OB_OK) return r;
+        ob_light_desc pd = points[i].desc;
+        linear3(points[i].desc.color, pd.color);
+        if ((r = ob_node_set_light(pl, &pd)) != OB_OK) return r;
         ob_node_set_position(pl, points[i].position);
     }
     return OB_OK;
@@ -222,7 +243,8 @@ ob_result ob_mirror_scene_build(ob_demo *d, const ob_mirror_scene_desc *desc)
     if ((r = ob_mirror_scene_palette(d, true, palette)) != OB_OK) goto done;
     ob_material *ground_mat = ob_mirror_scene_ground_material(d, &r);
     if (!ground_mat) goto done;
-    ob_material *mirror_mat = ob_material_create(d->lib, &mirror_material, &r);
+    ob_material_desc mirror_desc = linear_material(&mirror_material);
+    ob_material *mirror_mat = ob_material_create(d->lib, &mirror_desc, &r);
     if (!mirror_mat) goto done;
 
     if (!ob_demo_entity(d, NULL, "ground", ground_geometry, ground_mat)) {

@@ -6,6 +6,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ob_stab_world.h"
@@ -14,16 +15,25 @@
 #define H 96
 #define N (W * H)
 
-/* A clear colour exact in UNORM8: 51, 102, 153. */
+/* A linear clear colour: the image shows its tone-mapped sRGB levels. */
 static const ob_stab_world_desc desc = {.width = W, .height = H,
                                         .clear_color = {0.2f, 0.4f, 0.6f, 1.0f}};
 
-static bool is_clear(const uint8_t *p) { return p[0] == 51 && p[1] == 102 && p[2] == 153; }
-
-static uint32_t not_clear(const uint8_t *img)
+/* Within one level of the composite's output for the clear colour (the
+ * GPU's arithmetic may round the other way). */
+static bool is_clear(const ob_composite_view *cv, const uint8_t *p)
 {
+    for (int i = 0; i < 3; i++)
+        if (abs(p[i] - ob_composite_view_output_level(cv, desc.clear_color[i])) > 1) return false;
+    return true;
+}
+
+static uint32_t not_clear(const ob_stab_world *w, const uint8_t *img)
+{
+    if (!w->s) return N;
     uint32_t n = 0;
-    for (uint32_t i = 0; img && i < N; i++) n += !is_clear(img + 4 * i) || img[4 * i + 3] != 255;
+    for (uint32_t i = 0; img && i < N; i++)
+        n += !is_clear(w->s->composite, img + 4 * i) || img[4 * i + 3] != 255;
     return n;
 }
 
@@ -142,7 +152,7 @@ ob_result ob_stab_up_parallel(ob_stab_ctx *c)
     uint8_t *explicit_up = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
     if (w.err == OB_OK) {
-        uint32_t clear_like = N - not_clear(fallback);
+        uint32_t clear_like = N - not_clear(&w, fallback);
         r = ob_stab_add(c, "up_parallel_to_direction", "max abs pixel difference: look_at straight "
                                                        "down with up (0,1,0) vs explicit up (0,0,1)",
                         ob_stab_max_diff(fallback, explicit_up, N), "levels/255", 0,
@@ -234,7 +244,7 @@ ob_result ob_stab_empty_scene(ob_stab_ctx *c)
         shadow_skip = ob_stab_skip_reason(st, "shadow:sun");
         ok &= main_skip == OB_SKIP_EMPTY && shadow_skip == OB_SKIP_NO_CASTERS &&
               !ob_stab_view_stats(st, "shadow:sun");
-        if (img) worst = OB_MAX(worst, not_clear(img));
+        if (img) worst = OB_MAX(worst, not_clear(&w, img));
         ob_free(img);
     }
     ob_result r = OB_OK;
@@ -409,7 +419,7 @@ ob_result ob_stab_non_finite_light_camera(ob_stab_ctx *c)
         if (r == OB_OK)
             r = ob_stab_add(c, "non_finite_camera", "pixels other than the clear colour with a NaN "
                                                     "camera position",
-                            not_clear(img_cam), "pixels", 0, named && back, ob_stab_take_ms(c),
+                            not_clear(&w, img_cam), "pixels", 0, named && back, ob_stab_take_ms(c),
                             "log names view and camera: %s; image as before once fixed: %s",
                             yes(named), yes(back));
     }

@@ -6,6 +6,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ob_stab_world.h"
@@ -49,10 +50,12 @@ static void set_material(ob_stab_world *w, ob_node *n, ob_material *m)
     }
 }
 
-static bool is_rgb(const uint8_t *p, const float rgb[3])
+/* The composite's output for a linear colour, within one level. */
+static bool is_rgb(const ob_stab_world *w, const uint8_t *p, const float rgb[3])
 {
-    return p[0] == (uint8_t)(rgb[0] * 255) && p[1] == (uint8_t)(rgb[1] * 255) &&
-           p[2] == (uint8_t)(rgb[2] * 255);
+    for (int i = 0; i < 3; i++)
+        if (abs(p[i] - ob_composite_view_output_level(w->s->composite, rgb[i])) > 1) return false;
+    return true;
 }
 
 static depth_result depth_render(depth_rig *rig, double d, double gap, bool near_drawn_first)
@@ -73,10 +76,10 @@ static depth_result depth_render(depth_rig *rig, double d, double gap, bool near
         for (uint32_t x = 0; x < w->width; x++) {
             const uint8_t *p = img + ((size_t)y * w->width + x) * 4;
             if (x + 2 < w->width / 2) {
-                res.wrong_far += !is_rgb(p, far_rgb);
+                res.wrong_far += !is_rgb(w, p, far_rgb);
             } else if (x > w->width / 2 + 1) {
                 res.overlap_pixels++;
-                res.wrong_overlap += !is_rgb(p, near_rgb);
+                res.wrong_overlap += !is_rgb(w, p, near_rgb);
             }
         }
     }

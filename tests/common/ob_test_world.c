@@ -25,6 +25,7 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
         .camera = {.fovy = 1.0f, .znear = 0.1f},
         .env_map_size = d.env_map_size ? d.env_map_size : 64,
         .shadow_map_size = d.shadow_map_size ? d.shadow_map_size : 256,
+        .msaa = d.msaa,
     };
     if (d.clear_color[3] > 0.0f) memcpy(sd.clear_color, d.clear_color, sizeof sd.clear_color);
     ob_result r;
@@ -146,6 +147,16 @@ const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mo
 
 const uint8_t *ob_test_world_read(ob_test_world *w)
 {
+    /* The final image may have been resized since the last read. */
+    ob_image_info info;
+    CHECK(ob_image_get_info(w->dev, ob_composite_view_target(w->composite), &info), "final image");
+    if (info.width != w->width || info.height != w->height) {
+        free(w->pixels);
+        w->width = info.width;
+        w->height = info.height;
+        w->pixels = malloc((size_t)w->width * w->height * 4);
+        assert_non_null(w->pixels);
+    }
     CHECK(ob_image_read_rgba8(w->dev, ob_composite_view_target(w->composite), w->pixels), "read back");
     return w->pixels;
 }

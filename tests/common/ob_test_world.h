@@ -24,6 +24,7 @@ typedef struct ob_test_world_desc {
     uint32_t shadow_map_size;  /* 0 → 256 */
     float clear_color[4];      /* zero → opaque dark blue (0.1, 0.2, 0.3, 1) */
     uint32_t chunk_draws;      /* renderer's draws per job; 0 → the renderer's default */
+    uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
 } ob_test_world_desc;
 
 typedef struct ob_test_world {
@@ -66,7 +67,8 @@ const ob_frame_stats *ob_test_world_frame(ob_test_world *w, ob_threading mode, u
 const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mode,
                                                uint32_t workers, ob_view *const *extra,
                                                uint32_t extra_count);
-/* Read the final image into w->pixels; returns it. */
+/* Read the final image into w->pixels; returns it. When the final image
+ * was resized, w->width, w->height and w->pixels follow it first. */
 const uint8_t *ob_test_world_read(ob_test_world *w);
 /* Pixel (x, y) of the last read, RGBA. */
 const uint8_t *ob_test_world_pixel(const ob_test_world *w, uint32_t x, uint32_t y);

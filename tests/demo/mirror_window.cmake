@@ -7,7 +7,9 @@
 #   - resized from 320x240 to 400x300 by the window system during the run
 #     (--window-resize): every frame still presented, the swapchain rebuilt
 #     once at the new size, and the final image (the composite's target,
-#     which follows the window) is 400x300.
+#     which follows the window) is 400x300; the same with --msaa 4 and
+#     --exposure 1.5 (the multisampled main view follows the window too);
+#   - in every windowed run the swapchain is sRGB (no warning that it is not).
 # The renderer presents (ob_renderer_end_frame, same submission as the
 # frame); the demo only hands it the window's surface.
 # Skipped (prints SKIP) when the build has no window support or xvfb-run is
@@ -37,6 +39,10 @@ function(run name)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${name}: exited with ${rc}\n${out}\n${err}")
   endif()
+  # The window shows what the PNG holds only with an sRGB swapchain.
+  if(err MATCHES "offers no B8G8R8A8/R8G8B8A8 sRGB format")
+    message(FATAL_ERROR "${name}: the swapchain is not sRGB\n${err}")
+  endif()
   if(NOT out MATCHES "validation: 0 errors, 0 warnings")
     message(FATAL_ERROR "${name}: the run did not report a silent validation layer\n${out}")
   endif()
@@ -61,5 +67,14 @@ run(window_resize ${xvfb} ${BIN}/obelisk-mirror --window --no-overlay --threads 
     --window-resize 2:400x300)
 if(NOT last_out MATCHES "2 swapchains, last 400x300" OR NOT last_out MATCHES "wrote [^\n]* \\(400x300\\)")
   message(FATAL_ERROR "window_resize: the swapchain and the final target did not follow the "
+          "window to 400x300\n${last_out}")
+endif()
+
+# MSAA and an exposure with a resize: the multisampled main view and its
+# resolve target follow the window too, with a silent validation layer.
+run(window_resize_msaa ${xvfb} ${BIN}/obelisk-mirror --window --no-overlay --threads 2 --toggle 1
+    --msaa 4 --exposure 1.5 --window-resize 3:400x300)
+if(NOT last_out MATCHES "2 swapchains, last 400x300" OR NOT last_out MATCHES "wrote [^\n]* \\(400x300\\)")
+  message(FATAL_ERROR "window_resize_msaa: the swapchain and the final target did not follow the "
           "window to 400x300\n${last_out}")
 endif()

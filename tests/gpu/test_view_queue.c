@@ -481,7 +481,9 @@ static void empty_view_records_nothing(void **state)
     ob_test_world_look(&w, 0, 2, 5, 0, 0, 0);
     ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
     for (int i = 0; i < 5; i++) ob_test_world_entity(&w, NULL, "behind", w.box, m, i, 0, 20);
-    static const uint8_t clear[4] = {51, 102, 153, 255};
+    uint8_t clear[4] = {ob_composite_view_output_level(w.composite, 0.2f),
+                        ob_composite_view_output_level(w.composite, 0.4f),
+                        ob_composite_view_output_level(w.composite, 0.6f), 255};
     for (int mode = 0; mode < 2; mode++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);

@@ -29,7 +29,8 @@ static const char full_scene[] =
     "{\n"
     "  \"description\": \"everything\",\n"
     "  \"settings\": { \"size\": [320, 200], \"env_map_size\": 64, \"shadow_map_size\": 512,\n"
-    "                \"threads\": \"auto\", \"clear_color\": [0.1, 0.2, 0.3], \"ambient\": [1, 1, 1, 0] },\n"
+    "                \"threads\": \"auto\", \"clear_color\": [0.1, 0.2, 0.3], \"ambient\": [1, 1, 1, 0],\n"
+    "                \"exposure\": 1.5 },\n"
     "  \"camera\": { \"position\": [1, 2, 3], \"target\": [1, 2, 0], \"fov_degrees\": 40, \"near\": 0.5 },\n"
     "  \"lights\": [\n"
     "    { \"type\": \"directional\", \"position\": [0, 10, 0], \"target\": [0, 0, 0], \"shadows\": true },\n"
@@ -82,7 +83,9 @@ static void full_file_parses_to_its_description(void **state)
     assert_true(s->has_threads);
     assert_int_equal(s->threads, -1);
     assert_true(s->has_clear_color);
-    assert_near(s->clear_color[2], 0.3, 1e-6);
+    /* Colours are written sRGB-encoded and read back linear. */
+    assert_near(s->clear_color[2], pow((0.3 + 0.055) / 1.055, 2.4), 1e-6);
+    assert_near(s->exposure, 1.5, 0);
     assert_near(s->clear_color[3], 1.0, 0);   /* alpha 1 when three numbers are given */
     assert_true(s->has_ambient);              /* intensity 0 means no ambient light */
     assert_near(s->ambient[0], 0.0, 0);
@@ -104,7 +107,7 @@ static void full_file_parses_to_its_description(void **state)
     assert_near(sf.lights[0].desc.intensity, 1.0, 0);
     assert_string_equal(sf.lights[1].name, "lamp");
     assert_int_equal(sf.lights[1].desc.type, OB_LIGHT_POINT);
-    assert_near(sf.lights[1].desc.color[1], 0.5, 0);
+    assert_near(sf.lights[1].desc.color[1], pow((0.5 + 0.055) / 1.055, 2.4), 1e-6);
     assert_near(sf.lights[1].desc.range, 5.0, 0);
 
     assert_int_equal(sf.material_count, 3);   /* two named, one inline */
