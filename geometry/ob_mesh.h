@@ -87,6 +87,28 @@ ob_result ob_mesh_validate_primitives(const ob_mesh *mesh, const char *name,
  * is then left unchanged; OB_ERR_OUT_OF_HOST_MEMORY likewise. */
 ob_result ob_mesh_generate_normals(ob_mesh *mesh);
 
+/* Fills mesh->tangents (allocating the array if it is NULL) with unit
+ * tangents orthogonal to each vertex normal, w = ±1, in the glTF / MikkTSpace
+ * convention: tangent along increasing u, bitangent = cross(normal,
+ * tangent.xyz) · w along increasing v measured towards the TOP of the image
+ * (the normal map's +Y). uv_origin_bottom_left says which way the mesh's v
+ * runs: false for the ob_mesh convention (v = 0 at the top of the image,
+ * model files loaded with flip_uv), true for assimp's raw uv.
+ * Per triangle, the tangent and bitangent come from the uv derivatives
+ * (solving the edge equations), are normalized and added to its three
+ * vertices weighted by the corner angle (as MikkTSpace does); per vertex the
+ * sum is Gram-Schmidt orthogonalized against the normal and w is the sign of
+ * the accumulated bitangent against cross(normal, tangent). What differs
+ * from the full MikkTSpace algorithm: vertices are not split where
+ * triangles sharing one disagree on handedness (mirrored uv islands joined
+ * at a vertex) — the sum decides; and a vertex whose triangles all have
+ * degenerate uv gets an arbitrary unit tangent perpendicular to its normal
+ * (w = 1) rather than one borrowed from its neighbours. Normals must be
+ * unit length (as validated meshes and loaded models have them).
+ * OB_ERR_INVALID_ARGUMENT / OB_ERR_OUT_OF_RANGE (logged) on a bad mesh,
+ * OB_ERR_OUT_OF_HOST_MEMORY; the mesh is then unchanged. [any thread] */
+ob_result ob_mesh_generate_tangents(ob_mesh *mesh, bool uv_origin_bottom_left);
+
 /* ------------------------------------------------------------ generators
  * Each fills *out (which it first zeroes; the caller releases it) with unit
  * normals, uv in [0,1] and bounds, and returns OB_OK. Bad parameters
