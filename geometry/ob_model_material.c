@@ -348,6 +348,17 @@ static ob_result read_texture(material_ctx *c, const struct aiMaterial *m, enum 
     return OB_OK;
 }
 
+/* The first of `types` that the material names a texture for. */
+static ob_result read_first_texture(material_ctx *c, const struct aiMaterial *m,
+                                    const enum aiTextureType *types, int count,
+                                    const slot_info *si, ob_model_texture *tex)
+{
+    struct aiString ref;
+    for (int i = 0; i < count; i++)
+        if (texture_ref(m, types[i], &ref)) return read_texture(c, m, types[i], si, tex);
+    return OB_OK;
+}
+
 /* An image's channel count, and for 3 or 4 channels whether every texel is
  * grey (r = g = b): a height map saved as RGB. 0 when it cannot be read
  * (the texture loader will say why). */
@@ -485,12 +496,13 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
     out->roughness = clamp01(out->roughness);
     out->alpha_cutoff = out->alpha_cutoff < 0.0f ? 0.0f : out->alpha_cutoff;
 
-    /* Textures. */
+    /* Textures: for each slot, the first assimp type the file fills (glTF
+     * files fill BASE_COLOR and DIFFUSE with the same texture: one warning
+     * if its file is missing, not two). */
     slot_info si = base;
     si.slot = "baseColorTexture";
-    ob_result r = read_texture(c, m, aiTextureType_BASE_COLOR, &si, &out->base_color_texture);
-    if (r == OB_OK && out->base_color_texture.image < 0)
-        r = read_texture(c, m, aiTextureType_DIFFUSE, &si, &out->base_color_texture);
+    const enum aiTextureType base_types[] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
+    ob_result r = read_first_texture(c, m, base_types, 2, &si, &out->base_color_texture);
     if (r == OB_OK && gltf) {
         si.slot = "metallicRoughnessTexture";
         r = read_texture(c, m, aiTextureType_UNKNOWN, &si, &out->metallic_roughness_texture);
@@ -498,18 +510,15 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
     si.slot = "normalTexture";
     if (r == OB_OK) r = read_normal_texture(c, m, &si, out);
     si.slot = "occlusionTexture";
-    if (r == OB_OK && gltf) {
-        r = read_texture(c, m, aiTextureType_LIGHTMAP, &si, &out->occlusion_texture);
-        if (r == OB_OK && out->occlusion_texture.image >= 0 &&
-            get_float(m, AI_MATKEY_GLTF_TEXTURE_STRENGTH(aiTextureType_LIGHTMAP, 0), &f))
-            out->occlusion_strength = f;
-    }
-    if (r == OB_OK && out->occlusion_texture.image < 0)
-        r = read_texture(c, m, aiTextureType_AMBIENT_OCCLUSION, &si, &out->occlusion_texture);
+    const enum aiTextureType occlusion_types[] = {aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP};
+    if (r == OB_OK)   /* LIGHTMAP is glTF's occlusion; elsewhere it is baked light */
+        r = read_first_texture(c, m, occlusion_types, gltf ? 2 : 1, &si, &out->occlusion_texture);
+    if (r == OB_OK && out->occlusion_texture.image >= 0 &&
+        get_float(m, AI_MATKEY_GLTF_TEXTURE_STRENGTH(aiTextureType_LIGHTMAP, 0), &f))
+        out->occlusion_strength = f;
     si.slot = "emissiveTexture";
-    if (r == OB_OK) r = read_texture(c, m, aiTextureType_EMISSIVE, &si, &out->emissive_texture);
-    if (r == OB_OK && out->emissive_texture.image < 0)
-        r = read_texture(c, m, aiTextureType_EMISSION_COLOR, &si, &out->emissive_texture);
+    const enum aiTextureType emissive_types[] = {aiTextureType_EMISSIVE, aiTextureType_EMISSION_COLOR};
+    if (r == OB_OK) r = read_first_texture(c, m, emissive_types, 2, &si, &out->emissive_texture);
     if (r != OB_OK) return r;
     if (!isfinite(out->normal_scale) || !isfinite(out->occlusion_strength)) {
         ob_model_bad(c->chk, "material %u '%s': normal scale or occlusion strength is not finite",
