@@ -20,6 +20,12 @@
  * sphere geometry failed: ..."). Either is a hard failure: the load returns
  * the error and leaves nothing it made in the scene, the material library or
  * the views (a camera node given in the desc is restored as it was).
+ * Models keep their structure (ob_model_instance.h): the entity is the
+ * model's root, with one child entity per node of the file and one per
+ * primitive, each drawing with the model's own material, or, when the
+ * entity names a "material", with that one for every primitive. Each model
+ * file is opened once and its geometry and materials shared by the
+ * entities naming it.
  * A model that does not load is not a hard failure: its entity stays as a
  * transform-only node (its children still render), the loss is logged as a
  * warning naming the file and the entity ("scene.json: entities[2] 'ghost':
@@ -49,6 +55,7 @@
 #ifndef OB_SCENE_LOAD_H
 #define OB_SCENE_LOAD_H
 
+#include "ob_model_instance.h"
 #include "ob_scene_file.h"
 #include "ob_stack.h"
 
@@ -91,8 +98,13 @@ typedef struct ob_scene_load_left_out {
 typedef struct ob_scene_loaded {
     ob_node **entities;           /* entities[i] is "entities"[i]'s node (transform-only if left out) */
     uint32_t entity_count;
-    ob_geometry **geometry;       /* one per distinct description (shared by entities alike) */
+    ob_geometry **geometry;       /* generated shapes: one per distinct description (shared by
+                                     entities alike); models' geometry is in their assets */
     uint32_t geometry_count;
+    ob_model_assets **models;     /* one per distinct model file (NULL where it did not open) */
+    uint32_t model_count;
+    uint32_t model_entity_count;  /* entities made under model entities: per model node and
+                                     per placed primitive (ob_model_instance.h) */
     ob_material **materials;      /* the file's materials (ob_scene_file order), then "default",
                                      which entities without a material draw with */
     uint32_t material_count;

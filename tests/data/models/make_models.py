@@ -192,3 +192,17 @@ Kd 1 1 1
 Ns 0
 bump height.png
 """)
+
+# mirror.gltf: one red quad facing +Z placed twice, once through a mirroring
+# node (scale x -0.5): both must face the camera (the mirrored copy's
+# triangles are wound the other way by the loader).
+buf = Buffer()
+mirror = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"name": "left", "translation": [-1.5, 0, 0], "scale": [-0.5, 0.5, 0.5], "mesh": 0},
+              {"name": "right", "translation": [1.5, 0, 0], "scale": [0.5, 0.5, 0.5], "mesh": 0}],
+    "meshes": [{"name": "quad", "primitives": [dict(quad(buf), material=0)]}],
+    "materials": [{"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1], "metallicFactor": 0}}],
+}
+mirror.update(buf.gltf_fields())
+dump("mirror.gltf", mirror)
