@@ -337,34 +337,44 @@ static ob_result build(loader *L)
 
 /* ------------------------------------------------------------ bounds, camera */
 
-/* Bounds of every renderable (after one update, so world bounds exist). */
-static ob_result scene_bounds(loader *L)
+ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
+                                double *radius)
 {
-    ob_scene_loaded *o = L->out;
-    ob_result r = ob_scene_update(L->t.scene, 0.0);
-    if (r != OB_OK) return fail(L, r, "", "the scene did not update");
+    for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY, center[k] = 0.0;
+    *radius = 1.0;
+    ob_result r = ob_scene_update(scene, 0.0);
+    if (r != OB_OK) return r;
     uint32_t n = 0;
-    ob_node *const *nodes = ob_scene_renderables(L->t.scene, &n);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    ob_node *const *nodes = ob_scene_renderables(scene, &n);
+    if (!n) return OB_OK;
     for (uint32_t i = 0; i < n; i++) {
         double c[3];
         float rad;
         ob_node_world_sphere(nodes[i], c, &rad);
         for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], c[k] - rad), hi[k] = fmax(hi[k], c[k] + rad);
     }
-    o->has_bounds = n > 0;
-    o->radius = 1.0;
-    if (!n) return OB_OK;
-    memcpy(o->min, lo, sizeof lo);
-    memcpy(o->max, hi, sizeof hi);
-    for (int k = 0; k < 3; k++) o->center[k] = 0.5 * (lo[k] + hi[k]);
-    o->radius = 0.0;
+    for (int k = 0; k < 3; k++) center[k] = 0.5 * (lo[k] + hi[k]);
+    *radius = 0.0;
     for (uint32_t i = 0; i < n; i++) {
         double c[3];
         float rad;
         ob_node_world_sphere(nodes[i], c, &rad);
-        double dx = c[0] - o->center[0], dy = c[1] - o->center[1], dz = c[2] - o->center[2];
-        o->radius = fmax(o->radius, sqrt(dx * dx + dy * dy + dz * dz) + rad);
+        double dx = c[0] - center[0], dy = c[1] - center[1], dz = c[2] - center[2];
+        *radius = fmax(*radius, sqrt(dx * dx + dy * dy + dz * dz) + rad);
+    }
+    return OB_OK;
+}
+
+/* Bounds of every renderable (after one update, so world bounds exist). */
+static ob_result scene_bounds(loader *L)
+{
+    ob_scene_loaded *o = L->out;
+    ob_result r = ob_scene_load_measure(L->t.scene, o->min, o->max, o->center, &o->radius);
+    if (r != OB_OK) return fail(L, r, "", "the scene did not update");
+    o->has_bounds = o->max[0] >= o->min[0];
+    if (!o->has_bounds) {
+        memset(o->min, 0, sizeof o->min);
+        memset(o->max, 0, sizeof o->max);
     }
     return OB_OK;
 }

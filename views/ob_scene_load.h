@@ -167,6 +167,14 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_d
 void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
                                   const ob_scene_file_settings *settings);
 
+/* Updates the scene (dt 0) and measures every renderable in it (world
+ * bounding spheres): the box around them in lo/hi, its centre, and the
+ * radius of the sphere about that centre holding them all. No renderable:
+ * lo = +inf, hi = −inf, centre 0, radius 1, OB_OK. Failure: the update's
+ * result. [render thread, between frames] */
+ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
+                                double *radius);
+
 /* Points camera at a bounding sphere from a 3/4 view above it, at the
  * distance where the sphere fills the narrower field of view (45 degrees
  * vertical) of an image of this aspect (width / height). A non-finite centre
