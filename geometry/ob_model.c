@@ -459,6 +459,38 @@ bool ob_model_mesh_has_area(const ob_mesh *m)
     return false;
 }
 
+ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+                          const struct aiScene **out_scene)
+{
+    *out_scene = NULL;
+    const char *path = c->path;
+    ob_result r = ob_model_check_readable(path);
+    if (r == OB_OK) r = ob_model_ply_precheck(path);
+    if (r == OB_OK && gltf_precheck) r = ob_model_gltf_precheck(path);
+    if (r != OB_OK) return r;
+    char err[512];
+    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
+    if (!scene) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
+        return OB_ERR_PARSE;
+    }
+    r = ob_model_check_raw_scene(c, scene);
+    if (r != OB_OK) {
+        ob_model_report_more(c);
+        aiReleaseImport(scene);
+        return r;
+    }
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
+                     aiProcess_JoinIdenticalVertices | (flip_uv ? aiProcess_FlipUVs : 0u);
+    scene = aiApplyPostProcessing(scene, flags);
+    if (!scene) {   /* assimp has released the scene already */
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
+        return OB_ERR_PARSE;
+    }
+    *out_scene = scene;
+    return OB_OK;
+}
+
 ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info)
 {
     if (out) memset(out, 0, sizeof *out);
@@ -470,27 +502,9 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
     }
     model_ctx c = {.chk.path = desc->path};
     const char *path = desc->path;
-    ob_result r = ob_model_check_readable(path);
+    const struct aiScene *scene;
+    ob_result r = ob_model_import(&c.chk, desc->flip_uv, false, &scene);
     if (r != OB_OK) return r;
-    r = ob_model_ply_precheck(path);
-    if (r != OB_OK) return r;
-
-    char err[512];
-    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
-    if (!scene) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
-        return OB_ERR_PARSE;
-    }
-    r = ob_model_check_raw_scene(&c.chk, scene);
-    if (r != OB_OK) goto fail_release_scene;
-
-    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
-                     aiProcess_JoinIdenticalVertices | (desc->flip_uv ? aiProcess_FlipUVs : 0u);
-    scene = aiApplyPostProcessing(scene, flags);
-    if (!scene) {   /* assimp has released the scene already */
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
-        return OB_ERR_PARSE;
-    }
     r = merge_scene(&c, scene, out);
     if (r != OB_OK) goto fail_release_out;
     if (ob_mesh_validate(out, path) != OB_OK || ob_mesh_compute_bounds(out) != OB_OK) {
@@ -517,7 +531,6 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
 
 fail_release_out:
     ob_mesh_release(out);
-fail_release_scene:
     ob_model_report_more(&c.chk);
     aiReleaseImport(scene);
     return r;

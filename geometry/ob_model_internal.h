@@ -45,6 +45,17 @@ const struct aiScene *ob_model_parse(const char *path, char *err, size_t err_siz
  * mPrimitiveTypes to what its faces are (see ob_model.c). */
 ob_result ob_model_check_raw_scene(ob_model_check *c, const struct aiScene *s);
 
+/* The front both loaders share, in the order ob_model.c explains: the file
+ * is readable, the PLY precheck, the glTF extension scan (when asked: only
+ * ob_model_open refuses required extensions), assimp's parse with no
+ * post-processing, the raw checks, then triangulation, sorting by primitive
+ * type, missing normals (smooth), vertex joining and, with flip_uv, v → 1 − v.
+ * *out_scene is released with aiReleaseImport; NULL on failure, which is
+ * logged (the file and the problem): OB_ERR_IO, OB_ERR_PARSE,
+ * OB_ERR_BAD_MODEL, OB_ERR_UNSUPPORTED, OB_ERR_OUT_OF_HOST_MEMORY. */
+ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+                          const struct aiScene **out_scene);
+
 /* glTF files (.gltf JSON, .glb by its magic) are scanned for
  * extensionsRequired / extensionsUsed before assimp reads them: OK for
  * other files and for glTF files needing nothing unsupported (optional

@@ -15,7 +15,6 @@
 #include "ob_model_internal.h"
 
 #include <assimp/cimport.h>
-#include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <math.h>
@@ -333,32 +332,12 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
         return OB_ERR_INVALID_ARGUMENT;
     }
     const char *path = desc->path;
-    ob_result r = ob_model_check_readable(path);
-    if (r == OB_OK) r = ob_model_ply_precheck(path);
-    if (r == OB_OK) r = ob_model_gltf_precheck(path);
-    if (r != OB_OK) return r;
-
     open_ctx c = {.chk.path = path, .flip_uv = desc->flip_uv};
-    char err[512];
-    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
-    if (!scene) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
-        return OB_ERR_PARSE;
-    }
-    r = ob_model_check_raw_scene(&c.chk, scene);
-    if (r != OB_OK) {
-        ob_model_report_more(&c.chk);
-        aiReleaseImport(scene);
-        return r;
-    }
-    /* No PreTransformVertices: the hierarchy is kept. */
-    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
-                     aiProcess_JoinIdenticalVertices | (desc->flip_uv ? aiProcess_FlipUVs : 0u);
-    scene = aiApplyPostProcessing(scene, flags);
-    if (!scene) {   /* assimp has released the scene already */
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
-        return OB_ERR_PARSE;
-    }
+    /* The file's own hierarchy is kept: no PreTransformVertices (the
+     * import never asks for it). */
+    const struct aiScene *scene;
+    ob_result r = ob_model_import(&c.chk, desc->flip_uv, true, &scene);
+    if (r != OB_OK) return r;
     c.scene = scene;
     ob_model *model = ob_calloc(1, sizeof *model);
     c.model = model;

@@ -31,9 +31,8 @@ static ob_stack *make_stack(const ob_scene_file_settings *settings)
     return s;
 }
 
-/* Two frames, then the share of the final image's pixels that are not the
- * clear colour (opaque blue). */
-static double rendered_share(ob_stack *s)
+/* Two frames, then the final image (malloc'd, RGBA8). */
+static uint8_t *render_rgba(ob_stack *s)
 {
     assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
     assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
@@ -41,6 +40,14 @@ static double rendered_share(ob_stack *s)
     uint8_t *px = malloc((size_t)W * H * 4);   /* test-side image */
     assert_non_null(px);
     assert_int_equal(ob_image_read_rgba8(s->device, ob_stack_final_image(s), px), OB_OK);
+    return px;
+}
+
+/* Two frames, then the share of the final image's pixels that are not the
+ * clear colour (opaque blue). */
+static double rendered_share(ob_stack *s)
+{
+    uint8_t *px = render_rgba(s);
     uint32_t drawn = 0;
     for (uint32_t i = 0; i < W * H; i++) {
         const uint8_t *p = px + (size_t)i * 4;
@@ -236,17 +243,6 @@ static void test_load_missing_model(void **state)
     ob_test_assert_no_validation(s->device);
     ob_scene_unload(&l);
     ob_stack_destroy(s);
-}
-
-static uint8_t *render_rgba(ob_stack *s)
-{
-    assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
-    assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
-    assert_int_equal(ob_renderer_wait_idle(s->renderer), OB_OK);
-    uint8_t *px = malloc((size_t)W * H * 4);   /* test-side image */
-    assert_non_null(px);
-    assert_int_equal(ob_image_read_rgba8(s->device, ob_stack_final_image(s), px), OB_OK);
-    return px;
 }
 
 /* A glTF model in a scene keeps its hierarchy: the entity is the model's
