@@ -106,7 +106,8 @@ typedef struct ob_scene_loaded {
     uint32_t model_entity_count;  /* entities made under model entities: per model node and
                                      per placed primitive (ob_model_instance.h) */
     ob_material **materials;      /* the file's materials (ob_scene_file order), then "default",
-                                     which entities without a material draw with */
+                                     which generated shapes without a material draw with
+                                     (models without one draw with their own: see models) */
     uint32_t material_count;
     ob_node **lights;             /* the file's lights; without "lights", the default sun */
     uint32_t light_count;
