@@ -27,6 +27,13 @@ struct ob_model_assets {
 
 /* ------------------------------------------------------------ materials */
 
+bool ob_model_material_has_vertex_colors(const ob_model *model, uint32_t index)
+{
+    for (uint32_t p = 0; model && p < model->primitive_count; p++)
+        if (model->primitives[p].material == index && model->primitives[p].mesh.colors) return true;
+    return false;
+}
+
 ob_material *ob_model_material_to_material(const ob_model_material_context *ctx, uint32_t index,
                                            bool *out_extended_layout, ob_result *out_result)
 {

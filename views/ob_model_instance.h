@@ -61,6 +61,13 @@ typedef struct ob_model_material_context {
 ob_material *ob_model_material_to_material(const ob_model_material_context *ctx, uint32_t index,
                                            bool *out_extended_layout, ob_result *out_result);
 
+/* True when a primitive drawing with model->materials[index] has vertex
+ * colours (COLOR_0, PLY colours). Primitives of that material without them
+ * are uploaded white in the extended layout, so a material multiplying its
+ * base colour by COLOR0 (ob_material_pbr.vertex_colors) draws them right
+ * too. [any thread] */
+bool ob_model_material_has_vertex_colors(const ob_model *model, uint32_t index);
+
 typedef struct ob_model_assets ob_model_assets;
 
 #define OB_MODEL_ASSETS_IDS_PER_PRIMITIVE 4u

@@ -289,6 +289,10 @@ static void test_load_gltf_hierarchy(void **state)
     ob_material *masked = material_of(quad0);
     assert_string_equal(ob_material_name(masked), "features.gltf/masked");
     assert_string_equal(ob_material_name(material_of(quad1)), "features.gltf/blended");
+    const ob_model *fm = ob_model_assets_model(l.models[0]);
+    for (uint32_t i = 0; i < fm->material_count; i++)   /* only "masked" (quad-0) has COLOR_0 */
+        assert_int_equal(ob_model_material_has_vertex_colors(fm, i),
+                         strcmp(fm->materials[i].name, "masked") == 0);
     ob_node *grand = ob_node_next_sibling(quad1);
     assert_string_equal(ob_node_name(grand), "grandchild");
     assert_ptr_equal(material_of(ob_node_first_child(grand)), masked);
