@@ -14,6 +14,10 @@
 #include "ob_model.h"
 
 #include <cjson/cJSON.h>
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wstrict-prototypes"
+#include <stb_image.h>   /* compiled once in the library (engine/ob_stb_impl.c) */
+#pragma GCC diagnostic pop
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -621,6 +625,32 @@ static void obj_and_ply_from_the_package(void **state)
     ob_model_close(m);
 }
 
+/* A format whose embedded skins are raw texels (assimp's aiTexel arrays,
+ * mHeight != 0): the image arrives as a PNG that decodes, and HL1's
+ * embedded BMP-named textures as bytes too. */
+static void raw_embedded_texture_becomes_png(void **state)
+{
+    (void)state;
+    const char *mdl = MODELS "MDL/MDL3 (3DGS A4)/minigun.MDL";
+    const char *hl1 = MODELS "MDL/MDL (HL1)/chrome_sphere.mdl";
+    if (!have_model(mdl) || !have_model(hl1)) return;
+    for (int f = 0; f < 2; f++) {
+        ob_model *m = open_ok(f ? hl1 : mdl, true);
+        expect_well_formed(m);
+        const ob_model_material *mat = &m->materials[m->primitives[0].material];
+        assert_true(mat->base_color_texture.image >= 0);
+        const ob_model_image *img = &m->images[mat->base_color_texture.image];
+        assert_null(img->path);
+        int w = 0, h = 0, n = 0;
+        stbi_uc *px = stbi_load_from_memory(img->data, (int)img->size, &w, &h, &n, 4);
+        if (!px) fail_msg("%s: embedded image '%s' (%zu bytes) does not decode", m->path, img->name, img->size);
+        assert_true(w > 0 && h > 0);
+        stbi_image_free(px);
+        if (f == 0) assert_memory_equal(img->data, "\x89PNG", 4);   /* encoded here */
+        ob_model_close(m);
+    }
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -639,6 +669,7 @@ int main(void)
         cmocka_unit_test(engine_keeps_its_hierarchy),
         cmocka_unit_test(clear_coat_normal_maps_get_tangents),
         cmocka_unit_test(obj_and_ply_from_the_package),
+        cmocka_unit_test(raw_embedded_texture_becomes_png),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
