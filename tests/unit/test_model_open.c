@@ -19,6 +19,7 @@
 #include <stb_image.h>   /* compiled once in the library (engine/ob_stb_impl.c) */
 #pragma GCC diagnostic pop
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -651,6 +652,55 @@ static void raw_embedded_texture_becomes_png(void **state)
     }
 }
 
+/* Opens may run on several threads at once ([any thread]): each thread's
+ * models come out as a serial open makes them. */
+typedef struct open_job { uint32_t nodes[2], primitives[2], images[2]; bool ok; } open_job;
+
+static void *open_thread(void *arg)
+{
+    open_job *j = arg;
+    const char *files[2] = {DATA "features.gltf", DATA "mtl_quad.obj"};
+    j->ok = true;
+    for (int round = 0; round < 4; round++) {
+        for (int f = 0; f < 2; f++) {
+            ob_model *m = NULL;
+            if (ob_model_open(&(ob_model_desc){.path = files[f], .flip_uv = true}, &m) != OB_OK) {
+                j->ok = false;
+                continue;
+            }
+            j->ok = j->ok && m->node_count == j->nodes[f] && m->primitive_count == j->primitives[f] &&
+                    m->image_count == j->images[f];
+            ob_model_close(m);
+        }
+    }
+    return NULL;
+}
+
+static void concurrent_opens_agree_with_serial_ones(void **state)
+{
+    (void)state;
+    open_job serial = {0};
+    const char *files[2] = {DATA "features.gltf", DATA "mtl_quad.obj"};
+    for (int f = 0; f < 2; f++) {
+        ob_model *m = open_ok(files[f], true);
+        serial.nodes[f] = m->node_count;
+        serial.primitives[f] = m->primitive_count;
+        serial.images[f] = m->image_count;
+        ob_model_close(m);
+    }
+    enum { THREADS = 4 };
+    open_job jobs[THREADS];
+    pthread_t threads[THREADS];
+    for (int t = 0; t < THREADS; t++) {
+        jobs[t] = serial;
+        assert_int_equal(pthread_create(&threads[t], NULL, open_thread, &jobs[t]), 0);
+    }
+    for (int t = 0; t < THREADS; t++) {
+        assert_int_equal(pthread_join(threads[t], NULL), 0);
+        assert_true(jobs[t].ok);
+    }
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -670,6 +720,7 @@ int main(void)
         cmocka_unit_test(clear_coat_normal_maps_get_tangents),
         cmocka_unit_test(obj_and_ply_from_the_package),
         cmocka_unit_test(raw_embedded_texture_becomes_png),
+        cmocka_unit_test(concurrent_opens_agree_with_serial_ones),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
