@@ -30,8 +30,9 @@ set(OB_PUBLIC_HEADERS
     engine/ob_renderer.h engine/ob_renderer_layer.h engine/ob_resources.h engine/ob_scene.h
     engine/ob_view.h
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
-    geometry/ob_geometry.h geometry/ob_mesh.h
+    geometry/ob_geometry.h geometry/ob_mesh.h geometry/ob_model.h
     views/ob_views.h views/ob_views_layer.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h
+    views/ob_model_instance.h
     views/obelisk.h)
 
 # ------------------------------------------------------------------ shaders

@@ -1,9 +1,13 @@
 /* obelisk-view — renders a scene file (.json, see docs/scene-format.md) or a
  * single model file (.gltf, .glb, .obj, .ply and whatever else assimp reads).
  *
- * A model is framed automatically: a camera fitted to its bounding sphere
- * looking at its centre from a 3/4 view, a shadow-casting directional light
- * and a ground plane under it. A scene file is parsed and checked completely
+ * A model keeps its structure (ob_model_open, ob_model_instance.h): one
+ * entity per node of the file and one per primitive, each with the model's
+ * own material, under one root entity. It is framed automatically: a camera
+ * fitted to its bounding sphere looking at its centre from a 3/4 view, a
+ * shadow-casting directional light and a ground plane under it. A model
+ * that does not open (a parse error, a failed check, a required glTF
+ * extension the engine lacks) exits with code 2 and the loader's message. A scene file is parsed and checked completely
  * before the device is created: a malformed one exits with code 2 and one
  * message naming the file and the JSON path. The library's loader
  * (ob_scene_load.h) then builds it: a model of the scene that fails to load
@@ -23,34 +27,39 @@
 
 /* ------------------------------------------------------------ one model */
 
-/* The model on a ground plane under a shadow-casting sun, framed. */
-static ob_result build_model_view(ob_demo *d, const ob_mesh *mesh, const char *path)
+/* The model (its assets already made) on a ground plane under a
+ * shadow-casting sun, framed. *out_root gets the model's root entity. */
+static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const char *path,
+                                  ob_node **out_root)
 {
     ob_result r = OB_OK;
     const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-    ob_geometry *model = ob_demo_geometry(d, mesh, base);
-    if (!model) return OB_ERR_BAD_MODEL;
-    const ob_bounds *bb = ob_geometry_bounds(model);
-    double radius = bb->radius > 0.0f ? bb->radius : 1.0;
+    ob_node *root = ob_node_create(d->scene, NULL, base, &r);
+    if (!root) return r;
+    *out_root = root;
+    uint32_t entities = 0;
+    if ((r = ob_model_assets_instantiate(assets, d->scene, root, NULL, &entities)) != OB_OK) return r;
+    double lo[3], hi[3], center[3], radius;
+    if ((r = ob_scene_load_measure(d->scene, lo, hi, center, &radius)) != OB_OK) return r;
+    if (!(hi[0] >= lo[0])) return OB_ERR_BAD_MODEL;   /* nothing renderable */
+    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
+    const ob_model *model = ob_model_assets_model(assets);
+    printf("obelisk-view: %s: %u nodes, %u primitives, %u materials, %u images: %u entities\n", path,
+           model->node_count, model->primitive_count, model->material_count, model->image_count, entities);
     ob_mesh plane = {0};
     if ((r = ob_mesh_plane((float)(radius * 12.0), (float)(radius * 12.0), 1, &plane)) != OB_OK) return r;
     ob_geometry *ground = ob_demo_geometry(d, &plane, "ground");
     ob_mesh_release(&plane);
     if (!ground) return OB_ERR_OUT_OF_DEVICE_MEMORY;
-    ob_material_desc md = {.name = "model", .kind = OB_MATERIAL_LIT, .casts_shadows = true,
-                           .diffuse = {0.82f, 0.8f, 0.76f, 1.0f}, .specular = {0.3f, 0.3f, 0.3f, 48.0f}};
     ob_material_desc gd = {.name = "ground", .kind = OB_MATERIAL_LIT,
                            .diffuse = {0.45f, 0.47f, 0.5f, 1.0f}, .specular = {0.05f, 0.05f, 0.05f, 8.0f}};
-    ob_material *mm = ob_material_create(d->lib, &md, &r);
-    ob_material *gm = mm ? ob_material_create(d->lib, &gd, &r) : NULL;
+    ob_material *gm = ob_material_create(d->lib, &gd, &r);
     if (!gm) return r;
-    if (!ob_demo_entity(d, NULL, base, model, mm)) return OB_ERR_OUT_OF_HOST_MEMORY;
     ob_node *floor = ob_demo_entity(d, NULL, "ground", ground, gm);
     if (!floor) return OB_ERR_OUT_OF_HOST_MEMORY;
     /* A hair below the lowest point, so the contact shadow is not z-fighting. */
-    double floor_pos[3] = {bb->center[0], bb->min[1] - radius * 1e-3, bb->center[2]};
+    double floor_pos[3] = {center[0], lo[1] - radius * 1e-3, center[2]};
     ob_node_set_position(floor, floor_pos);
-    double center[3] = {bb->center[0], bb->center[1], bb->center[2]};
     /* The sun a scene file without "lights" gets (ob_scene_load.h), aimed
      * from the origin: a directional light's position is unused. */
     static const ob_light_desc sun_desc = {.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 0.97f, 0.92f},
@@ -95,7 +104,7 @@ int main(int argc, char **argv)
         return code;
     bool is_scene = has_suffix(opt.input, ".json");
     ob_scene_file sf = {0};
-    ob_mesh mesh = {0};
+    ob_model *model = NULL;
     ob_result r;
     if (is_scene) {
         ob_scene_file_error err;
@@ -104,7 +113,7 @@ int main(int argc, char **argv)
             return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
         }
         apply_settings(&opt, &sf.settings);
-    } else if ((r = ob_model_load(&(ob_model_desc){.path = opt.input}, &mesh, NULL)) != OB_OK) {
+    } else if ((r = ob_model_open(&(ob_model_desc){.path = opt.input, .flip_uv = true}, &model)) != OB_OK) {
         fprintf(stderr, "obelisk-view: %s: the model did not load (%s: %s)\n", opt.input,
                 ob_result_name(r), ob_result_text(r));
         return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
@@ -112,6 +121,8 @@ int main(int argc, char **argv)
 
     ob_demo d;
     ob_scene_loaded loaded = {0};
+    ob_model_assets *assets = NULL;
+    ob_node *model_root = NULL;
     r = ob_demo_init(&d, &opt);
     if (r != OB_OK) {
         fprintf(stderr, "obelisk-view: %s: set-up failed: %s (%s)\n", opt.input, ob_result_name(r),
@@ -125,11 +136,18 @@ int main(int argc, char **argv)
         ob_scene_file_error err;
         if ((r = ob_scene_load(&t, &ld, &loaded, &err)) != OB_OK)
             fprintf(stderr, "obelisk-view: %s\n", err.message);
-    } else if ((r = build_model_view(&d, &mesh, opt.input)) != OB_OK) {
-        fprintf(stderr, "obelisk-view: %s: set-up failed: %s (%s)\n", opt.input, ob_result_name(r),
-                ob_result_text(r));
+    } else {
+        /* Geometry ids derived from the contents: the ground uploaded after
+         * takes the stack's next id. */
+        ob_model_assets_desc ad = {.renderer = d.r, .materials = d.lib};
+        assets = ob_model_assets_create(&ad, model, &r);   /* takes the model */
+        model = NULL;
+        if (assets) r = build_model_view(&d, assets, opt.input, &model_root);
+        if (r != OB_OK)
+            fprintf(stderr, "obelisk-view: %s: set-up failed: %s (%s)\n", opt.input, ob_result_name(r),
+                    ob_result_text(r));
     }
-    ob_mesh_release(&mesh);
+    ob_model_close(model);   /* only when the device did not come up */
     if (r != OB_OK) {
         code = 1;
     } else {
@@ -147,6 +165,9 @@ int main(int argc, char **argv)
      * once no frame uses them, before the demo takes the scene and views down. */
     if (d.r) ob_renderer_wait_idle(d.r);
     ob_scene_unload(&loaded);
+    /* The model's entities draw with its assets: they go first. */
+    if (model_root) ob_node_destroy(d.scene, model_root);
+    ob_model_assets_destroy(assets);
     ob_demo_shutdown(&d);
     ob_scene_file_release(&sf);
     return code;

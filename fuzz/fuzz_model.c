@@ -1,13 +1,18 @@
-/* fuzz_model — libFuzzer target for the model loader (geometry/ob_model.c):
+/* fuzz_model — libFuzzer target for the model loaders (geometry/ob_model*.c):
  * assimp's parsers followed by our checks of the raw scene, post-processing
- * and the merge into one ob_mesh.
+ * and the merge into one ob_mesh (ob_model_load); then the same file through
+ * ob_model_open (the glTF extension scan, nodes, primitives, materials,
+ * images, tangents).
  *
  * Input: byte 0 picks the file extension (assimp chooses a parser by it and
  * by the content), the rest is the file. ob_model_load takes a path, so the
  * bytes are written to a file in a per-process temporary folder first.
  * A successful load must give a mesh that passes ob_mesh_validate and has
- * finite bounds; a failed one must leave the mesh empty. Anything else, and
- * any sanitizer report, is a finding.
+ * finite bounds; a failed one must leave the mesh empty. A successful open
+ * must give a model keeping every promise of ob_model.h (parents first,
+ * indices in range, finite transforms, unit tangents where normal maps
+ * are); a failed one must hand out NULL. Anything else, and any sanitizer
+ * report (leaks included), is a finding.
  *
  * Build and run: see fuzz/model.cmake (clang, OB_FUZZ=ON) and docs/soak.md
  * ("Fuzzing the model loader").
@@ -21,6 +26,7 @@
 #include <unistd.h>
 
 #include "ob_mesh.h"
+#include "ob_model.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -97,6 +103,50 @@ static void check_mesh(const ob_mesh *m, const ob_model_info *info)
     if (info->vertex_count != m->vertex_count || info->triangle_count != m->index_count / 3) abort();
 }
 
+static void check_texture(const ob_model *m, const ob_model_texture *t)
+{
+    if (t->image < -1 || t->image >= (int32_t)m->image_count) abort();
+}
+
+static void check_model(const ob_model *m)
+{
+    if (!m->path || !m->node_count || !m->primitive_count || !m->material_count) abort();
+    if (m->nodes[0].parent != -1) abort();
+    for (uint32_t i = 0; i < m->node_count; i++) {
+        const ob_model_node *n = &m->nodes[i];
+        if (!n->name || n->parent >= (int32_t)i || n->parent < -1) abort();
+        for (int k = 0; k < 16; k++)
+            if (!isfinite(n->local[k])) abort();
+        for (uint32_t p = 0; p < n->primitive_count; p++)
+            if (n->primitives[p] >= m->primitive_count) abort();
+    }
+    for (uint32_t i = 0; i < m->primitive_count; i++) {
+        const ob_model_primitive *p = &m->primitives[i];
+        if (!p->name || p->material >= m->material_count) abort();
+        if (ob_mesh_validate(&p->mesh, "fuzz") != OB_OK || !isfinite(p->mesh.bounds.radius)) abort();
+        bool normal_map = m->materials[p->material].normal_texture.image >= 0;
+        if ((p->mesh.tangents != NULL) != normal_map) abort();
+        for (uint32_t v = 0; p->mesh.tangents && v < p->mesh.vertex_count; v++) {
+            const float *t = p->mesh.tangents[v];
+            float len = sqrtf(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+            if (!(fabsf(len - 1.0f) < 1e-3f) || (t[3] != 1.0f && t[3] != -1.0f)) abort();
+        }
+    }
+    for (uint32_t i = 0; i < m->material_count; i++) {
+        const ob_model_material *mat = &m->materials[i];
+        if (!mat->name || mat->alpha_mode > OB_MODEL_ALPHA_BLEND) abort();
+        check_texture(m, &mat->base_color_texture);
+        check_texture(m, &mat->metallic_roughness_texture);
+        check_texture(m, &mat->normal_texture);
+        check_texture(m, &mat->occlusion_texture);
+        check_texture(m, &mat->emissive_texture);
+    }
+    for (uint32_t i = 0; i < m->image_count; i++) {
+        const ob_model_image *img = &m->images[i];
+        if (!img->name || (img->path == NULL) == (img->data == NULL) || (img->data && !img->size)) abort();
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1) return 0;
@@ -115,6 +165,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         ob_mesh_release(&mesh);
     } else if (mesh.vertices || mesh.indices || mesh.vertex_count || mesh.index_count) {
         abort(); /* a failed load hands out nothing */
+    }
+
+    ob_model *model = (ob_model *)&model;   /* must become NULL on failure */
+    r = ob_model_open(&(ob_model_desc){.path = path, .flip_uv = (data[0] & 0x80) != 0}, &model);
+    if (r == OB_OK) {
+        check_model(model);
+        ob_model_close(model);
+    } else if (model) {
+        abort(); /* a failed open hands out nothing */
     }
     return 0;
 }

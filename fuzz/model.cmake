@@ -2,7 +2,8 @@
 # and its bounded ctest run, included from fuzz/CMakeLists.txt (which the
 # top level adds when OB_FUZZ is ON). Needs clang. The loader and what it uses (engine/ob_core.c,
 # geometry/ob_mesh.c, geometry/ob_model*.c) are compiled again for this
-# target with coverage instrumentation (-fsanitize=fuzzer-no-link) and
+# target with coverage instrumentation (stb too: ob_model_open reads image
+# headers and encodes raw embedded textures) (-fsanitize=fuzzer-no-link) and
 # ASan + UBSan, whatever OB_SANITIZE says, so findings in our code are
 # reported. libassimp itself is Debian's (not instrumented, asserts on).
 if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
@@ -16,10 +17,11 @@ set(OB_FUZZ_SANITIZE -g -fsanitize=address,undefined -fno-sanitize-recover=undef
 file(GLOB OB_FUZZ_MODEL_SOURCES CONFIGURE_DEPENDS ${OB_FUZZ_ROOT}/geometry/ob_model*.c)
 add_library(ob_fuzz_model_lib STATIC
             ${OB_FUZZ_ROOT}/engine/ob_core.c
+            ${OB_FUZZ_ROOT}/engine/ob_stb_impl.c
             ${OB_FUZZ_ROOT}/geometry/ob_mesh.c
             ${OB_FUZZ_MODEL_SOURCES})
 target_include_directories(ob_fuzz_model_lib PUBLIC ${OB_FUZZ_ROOT}/engine
-                                                    ${OB_FUZZ_ROOT}/geometry)
+                                                    ${OB_FUZZ_ROOT}/geometry ${STB_INCLUDE_DIR})
 target_compile_options(ob_fuzz_model_lib PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer-no-link)
 target_link_libraries(ob_fuzz_model_lib PUBLIC PkgConfig::ASSIMP Threads::Threads m)
 

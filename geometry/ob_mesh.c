@@ -23,6 +23,8 @@ void ob_mesh_release(ob_mesh *mesh)
     if (!mesh) return;
     ob_free(mesh->vertices);
     ob_free(mesh->indices);
+    ob_free(mesh->tangents);
+    ob_free(mesh->colors);
     memset(mesh, 0, sizeof *mesh);
 }
 
@@ -147,6 +149,10 @@ ob_result ob_mesh_validate_primitives(const ob_mesh *mesh, const char *name,
         check_attribute(&s, v, "position", vx->position, 3);
         check_attribute(&s, v, "normal", vx->normal, 3);
         check_attribute(&s, v, "uv", vx->uv, 2);
+        if (mesh->tangents && !vec_finite(mesh->tangents[v], 4))
+            problem(&s, OB_ERR_NON_FINITE, "vertex %u tangent is not finite (%g, %g, %g, %g)", v,
+                    (double)mesh->tangents[v][0], (double)mesh->tangents[v][1],
+                    (double)mesh->tangents[v][2], (double)mesh->tangents[v][3]);
     }
 done:
     if (s.problems > OB_VALIDATE_LOG_MAX)
@@ -214,6 +220,128 @@ ob_result ob_mesh_generate_normals(ob_mesh *mesh)
         }
     }
     ob_free(acc);
+    return OB_OK;
+}
+
+/* ---------------------------------------------------------------- tangents */
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static bool normalize3(double *v)
+{
+    double len = sqrt(dot3(v, v));
+    if (!(len > 1e-20) || !isfinite(len)) return false;
+    for (int k = 0; k < 3; k++) v[k] /= len;
+    return true;
+}
+
+/* Angle at corner a of triangle (a, b, c). */
+static double corner_angle(const float *a, const float *b, const float *c)
+{
+    double u[3], v[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = (double)b[k] - a[k];
+        v[k] = (double)c[k] - a[k];
+    }
+    if (!normalize3(u) || !normalize3(v)) return 0.0;
+    double d = dot3(u, v);
+    return acos(d < -1.0 ? -1.0 : d > 1.0 ? 1.0 : d);
+}
+
+ob_result ob_mesh_generate_tangents(ob_mesh *mesh, bool uv_origin_bottom_left)
+{
+    if (!mesh || !mesh->vertices || !mesh->indices || mesh->index_count % 3 != 0) {
+        OB_LOG_E(OB_MESH_LOG, "generate tangents: %s", !mesh ? "NULL mesh"
+                 : mesh->index_count % 3 ? "index count is not a multiple of 3"
+                                         : "mesh has no vertices or indices");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    for (uint32_t i = 0; i < mesh->index_count; i++) {
+        if (mesh->indices[i] >= mesh->vertex_count) {
+            OB_LOG_E(OB_MESH_LOG, "generate tangents: index %u = %u out of range (%u vertices)", i,
+                     mesh->indices[i], mesh->vertex_count);
+            return OB_ERR_OUT_OF_RANGE;
+        }
+    }
+    /* tangent sum (3) and bitangent sum (3) per vertex */
+    double *acc = ob_calloc(mesh->vertex_count, 6 * sizeof(double));
+    float(*out)[4] = mesh->tangents ? mesh->tangents : ob_malloc((size_t)mesh->vertex_count * sizeof *out);
+    if (!acc || !out) {
+        ob_free(acc);
+        if (out != mesh->tangents) ob_free(out);
+        OB_LOG_E(OB_MESH_LOG, "generate tangents: out of memory for %u vertices", mesh->vertex_count);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    /* v measured up the image whichever way the mesh stores it. */
+    const double v_up = uv_origin_bottom_left ? 1.0 : -1.0;
+    for (uint32_t t = 0; t + 2 < mesh->index_count; t += 3) {
+        const uint32_t *tri = &mesh->indices[t];
+        const ob_vertex *a = &mesh->vertices[tri[0]], *b = &mesh->vertices[tri[1]],
+                        *c = &mesh->vertices[tri[2]];
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = (double)b->position[k] - a->position[k];
+            e2[k] = (double)c->position[k] - a->position[k];
+        }
+        double du1 = (double)b->uv[0] - a->uv[0], dv1 = v_up * ((double)b->uv[1] - a->uv[1]);
+        double du2 = (double)c->uv[0] - a->uv[0], dv2 = v_up * ((double)c->uv[1] - a->uv[1]);
+        double det = du1 * dv2 - du2 * dv1;
+        if (!(fabs(det) > 1e-20) || !isfinite(det)) continue;   /* no uv area: no direction */
+        double tan[3], bit[3];
+        for (int k = 0; k < 3; k++) {
+            tan[k] = (e1[k] * dv2 - e2[k] * dv1) / det;
+            bit[k] = (e2[k] * du1 - e1[k] * du2) / det;
+        }
+        if (!normalize3(tan) || !normalize3(bit)) continue;
+        const float *p[3] = {a->position, b->position, c->position};
+        for (int j = 0; j < 3; j++) {
+            double w = corner_angle(p[j], p[(j + 1) % 3], p[(j + 2) % 3]);
+            double *s = &acc[6 * (size_t)tri[j]];
+            for (int k = 0; k < 3; k++) {
+                s[k] += w * tan[k];
+                s[3 + k] += w * bit[k];
+            }
+        }
+    }
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const double *s = &acc[6 * (size_t)v];
+        const float *nf = mesh->vertices[v].normal;
+        double n[3] = {nf[0], nf[1], nf[2]};
+        if (!normalize3(n)) {
+            n[0] = 0.0;
+            n[1] = 1.0;
+            n[2] = 0.0;
+        }
+        double tan[3] = {s[0], s[1], s[2]};
+        double d = dot3(n, tan);
+        for (int k = 0; k < 3; k++) tan[k] -= n[k] * d;
+        double w = 1.0;
+        if (normalize3(tan)) {
+            double nxt[3];
+            cross3(n, tan, nxt);
+            w = dot3(nxt, s + 3) < 0.0 ? -1.0 : 1.0;
+        } else {
+            /* Any unit vector perpendicular to n: cross with the axis least
+             * aligned with it. */
+            double axis[3] = {0, 0, 0};
+            int m = fabs(n[0]) <= fabs(n[1]) && fabs(n[0]) <= fabs(n[2]) ? 0
+                    : fabs(n[1]) <= fabs(n[2])                           ? 1 : 2;
+            axis[m] = 1.0;
+            cross3(axis, n, tan);
+            normalize3(tan);
+        }
+        for (int k = 0; k < 3; k++) out[v][k] = (float)tan[k];
+        out[v][3] = (float)w;
+    }
+    ob_free(acc);
+    mesh->tangents = out;
     return OB_OK;
 }
 

@@ -43,12 +43,17 @@ typedef struct ob_bounds {
 typedef struct ob_mesh {
     ob_vertex *vertices;
     uint32_t vertex_count;
+    /* Optional arrays parallel to `vertices` (NULL when absent; generators
+     * leave them NULL; ob_mesh_release frees them). A mesh with either is
+     * uploaded in the extended layout (ob_vertex_layout_extended). */
+    float (*tangents)[4];   /* xyz unit tangent, w = ±1 bitangent sign (glTF convention) */
+    uint8_t (*colors)[4];   /* vertex colour COLOR_0, linear, RGBA8 */
     uint32_t *indices;      /* triangle list: index_count / 3 triangles */
     uint32_t index_count;
     ob_bounds bounds;       /* valid after a generator, ob_model_load or ob_mesh_compute_bounds */
 } ob_mesh;
 
-/* Frees the arrays and zeroes the mesh. NULL or a zeroed mesh is a no-op. */
+/* Frees the arrays (tangents and colours too) and zeroes the mesh. NULL or a zeroed mesh is a no-op. */
 void ob_mesh_release(ob_mesh *mesh);
 
 /* Bounds of `count` vertices into *out_bounds (zeroed when count is 0).
@@ -61,7 +66,7 @@ ob_result ob_mesh_compute_bounds(ob_mesh *mesh);
 
 /* Checks a mesh before it is used or uploaded: non-empty, index_count a
  * multiple of 3, every index < vertex_count, every position, normal and uv
- * finite. Logs each problem (the first few, then a count) prefixed with
+ * finite, and every tangent (when present) finite. Logs each problem (the first few, then a count) prefixed with
  * `name` (NULL → "mesh"), e.g. "crate: index 1234 = 99999 out of range
  * (8 vertices)". Returns the first problem found: OB_ERR_INVALID_ARGUMENT
  * (NULL, empty, missing arrays, count not a multiple of 3),
@@ -81,6 +86,28 @@ ob_result ob_mesh_validate_primitives(const ob_mesh *mesh, const char *name,
  * OB_ERR_INVALID_ARGUMENT / OB_ERR_OUT_OF_RANGE (logged) on a bad mesh, which
  * is then left unchanged; OB_ERR_OUT_OF_HOST_MEMORY likewise. */
 ob_result ob_mesh_generate_normals(ob_mesh *mesh);
+
+/* Fills mesh->tangents (allocating the array if it is NULL) with unit
+ * tangents orthogonal to each vertex normal, w = ±1, in the glTF / MikkTSpace
+ * convention: tangent along increasing u, bitangent = cross(normal,
+ * tangent.xyz) · w along increasing v measured towards the TOP of the image
+ * (the normal map's +Y). uv_origin_bottom_left says which way the mesh's v
+ * runs: false for the ob_mesh convention (v = 0 at the top of the image,
+ * model files loaded with flip_uv), true for assimp's raw uv.
+ * Per triangle, the tangent and bitangent come from the uv derivatives
+ * (solving the edge equations), are normalized and added to its three
+ * vertices weighted by the corner angle (as MikkTSpace does); per vertex the
+ * sum is Gram-Schmidt orthogonalized against the normal and w is the sign of
+ * the accumulated bitangent against cross(normal, tangent). What differs
+ * from the full MikkTSpace algorithm: vertices are not split where
+ * triangles sharing one disagree on handedness (mirrored uv islands joined
+ * at a vertex) — the sum decides; and a vertex whose triangles all have
+ * degenerate uv gets an arbitrary unit tangent perpendicular to its normal
+ * (w = 1) rather than one borrowed from its neighbours. Normals must be
+ * unit length (as validated meshes and loaded models have them).
+ * OB_ERR_INVALID_ARGUMENT / OB_ERR_OUT_OF_RANGE (logged) on a bad mesh,
+ * OB_ERR_OUT_OF_HOST_MEMORY; the mesh is then unchanged. [any thread] */
+ob_result ob_mesh_generate_tangents(ob_mesh *mesh, bool uv_origin_bottom_left);
 
 /* ------------------------------------------------------------ generators
  * Each fills *out (which it first zeroes; the caller releases it) with unit

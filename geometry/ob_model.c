@@ -38,9 +38,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define OB_MODEL_LOG "model"
-#define OB_MODEL_MAX_NODE_DEPTH 256u
-#define OB_MODEL_LOG_MAX 4u
 
 /* assimp's C API stores the text of the last failed import in one
  * process-wide std::string (written at the end of every failed
@@ -52,8 +49,7 @@
 static pthread_mutex_t ob_assimp_parse_lock = PTHREAD_MUTEX_INITIALIZER;
 
 typedef struct model_ctx {
-    const char *path;
-    uint32_t problems;      /* BAD_MODEL problems seen (first few are logged) */
+    ob_model_check chk;     /* path, BAD_MODEL problems seen (first few are logged) */
     uint64_t vertex_total;  /* sizing pass */
     uint64_t index_total;
     uint32_t instances;
@@ -62,20 +58,33 @@ typedef struct model_ctx {
     uint32_t vertex_at, index_at;
 } model_ctx;
 
+void ob_model_vbad(ob_model_check *c, const char *fmt, va_list ap)
+{
+    if (c->problems++ >= OB_MODEL_LOG_MAX) return;
+    char text[384];
+    vsnprintf(text, sizeof text, fmt, ap);
+    OB_LOG_E(OB_MODEL_LOG, "%s: %s", c->path, text);
+}
+
+void ob_model_bad(ob_model_check *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    ob_model_vbad(c, fmt, ap);
+    va_end(ap);
+}
+
 static void bad(model_ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 static void bad(model_ctx *c, const char *fmt, ...)
 {
-    if (c->problems++ >= OB_MODEL_LOG_MAX) return;
-    char text[384];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(text, sizeof text, fmt, ap);
+    ob_model_vbad(&c->chk, fmt, ap);
     va_end(ap);
-    OB_LOG_E(OB_MODEL_LOG, "%s: %s", c->path, text);
 }
 
-static void report_more(const model_ctx *c)
+void ob_model_report_more(const ob_model_check *c)
 {
     if (c->problems > OB_MODEL_LOG_MAX)
         OB_LOG_E(OB_MODEL_LOG, "%s: %u more problems not shown (%u in all)", c->path,
@@ -87,7 +96,7 @@ static const char *mesh_name(const struct aiMesh *m)
     return m->mName.length ? m->mName.data : "(unnamed)";
 }
 
-static ob_result check_readable(const char *path)
+ob_result ob_model_check_readable(const char *path)
 {
     char err[128];
     struct stat st;
@@ -112,27 +121,27 @@ static ob_result check_readable(const char *path)
     return OB_OK;
 }
 
-static bool v3_finite(const struct aiVector3D *v)
+bool ob_model_v3_finite(const struct aiVector3D *v)
 {
     return isfinite(v->x) && isfinite(v->y) && isfinite(v->z);
 }
 
 /* The raw file data, before any assimp step touches it. */
-static ob_result check_raw_mesh(model_ctx *c, uint32_t mi, const struct aiMesh *m,
+static ob_result check_raw_mesh(ob_model_check *c, uint32_t mi, const struct aiMesh *m,
                                 uint32_t *out_polygons)
 {
     uint32_t before = c->problems;
     if (m->mNumVertices && !m->mVertices)
-        bad(c, "mesh %u '%s': %u vertices but no positions", mi, mesh_name(m), m->mNumVertices);
+        ob_model_bad(c, "mesh %u '%s': %u vertices but no positions", mi, mesh_name(m), m->mNumVertices);
     if (m->mNumFaces && !m->mFaces)
-        bad(c, "mesh %u '%s': %u faces but no face array", mi, mesh_name(m), m->mNumFaces);
+        ob_model_bad(c, "mesh %u '%s': %u faces but no face array", mi, mesh_name(m), m->mNumFaces);
     if (c->problems != before) return OB_ERR_BAD_MODEL;
 
     unsigned types = 0;
     for (uint32_t f = 0; f < m->mNumFaces; f++) {
         const struct aiFace *face = &m->mFaces[f];
         if (!face->mNumIndices || !face->mIndices) {
-            bad(c, "mesh %u '%s': face %u has no indices", mi, mesh_name(m), f);
+            ob_model_bad(c, "mesh %u '%s': face %u has no indices", mi, mesh_name(m), f);
             continue;
         }
         types |= face->mNumIndices == 1   ? aiPrimitiveType_POINT
@@ -142,7 +151,7 @@ static ob_result check_raw_mesh(model_ctx *c, uint32_t mi, const struct aiMesh *
         *out_polygons += face->mNumIndices >= 3;
         for (uint32_t k = 0; k < face->mNumIndices; k++) {
             if (face->mIndices[k] >= m->mNumVertices)
-                bad(c, "mesh %u '%s': face %u index %u = %u out of range (%u vertices)", mi,
+                ob_model_bad(c, "mesh %u '%s': face %u index %u = %u out of range (%u vertices)", mi,
                     mesh_name(m), f, k, face->mIndices[k], m->mNumVertices);
         }
     }
@@ -152,18 +161,18 @@ static ob_result check_raw_mesh(model_ctx *c, uint32_t mi, const struct aiMesh *
 
     for (uint32_t v = 0; v < m->mNumVertices; v++) {
         const struct aiVector3D *p = &m->mVertices[v];
-        if (!v3_finite(p))
-            bad(c, "mesh %u '%s': vertex %u position is not finite (%g, %g, %g)", mi,
+        if (!ob_model_v3_finite(p))
+            ob_model_bad(c, "mesh %u '%s': vertex %u position is not finite (%g, %g, %g)", mi,
                 mesh_name(m), v, (double)p->x, (double)p->y, (double)p->z);
-        if (m->mNormals && !v3_finite(&m->mNormals[v])) {
+        if (m->mNormals && !ob_model_v3_finite(&m->mNormals[v])) {
             const struct aiVector3D *n = &m->mNormals[v];
-            bad(c, "mesh %u '%s': vertex %u normal is not finite (%g, %g, %g)", mi, mesh_name(m),
+            ob_model_bad(c, "mesh %u '%s': vertex %u normal is not finite (%g, %g, %g)", mi, mesh_name(m),
                 v, (double)n->x, (double)n->y, (double)n->z);
         }
         if (m->mTextureCoords[0]) {
             const struct aiVector3D *t = &m->mTextureCoords[0][v];
             if (!isfinite(t->x) || !isfinite(t->y))
-                bad(c, "mesh %u '%s': vertex %u uv is not finite (%g, %g)", mi, mesh_name(m), v,
+                ob_model_bad(c, "mesh %u '%s': vertex %u uv is not finite (%g, %g)", mi, mesh_name(m), v,
                     (double)t->x, (double)t->y);
         }
     }
@@ -178,23 +187,23 @@ static ob_result check_raw_mesh(model_ctx *c, uint32_t mi, const struct aiMesh *
     return OB_OK;
 }
 
-static ob_result check_raw_nodes(model_ctx *c, const struct aiScene *s, const struct aiNode *n,
+static ob_result check_raw_nodes(ob_model_check *c, const struct aiScene *s, const struct aiNode *n,
                                  uint32_t depth)
 {
     if (depth > OB_MODEL_MAX_NODE_DEPTH) {
-        bad(c, "node hierarchy deeper than %u levels", OB_MODEL_MAX_NODE_DEPTH);
+        ob_model_bad(c, "node hierarchy deeper than %u levels", OB_MODEL_MAX_NODE_DEPTH);
         return OB_ERR_BAD_MODEL;
     }
     for (uint32_t k = 0; k < n->mNumMeshes; k++) {
         if (!n->mMeshes || n->mMeshes[k] >= s->mNumMeshes) {
-            bad(c, "node '%s' refers to mesh %u of %u", n->mName.data,
+            ob_model_bad(c, "node '%s' refers to mesh %u of %u", n->mName.data,
                 n->mMeshes ? n->mMeshes[k] : 0u, s->mNumMeshes);
             return OB_ERR_BAD_MODEL;
         }
     }
     for (uint32_t k = 0; k < n->mNumChildren; k++) {
         if (!n->mChildren || !n->mChildren[k]) {
-            bad(c, "node '%s' has a missing child %u", n->mName.data, k);
+            ob_model_bad(c, "node '%s' has a missing child %u", n->mName.data, k);
             return OB_ERR_BAD_MODEL;
         }
         ob_result r = check_raw_nodes(c, s, n->mChildren[k], depth + 1);
@@ -203,14 +212,14 @@ static ob_result check_raw_nodes(model_ctx *c, const struct aiScene *s, const st
     return OB_OK;
 }
 
-static ob_result check_raw_scene(model_ctx *c, const struct aiScene *s)
+ob_result ob_model_check_raw_scene(ob_model_check *c, const struct aiScene *s)
 {
     if (!s->mNumMeshes || !s->mMeshes) {
-        bad(c, "contains no meshes");
+        ob_model_bad(c, "contains no meshes");
         return OB_ERR_BAD_MODEL;
     }
     if (!s->mRootNode) {
-        bad(c, "has no root node");
+        ob_model_bad(c, "has no root node");
         return OB_ERR_BAD_MODEL;
     }
     ob_result first = OB_OK;
@@ -220,12 +229,12 @@ static ob_result check_raw_scene(model_ctx *c, const struct aiScene *s)
         if (s->mMeshes[mi])
             r = check_raw_mesh(c, mi, s->mMeshes[mi], &polygons);
         else
-            bad(c, "mesh %u is missing", mi);
+            ob_model_bad(c, "mesh %u is missing", mi);
         if (first == OB_OK) first = r;
     }
     if (first != OB_OK) return first;
     if (polygons == 0) {
-        bad(c, "contains no triangles (%u meshes of points, lines or nothing)", s->mNumMeshes);
+        ob_model_bad(c, "contains no triangles (%u meshes of points, lines or nothing)", s->mNumMeshes);
         return OB_ERR_BAD_MODEL;
     }
     return check_raw_nodes(c, s, s->mRootNode, 0);
@@ -400,13 +409,13 @@ static ob_result merge_scene(model_ctx *c, const struct aiScene *s, ob_mesh *out
     }
     if (c->vertex_total > UINT32_MAX || c->index_total > UINT32_MAX) {
         OB_LOG_E(OB_MODEL_LOG, "%s: %llu vertices and %llu indices exceed the 32-bit index range",
-                 c->path, (unsigned long long)c->vertex_total, (unsigned long long)c->index_total);
+                 c->chk.path, (unsigned long long)c->vertex_total, (unsigned long long)c->index_total);
         return OB_ERR_LIMIT;
     }
     out->vertices = ob_calloc((size_t)c->vertex_total, sizeof(ob_vertex));
     out->indices = ob_calloc((size_t)c->index_total, sizeof(uint32_t));
     if (!out->vertices || !out->indices) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory for %llu vertices and %llu indices", c->path,
+        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory for %llu vertices and %llu indices", c->chk.path,
                  (unsigned long long)c->vertex_total, (unsigned long long)c->index_total);
         ob_mesh_release(out);
         return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -420,7 +429,7 @@ static ob_result merge_scene(model_ctx *c, const struct aiScene *s, ob_mesh *out
 
 /* ---------------------------------------------------------------- load */
 
-static const struct aiScene *parse(const char *path, char *err, size_t err_size)
+const struct aiScene *ob_model_parse(const char *path, char *err, size_t err_size)
 {
     pthread_mutex_lock(&ob_assimp_parse_lock);
     const struct aiScene *s = aiImportFile(path, 0);
@@ -432,9 +441,7 @@ static const struct aiScene *parse(const char *path, char *err, size_t err_size)
     return s;
 }
 
-/* A model whose triangles all have zero area draws nothing: reject it
- * rather than hand out a mesh that passes every other check. */
-static bool has_area(const ob_mesh *m)
+bool ob_model_mesh_has_area(const ob_mesh *m)
 {
     for (uint32_t t = 0; t < m->index_count; t += 3) {
         const float *a = m->vertices[m->indices[t]].position;
@@ -452,6 +459,38 @@ static bool has_area(const ob_mesh *m)
     return false;
 }
 
+ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+                          const struct aiScene **out_scene)
+{
+    *out_scene = NULL;
+    const char *path = c->path;
+    ob_result r = ob_model_check_readable(path);
+    if (r == OB_OK) r = ob_model_ply_precheck(path);
+    if (r == OB_OK && gltf_precheck) r = ob_model_gltf_precheck(path);
+    if (r != OB_OK) return r;
+    char err[512];
+    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
+    if (!scene) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
+        return OB_ERR_PARSE;
+    }
+    r = ob_model_check_raw_scene(c, scene);
+    if (r != OB_OK) {
+        ob_model_report_more(c);
+        aiReleaseImport(scene);
+        return r;
+    }
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
+                     aiProcess_JoinIdenticalVertices | (flip_uv ? aiProcess_FlipUVs : 0u);
+    scene = aiApplyPostProcessing(scene, flags);
+    if (!scene) {   /* assimp has released the scene already */
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
+        return OB_ERR_PARSE;
+    }
+    *out_scene = scene;
+    return OB_OK;
+}
+
 ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info)
 {
     if (out) memset(out, 0, sizeof *out);
@@ -461,56 +500,38 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
                  : !out ? "NULL out mesh" : "no path given");
         return OB_ERR_INVALID_ARGUMENT;
     }
-    model_ctx c = {.path = desc->path};
-    ob_result r = check_readable(c.path);
+    model_ctx c = {.chk.path = desc->path};
+    const char *path = desc->path;
+    const struct aiScene *scene;
+    ob_result r = ob_model_import(&c.chk, desc->flip_uv, false, &scene);
     if (r != OB_OK) return r;
-    r = ob_model_ply_precheck(c.path);
-    if (r != OB_OK) return r;
-
-    char err[512];
-    const struct aiScene *scene = parse(c.path, err, sizeof err);
-    if (!scene) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", c.path, err);
-        return OB_ERR_PARSE;
-    }
-    r = check_raw_scene(&c, scene);
-    if (r != OB_OK) goto fail_release_scene;
-
-    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
-                     aiProcess_JoinIdenticalVertices | (desc->flip_uv ? aiProcess_FlipUVs : 0u);
-    scene = aiApplyPostProcessing(scene, flags);
-    if (!scene) {   /* assimp has released the scene already */
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", c.path);
-        return OB_ERR_PARSE;
-    }
     r = merge_scene(&c, scene, out);
     if (r != OB_OK) goto fail_release_out;
-    if (ob_mesh_validate(out, c.path) != OB_OK || ob_mesh_compute_bounds(out) != OB_OK) {
+    if (ob_mesh_validate(out, path) != OB_OK || ob_mesh_compute_bounds(out) != OB_OK) {
         r = OB_ERR_BAD_MODEL;
         goto fail_release_out;
     }
-    if (!has_area(out)) {
+    if (!ob_model_mesh_has_area(out)) {
         bad(&c, "all %u triangles have zero area", out->index_count / 3);
         r = OB_ERR_BAD_MODEL;
         goto fail_release_out;
     }
     if (c.fixed_normals)
         OB_LOG_W(OB_MODEL_LOG, "%s: %u vertices have a zero-length normal (in the file, or "
-                 "only degenerate triangles use them); set to (0,1,0)", c.path, c.fixed_normals);
+                 "only degenerate triangles use them); set to (0,1,0)", path, c.fixed_normals);
     if (out_info) {
         out_info->mesh_count = c.instances;
         out_info->vertex_count = out->vertex_count;
         out_info->triangle_count = out->index_count / 3;
     }
-    OB_LOG_I(OB_MODEL_LOG, "%s: %u mesh instances, %u vertices, %u triangles", c.path,
+    OB_LOG_I(OB_MODEL_LOG, "%s: %u mesh instances, %u vertices, %u triangles", path,
              c.instances, out->vertex_count, out->index_count / 3);
     aiReleaseImport(scene);
     return OB_OK;
 
 fail_release_out:
     ob_mesh_release(out);
-fail_release_scene:
-    report_more(&c);
+    ob_model_report_more(&c.chk);
     aiReleaseImport(scene);
     return r;
 }

@@ -3,7 +3,73 @@
 #ifndef OB_MODEL_INTERNAL_H
 #define OB_MODEL_INTERNAL_H
 
-#include "ob_core.h"
+#include "ob_mesh.h"
+
+#include <stdarg.h>
+
+struct aiScene;
+struct aiVector3D;
+
+#define OB_MODEL_LOG "model"
+#define OB_MODEL_MAX_NODE_DEPTH 256u
+/* Problems logged per file before only a count is kept. */
+#define OB_MODEL_LOG_MAX 4u
+
+/* Problem bookkeeping of one load: the first OB_MODEL_LOG_MAX problems are
+ * logged prefixed with the path, the rest only counted. */
+typedef struct ob_model_check {
+    const char *path;
+    uint32_t problems;
+} ob_model_check;
+
+void ob_model_bad(ob_model_check *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void ob_model_vbad(ob_model_check *c, const char *fmt, va_list ap);
+/* "N more problems not shown" when more than were logged. */
+void ob_model_report_more(const ob_model_check *c);
+
+/* A model whose triangles all have zero area draws nothing: callers reject
+ * it rather than hand out a mesh that passes every other check. */
+bool ob_model_mesh_has_area(const ob_mesh *m);
+bool ob_model_v3_finite(const struct aiVector3D *v);
+
+/* OB_ERR_IO (logged) unless path names a readable regular file. */
+ob_result ob_model_check_readable(const char *path);
+
+/* aiImportFile(path, 0) under the lock that guards assimp's process-wide
+ * error string; on NULL, err holds assimp's message. */
+const struct aiScene *ob_model_parse(const char *path, char *err, size_t err_size);
+
+/* The raw scene before any post-processing: meshes present, face indices in
+ * range, finite positions / normals / uv, at least one polygon, nodes
+ * referring to existing meshes, depth bounded. Sets each mesh's
+ * mPrimitiveTypes to what its faces are (see ob_model.c). */
+ob_result ob_model_check_raw_scene(ob_model_check *c, const struct aiScene *s);
+
+/* The front both loaders share, in the order ob_model.c explains: the file
+ * is readable, the PLY precheck, the glTF extension scan (when asked: only
+ * ob_model_open refuses required extensions), assimp's parse with no
+ * post-processing, the raw checks, then triangulation, sorting by primitive
+ * type, missing normals (smooth), vertex joining and, with flip_uv, v → 1 − v.
+ * *out_scene is released with aiReleaseImport; NULL on failure, which is
+ * logged (the file and the problem): OB_ERR_IO, OB_ERR_PARSE,
+ * OB_ERR_BAD_MODEL, OB_ERR_UNSUPPORTED, OB_ERR_OUT_OF_HOST_MEMORY. */
+ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+                          const struct aiScene **out_scene);
+
+/* glTF files (.gltf JSON, .glb by its magic) are scanned for
+ * extensionsRequired / extensionsUsed before assimp reads them: OK for
+ * other files and for glTF files needing nothing unsupported (optional
+ * extensions get one info line); OB_ERR_UNSUPPORTED naming the file and
+ * the extension otherwise; OB_ERR_IO if the file cannot be read. JSON the
+ * scan cannot follow is left to assimp to reject. [any thread] */
+ob_result ob_model_gltf_precheck(const char *path);
+
+/* model->materials (at least one: a file without materials gets one
+ * default) and model->images from the scene (ob_model_material.c). On
+ * failure (logged) what was read so far stays in model, counted, for
+ * ob_model_close to free. [any thread] */
+struct ob_model;
+ob_result ob_model_read_materials(ob_model_check *c, const struct aiScene *s, struct ob_model *model);
 
 /* Checks a file that assimp would read as a PLY (a .ply extension, or
  * content starting with "ply") before assimp reads it: the first line must

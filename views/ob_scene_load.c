@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "ob_mesh.h"
+#include "ob_model_instance.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define LOG_MODULE "scene"
@@ -18,6 +19,13 @@ typedef struct shared_geometry {
     ob_result result;        /* ... with this result */
 } shared_geometry;
 
+/* One opened (or failed) model, shared by entities naming the same file. */
+typedef struct shared_model {
+    const ob_scene_file_geometry *desc;
+    ob_model_assets *assets;   /* NULL: the model failed to open ... */
+    ob_result result;          /* ... with this result */
+} shared_model;
+
 typedef struct loader {
     ob_scene_load_target t;
     const ob_scene_load_desc *desc;
@@ -26,7 +34,9 @@ typedef struct loader {
     ob_scene_file_error *err;
     shared_geometry *shared;
     uint32_t shared_count, shared_cap;
-    uint32_t geometry_cap, left_out_cap;
+    shared_model *shared_models;   /* [out->model_count], parallel to out->models */
+    uint32_t geometry_cap, left_out_cap, model_cap, models_cap;
+    uint32_t ids_used;         /* geometry ids handed out from desc->first_geometry_id */
 } loader;
 
 /* ------------------------------------------------------------ errors */
@@ -75,7 +85,7 @@ static ob_result generate_mesh(const ob_scene_file_geometry *g, ob_mesh *mesh)
     case OB_SCENE_GEOMETRY_CONE: return ob_mesh_cone(g->radius, g->height, g->segments[0], mesh);
     case OB_SCENE_GEOMETRY_TORUS:
         return ob_mesh_torus(g->major_radius, g->minor_radius, g->segments[0], g->segments[1], mesh);
-    case OB_SCENE_GEOMETRY_MODEL: return ob_model_load(&(ob_model_desc){.path = g->model}, mesh, NULL);
+    case OB_SCENE_GEOMETRY_MODEL:   /* models keep their structure: entity_model */
     case OB_SCENE_GEOMETRY_NONE: break;
     }
     return OB_ERR_INVALID_ARGUMENT;
@@ -116,32 +126,63 @@ static ob_result entity_geometry(loader *L, const ob_scene_file_entity *e, ob_ge
                              sizeof *o->geometry);
     if (r != OB_OK) return fail(L, r, "", "out of memory");
 
-    bool model = e->geometry.kind == OB_SCENE_GEOMETRY_MODEL;
     ob_mesh mesh = {0};
     ob_geometry *g = NULL;
     r = generate_mesh(&e->geometry, &mesh);
     if (r == OB_OK) {
-        const char *slash = model ? strrchr(e->geometry.model, '/') : NULL;
-        char name[64];
-        snprintf(name, sizeof name, "%s", !model ? ob_scene_file_geometry_kind_name(e->geometry.kind)
-                                          : slash ? slash + 1 : e->geometry.model);
-        uint32_t id = L->desc->first_geometry_id ? L->desc->first_geometry_id + o->geometry_count : 0;
-        ob_geometry_desc gd = {.mesh = &mesh, .name = name, .id = id};
+        uint32_t id = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
+        ob_geometry_desc gd = {.mesh = &mesh, .name = ob_scene_file_geometry_kind_name(e->geometry.kind),
+                               .id = id};
         g = ob_geometry_create(ob_renderer_device(L->t.renderer), &gd, &r);
     }
     ob_mesh_release(&mesh);
-    if (!g && !model) {
+    if (!g) {
         char path[48];
         snprintf(path, sizeof path, "entities[%u].geometry", e->index);
         return fail(L, r, path, "entity '%s': %s geometry failed", e->name,
                     ob_scene_file_geometry_kind_name(e->geometry.kind));
     }
-    /* A model that reads but does not upload is as bad as one that does not read. */
-    if (!g && r == OB_OK) r = OB_ERR_BAD_MODEL;
-    if (g) o->geometry[o->geometry_count++] = g;
+    L->ids_used++;
+    o->geometry[o->geometry_count++] = g;
     L->shared[L->shared_count++] = (shared_geometry){.desc = &e->geometry, .geometry = g, .result = r};
     *out_g = g;
-    return g ? OB_OK : left_out(L, e, r);
+    return OB_OK;
+}
+
+/* The entity's model, opened and given its materials once per file into
+ * *out_a. *out_a NULL with OB_OK: it did not open (reported, left out). */
+static ob_result entity_model(loader *L, const ob_scene_file_entity *e, ob_model_assets **out_a)
+{
+    *out_a = NULL;
+    ob_scene_loaded *o = L->out;
+    for (uint32_t i = 0; i < o->model_count; i++) {
+        const shared_model *sm = &L->shared_models[i];
+        if (!ob_scene_file_geometry_equal(sm->desc, &e->geometry)) continue;
+        *out_a = sm->assets;
+        return sm->assets ? OB_OK : left_out(L, e, sm->result);
+    }
+    ob_result r = ob_array_reserve((void **)&L->shared_models, &L->model_cap, o->model_count + 1,
+                                   sizeof *L->shared_models);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&o->models, &L->models_cap, o->model_count + 1, sizeof *o->models);
+    if (r != OB_OK) return fail(L, r, "", "out of memory");
+    /* flip_uv: the engine samples images with Vulkan's top-left origin. */
+    ob_model *model = NULL;
+    ob_model_assets *a = NULL;
+    r = ob_model_open(&(ob_model_desc){.path = e->geometry.model, .flip_uv = true}, &model);
+    if (r == OB_OK) {
+        uint32_t first = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
+        L->ids_used += OB_MODEL_ASSETS_IDS_PER_PRIMITIVE * model->primitive_count;
+        ob_model_assets_desc ad = {.renderer = L->t.renderer, .materials = L->t.materials,
+                                   .first_geometry_id = first};
+        a = ob_model_assets_create(&ad, model, &r);   /* takes the model */
+        /* A model that reads but whose materials cannot be made is left out
+         * like one that does not read; the library's error says why. */
+    }
+    L->shared_models[o->model_count] = (shared_model){.desc = &e->geometry, .assets = a, .result = r};
+    o->models[o->model_count++] = a;
+    *out_a = a;
+    return a ? OB_OK : left_out(L, e, r);
 }
 
 /* ------------------------------------------------------------ nodes */
@@ -177,9 +218,13 @@ static ob_result add_entity(loader *L, const ob_scene_file_entity *e)
     char path[32];
     snprintf(path, sizeof path, "entities[%u]", e->index);
     ob_geometry *g = NULL;
+    ob_model_assets *model = NULL;
     ob_result r = OB_OK;
-    if (e->geometry.kind != OB_SCENE_GEOMETRY_NONE && (r = entity_geometry(L, e, &g)) != OB_OK)
-        return r;   /* the error is recorded */
+    if (e->geometry.kind == OB_SCENE_GEOMETRY_MODEL) {
+        if ((r = entity_model(L, e, &model)) != OB_OK) return r;   /* the error is recorded */
+    } else if (e->geometry.kind != OB_SCENE_GEOMETRY_NONE && (r = entity_geometry(L, e, &g)) != OB_OK) {
+        return r;
+    }
     /* Without geometry (transform-only, or its model failed) the node stays
      * so that its children still render. */
     ob_node *n = ob_node_create(L->t.scene, parent, e->name, &r);
@@ -194,6 +239,15 @@ static ob_result add_entity(loader *L, const ob_scene_file_entity *e)
         memcpy(rd.local_center, b->center, sizeof rd.local_center);
         if ((r = ob_node_set_renderable(n, &rd)) != OB_OK)
             return fail(L, r, path, "entity '%s' could not be made renderable", e->name);
+    }
+    if (model) {
+        /* The entity is the model's root; a material the entity names
+         * overrides the model's own for every primitive. */
+        ob_material *override = e->material != OB_SCENE_FILE_NONE ? o->materials[e->material] : NULL;
+        uint32_t made = 0;
+        if ((r = ob_model_assets_instantiate(model, L->t.scene, n, override, &made)) != OB_OK)
+            return fail(L, r, path, "entity '%s': model '%s' could not be placed", e->name, e->geometry.model);
+        o->model_entity_count += made;
     }
     ob_node_set_position(n, e->position);
     if (e->rotation_kind == OB_SCENE_ROTATION_EULER)
@@ -283,34 +337,44 @@ static ob_result build(loader *L)
 
 /* ------------------------------------------------------------ bounds, camera */
 
-/* Bounds of every renderable (after one update, so world bounds exist). */
-static ob_result scene_bounds(loader *L)
+ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
+                                double *radius)
 {
-    ob_scene_loaded *o = L->out;
-    ob_result r = ob_scene_update(L->t.scene, 0.0);
-    if (r != OB_OK) return fail(L, r, "", "the scene did not update");
+    for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY, center[k] = 0.0;
+    *radius = 1.0;
+    ob_result r = ob_scene_update(scene, 0.0);
+    if (r != OB_OK) return r;
     uint32_t n = 0;
-    ob_node *const *nodes = ob_scene_renderables(L->t.scene, &n);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    ob_node *const *nodes = ob_scene_renderables(scene, &n);
+    if (!n) return OB_OK;
     for (uint32_t i = 0; i < n; i++) {
         double c[3];
         float rad;
         ob_node_world_sphere(nodes[i], c, &rad);
         for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], c[k] - rad), hi[k] = fmax(hi[k], c[k] + rad);
     }
-    o->has_bounds = n > 0;
-    o->radius = 1.0;
-    if (!n) return OB_OK;
-    memcpy(o->min, lo, sizeof lo);
-    memcpy(o->max, hi, sizeof hi);
-    for (int k = 0; k < 3; k++) o->center[k] = 0.5 * (lo[k] + hi[k]);
-    o->radius = 0.0;
+    for (int k = 0; k < 3; k++) center[k] = 0.5 * (lo[k] + hi[k]);
+    *radius = 0.0;
     for (uint32_t i = 0; i < n; i++) {
         double c[3];
         float rad;
         ob_node_world_sphere(nodes[i], c, &rad);
-        double dx = c[0] - o->center[0], dy = c[1] - o->center[1], dz = c[2] - o->center[2];
-        o->radius = fmax(o->radius, sqrt(dx * dx + dy * dy + dz * dz) + rad);
+        double dx = c[0] - center[0], dy = c[1] - center[1], dz = c[2] - center[2];
+        *radius = fmax(*radius, sqrt(dx * dx + dy * dy + dz * dz) + rad);
+    }
+    return OB_OK;
+}
+
+/* Bounds of every renderable (after one update, so world bounds exist). */
+static ob_result scene_bounds(loader *L)
+{
+    ob_scene_loaded *o = L->out;
+    ob_result r = ob_scene_load_measure(L->t.scene, o->min, o->max, o->center, &o->radius);
+    if (r != OB_OK) return fail(L, r, "", "the scene did not update");
+    o->has_bounds = o->max[0] >= o->min[0];
+    if (!o->has_bounds) {
+        memset(o->min, 0, sizeof o->min);
+        memset(o->max, 0, sizeof o->max);
     }
     return OB_OK;
 }
@@ -441,6 +505,7 @@ ob_result ob_scene_load(const ob_scene_load_target *t, const ob_scene_load_desc 
     }
     if (r == OB_OK) r = place_camera(&L);
     ob_free(L.shared);
+    ob_free(L.shared_models);
     ob_scene_file_release(&parsed);
     if (r != OB_OK) {
         ob_scene_unload(out);
@@ -490,8 +555,10 @@ void ob_scene_unload(ob_scene_loaded *l)
     if (l->camera_created) ob_node_destroy(l->scene, l->camera);
     for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->scene, l->lights[i]);
     for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->scene, l->entities[i]);
+    for (uint32_t i = l->model_count; i-- > 0;) ob_model_assets_destroy(l->models[i]);
     for (uint32_t i = l->material_count; i-- > 0;) ob_material_destroy(l->materials[i]);
     for (uint32_t i = l->geometry_count; i-- > 0;) ob_geometry_destroy(l->device, l->geometry[i]);
+    ob_free(l->models);
     ob_free(l->particles);
     ob_free(l->lights);
     ob_free(l->entities);

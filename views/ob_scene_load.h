@@ -20,6 +20,12 @@
  * sphere geometry failed: ..."). Either is a hard failure: the load returns
  * the error and leaves nothing it made in the scene, the material library or
  * the views (a camera node given in the desc is restored as it was).
+ * Models keep their structure (ob_model_instance.h): the entity is the
+ * model's root, with one child entity per node of the file and one per
+ * primitive, each drawing with the model's own material, or, when the
+ * entity names a "material", with that one for every primitive. Each model
+ * file is opened once and its geometry and materials shared by the
+ * entities naming it.
  * A model that does not load is not a hard failure: its entity stays as a
  * transform-only node (its children still render), the loss is logged as a
  * warning naming the file and the entity ("scene.json: entities[2] 'ghost':
@@ -49,6 +55,7 @@
 #ifndef OB_SCENE_LOAD_H
 #define OB_SCENE_LOAD_H
 
+#include "ob_model_instance.h"
 #include "ob_scene_file.h"
 #include "ob_stack.h"
 
@@ -91,10 +98,16 @@ typedef struct ob_scene_load_left_out {
 typedef struct ob_scene_loaded {
     ob_node **entities;           /* entities[i] is "entities"[i]'s node (transform-only if left out) */
     uint32_t entity_count;
-    ob_geometry **geometry;       /* one per distinct description (shared by entities alike) */
+    ob_geometry **geometry;       /* generated shapes: one per distinct description (shared by
+                                     entities alike); models' geometry is in their assets */
     uint32_t geometry_count;
+    ob_model_assets **models;     /* one per distinct model file (NULL where it did not open) */
+    uint32_t model_count;
+    uint32_t model_entity_count;  /* entities made under model entities: per model node and
+                                     per placed primitive (ob_model_instance.h) */
     ob_material **materials;      /* the file's materials (ob_scene_file order), then "default",
-                                     which entities without a material draw with */
+                                     which generated shapes without a material draw with
+                                     (models without one draw with their own: see models) */
     uint32_t material_count;
     ob_node **lights;             /* the file's lights; without "lights", the default sun */
     uint32_t light_count;
@@ -154,6 +167,14 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_d
  * entities' maps are, on first need). [render thread, between frames] */
 void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
                                   const ob_scene_file_settings *settings);
+
+/* Updates the scene (dt 0) and measures every renderable in it (world
+ * bounding spheres): the box around them in lo/hi, its centre, and the
+ * radius of the sphere about that centre holding them all. No renderable:
+ * lo = +inf, hi = −inf, centre 0, radius 1, OB_OK. Failure: the update's
+ * result. [render thread, between frames] */
+ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
+                                double *radius);
 
 /* Points camera at a bounding sphere from a 3/4 view above it, at the
  * distance where the sphere fills the narrower field of view (45 degrees

@@ -37,6 +37,8 @@
 
 #include "ob_geometry.h"
 #include "ob_mesh.h"
+#include "ob_model.h"
+#include "ob_model_instance.h"
 
 #include "ob_scene_file.h"
 #include "ob_scene_load.h"

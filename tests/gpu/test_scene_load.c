@@ -31,9 +31,8 @@ static ob_stack *make_stack(const ob_scene_file_settings *settings)
     return s;
 }
 
-/* Two frames, then the share of the final image's pixels that are not the
- * clear colour (opaque blue). */
-static double rendered_share(ob_stack *s)
+/* Two frames, then the final image (malloc'd, RGBA8). */
+static uint8_t *render_rgba(ob_stack *s)
 {
     assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
     assert_int_equal(ob_stack_frame(s, 1.0 / 60.0), OB_OK);
@@ -41,6 +40,14 @@ static double rendered_share(ob_stack *s)
     uint8_t *px = malloc((size_t)W * H * 4);   /* test-side image */
     assert_non_null(px);
     assert_int_equal(ob_image_read_rgba8(s->device, ob_stack_final_image(s), px), OB_OK);
+    return px;
+}
+
+/* Two frames, then the share of the final image's pixels that are not the
+ * clear colour (opaque blue). */
+static double rendered_share(ob_stack *s)
+{
+    uint8_t *px = render_rgba(s);
     uint32_t drawn = 0;
     for (uint32_t i = 0; i < W * H; i++) {
         const uint8_t *p = px + (size_t)i * 4;
@@ -55,6 +62,26 @@ static ob_material *material_of(ob_node *n)
     const ob_renderable *rd = ob_node_get_renderable(n);
     assert_non_null(rd);
     return rd->material;
+}
+
+/* The renderable entities in n's subtree (n included), and the first. */
+static uint32_t renderables_below(ob_node *n, ob_node **out_first)
+{
+    uint32_t count = 0;
+    if (ob_node_is_renderable(n)) {
+        if (out_first && !*out_first) *out_first = n;
+        count++;
+    }
+    for (ob_node *c = ob_node_first_child(n); c; c = ob_node_next_sibling(c))
+        count += renderables_below(c, out_first);
+    return count;
+}
+
+static uint32_t nodes_below(ob_node *n)
+{
+    uint32_t count = 0;
+    for (ob_node *c = ob_node_first_child(n); c; c = ob_node_next_sibling(c)) count += 1 + nodes_below(c);
+    return count;
 }
 
 static void test_load_small_scene(void **state)
@@ -88,8 +115,16 @@ static void test_load_small_scene(void **state)
     assert_int_equal(l.entity_count, 5);
     for (uint32_t i = 0; i < 5; i++) {
         assert_string_equal(ob_node_name(l.entities[i]), names[i]);
-        assert_true(ob_node_is_renderable(l.entities[i]));
+        assert_true(ob_node_is_renderable(l.entities[i]) == (i != 3));   /* 3: a model's root */
     }
+    /* The pyramid OBJ keeps its structure: assimp's root node and the
+     * "defaultobject" group, which places the one primitive. */
+    ob_node *model_root = ob_node_first_child(l.entities[3]);
+    assert_string_equal(ob_node_name(model_root), "load_pyramid.obj");
+    assert_string_equal(ob_node_name(ob_node_first_child(model_root)), "defaultobject");
+    ob_node *pyramid_draw = NULL;
+    assert_int_equal(renderables_below(l.entities[3], &pyramid_draw), 1);
+    assert_int_equal(l.model_entity_count, 3);
     assert_ptr_equal(ob_node_get_parent(l.entities[3]), l.entities[1]);
     assert_ptr_equal(ob_node_get_parent(l.entities[1]), ob_scene_root(s->scene));
     double p[3];
@@ -108,13 +143,15 @@ static void test_load_small_scene(void **state)
     assert_ptr_equal(material_of(l.entities[0]), l.materials[3]);
     assert_ptr_equal(material_of(l.entities[1]), l.materials[0]);
     assert_ptr_equal(material_of(l.entities[2]), l.materials[1]);
-    assert_ptr_equal(material_of(l.entities[3]), l.materials[2]);
+    assert_ptr_equal(material_of(pyramid_draw), l.materials[2]);   /* the entity's material overrides */
     assert_ptr_equal(material_of(l.entities[4]), l.materials[0]);
 
-    /* Geometry: plane, box (shared by the two crates), sphere, the model. */
-    assert_int_equal(l.geometry_count, 4);
+    /* Geometry: plane, box (shared by the two crates), sphere; the model's own. */
+    assert_int_equal(l.geometry_count, 3);
+    assert_int_equal(l.model_count, 1);
+    assert_int_equal(ob_model_assets_geometry_count(l.models[0]), 1);
     assert_ptr_equal(ob_node_get_renderable(l.entities[1])->geometry, ob_node_get_renderable(l.entities[4])->geometry);
-    const ob_bounds *pyramid = ob_geometry_bounds(ob_node_get_renderable(l.entities[3])->geometry);
+    const ob_bounds *pyramid = ob_geometry_bounds(ob_node_get_renderable(pyramid_draw)->geometry);
     assert_near(pyramid->max[1] - pyramid->min[1], 1.0, 1e-6);
 
     /* Lights as the file says. */
@@ -194,6 +231,10 @@ static void test_load_missing_model(void **state)
     assert_true(ob_node_is_renderable(l.entities[3]));
     assert_ptr_equal(ob_node_get_parent(l.entities[3]), l.entities[2]);
     assert_int_equal(l.geometry_count, 3);   /* plane, box, sphere */
+    assert_int_equal(l.model_count, 2);      /* the two files, both failed */
+    assert_null(l.models[0]);
+    assert_null(l.models[1]);
+    assert_int_equal(l.model_entity_count, 0);
     assert_int_equal(l.light_count, 1);      /* no "lights": the default sun */
     assert_string_equal(ob_node_name(l.lights[0]), "sun");
 
@@ -202,6 +243,96 @@ static void test_load_missing_model(void **state)
     ob_test_assert_no_validation(s->device);
     ob_scene_unload(&l);
     ob_stack_destroy(s);
+}
+
+/* A glTF model in a scene keeps its hierarchy: the entity is the model's
+ * root, with one entity per glTF node (assimp's ROOT above the file's two
+ * scene roots) and one per placed primitive, each with the model's own
+ * material, shared where primitives share one; the mirrored node's quad
+ * faces the camera like its twin; and it renders, identically whether one
+ * thread or several record. */
+static void test_load_gltf_hierarchy(void **state)
+{
+    (void)state;
+    ob_heap_stats before = ob_heap_stats_now();
+    ob_stack *s = make_stack(NULL);
+    uint32_t nodes_before = ob_scene_node_count(s->scene);
+    ob_scene_loaded l;
+    ob_scene_file_error err;
+    ob_result r = ob_scene_load_stack(s, &(ob_scene_load_desc){.path = DATA "load_gltf.json"}, &l, &err);
+    if (r != OB_OK) fail_msg("load failed: %s", err.message);
+    assert_int_equal(l.left_out_count, 0);
+    assert_int_equal(l.entity_count, 4);
+    assert_int_equal(l.model_count, 2);   /* each file opened once for its two entities */
+    ob_node *features = l.entities[0];
+    /* features.gltf: 5 nodes (ROOT, parent, child, grandchild, sibling);
+     * child and grandchild place the 2-primitive quad mesh, sibling the
+     * triangle: 5 primitive entities. */
+    assert_int_equal(nodes_below(features), 10);
+    assert_int_equal(renderables_below(features, NULL), 5);
+    ob_node *root = ob_node_first_child(features);
+    assert_string_equal(ob_node_name(root), "ROOT");
+    ob_node *parent = ob_node_first_child(root);
+    assert_string_equal(ob_node_name(parent), "parent");
+    double p[3];
+    ob_node_get_position(parent, p);
+    assert_near(p[0], 1.0, 1e-6);
+    assert_near(p[2], 3.0, 1e-6);
+    ob_node *child = ob_node_first_child(parent);
+    assert_string_equal(ob_node_name(child), "child");
+    ob_node *quad0 = ob_node_first_child(child);   /* the child's primitives come first */
+    assert_string_equal(ob_node_name(quad0), "quad-0");
+    ob_node *quad1 = ob_node_next_sibling(quad0);
+    assert_string_equal(ob_node_name(quad1), "quad-1");
+    /* Materials: one per model material that a primitive uses, shared by
+     * both placements of the quad; the blended one is blended. */
+    ob_material *masked = material_of(quad0);
+    assert_string_equal(ob_material_name(masked), "features.gltf/masked");
+    assert_string_equal(ob_material_name(material_of(quad1)), "features.gltf/blended");
+    const ob_model *fm = ob_model_assets_model(l.models[0]);
+    for (uint32_t i = 0; i < fm->material_count; i++)   /* only "masked" (quad-0) has COLOR_0 */
+        assert_int_equal(ob_model_material_has_vertex_colors(fm, i),
+                         strcmp(fm->materials[i].name, "masked") == 0);
+    ob_node *grand = ob_node_next_sibling(quad1);
+    assert_string_equal(ob_node_name(grand), "grandchild");
+    assert_ptr_equal(material_of(ob_node_first_child(grand)), masked);
+    assert_ptr_equal(ob_node_get_renderable(ob_node_first_child(grand))->geometry,
+                     ob_node_get_renderable(quad0)->geometry);
+    /* The second entity naming the file draws the same geometry. */
+    ob_node *again = ob_node_first_child(ob_node_first_child(ob_node_first_child(ob_node_first_child(l.entities[2]))));
+    assert_string_equal(ob_node_name(again), "quad-0");
+    assert_ptr_equal(ob_node_get_renderable(again)->geometry, ob_node_get_renderable(quad0)->geometry);
+    /* mirror.gltf: ROOT, left, right and a quad under each: 5; twice each file. */
+    assert_int_equal(nodes_below(l.entities[1]), 5);
+    assert_int_equal(l.model_entity_count, 2 * (10 + 5));
+
+    /* It renders, and one thread records what several do, byte for byte. */
+    ob_renderer_set_threading(s->renderer, OB_THREADING_SINGLE, 0);
+    uint8_t *st = render_rgba(s);
+    ob_renderer_set_threading(s->renderer, OB_THREADING_MULTI, 0);
+    uint8_t *mt = render_rgba(s);
+    assert_memory_equal(st, mt, (size_t)W * H * 4);
+    uint32_t drawn = 0;
+    for (uint32_t i = 0; i < W * H; i++) drawn += !(st[4 * i] < 8 && st[4 * i + 1] < 8 && st[4 * i + 2] > 247);
+    assert_true(drawn > W * H / 20);
+    /* The red quads at (±1.5, -1, 0), seen from (0, 0, 8) with 50° fov:
+     * pixels (22, 30) and (41, 30) of 64x48. The mirrored one (left) is not
+     * culled as a back face. */
+    const uint32_t at[2] = {30 * W + 22, 30 * W + 41};
+    for (int k = 0; k < 2; k++) {
+        const uint8_t *px = &st[4 * at[k]];
+        if (!(px[0] > 64 && px[2] < 64))
+            fail_msg("%s quad: pixel (%u, 30) is %u %u %u, not red", k ? "right" : "mirrored left",
+                     at[k] % W, px[0], px[1], px[2]);
+    }
+    free(st);
+    free(mt);
+    ob_test_assert_no_validation(s->device);
+    ob_scene_unload(&l);
+    assert_int_equal(ob_scene_node_count(s->scene), nodes_before);
+    ob_stack_destroy(s);
+    ob_heap_stats after = ob_heap_stats_now();
+    assert_int_equal(after.live_blocks, before.live_blocks);
 }
 
 static void test_load_frames_without_camera(void **state)
@@ -339,6 +470,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_load_small_scene),
         cmocka_unit_test(test_load_missing_model),
+        cmocka_unit_test(test_load_gltf_hierarchy),
         cmocka_unit_test(test_load_frames_without_camera),
         cmocka_unit_test(test_load_malformed_leaves_scene),
         cmocka_unit_test(test_load_host_faults),

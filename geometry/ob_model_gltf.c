@@ -1,0 +1,344 @@
+/* ob_model_gltf.c — the glTF extension check made before assimp reads a
+ * glTF file (ob_model_internal.h).
+ *
+ * assimp 5.2 imports a file whatever its extensionsRequired says (it refuses
+ * only Draco when built without it), so a model that needs, say,
+ * KHR_texture_transform or KHR_mesh_quantization would load and render
+ * wrong. The glTF spec says a loader that does not support a required
+ * extension must not load the asset: we read the two top-level arrays
+ * ourselves. geometry may not depend on the views layer's cJSON, and only
+ * two arrays of strings are needed, so this is a small scanner: it follows
+ * JSON's nesting and strings (escapes included) without building anything,
+ * and gives up — leaving the verdict to assimp's own parser — on anything
+ * it cannot follow. Every read is bounded by the buffer.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "ob_model_internal.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+/* JSON bigger than this is not scanned (a warning says so); .gltf files
+ * carrying base64 buffers reach tens of megabytes. */
+#define GLTF_JSON_MAX (256u << 20)
+#define GLTF_MAX_DEPTH 1024u
+#define GLTF_MAX_NAMES 32u
+#define GLTF_NAME_MAX 96u
+
+/* Extensions the engine honours when a file requires them. None yet: the
+ * ones assimp 5.2 reads (texture transform, the KHR_materials_* family,
+ * specular-glossiness, unlit) are not carried into ob_model_material, and
+ * quantized or Draco-compressed geometry is not decoded. Add a name here
+ * only together with the code that honours it. */
+static const char *const supported_required[] = {NULL};
+
+typedef struct scan {
+    const char *p, *end;
+} scan;
+
+typedef struct name_list {
+    char names[GLTF_MAX_NAMES][GLTF_NAME_MAX];
+    uint32_t count;
+    uint32_t dropped;   /* names past GLTF_MAX_NAMES */
+} name_list;
+
+static void skip_ws(scan *s)
+{
+    while (s->p < s->end && (*s->p == ' ' || *s->p == '\t' || *s->p == '\n' || *s->p == '\r'))
+        s->p++;
+}
+
+/* A string starting at s->p ('"'); its text (escapes decoded, anything not
+ * printable ASCII as '?', cut to out_size − 1) into out when out is not
+ * NULL. False if the string is malformed or unterminated. */
+static bool read_string(scan *s, char *out, size_t out_size)
+{
+    if (s->p >= s->end || *s->p != '"') return false;
+    s->p++;
+    size_t n = 0;
+    while (s->p < s->end) {
+        char ch = *s->p++;
+        if (ch == '"') {
+            if (out) out[n] = '\0';
+            return true;
+        }
+        if ((unsigned char)ch < 0x20) return false;   /* raw control characters are not JSON */
+        if (ch == '\\') {
+            if (s->p >= s->end) return false;
+            char e = *s->p++;
+            switch (e) {
+            case '"': case '\\': case '/': ch = e; break;
+            case 'b': case 'f': case 'n': case 'r': case 't': ch = '?'; break;
+            case 'u':
+                if (s->end - s->p < 4) return false;
+                for (int k = 0; k < 4; k++)
+                    if (!isxdigit((unsigned char)s->p[k])) return false;
+                s->p += 4;
+                ch = '?';
+                break;
+            default: return false;
+            }
+        } else if ((unsigned char)ch >= 0x7f) {
+            ch = '?';
+        }
+        if (out && n + 1 < out_size) out[n++] = ch;
+    }
+    return false;
+}
+
+/* Skips one value of any kind (object and array nesting tracked up to
+ * GLTF_MAX_DEPTH; scalars are skipped up to the next delimiter, since only
+ * the structure matters here). */
+static bool skip_value(scan *s)
+{
+    char stack[GLTF_MAX_DEPTH];
+    uint32_t depth = 0;
+    do {
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        char ch = *s->p;
+        if (ch == '"') {
+            if (!read_string(s, NULL, 0)) return false;
+        } else if (ch == '{' || ch == '[') {
+            if (depth == GLTF_MAX_DEPTH) return false;
+            stack[depth++] = ch == '{' ? '}' : ']';
+            s->p++;
+            continue;
+        } else if (ch == '}' || ch == ']') {
+            if (depth == 0 || stack[depth - 1] != ch) return false;
+            depth--;
+            s->p++;
+        } else if (ch == ',' || ch == ':') {
+            if (depth == 0) return false;
+            s->p++;
+            continue;
+        } else {
+            const char *start = s->p;
+            while (s->p < s->end && !strchr(",:]} \t\r\n\"{[", *s->p)) s->p++;
+            if (s->p == start) return false;
+        }
+        /* Inside a container, separators and closers follow: keep going. */
+        if (depth > 0) {
+            skip_ws(s);
+            if (s->p < s->end && (*s->p == ',' || *s->p == ':')) s->p++;
+        }
+    } while (depth > 0);
+    return true;
+}
+
+static void list_add(name_list *l, const char *name)
+{
+    for (uint32_t i = 0; i < l->count; i++)
+        if (strcmp(l->names[i], name) == 0) return;
+    if (l->count == GLTF_MAX_NAMES) {
+        l->dropped++;
+        return;
+    }
+    snprintf(l->names[l->count++], GLTF_NAME_MAX, "%s", name);
+}
+
+/* An array of strings into l; a non-string element makes the file
+ * unreadable for this scan. */
+static bool read_name_array(scan *s, name_list *l)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '[') return false;
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == ']') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        skip_ws(s);
+        char name[GLTF_NAME_MAX];
+        if (!read_string(s, name, sizeof name)) return false;
+        list_add(l, name);
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == ']') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
+/* The top-level object: extensionsRequired and extensionsUsed into the
+ * lists, every other member skipped. */
+static bool scan_top(scan *s, name_list *required, name_list *used)
+{
+    skip_ws(s);
+    if (s->end - s->p >= 3 && memcmp(s->p, "\xEF\xBB\xBF", 3) == 0) s->p += 3;   /* UTF-8 BOM */
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{') return false;
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == '}') return true;
+    for (;;) {
+        skip_ws(s);
+        char key[32];
+        if (!read_string(s, key, sizeof key)) return false;
+        skip_ws(s);
+        if (s->p >= s->end || *s->p++ != ':') return false;
+        bool ok;
+        if (strcmp(key, "extensionsRequired") == 0) ok = read_name_array(s, required);
+        else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
+        else ok = skip_value(s);
+        if (!ok) return false;
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == '}') return true;
+        if (*s->p++ != ',') return false;
+    }
+}
+
+static uint32_t read_u32le(const unsigned char *b)
+{
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+/* The JSON text of a glTF file into *out (ob_malloc'd) or *out NULL when
+ * the file is not glTF (nor JSON), or its JSON is out of reach (too big,
+ * a .glb whose header lies: assimp rejects those). */
+static ob_result read_json(const char *path, char **out, size_t *out_size)
+{
+    *out = NULL;
+    *out_size = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: %s", path, strerror(errno));
+        return OB_ERR_IO;
+    }
+    unsigned char head[20];
+    size_t got = fread(head, 1, sizeof head, f);
+    size_t offset = 0, length = 0;
+    if (got >= 20 && memcmp(head, "glTF", 4) == 0) {
+        uint32_t version = read_u32le(head + 4);
+        /* glTF 2 .glb: 12-byte header, then the first chunk (JSON, "JSON"
+         * type); glTF 1 binary: 20-byte header whose content is the JSON. */
+        if (version == 2 && read_u32le(head + 16) == 0x4E4F534Au) {
+            offset = 20;
+            length = read_u32le(head + 12);
+        } else if (version == 1 && read_u32le(head + 16) == 0) {
+            offset = 20;
+            length = read_u32le(head + 12);
+        }
+    } else {
+        size_t i = 0;
+        if (got >= 3 && memcmp(head, "\xEF\xBB\xBF", 3) == 0) i = 3;
+        while (i < got && isspace(head[i])) i++;
+        if (i < got && head[i] == '{') {
+            if (fseek(f, 0, SEEK_END) == 0) {
+                long end = ftell(f);
+                length = end > 0 ? (size_t)end : 0;
+            }
+        }
+    }
+    if (length == 0) {
+        fclose(f);
+        return OB_OK;
+    }
+    if (length > GLTF_JSON_MAX) {
+        OB_LOG_W(OB_MODEL_LOG, "%s: glTF JSON of %zu bytes not scanned for required extensions "
+                 "(over %u MiB)", path, length, GLTF_JSON_MAX >> 20);
+        fclose(f);
+        return OB_OK;
+    }
+    char *text = ob_malloc(length);
+    if (!text) {
+        fclose(f);
+        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory reading %zu bytes of glTF JSON", path, length);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    size_t n = 0;
+    if (fseek(f, (long)offset, SEEK_SET) == 0) n = fread(text, 1, length, f);
+    fclose(f);
+    if (n != length) {   /* a .glb whose chunk runs past the file: assimp's to reject */
+        ob_free(text);
+        return OB_OK;
+    }
+    *out = text;
+    *out_size = length;
+    return OB_OK;
+}
+
+static bool is_supported(const char *name)
+{
+    for (const char *const *s = supported_required; *s; s++)
+        if (strcmp(*s, name) == 0) return true;
+    return false;
+}
+
+/* "a, b, c" (and "(+N more)") into out. */
+static void join_names(const name_list *l, const bool *pick, char *out, size_t size)
+{
+    size_t at = 0;
+    out[0] = '\0';
+    for (uint32_t i = 0; i < l->count; i++) {
+        if (pick && !pick[i]) continue;
+        int w = snprintf(out + at, size - at, "%s%s", at ? ", " : "", l->names[i]);
+        if (w < 0 || (size_t)w >= size - at) break;
+        at += (size_t)w;
+    }
+    if (l->dropped && at < size)
+        snprintf(out + at, size - at, " (+%u more)", l->dropped);
+}
+
+ob_result ob_model_gltf_precheck(const char *path)
+{
+    char *text;
+    size_t size;
+    ob_result r = read_json(path, &text, &size);
+    if (r != OB_OK || !text) return r;
+    name_list *lists = ob_calloc(2, sizeof *lists);
+    if (!lists) {
+        ob_free(text);
+        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory scanning glTF extensions", path);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    name_list *required = &lists[0], *used = &lists[1];
+    scan s = {.p = text, .end = text + size};
+    bool scanned = scan_top(&s, required, used);
+    ob_free(text);
+    if (!scanned) {
+        OB_LOG_D(OB_MODEL_LOG, "%s: JSON not followed by the extension scan; assimp decides", path);
+        ob_free(lists);
+        return OB_OK;
+    }
+
+    bool unsupported[GLTF_MAX_NAMES] = {false};
+    uint32_t refused = 0;
+    for (uint32_t i = 0; i < required->count; i++) {
+        unsupported[i] = !is_supported(required->names[i]);
+        refused += unsupported[i];
+    }
+    char text_names[512];
+    if (refused || required->dropped) {
+        join_names(required, unsupported, text_names, sizeof text_names);
+        OB_LOG_E(OB_MODEL_LOG, "%s: refused: the model requires the glTF extension%s %s, which "
+                 "Obelisk does not support", path, refused + required->dropped > 1 ? "s" : "",
+                 text_names);
+        ob_free(lists);
+        return OB_ERR_UNSUPPORTED;
+    }
+    /* Optional ones: everything used that is not required (and supported). */
+    bool optional[GLTF_MAX_NAMES] = {false};
+    uint32_t optional_count = 0;
+    for (uint32_t i = 0; i < used->count; i++) {
+        bool req = false;
+        for (uint32_t k = 0; k < required->count && !req; k++)
+            req = strcmp(required->names[k], used->names[i]) == 0;
+        optional[i] = !req;
+        optional_count += !req;
+    }
+    if (optional_count || used->dropped) {
+        join_names(used, optional, text_names, sizeof text_names);
+        OB_LOG_I(OB_MODEL_LOG, "%s: optional glTF extension%s ignored: %s", path,
+                 optional_count + used->dropped > 1 ? "s" : "", text_names);
+    }
+    ob_free(lists);
+    return OB_OK;
+}

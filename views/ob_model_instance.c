@@ -1,0 +1,348 @@
+/* ob_model_instance.c — models into the scene: materials, geometry variants
+ * and the entity tree (ob_model_instance.h). */
+#include "ob_model_instance.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define LOG_MODULE "model"
+
+/* Geometry variants of one primitive: extended layout × mirrored winding. */
+#define VARIANT_EXTENDED 1u
+#define VARIANT_FLIPPED 2u
+#define VARIANT_COUNT OB_MODEL_ASSETS_IDS_PER_PRIMITIVE
+
+struct ob_model_assets {
+    ob_renderer *renderer;
+    ob_material_library *library;
+    ob_model *model;
+    char *name;
+    uint32_t first_geometry_id;
+    ob_material **materials;          /* per model material, NULL when no primitive uses it */
+    bool *material_extended;          /* per model material: its effects read the extended layout */
+    ob_geometry *(*geometry)[VARIANT_COUNT];   /* per primitive */
+    uint32_t geometry_count;
+};
+
+/* ------------------------------------------------------------ materials */
+
+bool ob_model_material_has_vertex_colors(const ob_model *model, uint32_t index)
+{
+    for (uint32_t p = 0; model && p < model->primitive_count; p++)
+        if (model->primitives[p].material == index && model->primitives[p].mesh.colors) return true;
+    return false;
+}
+
+ob_material *ob_model_material_to_material(const ob_model_material_context *ctx, uint32_t index,
+                                           bool *out_extended_layout, ob_result *out_result)
+{
+    if (out_extended_layout) *out_extended_layout = false;
+    if (!ctx || !ctx->library || !ctx->model || index >= ctx->model->material_count) {
+        OB_LOG_E(LOG_MODULE, "ob_model_material_to_material: %s",
+                 !ctx || !ctx->library ? "no material library" : !ctx->model ? "no model"
+                                                                : "material index out of range");
+        if (out_result) *out_result = OB_ERR_INVALID_ARGUMENT;
+        return NULL;
+    }
+    const ob_model_material *mm = &ctx->model->materials[index];
+    char name[256];
+    snprintf(name, sizeof name, "%s/%s", ctx->model_name ? ctx->model_name : ctx->model->path, mm->name);
+    const bool blend = mm->alpha_mode == OB_MODEL_ALPHA_BLEND;
+    /* LIT until the PBR material joins: the base colour factor as diffuse,
+     * glTF's default dielectric highlight. */
+    ob_material_desc desc = {.name = name, .kind = OB_MATERIAL_LIT, .blended = blend,
+                             .casts_shadows = !blend, .specular = {0.04f, 0.04f, 0.04f, 32.0f}};
+    memcpy(desc.diffuse, mm->base_color, sizeof desc.diffuse);
+    ob_result r;
+    ob_material *m = ob_material_create(ctx->library, &desc, &r);
+    /* The library reads an all-zero diffuse as "default" (white): set it as is. */
+    if (m && (r = ob_material_set_diffuse(m, mm->base_color)) != OB_OK) {
+        ob_material_destroy(m);
+        m = NULL;
+    }
+    if (!m)
+        OB_LOG_E(LOG_MODULE, "%s: material %u '%s' could not be made: %s", ctx->model->path, index,
+                 mm->name, ob_result_name(r));
+    if (out_result) *out_result = m ? OB_OK : r;
+    return m;
+}
+
+/* ------------------------------------------------------------ assets */
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_model *model,
+                                        ob_result *out_result)
+{
+    ob_result r = OB_OK;
+    if (!desc || !desc->renderer || !desc->materials || !model) {
+        OB_LOG_E(LOG_MODULE, "ob_model_assets_create: no %s", !desc ? "desc" : !desc->renderer ? "renderer"
+                 : !desc->materials ? "material library" : "model");
+        ob_model_close(model);
+        if (out_result) *out_result = OB_ERR_INVALID_ARGUMENT;
+        return NULL;
+    }
+    ob_model_assets *a = ob_calloc(1, sizeof *a);
+    if (!a) {
+        OB_LOG_E(LOG_MODULE, "%s: out of memory for the model's assets", model->path);
+        ob_model_close(model);
+        if (out_result) *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
+        return NULL;
+    }
+    a->renderer = desc->renderer;
+    a->library = desc->materials;
+    a->model = model;
+    a->first_geometry_id = desc->first_geometry_id;
+    a->name = ob_strdup(desc->name ? desc->name : base_name(model->path));
+    a->materials = ob_calloc(model->material_count, sizeof *a->materials);
+    a->material_extended = ob_calloc(model->material_count, sizeof *a->material_extended);
+    a->geometry = ob_calloc(model->primitive_count, sizeof *a->geometry);
+    if (!a->name || !a->materials || !a->material_extended || !a->geometry) {
+        OB_LOG_E(LOG_MODULE, "%s: out of memory for the model's assets", model->path);
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail;
+    }
+    /* One material per model material a primitive uses, in material order. */
+    ob_model_material_context ctx = {.library = a->library, .model = model, .model_name = a->name};
+    for (uint32_t m = 0; m < model->material_count; m++) {
+        bool used = false;
+        for (uint32_t p = 0; p < model->primitive_count && !used; p++)
+            used = model->primitives[p].material == m;
+        if (!used) continue;
+        a->materials[m] = ob_model_material_to_material(&ctx, m, &a->material_extended[m], &r);
+        if (!a->materials[m]) goto fail;
+    }
+    if (out_result) *out_result = OB_OK;
+    return a;
+
+fail:
+    ob_model_assets_destroy(a);
+    if (out_result) *out_result = r;
+    return NULL;
+}
+
+void ob_model_assets_destroy(ob_model_assets *a)
+{
+    if (!a) return;
+    ob_device *dev = ob_renderer_device(a->renderer);
+    for (uint32_t p = 0; a->geometry && p < a->model->primitive_count; p++)
+        for (uint32_t v = 0; v < VARIANT_COUNT; v++) ob_geometry_destroy(dev, a->geometry[p][v]);
+    for (uint32_t m = 0; a->materials && m < a->model->material_count; m++)
+        ob_material_destroy(a->materials[m]);
+    ob_free(a->geometry);
+    ob_free(a->materials);
+    ob_free(a->material_extended);
+    ob_free(a->name);
+    ob_model_close(a->model);
+    ob_free(a);
+}
+
+const ob_model *ob_model_assets_model(const ob_model_assets *a) { return a ? a->model : NULL; }
+uint32_t ob_model_assets_geometry_count(const ob_model_assets *a) { return a ? a->geometry_count : 0; }
+
+ob_material *ob_model_assets_material(const ob_model_assets *a, uint32_t model_material)
+{
+    return a && model_material < a->model->material_count ? a->materials[model_material] : NULL;
+}
+
+/* Primitive p's geometry in one variant, uploaded on first need. */
+static ob_geometry *variant(ob_model_assets *a, uint32_t p, uint32_t v, ob_result *out_result)
+{
+    if (a->geometry[p][v]) return a->geometry[p][v];
+    const ob_model_primitive *prim = &a->model->primitives[p];
+    ob_mesh mesh = prim->mesh;   /* shallow: the arrays stay the model's */
+    if (!(v & VARIANT_EXTENDED)) mesh.tangents = NULL, mesh.colors = NULL;
+    uint32_t *flipped = NULL;
+    ob_vertex *vertices = NULL;
+    float(*tangents)[4] = NULL;
+    if (v & VARIANT_FLIPPED) {
+        /* The engine's normal matrix is the cofactor of the world matrix,
+         * which under a mirror turns normals inwards (and the bitangent
+         * cross(N, T)·w with them): the mirrored copy stores them negated,
+         * so the cofactor turns them back out. */
+        flipped = ob_malloc((size_t)mesh.index_count * sizeof *flipped);
+        vertices = ob_malloc((size_t)mesh.vertex_count * sizeof *vertices);
+        if (mesh.tangents) tangents = ob_malloc((size_t)mesh.vertex_count * sizeof *tangents);
+        if (!flipped || !vertices || (mesh.tangents && !tangents)) {
+            ob_free(flipped);
+            ob_free(vertices);
+            ob_free(tangents);
+            OB_LOG_E(LOG_MODULE, "%s: out of memory mirroring primitive '%s'", a->model->path, prim->name);
+            *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
+            return NULL;
+        }
+        for (uint32_t i = 0; i + 2 < mesh.index_count; i += 3) {
+            flipped[i] = mesh.indices[i];
+            flipped[i + 1] = mesh.indices[i + 2];
+            flipped[i + 2] = mesh.indices[i + 1];
+        }
+        for (uint32_t i = 0; i < mesh.vertex_count; i++) {
+            vertices[i] = mesh.vertices[i];
+            for (int k = 0; k < 3; k++) vertices[i].normal[k] = -vertices[i].normal[k];
+            if (tangents) {
+                memcpy(tangents[i], mesh.tangents[i], sizeof tangents[i]);
+                tangents[i][3] = -tangents[i][3];
+            }
+        }
+        mesh.indices = flipped;
+        mesh.vertices = vertices;
+        if (tangents) mesh.tangents = tangents;
+    }
+    char name[160];
+    snprintf(name, sizeof name, "%s/%s%s", a->name, prim->name, v & VARIANT_FLIPPED ? " (mirrored)" : "");
+    ob_geometry_desc gd = {.mesh = &mesh, .name = name, .extended = (v & VARIANT_EXTENDED) != 0,
+                           .id = a->first_geometry_id ? a->first_geometry_id + p * VARIANT_COUNT + v : 0};
+    ob_geometry *g = ob_geometry_create(ob_renderer_device(a->renderer), &gd, out_result);
+    ob_free(flipped);
+    ob_free(vertices);
+    ob_free(tangents);
+    if (!g) {
+        OB_LOG_E(LOG_MODULE, "%s: primitive %u '%s' could not be uploaded: %s", a->model->path, p,
+                 prim->name, ob_result_name(*out_result));
+        return NULL;
+    }
+    a->geometry[p][v] = g;
+    a->geometry_count++;
+    return g;
+}
+
+/* ------------------------------------------------------------ instances */
+
+/* A local matrix (column-major) as position, rotation and scale. glTF
+ * matrices decompose exactly (the spec rules out shear); other formats'
+ * shear is dropped (the rotation is re-orthogonalized). A negative
+ * determinant becomes a negative x scale. */
+static void decompose(const float *m, double pos[3], double quat[4], float scale[3])
+{
+    double c[3][3];
+    for (int k = 0; k < 3; k++) {
+        pos[k] = m[12 + k];
+        for (int r = 0; r < 3; r++) c[k][r] = m[k * 4 + r];
+    }
+    double det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) -
+                 c[1][0] * (c[0][1] * c[2][2] - c[0][2] * c[2][1]) +
+                 c[2][0] * (c[0][1] * c[1][2] - c[0][2] * c[1][1]);
+    double s[3];
+    for (int k = 0; k < 3; k++) s[k] = sqrt(c[k][0] * c[k][0] + c[k][1] * c[k][1] + c[k][2] * c[k][2]);
+    if (det < 0.0) s[0] = -s[0];
+    for (int k = 0; k < 3; k++) scale[k] = (float)s[k];
+    quat[0] = quat[1] = quat[2] = 0.0;
+    quat[3] = 1.0;
+    if (!(fabs(s[0]) > 1e-30 && fabs(s[1]) > 1e-30 && fabs(s[2]) > 1e-30)) return;   /* zero scale */
+    /* Rotation columns, Gram-Schmidt against shear. */
+    double R[3][3];
+    for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 3; r++) R[k][r] = c[k][r] / s[k];
+    double d01 = R[0][0] * R[1][0] + R[0][1] * R[1][1] + R[0][2] * R[1][2];
+    for (int r = 0; r < 3; r++) R[1][r] -= d01 * R[0][r];
+    double l1 = sqrt(R[1][0] * R[1][0] + R[1][1] * R[1][1] + R[1][2] * R[1][2]);
+    if (!(l1 > 1e-30)) return;
+    for (int r = 0; r < 3; r++) R[1][r] /= l1;
+    R[2][0] = R[0][1] * R[1][2] - R[0][2] * R[1][1];
+    R[2][1] = R[0][2] * R[1][0] - R[0][0] * R[1][2];
+    R[2][2] = R[0][0] * R[1][1] - R[0][1] * R[1][0];
+    /* Matrix (row r, column k) = R[k][r] → quaternion (x, y, z, w). */
+    double m00 = R[0][0], m11 = R[1][1], m22 = R[2][2];
+    double tr = m00 + m11 + m22;
+    if (tr > 0.0) {
+        double q = sqrt(tr + 1.0) * 2.0;
+        quat[3] = 0.25 * q;
+        quat[0] = (R[1][2] - R[2][1]) / q;
+        quat[1] = (R[2][0] - R[0][2]) / q;
+        quat[2] = (R[0][1] - R[1][0]) / q;
+    } else if (m00 > m11 && m00 > m22) {
+        double q = sqrt(1.0 + m00 - m11 - m22) * 2.0;
+        quat[3] = (R[1][2] - R[2][1]) / q;
+        quat[0] = 0.25 * q;
+        quat[1] = (R[1][0] + R[0][1]) / q;
+        quat[2] = (R[2][0] + R[0][2]) / q;
+    } else if (m11 > m22) {
+        double q = sqrt(1.0 + m11 - m00 - m22) * 2.0;
+        quat[3] = (R[2][0] - R[0][2]) / q;
+        quat[0] = (R[1][0] + R[0][1]) / q;
+        quat[1] = 0.25 * q;
+        quat[2] = (R[2][1] + R[1][2]) / q;
+    } else {
+        double q = sqrt(1.0 + m22 - m00 - m11) * 2.0;
+        quat[3] = (R[0][1] - R[1][0]) / q;
+        quat[0] = (R[2][0] + R[0][2]) / q;
+        quat[1] = (R[2][1] + R[1][2]) / q;
+        quat[2] = 0.25 * q;
+    }
+}
+
+static bool mirrors(const float *m)
+{
+    double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) +
+                 m[8] * (m[1] * m[6] - m[2] * m[5]);
+    return det < 0.0;
+}
+
+ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_node *root,
+                                      ob_material *override, uint32_t *out_entities)
+{
+    if (out_entities) *out_entities = 0;
+    if (!a || !scene || !root) {
+        OB_LOG_E(LOG_MODULE, "ob_model_assets_instantiate: no %s", !a ? "assets" : !scene ? "scene" : "root");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    const ob_model *model = a->model;
+    ob_node **nodes = ob_calloc(model->node_count, sizeof *nodes);
+    bool *flip = ob_calloc(model->node_count, sizeof *flip);
+    ob_result r = OB_OK;
+    uint32_t made = 0;
+    if (!nodes || !flip) {
+        OB_LOG_E(LOG_MODULE, "%s: out of memory instantiating %u nodes", model->path, model->node_count);
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto done;
+    }
+    for (uint32_t i = 0; i < model->node_count && r == OB_OK; i++) {
+        const ob_model_node *mn = &model->nodes[i];
+        ob_node *parent = mn->parent >= 0 ? nodes[mn->parent] : root;
+        ob_node *n = ob_node_create(scene, parent, mn->name, &r);
+        if (!n) break;
+        nodes[i] = n;
+        made++;
+        double pos[3], quat[4];
+        float scale[3];
+        decompose(mn->local, pos, quat, scale);
+        ob_node_set_position(n, pos);
+        ob_node_set_rotation_d(n, quat);
+        ob_node_set_scale(n, scale);
+        flip[i] = (mn->parent >= 0 && flip[mn->parent]) != mirrors(mn->local);
+        for (uint32_t k = 0; k < mn->primitive_count && r == OB_OK; k++) {
+            uint32_t p = mn->primitives[k];
+            uint32_t mat = model->primitives[p].material;
+            uint32_t v = (flip[i] ? VARIANT_FLIPPED : 0u) |
+                         (!override && a->material_extended[mat] ? VARIANT_EXTENDED : 0u);
+            ob_geometry *g = variant(a, p, v, &r);
+            if (!g) break;
+            ob_node *e = ob_node_create(scene, n, model->primitives[p].name, &r);
+            if (!e) break;
+            made++;
+            const ob_bounds *b = ob_geometry_bounds(g);
+            ob_renderable rd = {.material = override ? override : a->materials[mat], .geometry = g,
+                                .local_radius = b->radius};
+            memcpy(rd.local_center, b->center, sizeof rd.local_center);
+            r = ob_node_set_renderable(e, &rd);
+        }
+    }
+    if (r != OB_OK) {
+        OB_LOG_E(LOG_MODULE, "%s: instance under '%s' failed after %u entities: %s", model->path,
+                 ob_node_name(root), made, ob_result_name(r));
+        /* Roots of the model's subtrees: destroying them takes the rest. */
+        for (uint32_t i = model->node_count; i-- > 0;)
+            if (nodes[i] && model->nodes[i].parent < 0) ob_node_destroy(scene, nodes[i]);
+        made = 0;
+    }
+done:
+    ob_free(nodes);
+    ob_free(flip);
+    if (out_entities) *out_entities = made;
+    return r;
+}

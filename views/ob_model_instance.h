@@ -1,0 +1,121 @@
+/* ob_model_instance.h — a model (geometry/ob_model.h) put into a scene: its
+ * device resources made once (ob_model_assets: one geometry per primitive,
+ * one engine material per model material), then any number of instances,
+ * each a tree of entities under a root the caller gives: one entity per
+ * model node (its local transform), under it one entity per primitive the
+ * node places, drawing that primitive's geometry with its material. The
+ * scene graph, culling and sort keys then see every primitive on its own.
+ *
+ * Lifecycle: ob_model_open → ob_model_assets_create (takes the model) →
+ * ob_model_assets_instantiate (as often as wanted) → frames → destroy the
+ * instances' root nodes (or the scene) → ob_renderer_wait_idle →
+ * ob_model_assets_destroy. The entities reference the assets' geometry and
+ * materials: destroy them first.
+ *
+ * Materials. ob_model_material_to_material is the one place where an
+ * ob_model_material becomes an engine material. For now a LIT material:
+ * diffuse = base colour factor (rgba), blended for alpha mode BLEND, casting
+ * shadows unless blended; textures, metallic-roughness, emissive, MASK and
+ * double-sidedness are not drawn yet (the PBR material will take them: this
+ * function is what changes). The function also says whether the material's
+ * effects read the extended vertex layout; a primitive is uploaded in the
+ * layout its material reads (the standard layout for LIT, its tangents and
+ * colours left out).
+ *
+ * Mirroring: a primitive whose node transform within the model (the product
+ * of the local transforms from the model root) has a negative determinant
+ * is drawn with a copy of its geometry whose triangles are wound the other
+ * way, so its outside stays the front face (the model's culling is
+ * back-face). A scene transform above the model root that mirrors is not
+ * compensated.
+ *
+ * Thread rule: everything here is [render thread], between frames (it makes
+ * device resources, materials and nodes).
+ */
+#ifndef OB_MODEL_INSTANCE_H
+#define OB_MODEL_INSTANCE_H
+
+#include "ob_geometry.h"
+#include "ob_material.h"
+#include "ob_model.h"
+#include "ob_renderer.h"
+#include "ob_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What converting one model material needs (the textures branch adds its
+ * texture cache here). */
+typedef struct ob_model_material_context {
+    ob_material_library *library;
+    const ob_model *model;     /* the material's model: images, path */
+    const char *model_name;    /* for names and messages: "BoxTextured.glb" */
+} ob_model_material_context;
+
+/* An engine material for model->materials[index], named
+ * "<model_name>/<material name>"; *out_extended_layout (may be NULL) says
+ * whether its effects read the extended vertex layout. NULL with
+ * *out_result set (may be NULL) when the library refuses it. The caller
+ * owns the material (ob_material_destroy). [render thread] */
+ob_material *ob_model_material_to_material(const ob_model_material_context *ctx, uint32_t index,
+                                           bool *out_extended_layout, ob_result *out_result);
+
+/* True when a primitive drawing with model->materials[index] has vertex
+ * colours (COLOR_0, PLY colours). Primitives of that material without them
+ * are uploaded white in the extended layout, so a material multiplying its
+ * base colour by COLOR0 (ob_material_pbr.vertex_colors) draws them right
+ * too. [any thread] */
+bool ob_model_material_has_vertex_colors(const ob_model *model, uint32_t index);
+
+typedef struct ob_model_assets ob_model_assets;
+
+#define OB_MODEL_ASSETS_IDS_PER_PRIMITIVE 4u
+
+typedef struct ob_model_assets_desc {
+    ob_renderer *renderer;           /* geometry goes to its device */
+    ob_material_library *materials;  /* the one the views draw with */
+    const char *name;                /* for geometry, materials and logs; NULL → the model's file name */
+    /* Geometry ids for command hashes: primitive p's variant v (0..3) gets
+     * first_geometry_id + 4·p + v, so the model reserves
+     * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE × primitive_count ids whatever is
+     * uploaded; 0 → each derived from its contents. */
+    uint32_t first_geometry_id;
+} ob_model_assets_desc;
+
+/* Takes `model` (closed by ob_model_assets_destroy, or here on failure) and
+ * makes one engine material per model material that a primitive uses.
+ * Geometry is uploaded by instantiation, once per primitive and variant
+ * (its material's layout or the standard one for an override; mirrored or
+ * not), and shared by every later instance. NULL with *out_result set (may be
+ * NULL) on failure: the geometry's or the material's error, logged with the
+ * model's file and the primitive or material; nothing stays allocated.
+ * [render thread] */
+ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_model *model,
+                                        ob_result *out_result);
+
+/* Destroys the geometry (deferred) and the materials and closes the model.
+ * NULL is a no-op. [render thread, after the entities drawing them are gone
+ * and ob_renderer_wait_idle] */
+void ob_model_assets_destroy(ob_model_assets *a);
+
+const ob_model *ob_model_assets_model(const ob_model_assets *a);
+uint32_t ob_model_assets_geometry_count(const ob_model_assets *a);   /* uploads so far */
+ob_material *ob_model_assets_material(const ob_model_assets *a, uint32_t model_material);   /* NULL if unused */
+
+/* Creates the model's entities under `root` (an existing node: the model's
+ * root, whose transform places the model): one per model node, named as
+ * the node, and under each one per primitive it places, named as the
+ * primitive, renderable with the primitive's geometry and material (or
+ * `override`, when not NULL, for every primitive: it must read the standard
+ * layout, like every material of the library's standard kinds).
+ * *out_entities (may be NULL) gets the number of entities made.
+ * Failure (node creation, an upload): the error, and the entities made so
+ * far are destroyed again (root itself stays). [render thread] */
+ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_node *root,
+                                      ob_material *override, uint32_t *out_entities);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* OB_MODEL_INSTANCE_H */
