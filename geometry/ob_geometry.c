@@ -15,6 +15,7 @@ struct ob_geometry {
     VkPrimitiveTopology topology;
     ob_bounds bounds;
     uint32_t id;
+    bool extended;
     char *name;
 };
 
@@ -31,6 +32,47 @@ static const ob_vertex_layout standard_layout = {
 
 const ob_vertex_layout *ob_vertex_layout_standard(void) { return &standard_layout; }
 
+_Static_assert(sizeof(ob_vertex_extended) == 52, "the extended vertex is 52 bytes, unpadded");
+
+static const ob_vertex_layout extended_layout = {
+    .stride = sizeof(ob_vertex_extended),
+    .attribute_count = 5,
+    .attributes = {
+        {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},
+        {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},
+        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},
+        {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},
+        {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"},
+    },
+};
+
+const ob_vertex_layout *ob_vertex_layout_extended(void) { return &extended_layout; }
+
+/* The mesh interleaved in the extended layout, defaults where an optional
+ * array is missing. NULL when out of memory. */
+static ob_vertex_extended *interleave_extended(const ob_mesh *mesh)
+{
+    ob_vertex_extended *out = ob_malloc((size_t)mesh->vertex_count * sizeof *out);
+    if (!out) return NULL;
+    for (uint32_t i = 0; i < mesh->vertex_count; i++) {
+        ob_vertex_extended *e = &out[i];
+        const ob_vertex *v = &mesh->vertices[i];
+        memcpy(e->position, v->position, sizeof e->position);
+        memcpy(e->normal, v->normal, sizeof e->normal);
+        memcpy(e->uv, v->uv, sizeof e->uv);
+        if (mesh->colors) memcpy(e->color, mesh->colors[i], sizeof e->color);
+        else memset(e->color, 255, sizeof e->color);
+        if (mesh->tangents) {
+            memcpy(e->tangent, mesh->tangents[i], sizeof e->tangent);
+        } else {
+            e->tangent[0] = 1.0f;
+            e->tangent[1] = e->tangent[2] = 0.0f;
+            e->tangent[3] = 1.0f;
+        }
+    }
+    return out;
+}
+
 /* How many indices make one primitive, and the fewest a draw needs. */
 static bool topology_shape(VkPrimitiveTopology t, uint32_t *out_per_primitive, uint32_t *out_min)
 {
@@ -44,12 +86,16 @@ static bool topology_shape(VkPrimitiveTopology t, uint32_t *out_per_primitive, u
     }
 }
 
-static uint32_t derive_id(const char *name, const ob_mesh *mesh)
+/* Hashes the bytes that are uploaded, so the same mesh uploaded standard
+ * and extended gets two ids. */
+static uint32_t derive_id(const char *name, const ob_mesh *mesh, const void *vertex_bytes,
+                          size_t vertex_size)
 {
     uint64_t h = ob_hash_str(OB_HASH_SEED, name);
     h = ob_hash_u64(h, mesh->vertex_count);
     h = ob_hash_u64(h, mesh->index_count);
-    h = ob_hash_bytes(h, mesh->vertices, (size_t)mesh->vertex_count * sizeof(ob_vertex));
+    h = ob_hash_u64(h, vertex_size);
+    h = ob_hash_bytes(h, vertex_bytes, vertex_size);
     h = ob_hash_bytes(h, mesh->indices, (size_t)mesh->index_count * sizeof(uint32_t));
     uint32_t id = (uint32_t)(h ^ (h >> 32));
     return id ? id : 1u;   /* 0 means "none" everywhere else */
@@ -96,6 +142,7 @@ static ob_geometry *create_procedural(const ob_geometry_desc *desc, ob_result *o
     g->vertex_count = desc->vertex_count;
     g->instance_count = desc->instance_count ? desc->instance_count : 1;
     g->topology = desc->topology ? desc->topology : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    g->extended = desc->extended;
     g->id = desc->id ? desc->id
                      : (uint32_t)ob_hash_u64(ob_hash_str(OB_HASH_SEED, name),
                                              ((uint64_t)g->vertex_count << 32) | g->instance_count);
@@ -146,18 +193,36 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     g->index_count = mesh->index_count;
     g->instance_count = 1;
     g->topology = topology;
-    g->id = desc->id ? desc->id : derive_id(name, mesh);
+    g->extended = desc->extended || mesh->tangents || mesh->colors;
 
-    g->vertex_buffer = upload(dev, name, "vertices", OB_BUFFER_VERTEX, mesh->vertices,
-                              (uint64_t)mesh->vertex_count * sizeof(ob_vertex), &r);
-    if (!g->vertex_buffer.id) goto fail_free_geometry;
+    ob_vertex_extended *interleaved = NULL;
+    const void *vertex_bytes = mesh->vertices;
+    size_t vertex_size = (size_t)mesh->vertex_count * sizeof(ob_vertex);
+    if (g->extended) {
+        interleaved = interleave_extended(mesh);
+        if (!interleaved) {
+            OB_LOG_E(OB_GEOMETRY_LOG, "%s: out of host memory interleaving %u extended vertices",
+                     name, mesh->vertex_count);
+            r = OB_ERR_OUT_OF_HOST_MEMORY;
+            goto fail_free_geometry;
+        }
+        vertex_bytes = interleaved;
+        vertex_size = (size_t)mesh->vertex_count * sizeof(ob_vertex_extended);
+    }
+    g->id = desc->id ? desc->id : derive_id(name, mesh, vertex_bytes, vertex_size);
+
+    g->vertex_buffer = upload(dev, name, "vertices", OB_BUFFER_VERTEX, vertex_bytes, vertex_size, &r);
+    if (!g->vertex_buffer.id) goto fail_free_interleaved;
     g->index_buffer = upload(dev, name, "indices", OB_BUFFER_INDEX, mesh->indices,
                              (uint64_t)mesh->index_count * sizeof(uint32_t), &r);
     if (!g->index_buffer.id) goto fail_destroy_vertex_buffer;
+    ob_free(interleaved);
     return g;
 
 fail_destroy_vertex_buffer:
     ob_buffer_destroy(dev, g->vertex_buffer);
+fail_free_interleaved:
+    ob_free(interleaved);
 fail_free_geometry:
     ob_free(g->name);
     ob_free(g);
@@ -195,7 +260,8 @@ uint32_t ob_geometry_instance_count(const ob_geometry *g) { return g ? g->instan
 
 const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g)
 {
-    return g ? &standard_layout : NULL;
+    if (!g) return NULL;
+    return g->extended ? &extended_layout : &standard_layout;
 }
 
 VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g)

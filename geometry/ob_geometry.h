@@ -26,7 +26,7 @@ typedef struct ob_vertex_attribute {
     uint32_t location;
     VkFormat format;
     uint32_t offset;        /* bytes from the start of the vertex */
-    const char *semantic;   /* "POSITION", "NORMAL", "TEXCOORD0" */
+    const char *semantic;   /* "POSITION", "NORMAL", "TEXCOORD0", "COLOR0", "TANGENT" */
 } ob_vertex_attribute;
 
 typedef struct ob_vertex_layout {
@@ -39,6 +39,23 @@ typedef struct ob_vertex_layout {
  * 1 NORMAL (R32G32B32_SFLOAT, 12), 2 TEXCOORD0 (R32G32_SFLOAT, 24);
  * stride 32. A static constant, never NULL. [any thread] */
 const ob_vertex_layout *ob_vertex_layout_standard(void);
+
+/* One vertex of the extended layout (52 bytes, no padding): the standard
+ * vertex followed by COLOR_0 and the tangent. */
+typedef struct ob_vertex_extended {
+    float position[3];
+    float normal[3];
+    float uv[2];
+    uint8_t color[4];       /* linear RGBA8; 255,255,255,255 when the mesh has none */
+    float tangent[4];       /* xyz unit, w = ±1 bitangent sign; (1,0,0,1) when the mesh has none */
+} ob_vertex_extended;
+
+/* The layout of ob_vertex_extended, for meshes with vertex colours or
+ * tangents (glTF models): location 0 POSITION (R32G32B32_SFLOAT, 0),
+ * 1 NORMAL (R32G32B32_SFLOAT, 12), 2 TEXCOORD0 (R32G32_SFLOAT, 24),
+ * 3 COLOR0 (R8G8B8A8_UNORM, 32), 4 TANGENT (R32G32B32A32_SFLOAT, 36);
+ * stride 52. A static constant, never NULL. [any thread] */
+const ob_vertex_layout *ob_vertex_layout_extended(void);
 
 typedef struct ob_geometry ob_geometry;
 
@@ -59,6 +76,12 @@ typedef struct ob_geometry_desc {
      * (particles). Bounds are then unknown: the entity supplies its own. */
     uint32_t vertex_count;
     uint32_t instance_count;   /* 0 → 1 */
+    /* Upload in the extended layout (ob_vertex_extended): missing colours
+     * become 255,255,255,255, missing tangents (1,0,0,1). A mesh with
+     * tangents or colours is uploaded extended even without this flag; to
+     * draw such a mesh with a standard-layout effect, pass a copy of the
+     * ob_mesh with those two pointers set to NULL. */
+    bool extended;
 } ob_geometry_desc;
 
 /* Validates the mesh for the topology first (ob_mesh_validate_primitives:
@@ -85,7 +108,7 @@ ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UIN
 uint32_t ob_geometry_index_count(const ob_geometry *g);
 uint32_t ob_geometry_vertex_count(const ob_geometry *g);
 uint32_t ob_geometry_instance_count(const ob_geometry *g);  /* 1 for meshes */
-const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);
+const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);  /* standard or extended */
 VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g);
 const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
 uint32_t ob_geometry_id(const ob_geometry *g);              /* never 0 for a live geometry */

@@ -23,6 +23,8 @@ void ob_mesh_release(ob_mesh *mesh)
     if (!mesh) return;
     ob_free(mesh->vertices);
     ob_free(mesh->indices);
+    ob_free(mesh->tangents);
+    ob_free(mesh->colors);
     memset(mesh, 0, sizeof *mesh);
 }
 
@@ -147,6 +149,10 @@ ob_result ob_mesh_validate_primitives(const ob_mesh *mesh, const char *name,
         check_attribute(&s, v, "position", vx->position, 3);
         check_attribute(&s, v, "normal", vx->normal, 3);
         check_attribute(&s, v, "uv", vx->uv, 2);
+        if (mesh->tangents && !vec_finite(mesh->tangents[v], 4))
+            problem(&s, OB_ERR_NON_FINITE, "vertex %u tangent is not finite (%g, %g, %g, %g)", v,
+                    (double)mesh->tangents[v][0], (double)mesh->tangents[v][1],
+                    (double)mesh->tangents[v][2], (double)mesh->tangents[v][3]);
     }
 done:
     if (s.problems > OB_VALIDATE_LOG_MAX)

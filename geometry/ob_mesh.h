@@ -43,12 +43,17 @@ typedef struct ob_bounds {
 typedef struct ob_mesh {
     ob_vertex *vertices;
     uint32_t vertex_count;
+    /* Optional arrays parallel to `vertices` (NULL when absent; generators
+     * leave them NULL; ob_mesh_release frees them). A mesh with either is
+     * uploaded in the extended layout (ob_vertex_layout_extended). */
+    float (*tangents)[4];   /* xyz unit tangent, w = ±1 bitangent sign (glTF convention) */
+    uint8_t (*colors)[4];   /* vertex colour COLOR_0, linear, RGBA8 */
     uint32_t *indices;      /* triangle list: index_count / 3 triangles */
     uint32_t index_count;
     ob_bounds bounds;       /* valid after a generator, ob_model_load or ob_mesh_compute_bounds */
 } ob_mesh;
 
-/* Frees the arrays and zeroes the mesh. NULL or a zeroed mesh is a no-op. */
+/* Frees the arrays (tangents and colours too) and zeroes the mesh. NULL or a zeroed mesh is a no-op. */
 void ob_mesh_release(ob_mesh *mesh);
 
 /* Bounds of `count` vertices into *out_bounds (zeroed when count is 0).
@@ -61,7 +66,7 @@ ob_result ob_mesh_compute_bounds(ob_mesh *mesh);
 
 /* Checks a mesh before it is used or uploaded: non-empty, index_count a
  * multiple of 3, every index < vertex_count, every position, normal and uv
- * finite. Logs each problem (the first few, then a count) prefixed with
+ * finite, and every tangent (when present) finite. Logs each problem (the first few, then a count) prefixed with
  * `name` (NULL → "mesh"), e.g. "crate: index 1234 = 99999 out of range
  * (8 vertices)". Returns the first problem found: OB_ERR_INVALID_ARGUMENT
  * (NULL, empty, missing arrays, count not a multiple of 3),

@@ -4,6 +4,7 @@
 #include "ob_test.h"
 #include "ob_geometry.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -94,6 +95,119 @@ static void box_uploads_with_counts_bounds_and_contents(void **state)
     ob_test_assert_no_validation(dev);
 }
 
+/* The extended layout: colours and tangents interleave after the standard
+ * attributes; what a mesh lacks gets the documented defaults. */
+static void extended_layout_interleaves_colours_and_tangents(void **state)
+{
+    (void)state;
+    const ob_vertex_layout *l = ob_vertex_layout_extended();
+    assert_int_equal(l->stride, 52);
+    assert_int_equal(l->attribute_count, 5);
+    const uint32_t offsets[5] = {0, 12, 24, 32, 36};
+    const VkFormat formats[5] = {VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT,
+                                 VK_FORMAT_R32G32_SFLOAT, VK_FORMAT_R8G8B8A8_UNORM,
+                                 VK_FORMAT_R32G32B32A32_SFLOAT};
+    for (uint32_t i = 0; i < 5; i++) {
+        assert_int_equal(l->attributes[i].location, i);
+        assert_int_equal(l->attributes[i].offset, offsets[i]);
+        assert_int_equal(l->attributes[i].format, formats[i]);
+    }
+    assert_string_equal(l->attributes[3].semantic, "COLOR0");
+    assert_string_equal(l->attributes[4].semantic, "TANGENT");
+
+    const float h[3] = {1, 1, 1};
+    ob_mesh box;
+    assert_int_equal(ob_mesh_box(h, &box), OB_OK);
+    assert_null(box.tangents);
+    assert_null(box.colors);
+    ob_resource_counts before = ob_resource_counts_get(dev);
+
+    /* A plain mesh uploaded with the flag: defaults everywhere. */
+    ob_result r;
+    ob_geometry_desc plain = {.mesh = &box, .name = "crate", .extended = true};
+    ob_geometry *g = ob_geometry_create(dev, &plain, &r);
+    assert_int_equal(r, OB_OK);
+    assert_ptr_equal(ob_geometry_layout(g), ob_vertex_layout_extended());
+    assert_int_equal(ob_buffer_size(dev, ob_geometry_vertex_buffer(g)), 24 * 52);
+    ob_vertex_extended *x = read_back(ob_geometry_vertex_buffer(g), 24 * 52);
+    for (uint32_t i = 0; i < 24; i++) {
+        assert_memory_equal(x[i].position, box.vertices[i].position, sizeof x[i].position);
+        assert_memory_equal(x[i].normal, box.vertices[i].normal, sizeof x[i].normal);
+        assert_memory_equal(x[i].uv, box.vertices[i].uv, sizeof x[i].uv);
+        const uint8_t white[4] = {255, 255, 255, 255};
+        const float tangent[4] = {1, 0, 0, 1};
+        assert_memory_equal(x[i].color, white, 4);
+        assert_memory_equal(x[i].tangent, tangent, sizeof tangent);
+    }
+    free(x);
+    ob_geometry_desc standard = {.mesh = &box, .name = "crate"};
+    ob_geometry *s = ob_geometry_create(dev, &standard, &r);
+    assert_ptr_equal(ob_geometry_layout(s), ob_vertex_layout_standard());
+    assert_int_not_equal(ob_geometry_id(s), ob_geometry_id(g));   /* different bytes on the device */
+    ob_geometry_destroy(dev, s);
+    ob_geometry_destroy(dev, g);
+
+    /* A mesh with colours and tangents is extended without the flag. */
+    box.colors = ob_calloc(24, sizeof *box.colors);
+    box.tangents = ob_calloc(24, sizeof *box.tangents);
+    assert_non_null(box.colors);
+    assert_non_null(box.tangents);
+    for (uint32_t i = 0; i < 24; i++) {
+        box.colors[i][0] = (uint8_t)i;
+        box.colors[i][1] = (uint8_t)(2 * i);
+        box.colors[i][2] = 7;
+        box.colors[i][3] = 200;
+        box.tangents[i][0] = 0;
+        box.tangents[i][1] = 0;
+        box.tangents[i][2] = 1;
+        box.tangents[i][3] = (i & 1) ? -1.0f : 1.0f;
+    }
+    ob_geometry_desc full = {.mesh = &box, .name = "painted"};
+    g = ob_geometry_create(dev, &full, &r);
+    assert_int_equal(r, OB_OK);
+    assert_ptr_equal(ob_geometry_layout(g), ob_vertex_layout_extended());
+    x = read_back(ob_geometry_vertex_buffer(g), 24 * 52);
+    for (uint32_t i = 0; i < 24; i++) {
+        assert_memory_equal(x[i].position, box.vertices[i].position, sizeof x[i].position);
+        assert_memory_equal(x[i].color, box.colors[i], 4);
+        assert_memory_equal(x[i].tangent, box.tangents[i], 16);
+    }
+    free(x);
+    ob_geometry_destroy(dev, g);
+
+    /* A non-finite tangent is refused like any other attribute. */
+    box.tangents[3][1] = NAN;
+    ob_test_log_clear();
+    assert_null(ob_geometry_create(dev, &full, &r));
+    assert_int_equal(r, OB_ERR_NON_FINITE);
+    assert_true(ob_test_log_has("painted: vertex 3 tangent is not finite", NULL));
+
+    /* The extended path's interleaving buffer fails cleanly too. */
+    box.tangents[3][1] = 0;
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+    g = ob_geometry_create(dev, &full, NULL);
+    uint64_t points = ob_fault_count(OB_FAULT_HOST_ALLOC);
+    ob_geometry_destroy(dev, g);
+    for (uint64_t n = 1; n <= points; n++) {
+        ob_fault_arm(OB_FAULT_HOST_ALLOC, n);
+        g = ob_geometry_create(dev, &full, &r);
+        ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+        if (g) ob_geometry_destroy(dev, g);
+        else assert_int_equal(r, OB_ERR_OUT_OF_HOST_MEMORY);
+        assert_int_equal(ob_resource_counts_get(dev).buffers, before.buffers);
+    }
+
+    /* ob_mesh_release frees the optional arrays (ob_calloc'd above): the
+     * heap's live block count returns to where it was. */
+    ob_heap_stats heap = ob_heap_stats_now();
+    ob_mesh_release(&box);
+    assert_null(box.colors);
+    assert_null(box.tangents);
+    assert_int_equal(ob_heap_stats_now().live_blocks, heap.live_blocks - 4);
+    assert_int_equal(ob_resource_counts_get(dev).buffers, before.buffers);
+    ob_test_assert_no_validation(dev);
+}
+
 static void broken_mesh_uploads_nothing(void **state)
 {
     (void)state;
@@ -177,6 +291,7 @@ int main(void)
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(box_uploads_with_counts_bounds_and_contents),
+        cmocka_unit_test(extended_layout_interleaves_colours_and_tangents),
         cmocka_unit_test(broken_mesh_uploads_nothing),
         cmocka_unit_test(line_list_topology_is_kept),
         cmocka_unit_test(failures_leave_no_resources),
