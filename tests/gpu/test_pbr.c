@@ -1,0 +1,530 @@
+/* test_pbr.c — the glTF metallic-roughness material as a user sees it: the
+ * lit side of a sphere is brighter than the unlit side, a smooth metal shows
+ * its highlight at the mirror direction, an alpha-MASK quad cuts out (also
+ * from the shadow), BLEND quads are composited back to front whatever their
+ * creation order, a double-sided quad shows its back face, shadows and
+ * environment maps feed the PBR shading, ST and MT recording give the same
+ * bytes, and variants compile only the features a material uses.
+ *
+ * Assertions are on relations a viewer would see (brighter, redder, the
+ * background showing through), not on exact values, so they hold whether
+ * the final image is the linear target or the tone-mapped sRGB one.
+ */
+#define _XOPEN_SOURCE 700
+#include "ob_test_world.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image_write.h>
+unsigned char *stbi_write_png_to_mem(const unsigned char *pixels, int stride_bytes, int x, int y, int n,
+                                     int *out_len);
+
+#include "ob_texture.h"
+
+/* Geometry in the extended layout: a mesh with vertex colours is uploaded
+ * extended (white here unless `tint` is given). */
+static ob_geometry *extended(ob_test_world *w, ob_mesh *m, const char *name, const uint8_t *tint)
+{
+    m->colors = ob_calloc(m->vertex_count, sizeof *m->colors);
+    assert_non_null(m->colors);
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        static const uint8_t white[4] = {255, 255, 255, 255};
+        memcpy(m->colors[i], tint ? tint : white, 4);
+    }
+    ob_geometry *g = ob_test_world_geometry(w, m, name);
+    ob_mesh_release(m);
+    return g;
+}
+
+static ob_geometry *ext_sphere(ob_test_world *w)
+{
+    ob_mesh m;
+    assert_int_equal(ob_mesh_sphere(0.5f, 48, 32, &m), OB_OK);
+    return extended(w, &m, "pbr sphere", NULL);
+}
+
+static ob_geometry *ext_quad(ob_test_world *w, float size, const char *name)
+{
+    ob_mesh m;
+    assert_int_equal(ob_mesh_plane(size, size, 1, &m), OB_OK);
+    return extended(w, &m, name, NULL);
+}
+
+static ob_material *pbr(ob_test_world *w, const char *name, const ob_material_pbr *p, bool shadows,
+                        float reflectivity)
+{
+    ob_result r;
+    ob_material *m = ob_material_create(w->lib, &(ob_material_desc){
+        .name = name, .kind = OB_MATERIAL_PBR, .pbr = *p, .casts_shadows = shadows,
+        .reflectivity = reflectivity}, &r);
+    if (!m) fail_msg("material '%s': %s", name, ob_result_name(r));
+    return m;
+}
+
+/* A quad (the XZ plane turned to face +Z, toward a camera on +Z). */
+static ob_node *facing_quad(ob_test_world *w, const char *name, ob_geometry *g, ob_material *m, double x, double y,
+                            double z, bool away)
+{
+    ob_node *n = ob_test_world_entity(w, NULL, name, g, m, x, y, z);
+    const float s = sqrtf(0.5f);
+    /* +90 degrees about X takes +Y to +Z; -90 turns it away. */
+    ob_node_set_rotation(n, (const float[4]){away ? -s : s, 0, 0, s});
+    return n;
+}
+
+/* OB_PBR_DUMP=dir writes each checked image as <dir>/<name>.png. */
+static void dump(const ob_test_world *w, const char *name)
+{
+    const char *dir = getenv("OB_PBR_DUMP");
+    if (!dir) return;
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s.png", dir, name);
+    stbi_write_png(path, (int)w->width, (int)w->height, 4, w->pixels, (int)w->width * 4);
+}
+
+static float luminance(const uint8_t *p) { return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; }
+
+static bool same_rgb(const uint8_t *a, const uint8_t *b, int tol)
+{
+    for (int c = 0; c < 3; c++)
+        if (abs((int)a[c] - (int)b[c]) > tol) return false;
+    return true;
+}
+
+/* ---------------------------------------------------------------- tests */
+
+/* Light from +X: the right half of the sphere is brighter than the left. */
+static void lit_side_is_brighter(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.8f;
+    p.metallic = 0.0f;
+    p.roughness = 0.6f;
+    ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), pbr(&w, "clay", &p, false, 0), 0, 0, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 5, 0, 0);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    dump(&w, __func__);
+    float right = luminance(ob_test_world_pixel(&w, 80 + 14, 60));
+    float left = luminance(ob_test_world_pixel(&w, 80 - 14, 60));
+    if (!(right > left + 40.0f)) fail_msg("lit side %.0f, unlit side %.0f", right, left);
+    ob_test_world_destroy(&w);
+}
+
+/* A smooth white metal lit from the upper right: the brightest pixel of the
+ * sphere sits where the normal is the half vector between the light and the
+ * eye (up and to the right of the centre), and it is much brighter than the
+ * rest of the (dark: no diffuse) metal. */
+static void smooth_metal_highlight_at_mirror_direction(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.metallic = 1.0f;
+    p.roughness = 0.05f;
+    ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), pbr(&w, "chrome", &p, false, 0), 0, 0, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 3.0f, 5, 5, 5);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    dump(&w, __func__);
+    uint32_t bx = 0, by = 0;
+    float best = -1.0f;
+    for (uint32_t y = 30; y < 90; y++)
+        for (uint32_t x = 50; x < 110; x++) {
+            float l = luminance(ob_test_world_pixel(&w, x, y));
+            if (l > best) best = l, bx = x, by = y;
+        }
+    /* The half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a sphere of
+     * radius ~23 pixels at (80, 60): about 9 pixels right and up. */
+    float h[3] = {0.57735f, 0.57735f, 1.57735f};
+    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
+    float ex = 80.0f + radius_px * h[0] / hl, ey = 60.0f - radius_px * h[1] / hl;
+    if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
+        fail_msg("highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
+    float opposite = luminance(ob_test_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
+    if (!(best > 200.0f && opposite < best * 0.5f))
+        fail_msg("highlight %.0f, the opposite side %.0f", best, opposite);
+    ob_test_world_destroy(&w);
+}
+
+/* A 2x1 PNG: left texel transparent, right opaque white. */
+static const ob_texture *half_transparent(ob_texture_cache *cache)
+{
+    static const uint8_t px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
+    int size;
+    uint8_t *png = stbi_write_png_to_mem(px, 8, 2, 1, 4, &size);
+    assert_non_null(png);
+    ob_result r;
+    const ob_texture *t = ob_texture_cache_load(cache, &(ob_texture_desc){
+        .data = png, .size = (size_t)size, .srgb = true, .context = "test: half transparent",
+        .sampling = {.mag = OB_TEXTURE_FILTER_NEAREST, .min = OB_TEXTURE_FILTER_NEAREST,
+                     .mip = OB_TEXTURE_FILTER_NEAREST, .wrap_u = OB_TEXTURE_WRAP_CLAMP,
+                     .wrap_v = OB_TEXTURE_WRAP_CLAMP}}, &r);
+    ob_free(png);
+    assert_non_null(t);
+    return t;
+}
+
+/* MASK: the transparent half of the texture shows the background, the
+ * opaque half the (green, emissive) quad; the light's shadow of the quad is
+ * cut out the same way. */
+static void alpha_mask_cuts_out(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color_texture.texture = half_transparent(cache);
+    p.alpha_mode = OB_ALPHA_MASK;
+    p.metallic = 0.0f;
+    p.emissive[1] = 1.0f;
+    ob_material *leaf = pbr(&w, "leaf", &p, true, 0);
+    facing_quad(&w, "leaf", ext_quad(&w, 1.0f, "leaf quad"), leaf, 0, 0, 0, false);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    dump(&w, __func__);
+    uint8_t bg[4];
+    memcpy(bg, ob_test_world_pixel(&w, 2, 2), 4);
+    const uint8_t *cut = ob_test_world_pixel(&w, 80 - 8, 60);
+    const uint8_t *kept = ob_test_world_pixel(&w, 80 + 8, 60);
+    if (!same_rgb(cut, bg, 0)) fail_msg("cut-out half (%u, %u, %u) is not the background", cut[0], cut[1], cut[2]);
+    if (!(kept[1] > bg[1] + 60)) fail_msg("kept half (%u, %u, %u) is not the green quad", kept[0], kept[1], kept[2]);
+    char effect[96];
+    snprintf(effect, sizeof effect, "%s",
+             ob_effect_name(ob_material_view_effect(leaf, w.r, NULL, ob_perspective_view_base(w.main), false, &r)));
+    assert_non_null(strstr(effect, "mask"));
+    assert_non_null(strstr(effect, "base"));
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+}
+
+/* The same quad held over a ground, under a sun that casts shadows or not:
+ * the pixels the shadow darkens all lie under the opaque half (right of the
+ * middle: the scene and camera are symmetric in x), none under the cut-out
+ * half. */
+static uint8_t *mask_shadow_scene(bool shadows)
+{
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color_texture.texture = half_transparent(cache);
+    p.alpha_mode = OB_ALPHA_MASK;
+    p.metallic = 0.0f;
+    p.double_sided = true;
+    ob_material *leaf = pbr(&w, "leaf", &p, true, 0);
+    /* Horizontal (the plane faces +Y), one unit above the ground. */
+    ob_test_world_entity(&w, NULL, "leaf", ext_quad(&w, 2.0f, "leaf quad"), leaf, 0, 1, 0);
+    ob_material_pbr g = ob_material_pbr_defaults();
+    g.metallic = 0.0f;
+    g.base_color[0] = g.base_color[1] = g.base_color[2] = 0.4f;
+    ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 12.0f, "ground quad"), pbr(&w, "ground", &g, true, 0), 0,
+                         0, 0);
+    /* From behind and above: the shadow falls toward the camera. */
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 1.5f, 0, 10, -8);
+    ob_test_world_look(&w, 0, 5, 5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *img = ob_test_world_snapshot(&w);
+    dump(&w, shadows ? "mask_shadow_on" : "mask_shadow_off");
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+    return img;
+}
+
+static void alpha_mask_cuts_the_shadow_too(void **state)
+{
+    (void)state;
+    uint8_t *lit = mask_shadow_scene(false), *shadowed = mask_shadow_scene(true);
+    uint32_t left = 0, right = 0;
+    for (uint32_t y = 0; y < 120; y++)
+        for (uint32_t x = 0; x < 160; x++) {
+            size_t i = 4 * ((size_t)y * 160 + x);
+            /* (A band around x = 0 is left out: the shadow's filtered edge.) */
+            if (luminance(shadowed + i) < luminance(lit + i) - 20.0f && (x < 74 || x >= 80))
+                *(x < 74 ? &left : &right) += 1;
+        }
+    if (right < 100 || left > 0) fail_msg("shadowed pixels: %u under the cut-out half, %u under the opaque half", left, right);
+    free(lit);
+    free(shadowed);
+}
+
+/* Two half-transparent emissive quads overlapping: green in front, red
+ * behind, created front first. Back to front, the overlap is greener than
+ * it is red (red first then green over it). */
+static void blend_sorts_back_to_front(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.alpha_mode = OB_ALPHA_BLEND;
+    p.metallic = 0.0f;
+    p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.0f;
+    p.base_color[3] = 0.5f;
+    ob_material_pbr green = p, red = p;
+    green.emissive[1] = 1.0f;
+    red.emissive[0] = 1.0f;
+    ob_geometry *q = ext_quad(&w, 1.0f, "glass quad");
+    facing_quad(&w, "front", q, pbr(&w, "green glass", &green, false, 0), 0.25, 0, 0.5, false);
+    facing_quad(&w, "back", q, pbr(&w, "red glass", &red, false, 0), -0.25, 0, 0, false);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    dump(&w, __func__);
+    const uint8_t *overlap = ob_test_world_pixel(&w, 80, 60);
+    if (!(overlap[1] > overlap[0] + 20))
+        fail_msg("overlap (%u, %u, %u): the front (green) layer should dominate", overlap[0], overlap[1], overlap[2]);
+    /* Each quad alone where they do not overlap: half of its colour over the background. */
+    const uint8_t *only_red = ob_test_world_pixel(&w, 80 - 30, 60);
+    assert_true(only_red[0] > only_red[1] + 20);
+    ob_test_world_destroy(&w);
+}
+
+/* A quad facing away from the camera: culled when single-sided, drawn (and
+ * lit on its back, the normal flipped) when double-sided. */
+static void double_sided_shows_the_back(void **state)
+{
+    (void)state;
+    for (int ds = 0; ds < 2; ds++) {
+        ob_test_world w;
+        ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+        ob_material_pbr p = ob_material_pbr_defaults();
+        p.metallic = 0.0f;
+        p.double_sided = ds;
+        facing_quad(&w, "card", ext_quad(&w, 1.0f, "card quad"), pbr(&w, "card", &p, false, 0), 0, 0, 0, true);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 0, 0, 5);
+        ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+        ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        ob_test_world_read(&w);
+    dump(&w, __func__);
+        const uint8_t *bg = ob_test_world_pixel(&w, 2, 2), *mid = ob_test_world_pixel(&w, 80, 60);
+        if (ds && !(luminance(mid) > luminance(bg) + 80))
+            fail_msg("double-sided back face (%u, %u, %u) is not lit", mid[0], mid[1], mid[2]);
+        if (!ds && !same_rgb(mid, bg, 0)) fail_msg("single-sided back face was drawn");
+        ob_test_world_destroy(&w);
+    }
+}
+
+/* A PBR box on a PBR ground under a shadow-casting sun: the ground has a
+ * shadow (darker pixels than with the same sun casting none), and the
+ * ground's variant is the shadowed one. */
+static void shadow_map_feeds_pbr(void **state)
+{
+    (void)state;
+    uint8_t *img[2];
+    for (int shadows = 0; shadows < 2; shadows++) {
+        ob_test_world w;
+        ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+        ob_material_pbr p = ob_material_pbr_defaults();
+        p.metallic = 0.0f;
+        p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.7f;
+        ob_material *m = pbr(&w, "stone", &p, true, 0);
+        ob_mesh box;
+        assert_int_equal(ob_mesh_box((const float[3]){0.5f, 0.5f, 0.5f}, &box), OB_OK);
+        ob_test_world_entity(&w, NULL, "box", extended(&w, &box, "pbr box", NULL), m, 0, 0.5, 0);
+        ob_node *ground = ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 10.0f, "ground quad"), m, 0, 0, 0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 2.0f, 3, 6, 2);
+        ob_test_world_look(&w, 0, 4, 5, 0, 0, 0);
+        ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        img[shadows] = ob_test_world_snapshot(&w);
+        dump(&w, shadows ? "shadow_on" : "shadow_off");
+        ob_result r;
+        const char *name = ob_effect_name(
+            ob_material_view_effect(m, w.r, ground, ob_perspective_view_base(w.main), false, &r));
+        if (shadows != (strstr(name, "sh") != NULL)) fail_msg("variant '%s' with shadows %d", name, shadows);
+        ob_test_world_destroy(&w);
+    }
+    uint32_t darker = 0, brighter = 0;
+    for (size_t i = 0; i < 160 * 120; i++) {
+        float a = luminance(img[0] + 4 * i), b = luminance(img[1] + 4 * i);
+        darker += b < a - 30.0f;
+        brighter += b > a + 2.0f;
+    }
+    if (darker < 40 || brighter > 0) fail_msg("%u pixels in shadow, %u brighter", darker, brighter);
+    free(img[0]);
+    free(img[1]);
+}
+
+/* A smooth metal sphere with reflectivity 1 next to a red emissive box:
+ * its environment map (drawn with PBR shading in the paraboloid views)
+ * makes the side facing the box redder than the other side. */
+static void environment_map_feeds_pbr(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_material_pbr chrome = ob_material_pbr_defaults();
+    chrome.roughness = 0.05f;
+    ob_material *mirror = pbr(&w, "chrome", &chrome, false, 1.0f);
+    ob_node *ball = ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), mirror, 0, 0, 0);
+    ob_material_pbr glow = ob_material_pbr_defaults();
+    glow.base_color[0] = glow.base_color[1] = glow.base_color[2] = 0.0f;
+    glow.metallic = 0.0f;
+    glow.emissive[0] = 1.0f;
+    ob_mesh box;
+    assert_int_equal(ob_mesh_box((const float[3]){0.5f, 1.0f, 1.0f}, &box), OB_OK);
+    ob_test_world_entity(&w, NULL, "red wall", extended(&w, &box, "wall", NULL), pbr(&w, "glow", &glow, false, 0),
+                         1.5, 0, 0);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_true(ob_test_count_views(st, OB_VIEW_PARABOLOID) >= 1);
+    ob_test_world_read(&w);
+    dump(&w, __func__);
+    const uint8_t *toward = ob_test_world_pixel(&w, 80 + 16, 60), *away = ob_test_world_pixel(&w, 80 - 16, 60);
+    if (!(toward[0] > away[0] + 40))
+        fail_msg("side facing the red wall (%u, %u, %u), other side (%u, %u, %u)", toward[0], toward[1], toward[2],
+                 away[0], away[1], away[2]);
+    ob_result r;
+    const char *name = ob_effect_name(
+        ob_material_view_effect(mirror, w.r, ball, ob_perspective_view_base(w.main), false, &r));
+    assert_non_null(strstr(name, "env"));
+    ob_test_world_destroy(&w);
+}
+
+/* Textured, masked, blended, double-sided and plain PBR materials with
+ * shadows: ST and MT recording give the same bytes and the same hash. */
+static void st_and_mt_are_byte_identical(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120, .workers = 4});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    const ob_texture *tex = half_transparent(cache);
+    ob_material_pbr kinds[4];
+    for (int i = 0; i < 4; i++) {
+        kinds[i] = ob_material_pbr_defaults();
+        kinds[i].metallic = i * 0.3f;
+        kinds[i].roughness = 0.3f + i * 0.2f;
+        kinds[i].base_color_texture.texture = tex;
+    }
+    kinds[1].alpha_mode = OB_ALPHA_MASK;
+    kinds[2].alpha_mode = OB_ALPHA_BLEND;
+    kinds[3].double_sided = true;
+    ob_material *mats[4];
+    for (int i = 0; i < 4; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "pbr %d", i);
+        mats[i] = pbr(&w, name, &kinds[i], true, 0);
+    }
+    ob_geometry *ball = ext_sphere(&w);
+    for (int i = 0; i < 40; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "ball %d", i);
+        ob_test_world_entity(&w, NULL, name, ball, mats[i % 4], (i % 8) - 3.5, 0.5 * (i / 8) - 1.0, -(i % 3));
+    }
+    ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 20.0f, "ground quad"), mats[0], 0, -1.6, 0);
+    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 2.0f, 2, 6, 3);
+    ob_test_world_look(&w, 0, 1, 7, 0, 0, 0);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint64_t st_hash = st->frame_hash;
+    uint8_t *single = ob_test_world_snapshot(&w);
+    st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
+    uint64_t mt_hash = st->frame_hash;
+    uint8_t *multi = ob_test_world_snapshot(&w);
+    assert_int_equal(st_hash, mt_hash);
+    assert_int_equal(ob_test_image_diff_count(single, multi, 160, 120, 0), 0);
+    free(single);
+    free(multi);
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+}
+
+/* A material without textures compiles the variant without any texture
+ * define (and says what it left out); one with a base colour texture only
+ * that one. */
+static void variants_only_use_what_the_material_uses(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 64, .height = 48});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    ob_material_pbr plain = ob_material_pbr_defaults(), textured = ob_material_pbr_defaults();
+    textured.base_color_texture.texture = half_transparent(cache);
+    ob_material *mp = pbr(&w, "plain", &plain, false, 0), *mt = pbr(&w, "textured", &textured, false, 0);
+    ob_geometry *ball = ext_sphere(&w);
+    ob_node *a = ob_test_world_entity(&w, NULL, "a", ball, mp, -0.6, 0, 0);
+    ob_node *b = ob_test_world_entity(&w, NULL, "b", ball, mt, 0.6, 0, 0);
+    ob_node_set_hidden(a, true);
+    ob_node_set_hidden(b, true);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);   /* the composite's own effect, first */
+    ob_node_set_hidden(a, false);
+    ob_node_set_hidden(b, false);
+    uint32_t before = ob_effect_context_counters(w.fx).variants_compiled;
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    /* Two variants: one per feature set (no shadow, env or depth pass here). */
+    assert_int_equal(ob_effect_context_counters(w.fx).variants_compiled - before, 2);
+    ob_view *main_view = ob_perspective_view_base(w.main);
+    assert_string_equal(ob_effect_name(ob_material_view_effect(mp, w.r, a, main_view, false, &r)), "pbr");
+    assert_string_equal(ob_effect_name(ob_material_view_effect(mt, w.r, b, main_view, false, &r)), "pbr:base");
+    char left[256];
+    assert_int_equal(ob_material_pbr_left_out(mp, left, sizeof left), 9);
+    assert_non_null(strstr(left, "normal texture"));
+    assert_int_equal(ob_material_pbr_left_out(mt, left, sizeof left), 8);
+    assert_null(strstr(left, "base colour texture"));
+    /* The same feature set in another material shares the variant. */
+    ob_material *mp2 = pbr(&w, "plain too", &plain, false, 0);
+    ob_test_world_entity(&w, NULL, "c", ball, mp2, 0, 0.8, 0);
+    before = ob_effect_context_counters(w.fx).variants_compiled;
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(ob_effect_context_counters(w.fx).variants_compiled - before, 0);
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+}
+
+/* Bad factors are refused by name; defaults are glTF's. */
+static void defaults_and_bad_input(void **state)
+{
+    (void)state;
+    ob_material_pbr d = ob_material_pbr_defaults();
+    assert_true(d.base_color[3] == 1.0f && d.metallic == 1.0f && d.roughness == 1.0f && d.alpha_cutoff == 0.5f &&
+                d.normal_scale == 1.0f && d.occlusion_strength == 1.0f && d.alpha_mode == OB_ALPHA_OPAQUE);
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 64, .height = 48});
+    ob_result r;
+    d.roughness = NAN;
+    ob_test_log_clear();
+    assert_null(ob_material_create(w.lib, &(ob_material_desc){.name = "broken", .kind = OB_MATERIAL_PBR, .pbr = d},
+                                   &r));
+    assert_int_equal(r, OB_ERR_NON_FINITE);
+    assert_true(ob_test_log_has("broken", NULL));
+    d = ob_material_pbr_defaults();
+    d.alpha_mode = (ob_alpha_mode)7;
+    assert_null(ob_material_create(w.lib, &(ob_material_desc){.name = "odd", .kind = OB_MATERIAL_PBR, .pbr = d}, &r));
+    assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
+    ob_test_world_destroy(&w);
+}
+
+int main(void)
+{
+    ob_test_setup_log();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(lit_side_is_brighter),
+        cmocka_unit_test(smooth_metal_highlight_at_mirror_direction),
+        cmocka_unit_test(alpha_mask_cuts_out),
+        cmocka_unit_test(alpha_mask_cuts_the_shadow_too),
+        cmocka_unit_test(blend_sorts_back_to_front),
+        cmocka_unit_test(double_sided_shows_the_back),
+        cmocka_unit_test(shadow_map_feeds_pbr),
+        cmocka_unit_test(environment_map_feeds_pbr),
+        cmocka_unit_test(st_and_mt_are_byte_identical),
+        cmocka_unit_test(variants_only_use_what_the_material_uses),
+        cmocka_unit_test(defaults_and_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
