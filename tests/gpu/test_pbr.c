@@ -487,6 +487,81 @@ static void variants_only_use_what_the_material_uses(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A 1x1 texture of one texel. */
+static const ob_texture *texel(ob_texture_cache *cache, uint8_t r, uint8_t g, uint8_t b, bool srgb)
+{
+    const uint8_t px[4] = {r, g, b, 255};
+    int size;
+    uint8_t *png = stbi_write_png_to_mem(px, 4, 1, 1, 4, &size);
+    assert_non_null(png);
+    ob_result res;
+    const ob_texture *t = ob_texture_cache_load(cache, &(ob_texture_desc){
+        .data = png, .size = (size_t)size, .srgb = srgb, .context = "test: one texel"}, &res);
+    ob_free(png);
+    assert_non_null(t);
+    return t;
+}
+
+enum { MAP_NONE, MAP_NORMAL, MAP_OCCLUSION, MAP_EMISSIVE, MAP_METALLIC_ROUGHNESS };
+
+/* Luminance in the middle of a grey quad facing the camera, lit by a sun
+ * from +X at a grazing angle (or by the ambient light alone), with one map. */
+static float quad_with_map(int map, bool sun)
+{
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 64, .height = 48});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.metallic = 0.0f;
+    p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.6f;
+    switch (map) {
+    case MAP_NORMAL:   /* tangent-space (0.6, 0, 0.8): tilted toward the tangent, +X */
+        p.normal_texture.texture = texel(cache, 204, 128, 230, false);
+        break;
+    case MAP_OCCLUSION:
+        p.occlusion_texture.texture = texel(cache, 0, 0, 0, false);
+        break;
+    case MAP_EMISSIVE:
+        p.emissive[0] = p.emissive[1] = p.emissive[2] = 1.0f;
+        p.emissive_texture.texture = texel(cache, 255, 0, 0, true);
+        break;
+    case MAP_METALLIC_ROUGHNESS:   /* metallic factor 1 times B = 255, roughness 1 times G = 0 */
+        p.metallic = 1.0f;
+        p.metallic_roughness_texture.texture = texel(cache, 0, 0, 255, false);
+        break;
+    default:
+        break;
+    }
+    facing_quad(&w, "card", ext_quad(&w, 2.0f, "card quad"), pbr(&w, "card", &p, false, 0), 0, 0, 0, false);
+    if (sun) ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 5, 0, 0.5);
+    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    const uint8_t *mid = ob_test_world_pixel(&w, 32, 24);
+    float l = map == MAP_EMISSIVE ? (float)mid[0] - (float)mid[1] : luminance(mid);
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+    return l;
+}
+
+/* Each map changes what it should: a normal map tilted toward a grazing
+ * light brightens the quad, a black occlusion map removes the ambient
+ * light, a red emissive texture makes it glow red, and a metallic-
+ * roughness map making it metal removes the diffuse light. */
+static void texture_maps_change_the_shading(void **state)
+{
+    (void)state;
+    float flat = quad_with_map(MAP_NONE, true), bumped = quad_with_map(MAP_NORMAL, true);
+    if (!(bumped > flat + 40.0f)) fail_msg("normal map toward the light %.0f, without %.0f", bumped, flat);
+    float ambient = quad_with_map(MAP_NONE, false), occluded = quad_with_map(MAP_OCCLUSION, false);
+    if (!(ambient > occluded + 15.0f)) fail_msg("ambient alone %.0f, occluded %.0f", ambient, occluded);
+    float redness = quad_with_map(MAP_EMISSIVE, false);
+    if (!(redness > 150.0f)) fail_msg("red emissive texture: red - green = %.0f", redness);
+    float metal = quad_with_map(MAP_METALLIC_ROUGHNESS, true);
+    if (!(metal < flat - 10.0f)) fail_msg("metal (no diffuse) %.0f, dielectric %.0f", metal, flat);
+}
+
 /* Bad factors are refused by name; defaults are glTF's. */
 static void defaults_and_bad_input(void **state)
 {
@@ -522,6 +597,7 @@ int main(void)
         cmocka_unit_test(double_sided_shows_the_back),
         cmocka_unit_test(shadow_map_feeds_pbr),
         cmocka_unit_test(environment_map_feeds_pbr),
+        cmocka_unit_test(texture_maps_change_the_shading),
         cmocka_unit_test(st_and_mt_are_byte_identical),
         cmocka_unit_test(variants_only_use_what_the_material_uses),
         cmocka_unit_test(defaults_and_bad_input),
