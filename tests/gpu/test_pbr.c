@@ -97,22 +97,30 @@ static bool same_rgb(const uint8_t *a, const uint8_t *b, int tol)
 
 /* ---------------------------------------------------------------- tests */
 
+/* A 160x120 world with one PBR ball at the origin, a sun at (lx, ly, lz)
+ * and the camera 2.5 units away on +Z; one frame, read back. */
+static void ball_under_sun(ob_test_world *w, const char *name, const ob_material_pbr *p, float intensity, double lx,
+                           double ly, double lz, const char *dump_name)
+{
+    ob_test_world_create(w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_test_world_entity(w, NULL, "ball", ext_sphere(w), pbr(w, name, p, false, 0), 0, 0, 0);
+    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, false, intensity, lx, ly, lz);
+    ob_test_world_look(w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(w);
+    dump(w, dump_name);
+}
+
 /* Light from +X: the right half of the sphere is brighter than the left. */
 static void lit_side_is_brighter(void **state)
 {
     (void)state;
-    ob_test_world w;
-    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
     ob_material_pbr p = ob_material_pbr_defaults();
     p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.8f;
     p.metallic = 0.0f;
     p.roughness = 0.6f;
-    ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), pbr(&w, "clay", &p, false, 0), 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 5, 0, 0);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
-    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
-    dump(&w, __func__);
+    ob_test_world w;
+    ball_under_sun(&w, "clay", &p, 2.0f, 5, 0, 0, __func__);
     float right = luminance(ob_test_world_pixel(&w, 80 + 14, 60));
     float left = luminance(ob_test_world_pixel(&w, 80 - 14, 60));
     if (!(right > left + 40.0f)) fail_msg("lit side %.0f, unlit side %.0f", right, left);
@@ -126,17 +134,11 @@ static void lit_side_is_brighter(void **state)
 static void smooth_metal_highlight_at_mirror_direction(void **state)
 {
     (void)state;
-    ob_test_world w;
-    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
     ob_material_pbr p = ob_material_pbr_defaults();
     p.metallic = 1.0f;
     p.roughness = 0.05f;
-    ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), pbr(&w, "chrome", &p, false, 0), 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 3.0f, 5, 5, 5);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
-    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
-    dump(&w, __func__);
+    ob_test_world w;
+    ball_under_sun(&w, "chrome", &p, 3.0f, 5, 5, 5, __func__);
     uint32_t bx = 0, by = 0;
     float best = -1.0f;
     for (uint32_t y = 30; y < 90; y++)
@@ -176,6 +178,24 @@ static const ob_texture *half_transparent(ob_texture_cache *cache)
     return t;
 }
 
+/* A 160x120 world with a texture cache and a shadow-casting "leaf":
+ * MASK with the half-transparent texture, lit green (emissive) or, double-
+ * sided, plain white. */
+static ob_material *leaf_world(ob_test_world *w, ob_texture_cache **out_cache, bool double_sided)
+{
+    ob_test_world_create(w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_result r;
+    *out_cache = ob_texture_cache_create(w->dev, &r);
+    assert_non_null(*out_cache);
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color_texture.texture = half_transparent(*out_cache);
+    p.alpha_mode = OB_ALPHA_MASK;
+    p.metallic = 0.0f;
+    p.double_sided = double_sided;
+    if (!double_sided) p.emissive[1] = 1.0f;
+    return pbr(w, "leaf", &p, true, 0);
+}
+
 /* MASK: the transparent half of the texture shows the background, the
  * opaque half the (green, emissive) quad; the light's shadow of the quad is
  * cut out the same way. */
@@ -183,15 +203,9 @@ static void alpha_mask_cuts_out(void **state)
 {
     (void)state;
     ob_test_world w;
-    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+    ob_texture_cache *cache;
+    ob_material *leaf = leaf_world(&w, &cache, false);
     ob_result r;
-    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
-    ob_material_pbr p = ob_material_pbr_defaults();
-    p.base_color_texture.texture = half_transparent(cache);
-    p.alpha_mode = OB_ALPHA_MASK;
-    p.metallic = 0.0f;
-    p.emissive[1] = 1.0f;
-    ob_material *leaf = pbr(&w, "leaf", &p, true, 0);
     facing_quad(&w, "leaf", ext_quad(&w, 1.0f, "leaf quad"), leaf, 0, 0, 0, false);
     ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
@@ -219,15 +233,8 @@ static void alpha_mask_cuts_out(void **state)
 static uint8_t *mask_shadow_scene(bool shadows)
 {
     ob_test_world w;
-    ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
-    ob_result r;
-    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
-    ob_material_pbr p = ob_material_pbr_defaults();
-    p.base_color_texture.texture = half_transparent(cache);
-    p.alpha_mode = OB_ALPHA_MASK;
-    p.metallic = 0.0f;
-    p.double_sided = true;
-    ob_material *leaf = pbr(&w, "leaf", &p, true, 0);
+    ob_texture_cache *cache;
+    ob_material *leaf = leaf_world(&w, &cache, true);
     /* Horizontal (the plane faces +Y), one unit above the ground. */
     ob_test_world_entity(&w, NULL, "leaf", ext_quad(&w, 2.0f, "leaf quad"), leaf, 0, 1, 0);
     ob_material_pbr g = ob_material_pbr_defaults();
@@ -586,6 +593,25 @@ static void walk_pngs(uint8_t *png[2], int size[2])
     assert_true(png[0] && png[1]);
 }
 
+/* The mesh `made` filled, with (white) vertex colours so it is uploaded
+ * extended; released either way. NULL with *out_result on failure. */
+static ob_geometry *extended_or_error(ob_stack *s, ob_result made, ob_mesh *m, const char *name, ob_result *out_result)
+{
+    ob_geometry *g = NULL;
+    *out_result = made;
+    if (made == OB_OK) {
+        m->colors = ob_calloc(m->vertex_count, sizeof *m->colors);
+        if (m->colors) {
+            g = ob_stack_add_geometry(s, m, name, out_result);
+        } else {
+            OB_LOG_W("test", "fault walk: no memory for the test's vertex colours");
+            *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+    }
+    ob_mesh_release(m);
+    return g;
+}
+
 static ob_result pbr_stack_build(pbr_stack *ps)
 {
     ob_stack *s = ps->t.stack;
@@ -613,26 +639,9 @@ static ob_result pbr_stack_build(pbr_stack *ps)
         .name = "chrome", .kind = OB_MATERIAL_PBR, .pbr = chrome, .reflectivity = 1.0f}, &r);
     if (!mc) return r;
     ob_mesh m;
-    ob_geometry *ball = NULL, *ground = NULL;
-    r = ob_mesh_sphere(0.5f, 16, 8, &m);
-    if (r != OB_OK) return r;
-    m.colors = ob_calloc(m.vertex_count, sizeof *m.colors);
-    if (m.colors) ball = ob_stack_add_geometry(s, &m, "fault ball", &r);
-    else {
-        OB_LOG_W("test", "fault walk: no memory for the test's vertex colours");
-        r = OB_ERR_OUT_OF_HOST_MEMORY;
-    }
-    ob_mesh_release(&m);
+    ob_geometry *ball = extended_or_error(s, ob_mesh_sphere(0.5f, 16, 8, &m), &m, "fault ball", &r);
     if (!ball) return r;
-    r = ob_mesh_plane(6.0f, 6.0f, 1, &m);
-    if (r != OB_OK) return r;
-    m.colors = ob_calloc(m.vertex_count, sizeof *m.colors);
-    if (m.colors) ground = ob_stack_add_geometry(s, &m, "fault ground", &r);
-    else {
-        OB_LOG_W("test", "fault walk: no memory for the test's vertex colours");
-        r = OB_ERR_OUT_OF_HOST_MEMORY;
-    }
-    ob_mesh_release(&m);
+    ob_geometry *ground = extended_or_error(s, ob_mesh_plane(6.0f, 6.0f, 1, &m), &m, "fault ground", &r);
     if (!ground) return r;
     ob_node *n;
     if (!(n = ob_stack_add_entity(s, NULL, "leaf ball", ball, ml, &r))) return r;
