@@ -610,7 +610,8 @@ ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_vie
     return p;
 }
 
-void ob_material_view_formats(ob_device *dev, const ob_view *v, VkFormat *out_color, VkFormat *out_depth)
+static void view_formats(ob_device *dev, const ob_view *v, VkFormat *out_color,
+                         VkFormat *out_depth)
 {
     ob_image_info info;
     *out_color = *out_depth = VK_FORMAT_UNDEFINED;
@@ -630,7 +631,7 @@ void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, 
 {
     if (!lib || !v) return;
     VkFormat color, depth;
-    ob_material_view_formats(lib->dev, v, &color, &depth);
+    view_formats(lib->dev, v, &color, &depth);
     for (uint32_t i = 0; i < v->item_count; i++) {
         ob_node *n = v->items[i].node;
         const ob_renderable *rd = n ? ob_node_renderable(n) : NULL;
@@ -663,15 +664,13 @@ static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer
     if (wants_env && !m->custom[v->type] && v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
         lib->queue_fn(lib->queue_user, entity, r, v, OB_VIEW_PARABOLOID);
     VkFormat color, depth;
-    ob_material_view_formats(lib->dev, v, &color, &depth);
+    view_formats(lib->dev, v, &color, &depth);
     prepare(m, r, entity, v, color, depth);
 }
 
 static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_renderer *r,
                                    ob_pipeline_manager *pm, const ob_view *v)
 {
-    if (m->kind == OB_MATERIAL_PBR && renders(m, v->type) && !m->custom[v->type])
-        return ob_pbr_apply(m, entity, r, pm, v);
     uint32_t variant;
     ob_effect *e = resolve(m, r, entity, v, false, &variant, NULL);
     if (!e) {
@@ -682,13 +681,15 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
         return OB_APPLY_SKIP;
     }
     VkFormat color, depth;
-    ob_material_view_formats(m->lib->dev, v, &color, &depth);
+    view_formats(m->lib->dev, v, &color, &depth);
     uint32_t pipeline_id;
     VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
     if (!pipeline) return OB_APPLY_SKIP;
     ob_pipeline_manager_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
 
     ob_params *params = ob_pipeline_manager_params(pm);
+    if (m->kind == OB_MATERIAL_PBR && !m->custom[v->type])
+        return ob_pbr_set_params(m, entity, r, params, v, variant & OB_VARIANT_ENVMAP);
     const ob_material_library *lib = m->lib;
     ob_params_set_vec4(params, lib->diffuse, m->diffuse);
     ob_params_set_vec4(params, lib->specular, m->specular);

@@ -85,7 +85,6 @@ struct ob_material {
 /* ob_material.c helpers the PBR kind shares. */
 bool ob_material_view_depends_on(const ob_view *v, ob_view_type type);
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity);
-void ob_material_view_formats(ob_device *dev, const ob_view *v, VkFormat *out_color, VkFormat *out_depth);
 
 /* ob_material_pbr.c */
 /* Registers PbrBaseColor, PbrFactors, PbrEmissive and the five texture and
@@ -100,7 +99,9 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc);
  * *out_env says whether it is the ENVMAP variant. */
 ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity, const ob_view *v, bool create,
                           bool *out_env, ob_result *out_result);
-ob_apply_result ob_pbr_apply(ob_material *m, ob_node *entity, ob_renderer *r, ob_pipeline_manager *pm,
-                             const ob_view *v);
+/* apply's PBR part, after the shared code set the pipeline: the material's
+ * factors and textures, and with `env` the entity's environment map. */
+ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,
+                                  const ob_view *v, bool env);
 
 #endif /* OB_MATERIAL_INTERNAL_H */

@@ -334,27 +334,10 @@ ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
     return e;
 }
 
-ob_apply_result ob_pbr_apply(ob_material *m, ob_node *entity, ob_renderer *r, ob_pipeline_manager *pm,
-                             const ob_view *v)
+ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,
+                                  const ob_view *v, bool env)
 {
-    bool env = false;
-    ob_effect *e = ob_pbr_resolve(m, r, entity, v, false, &env, NULL);
-    if (!e) {
-        if (!atomic_exchange(&m->warned, true))
-            OB_LOG_W("material", "material '%s': no PBR variant prepared for %s view '%s'; its draws are "
-                                 "skipped (was PreRender run for this view?)", m->name,
-                     ob_view_type_name(v->type), v->name);
-        return OB_APPLY_SKIP;
-    }
     const ob_material_library *lib = m->lib;
-    VkFormat color, depth;
-    ob_material_view_formats(lib->dev, v, &color, &depth);
-    uint32_t pipeline_id;
-    VkPipeline pipeline = ob_effect_pipeline(e, color, depth, &pipeline_id);
-    if (!pipeline) return OB_APPLY_SKIP;
-    ob_pipeline_manager_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
-
-    ob_params *params = ob_pipeline_manager_params(pm);
     const ob_pbr_params *p = &lib->pbr;
     ob_params_set_vec4(params, p->base_color, m->pbr.block[0]);
     ob_params_set_vec4(params, p->factors, m->pbr.block[1]);
