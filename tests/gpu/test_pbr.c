@@ -155,7 +155,7 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
         fail_msg("highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
     float opposite = luminance(ob_test_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
-    if (!(best > 200.0f && opposite < best * 0.5f))
+    if (!(best > 200.0f && opposite < best - 80.0f))
         fail_msg("highlight %.0f, the opposite side %.0f", best, opposite);
     ob_test_world_destroy(&w);
 }
@@ -393,7 +393,8 @@ static void environment_map_feeds_pbr(void **state)
     ob_test_world_read(&w);
     dump(&w, __func__);
     const uint8_t *toward = ob_test_world_pixel(&w, 80 + 16, 60), *away = ob_test_world_pixel(&w, 80 - 16, 60);
-    if (!(toward[0] > away[0] + 40))
+    /* Redness (red over green), so the check holds through tone mapping too. */
+    if (!((int)toward[0] - (int)toward[1] > (int)away[0] - (int)away[1] + 30))
         fail_msg("side facing the red wall (%u, %u, %u), other side (%u, %u, %u)", toward[0], toward[1], toward[2],
                  away[0], away[1], away[2]);
     ob_result r;
@@ -565,7 +566,7 @@ static void texture_maps_change_the_shading(void **state)
     float ambient = quad_with_map(MAP_NONE, false), occluded = quad_with_map(MAP_OCCLUSION, false);
     if (!(ambient > occluded + 15.0f)) fail_msg("ambient alone %.0f, occluded %.0f", ambient, occluded);
     float redness = quad_with_map(MAP_EMISSIVE, false);
-    if (!(redness > 150.0f)) fail_msg("red emissive texture: red - green = %.0f", redness);
+    if (!(redness > 100.0f)) fail_msg("red emissive texture: red - green = %.0f", redness);
     float metal = quad_with_map(MAP_METALLIC_ROUGHNESS, true);
     if (!(metal < flat - 10.0f)) fail_msg("metal (no diffuse) %.0f, dielectric %.0f", metal, flat);
 }
