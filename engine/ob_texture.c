@@ -110,6 +110,29 @@ static bool sampling_valid(const ob_texture_sampling *s)
            (unsigned)s->wrap_v <= OB_TEXTURE_WRAP_MIRROR;
 }
 
+static ob_texture_wrap gltf_wrap(uint32_t code)
+{
+    return code == 33071 ? OB_TEXTURE_WRAP_CLAMP : code == 33648 ? OB_TEXTURE_WRAP_MIRROR : OB_TEXTURE_WRAP_REPEAT;
+}
+
+ob_texture_sampling ob_texture_sampling_from_gltf(uint32_t mag_filter, uint32_t min_filter, uint32_t wrap_s,
+                                                  uint32_t wrap_t)
+{
+    ob_texture_sampling s = {.wrap_u = gltf_wrap(wrap_s), .wrap_v = gltf_wrap(wrap_t)};
+    if (mag_filter == 9728) s.mag = OB_TEXTURE_FILTER_NEAREST;
+    else if (mag_filter == 9729) s.mag = OB_TEXTURE_FILTER_LINEAR;
+    switch (min_filter) {
+    case 9728: s.min = OB_TEXTURE_FILTER_NEAREST; s.no_mips = true; break;
+    case 9729: s.min = OB_TEXTURE_FILTER_LINEAR; s.no_mips = true; break;
+    case 9984: s.min = OB_TEXTURE_FILTER_NEAREST; s.mip = OB_TEXTURE_FILTER_NEAREST; break;
+    case 9985: s.min = OB_TEXTURE_FILTER_LINEAR; s.mip = OB_TEXTURE_FILTER_NEAREST; break;
+    case 9986: s.min = OB_TEXTURE_FILTER_NEAREST; s.mip = OB_TEXTURE_FILTER_LINEAR; break;
+    case 9987: s.min = OB_TEXTURE_FILTER_LINEAR; s.mip = OB_TEXTURE_FILTER_LINEAR; break;
+    default: break;
+    }
+    return s;
+}
+
 static VkSamplerAddressMode vk_wrap(ob_texture_wrap w)
 {
     return w == OB_TEXTURE_WRAP_CLAMP    ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE

@@ -64,6 +64,15 @@ typedef struct ob_texture_sampling {
     ob_texture_wrap wrap_u, wrap_v;
 } ob_texture_sampling;
 
+/* The sampling of a glTF 2 sampler from its numeric codes (0 = unspecified
+ * → the default): mag 9728 NEAREST / 9729 LINEAR; min 9728 NEAREST and 9729
+ * LINEAR (no mips), 9984..9987 NEAREST_MIPMAP_NEAREST, LINEAR_MIPMAP_NEAREST,
+ * NEAREST_MIPMAP_LINEAR, LINEAR_MIPMAP_LINEAR; wrap 10497 REPEAT, 33071
+ * CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT. An unknown code is taken as
+ * unspecified. [any thread] */
+ob_texture_sampling ob_texture_sampling_from_gltf(uint32_t mag_filter, uint32_t min_filter, uint32_t wrap_s,
+                                                  uint32_t wrap_t);
+
 typedef struct ob_texture_desc {
     const char *path;            /* an image file stb_image reads (PNG, JPEG, ...), or ... */
     const void *data;            /* ... encoded image bytes in memory (.glb buffer view, */

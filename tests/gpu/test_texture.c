@@ -404,6 +404,29 @@ static void oversized_texture_is_downscaled(void **state)
     ob_test_assert_no_validation(f->dev);
 }
 
+/* glTF sampler codes map to the sampling a glTF viewer would use. */
+static void gltf_sampler_codes_map(void **state)
+{
+    (void)state;
+    ob_texture_sampling s = ob_texture_sampling_from_gltf(0, 0, 0, 0);
+    assert_int_equal(s.mag, OB_TEXTURE_FILTER_DEFAULT);
+    assert_int_equal(s.min, OB_TEXTURE_FILTER_DEFAULT);
+    assert_false(s.no_mips);
+    assert_int_equal(s.wrap_u, OB_TEXTURE_WRAP_REPEAT);
+    s = ob_texture_sampling_from_gltf(9728, 9986, 33071, 33648);
+    assert_int_equal(s.mag, OB_TEXTURE_FILTER_NEAREST);
+    assert_int_equal(s.min, OB_TEXTURE_FILTER_NEAREST);
+    assert_int_equal(s.mip, OB_TEXTURE_FILTER_LINEAR);
+    assert_int_equal(s.wrap_u, OB_TEXTURE_WRAP_CLAMP);
+    assert_int_equal(s.wrap_v, OB_TEXTURE_WRAP_MIRROR);
+    s = ob_texture_sampling_from_gltf(9729, 9729, 10497, 10497);
+    assert_int_equal(s.min, OB_TEXTURE_FILTER_LINEAR);
+    assert_true(s.no_mips);
+    s = ob_texture_sampling_from_gltf(9729, 9985, 0, 0);
+    assert_int_equal(s.mip, OB_TEXTURE_FILTER_NEAREST);
+    assert_false(s.no_mips);
+}
+
 /* -------------------------------------------------------------- faults */
 
 typedef struct fault_run {
@@ -498,6 +521,7 @@ int main(void)
         cmocka_unit_test(mips_made_on_the_device),
         cmocka_unit_test(mips_made_on_the_cpu),
         cmocka_unit_test(oversized_texture_is_downscaled),
+        cmocka_unit_test(gltf_sampler_codes_map),
         cmocka_unit_test(loading_survives_every_fault_device_mips),
         cmocka_unit_test(loading_survives_every_fault_cpu_mips),
     };
