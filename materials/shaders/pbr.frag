@@ -125,9 +125,13 @@ void main()
 #if defined(HAS_NORMAL_TEXTURE)
     // Tangent frame (glTF: bitangent = cross(normal, tangent.xyz) * tangent.w),
     // made orthogonal to the interpolated normal; reversed with it on back faces.
-    vec3 t = ob_safe_normalize(vTangent.xyz - n * dot(n, vTangent.xyz));
-    if (back) t = -t;
-    vec3 b = cross(n, t) * vTangent.w;
+    vec3 front_n = back ? -n : n;
+    vec3 t = ob_safe_normalize(vTangent.xyz - front_n * dot(front_n, vTangent.xyz));
+    vec3 b = cross(front_n, t) * vTangent.w;
+    if (back) {
+        t = -t;
+        b = -b;
+    }
     vec3 tn = texture(NormalTexture, vUV).xyz * 2.0 - 1.0;
     tn.xy *= PbrFactors.z;
     vec3 mapped = ob_safe_normalize(mat3(t, b, n) * tn);
