@@ -28,7 +28,7 @@ set(OB_PUBLIC_HEADERS
     engine/ob_core.h engine/ob_device.h engine/ob_math.h engine/ob_params.h
     engine/ob_pipeline_manager.h engine/ob_program.h engine/ob_reflect.h
     engine/ob_renderer.h engine/ob_renderer_layer.h engine/ob_resources.h engine/ob_scene.h
-    engine/ob_view.h
+    engine/ob_texture.h engine/ob_view.h
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h geometry/ob_model.h
     views/ob_views.h views/ob_views_layer.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h

@@ -382,8 +382,14 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
     }
     if ((unsigned)desc->filter > VK_FILTER_LINEAR ||
         (unsigned)desc->address > VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER ||
-        (unsigned)desc->compare_op > VK_COMPARE_OP_ALWAYS) {
-        OB_LOG_E("resources", "sampler '%s': filter %d, address mode %d or compare op %d is out of range", name,
+        (unsigned)desc->compare_op > VK_COMPARE_OP_ALWAYS ||
+        (desc->detailed && ((unsigned)desc->mag_filter > VK_FILTER_LINEAR || (unsigned)desc->min_filter > VK_FILTER_LINEAR ||
+                            (unsigned)desc->mipmap_mode > VK_SAMPLER_MIPMAP_MODE_LINEAR ||
+                            (unsigned)desc->address_u > VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER ||
+                            (unsigned)desc->address_v > VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER ||
+                            !(desc->max_lod >= 0.0f && desc->max_lod <= VK_LOD_CLAMP_NONE)))) {
+        OB_LOG_E("resources", "sampler '%s': filter %d, address mode %d, compare op %d or a detailed "
+                              "filter, mip mode, address mode or max_lod is out of range", name,
                  (int)desc->filter, (int)desc->address, (int)desc->compare_op);
         r = OB_ERR_INVALID_ARGUMENT;
         goto fail_log;
@@ -416,6 +422,14 @@ ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_res
         /* Outside a clamped shadow map counts as lit. */
         .borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE,
     };
+    if (desc->detailed) {
+        info.magFilter = desc->mag_filter;
+        info.minFilter = desc->min_filter;
+        info.mipmapMode = desc->mipmap_mode;
+        info.addressModeU = info.addressModeW = desc->address_u;
+        info.addressModeV = desc->address_v;
+        info.maxLod = desc->max_lod;
+    }
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateSampler(ob_device_vk(dev), &info, NULL, &rec->sampler));
     if (vr < 0) {
         rec->sampler = VK_NULL_HANDLE;

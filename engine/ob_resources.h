@@ -83,9 +83,24 @@ typedef struct ob_image_desc {
                                 D16/D32 or BC formats); staged, leaving the image in
                                 SHADER_READ_ONLY_OPTIMAL (TRANSFER_DST is implied) */
     const char *name;
+    /* Mip levels: 0 → 1; at most floor(log2(max(width, height))) + 1. With
+     * data and more than one level, level 0 comes from data and the others
+     * are made from it on the device (a chain of linear blits; TRANSFER_SRC
+     * is implied): the format must support linear blit filtering
+     * (OB_ERR_UNSUPPORTED otherwise) unless data_mips is set. Sampled views
+     * cover every level; targets and read-back use level 0. */
+    uint32_t mip_levels;
+    /* data holds every level, level 0 first, each tightly packed (mips the
+     * caller made, e.g. on the CPU where the format cannot be blitted). */
+    bool data_mips;
 } ob_image_desc;
 
 ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *out_result);
+/* floor(log2(max(width, height))) + 1: the levels of a full mip chain. [any thread] */
+uint32_t ob_image_mip_levels_max(uint32_t width, uint32_t height);
+/* True when format's optimal tiling can be blitted with linear filtering on
+ * this device (what device-made mips need). [any thread] */
+bool ob_image_format_blits_linear(const ob_device *dev, VkFormat format);
 void ob_image_destroy(ob_device *dev, ob_image img);      /* deferred */
 bool ob_image_is_valid(const ob_device *dev, ob_image img);
 VkImage ob_image_vk(const ob_device *dev, ob_image img);
@@ -98,6 +113,7 @@ typedef struct ob_image_info {
     VkFormat format;
     uint32_t usage;
     VkImageAspectFlags aspect;
+    uint32_t mip_levels;     /* ≥ 1 */
     uint32_t samples;        /* 1 unless made multisampled */
 } ob_image_info;
 ob_result ob_image_get_info(const ob_device *dev, ob_image img, ob_image_info *out_info);
@@ -146,6 +162,13 @@ typedef struct ob_sampler_desc {
     bool compare;                      /* depth comparison (shadow maps) */
     VkCompareOp compare_op;            /* with compare: 0 (NEVER) → LESS_OR_EQUAL */
     const char *name;
+    /* Per-axis control (textures from models): when set, the fields below
+     * replace filter and address (W follows U). */
+    bool detailed;
+    VkFilter mag_filter, min_filter;
+    VkSamplerMipmapMode mipmap_mode;
+    VkSamplerAddressMode address_u, address_v;
+    float max_lod;                     /* highest level sampled; 0 → level 0 only */
 } ob_sampler_desc;
 
 ob_sampler ob_sampler_create(ob_device *dev, const ob_sampler_desc *desc, ob_result *out_result);

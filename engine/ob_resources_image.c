@@ -182,6 +182,12 @@ static ob_result image_desc_check(const ob_image_desc *desc, const char *name, u
             return OB_ERR_INVALID_ARGUMENT;
         }
     }
+    if (desc->mip_levels > ob_image_mip_levels_max(desc->width, desc->height) ||
+        (desc->mip_levels > 1 && (desc->usage & (OB_IMAGE_COLOR_TARGET | OB_IMAGE_DEPTH_TARGET)))) {
+        OB_LOG_E("resources", "image '%s': %u mip levels for %ux%u%s", name, desc->mip_levels, desc->width,
+                 desc->height, desc->mip_levels > 1 ? " (too many, or on a render target)" : "");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     if (!desc->data) return OB_OK;
     uint32_t bytes, dim;
     if (format_aspect(desc->format) != VK_IMAGE_ASPECT_COLOR_BIT &&
@@ -196,7 +202,11 @@ static ob_result image_desc_check(const ob_image_desc *desc, const char *name, u
         return OB_ERR_UNSUPPORTED;
     }
     uint64_t layers = desc->layers ? desc->layers : 1;
-    *out_data_size = (uint64_t)((desc->width + dim - 1) / dim) * ((desc->height + dim - 1) / dim) * bytes * layers;
+    uint32_t levels = desc->data_mips && desc->mip_levels ? desc->mip_levels : 1;
+    for (uint32_t l = 0; l < levels; l++) {
+        uint32_t w = OB_MAX(desc->width >> l, 1u), h = OB_MAX(desc->height >> l, 1u);
+        *out_data_size += (uint64_t)((w + dim - 1) / dim) * ((h + dim - 1) / dim) * bytes * layers;
+    }
     return OB_OK;
 }
 
@@ -235,7 +245,7 @@ static ob_result image_view_create(ob_device *dev, ob_image_rec *rec, VkImageVie
         .image = rec->image,
         .viewType = type,
         .format = rec->info.format,
-        .subresourceRange = {view_aspect(rec), 0, 1, first_layer, layer_count},
+        .subresourceRange = {view_aspect(rec), 0, rec->info.mip_levels, first_layer, layer_count},
     };
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateImageView(ob_device_vk(dev), &info, NULL, out_view));
     if (vr < 0) {
@@ -265,7 +275,7 @@ static ob_result image_views_create(ob_device *dev, ob_image_rec *rec)
 }
 
 /* Staging upload of every layer, leaving the image shader-readable. */
-static ob_result image_upload(ob_device *dev, ob_image_rec *rec, const void *data, uint64_t size)
+static ob_result image_upload(ob_device *dev, ob_image_rec *rec, const void *data, uint64_t size, bool data_mips)
 {
     ob_staging staging;
     ob_result r = ob_staging_create(dev, size, rec->name, &staging);
@@ -276,7 +286,10 @@ static ob_result image_upload(ob_device *dev, ob_image_rec *rec, const void *dat
     if (r != OB_OK) goto done;
     ob_image_state saved = rec->state;
     VkImageMemoryBarrier2 barrier;
-    ob_image_state to_copy = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+    /* Blits write the levels below 0 after this transition: make it wait for them too. */
+    ob_image_state to_copy = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                              rec->info.mip_levels > 1 ? VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT
+                                                       : VK_PIPELINE_STAGE_2_COPY_BIT,
                               VK_ACCESS_2_TRANSFER_WRITE_BIT};
     VkDependencyInfo dep = {
         .sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
@@ -284,11 +297,18 @@ static ob_result image_upload(ob_device *dev, ob_image_rec *rec, const void *dat
         .pImageMemoryBarriers = &barrier,
     };
     if (ob_res_image_transition(rec, &to_copy, &barrier)) vkCmdPipelineBarrier2(cmd, &dep);
-    VkBufferImageCopy region = {
-        .imageSubresource = {rec->info.aspect, 0, 0, rec->info.layers},
-        .imageExtent = {rec->info.width, rec->info.height, 1},
-    };
-    vkCmdCopyBufferToImage(cmd, staging.buffer, rec->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    if (data_mips) {
+        uint32_t bytes = 4, dim = 1;
+        format_block(rec->info.format, &bytes, &dim);   /* known: image_desc_check passed */
+        ob_res_image_copy_levels(cmd, staging.buffer, rec, bytes, dim);
+    } else {
+        VkBufferImageCopy region = {
+            .imageSubresource = {rec->info.aspect, 0, 0, rec->info.layers},
+            .imageExtent = {rec->info.width, rec->info.height, 1},
+        };
+        vkCmdCopyBufferToImage(cmd, staging.buffer, rec->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        if (rec->info.mip_levels > 1) ob_res_image_blit_mips(cmd, rec);
+    }
     /* Any shader stage may sample it next; ALL_COMMANDS keeps that true for
      * compute and vertex fetches as well as fragment shaders. */
     ob_image_state readable = {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
@@ -323,8 +343,12 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
     r = image_desc_check(desc, name, &data_size);
     if (r != OB_OK) goto fail;
     uint32_t layers = desc->layers ? desc->layers : 1;
+    uint32_t levels = desc->mip_levels ? desc->mip_levels : 1;
+    bool blit_mips = desc->data && levels > 1 && !desc->data_mips;
     VkImageUsageFlags vk_usage = image_vk_usage(desc->usage, desc->data != NULL);
+    if (blit_mips) vk_usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     r = image_support_check(dev, name, desc, layers, vk_usage);
+    if (r == OB_OK && blit_mips) r = ob_res_mips_blit_check(dev, name, desc->format);
     if (r != OB_OK) goto fail;
 
     VkDevice vk = ob_device_vk(dev);
@@ -334,7 +358,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
         goto fail;
     }
     rec->info = (ob_image_info){desc->width, desc->height, layers, desc->format, desc->usage,
-                                format_aspect(desc->format), desc->samples > 1 ? desc->samples : 1};
+                                format_aspect(desc->format), levels, desc->samples > 1 ? desc->samples : 1};
     rec->state = (ob_image_state){VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
     rec->name = ob_strdup(name);
     if (!rec->name) {
@@ -346,7 +370,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
         .imageType = VK_IMAGE_TYPE_2D,
         .format = desc->format,
         .extent = {desc->width, desc->height, 1},
-        .mipLevels = 1,
+        .mipLevels = levels,
         .arrayLayers = layers,
         .samples = (VkSampleCountFlagBits)rec->info.samples,
         .tiling = VK_IMAGE_TILING_OPTIMAL,
@@ -377,7 +401,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
     r = image_views_create(dev, rec);
     if (r != OB_OK) goto fail_free_rec;
     if (desc->data) {
-        r = image_upload(dev, rec, desc->data, data_size);
+        r = image_upload(dev, rec, desc->data, data_size, desc->data_mips);
         if (r != OB_OK) goto fail_free_rec;
     }
     handle.id = ob_res_register(dev, &ob_device_registry(dev)->images, rec, rec->mem_size, &r);
@@ -495,7 +519,7 @@ bool ob_res_image_transition(ob_image_rec *rec, const ob_image_state *next, VkIm
         .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
         .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
         .image = rec->image,
-        .subresourceRange = {rec->info.aspect, 0, 1, 0, rec->info.layers},
+        .subresourceRange = {rec->info.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, rec->info.layers},
     };
     if (read_to_read) {
         /* Keep every reader in the state, so the next write waits for all. */

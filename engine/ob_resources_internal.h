@@ -96,6 +96,20 @@ ob_image_rec *ob_res_image_get(const ob_device *dev, ob_image img, const char *c
  * records the new state; false when no barrier is needed. */
 bool ob_res_image_transition(ob_image_rec *rec, const ob_image_state *next, VkImageMemoryBarrier2 *out_barrier);
 
+/* Mip levels (ob_resources_mips.c). */
+/* OB_OK when format's optimal tiling supports blits with linear filtering on
+ * this device; else logs naming the image and returns OB_ERR_UNSUPPORTED. */
+ob_result ob_res_mips_blit_check(ob_device *dev, const char *name, VkFormat format);
+/* Records the chain of linear blits level i-1 → i for every level of rec,
+ * whose level 0 has just been written by a copy and whose levels are all in
+ * TRANSFER_DST_OPTIMAL (made wait for ALL_TRANSFER). Leaves every level in
+ * TRANSFER_SRC_OPTIMAL and rec's tracked state saying so. */
+void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec);
+/* Records the copy of every level from a staging buffer that holds them
+ * tightly packed, level 0 first (all in TRANSFER_DST_OPTIMAL). */
+void ob_res_image_copy_levels(VkCommandBuffer cmd, VkBuffer staging, const ob_image_rec *rec, uint32_t block_bytes,
+                              uint32_t block_dim);
+
 /* Freed here so that the registry can release leaked images at destroy. */
 void ob_res_image_free(ob_device *dev, ob_image_rec *rec);
 

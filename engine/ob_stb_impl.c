@@ -1,5 +1,5 @@
-/* ob_stb_impl.c — the one translation unit that compiles stb_image and
- * stb_image_write. Everyone else includes the headers without the
+/* ob_stb_impl.c — the one translation unit that compiles stb_image,
+ * stb_image_write and stb_image_resize (textures above the device limit). Everyone else includes the headers without the
  * IMPLEMENTATION defines and links against these definitions.
  *
  * Their allocations go through ob_malloc & co., so fault injection reaches
@@ -13,6 +13,8 @@
 #define STBIW_MALLOC(sz) ob_malloc(sz)
 #define STBIW_REALLOC(p, newsz) ob_realloc(p, newsz)
 #define STBIW_FREE(p) ob_free(p)
+#define STBIR_MALLOC(sz, ctx) ((void)(ctx), ob_malloc(sz))
+#define STBIR_FREE(p, ctx) ((void)(ctx), ob_free(p))
 
 /* Third-party code: its warnings are not ours to fix. */
 #pragma GCC diagnostic push
@@ -31,4 +33,6 @@
 #include <stb_image.h>
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
+#define STB_IMAGE_RESIZE_IMPLEMENTATION
+#include <stb_image_resize.h>
 #pragma GCC diagnostic pop

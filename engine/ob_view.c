@@ -1,4 +1,5 @@
 #include "ob_renderer.h"
+#include "ob_renderer_layer.h"
 
 #include <math.h>
 #include <stdio.h>

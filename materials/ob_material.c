@@ -1,47 +1,9 @@
-#include "ob_material.h"
+#include "ob_material_internal.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
-
-#define VARIANT_COUNT 8u   /* every combination of the ob_std_variant bits */
-
-typedef struct std_slot {
-    _Atomic(ob_effect *) effect;   /* published once created; read while recording */
-    ob_result failure;             /* OB_OK until a creation failed (not retried) */
-} std_slot;
-
-enum { SAMPLER_SHADOW, SAMPLER_ENV, SAMPLER_SOURCE, SAMPLER_COUNT };
-
-struct ob_material_library {
-    ob_effect_context *ctx;
-    ob_device *dev;
-    ob_param_registry *reg;
-    ob_effect_vertex_input standard_layout, text_layout;
-    float bias_constant, bias_slope;
-    std_slot slots[OB_STD_EFFECT_COUNT][VARIANT_COUNT];
-    ob_material_queue_fn queue_fn;
-    void *queue_user;
-    ob_param diffuse, specular, emissive, reflectivity;
-    ob_sampler samplers[SAMPLER_COUNT];
-    ob_material **materials;
-    uint32_t material_count, material_cap;
-    uint32_t next_id;
-};
-
-struct ob_material {
-    ob_material_library *lib;
-    char name[48];
-    ob_material_kind kind;
-    float diffuse[4], specular[4], emissive[4], reflectivity[4];
-    bool casts_shadows, blended;
-    uint32_t priority;
-    uint32_t id;                   /* creation order in its library: groups draws */
-    bool render[OB_VIEW_TYPE_COUNT];
-    ob_effect *custom[OB_VIEW_TYPE_COUNT];
-    atomic_bool warned;            /* a skipped draw is logged once */
-};
 
 /* What a material draws with in one view: a standard variant or a custom effect. */
 typedef struct effect_choice {
@@ -189,6 +151,16 @@ static const ob_effect_vertex_input builtin_standard_layout = {
                    {2, VK_FORMAT_R32G32_SFLOAT, 24}},
 };
 
+static const ob_effect_vertex_input builtin_extended_layout = {
+    .stride = 52,
+    .attribute_count = 5,
+    .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, VK_FORMAT_R32G32_SFLOAT, 24},
+                   {3, VK_FORMAT_R8G8B8A8_UNORM, 32},
+                   {4, VK_FORMAT_R32G32B32A32_SFLOAT, 36}},
+};
+
 static const ob_effect_vertex_input builtin_text_layout = {
     .stride = 16,
     .attribute_count = 2,
@@ -285,7 +257,8 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
         goto fail;
     }
     if ((d.standard_layout && d.standard_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES) ||
-        (d.text_layout && d.text_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES)) {
+        (d.text_layout && d.text_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES) ||
+        (d.extended_layout && d.extended_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES)) {
         OB_LOG_E("material", "material library: a vertex layout has more than %u attributes",
                  OB_EFFECT_MAX_ATTRIBUTES);
         r = OB_ERR_INVALID_ARGUMENT;
@@ -301,10 +274,12 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     lib->reg = ob_effect_context_registry(ctx);
     lib->standard_layout = d.standard_layout ? *d.standard_layout : builtin_standard_layout;
     lib->text_layout = d.text_layout ? *d.text_layout : builtin_text_layout;
+    lib->extended_layout = d.extended_layout ? *d.extended_layout : builtin_extended_layout;
     lib->bias_constant = d.shadow_bias_constant != 0.0f ? d.shadow_bias_constant : -1.0f;
     lib->bias_slope = d.shadow_bias_slope != 0.0f ? d.shadow_bias_slope : -1.75f;
 
     r = register_standard_params(lib);
+    if (r == OB_OK) r = ob_pbr_register_params(lib);
     if (r == OB_OK) r = create_samplers(lib);
     if (r != OB_OK) goto fail_destroy;
     if (out_result) *out_result = OB_OK;
@@ -325,6 +300,7 @@ void ob_material_library_destroy(ob_material_library *lib)
     ob_free(lib->materials);
     for (uint32_t k = 0; k < OB_STD_EFFECT_COUNT; k++)
         for (uint32_t v = 0; v < VARIANT_COUNT; v++) ob_effect_destroy(lib->slots[k][v].effect);
+    ob_pbr_library_release(lib);
     for (uint32_t i = 0; i < SAMPLER_COUNT; i++)
         if (lib->samplers[i].id) ob_sampler_destroy(lib->dev, lib->samplers[i]);
     ob_free(lib);
@@ -359,6 +335,11 @@ static void set_render_flags(ob_material *m)
     switch (m->kind) {
     case OB_MATERIAL_LIT:
     case OB_MATERIAL_REFLECTIVE:
+        m->render[OB_VIEW_PERSPECTIVE] = true;
+        m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_SHADOW] = m->casts_shadows;
+        break;
+    case OB_MATERIAL_PBR:
         m->render[OB_VIEW_PERSPECTIVE] = true;
         m->render[OB_VIEW_PARABOLOID] = true;
         m->render[OB_VIEW_SHADOW] = m->casts_shadows;
@@ -407,11 +388,20 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
     memcpy(m->specular, all_zero(desc->specular) ? soft_highlight : desc->specular,
            sizeof m->specular);
     memcpy(m->emissive, desc->emissive, sizeof m->emissive);
-    m->reflectivity[0] = desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
+    m->reflectivity[0] = desc->kind == OB_MATERIAL_PBR         ? OB_MAX(desc->reflectivity, 0.0f)
+                         : desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
                          : desc->reflectivity != 0.0f          ? desc->reflectivity
                                                                : 0.6f;
     m->casts_shadows = desc->casts_shadows;
     m->blended = desc->blended;
+    if (desc->kind == OB_MATERIAL_PBR) {
+        r = ob_pbr_material_init(m, desc);
+        if (r != OB_OK) {
+            ob_free(m);
+            goto fail;
+        }
+        m->blended = desc->pbr.alpha_mode == OB_ALPHA_BLEND;
+    }
     m->priority = desc->priority;
     m->id = lib->next_id++;
     set_render_flags(m);
@@ -492,14 +482,14 @@ ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity)
 
 /* ---------------------------------------------------------- view effects */
 
-static bool view_depends_on(const ob_view *v, ob_view_type type)
+bool ob_material_view_depends_on(const ob_view *v, ob_view_type type)
 {
     for (uint32_t i = 0; i < v->dep_count; i++)
         if (v->deps[i] && v->deps[i]->type == type) return true;
     return false;
 }
 
-static ob_view *attached_env_map(const ob_renderer *r, const ob_node *entity)
+ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity)
 {
     return r && entity ? ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID) : NULL;
 }
@@ -525,8 +515,8 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
         }
         out->kind = OB_STD_LIT;
         out->variant = blended;
-        if (view_depends_on(v, OB_VIEW_SHADOW)) out->variant |= OB_VARIANT_SHADOWS;
-        if (m->kind == OB_MATERIAL_REFLECTIVE && attached_env_map(r, entity))
+        if (ob_material_view_depends_on(v, OB_VIEW_SHADOW)) out->variant |= OB_VARIANT_SHADOWS;
+        if (m->kind == OB_MATERIAL_REFLECTIVE && ob_material_attached_env_map(r, entity))
             out->variant |= OB_VARIANT_ENVMAP;
         return true;
     case OB_VIEW_SHADOW:
@@ -570,6 +560,12 @@ static ob_effect *resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
     effect_choice c;
     *out_variant = 0;
     if (out_result) *out_result = OB_OK;
+    if (v && m->kind == OB_MATERIAL_PBR && renders(m, v->type) && !m->custom[v->type]) {
+        bool env = false;
+        ob_effect *e = ob_pbr_resolve(m, r, entity, v, create, &env, out_result);
+        *out_variant = env ? OB_VARIANT_ENVMAP : 0u;
+        return e;
+    }
     if (!v || !choose(m, r, entity, v, &c)) {
         if (out_result) *out_result = OB_ERR_NOT_FOUND;
         return NULL;
@@ -603,6 +599,11 @@ ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_vie
     ob_view probe;
     memset(&probe, 0, sizeof probe);
     probe.type = type;
+    if (m->kind == OB_MATERIAL_PBR && !m->custom[type]) {
+        bool env;
+        p.effect = ob_pbr_resolve((ob_material *)m, NULL, NULL, &probe, false, &env, NULL);
+        return p;
+    }
     effect_choice c;
     if (choose(m, NULL, NULL, &probe, &c))
         p.effect = c.custom ? c.custom : ob_material_library_find_effect(m->lib, c.kind, c.variant);
@@ -657,8 +658,8 @@ static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer
 {
     if (!renders(m, v->type)) return;
     ob_material_library *lib = m->lib;
-    if (m->kind == OB_MATERIAL_REFLECTIVE && !m->custom[v->type] &&
-        v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
+    bool wants_env = m->kind == OB_MATERIAL_REFLECTIVE || (m->kind == OB_MATERIAL_PBR && m->reflectivity[0] > 0.0f);
+    if (wants_env && !m->custom[v->type] && v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
         lib->queue_fn(lib->queue_user, entity, r, v, OB_VIEW_PARABOLOID);
     ob_effect_targets targets = view_targets(lib->dev, v);
     prepare(m, r, entity, v, &targets);
@@ -683,6 +684,8 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
     ob_pipeline_manager_set_pipeline(pm, pipeline, pipeline_id, ob_effect_program(e));
 
     ob_params *params = ob_pipeline_manager_params(pm);
+    if (m->kind == OB_MATERIAL_PBR && !m->custom[v->type])
+        return ob_pbr_set_params(m, entity, r, params, v, variant & OB_VARIANT_ENVMAP);
     const ob_material_library *lib = m->lib;
     ob_params_set_vec4(params, lib->diffuse, m->diffuse);
     ob_params_set_vec4(params, lib->specular, m->specular);
@@ -690,7 +693,7 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
     ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
     if (variant & OB_VARIANT_ENVMAP) {
         /* Each reflective entity samples its own map: bind it per draw. */
-        ob_view *env = attached_env_map(r, entity);
+        ob_view *env = ob_material_attached_env_map(r, entity);
         if (env && env->vtbl && env->vtbl->set_usage_params)
             env->vtbl->set_usage_params(env, r, params, v);
     }

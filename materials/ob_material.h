@@ -22,6 +22,15 @@
  *               unlit with vertex colours, alpha blended, no depth (text);
  *               shadow: depth-only when casts_shadows.
  *   CUSTOM      only the effects given with ob_material_set_view_effect.
+ *   PBR         glTF 2 metallic-roughness (ob_material_pbr; docs/materials.md):
+ *               perspective: pbr.vert + pbr.frag with the defines of the
+ *               features the material uses (+SHADOWS, +ENVMAP as LIT and
+ *               REFLECTIVE); paraboloid: the same with PARABOLOID; shadow
+ *               (casts_shadows): depth only, the ALPHA_MASK cut-out included.
+ *               Extended vertex layout. Alpha BLEND draws in the blended
+ *               class (back to front, no depth write). With reflectivity > 0
+ *               it asks for an environment map like REFLECTIVE, and
+ *               reflectivity scales that map's specular term (1 = as lit).
  * A view type with no effect is not drawn (renders() is false, so culling
  * counts the entity as culled).
  *
@@ -55,6 +64,7 @@
 
 #include "ob_effect.h"
 #include "ob_renderer.h"
+#include "ob_texture.h"
 #include "ob_view.h"
 
 #ifdef __cplusplus
@@ -70,6 +80,7 @@ typedef enum ob_material_kind {
     OB_MATERIAL_REFLECTIVE,
     OB_MATERIAL_UNLIT,
     OB_MATERIAL_CUSTOM,
+    OB_MATERIAL_PBR,          /* glTF 2 metallic-roughness (desc.pbr) */
     OB_MATERIAL_KIND_COUNT
 } ob_material_kind;
 
@@ -85,6 +96,39 @@ typedef enum ob_std_effect {
     OB_STD_PARTICLES_DRAW,    /* particles.vert + .frag, pulled quads, blended */
     OB_STD_EFFECT_COUNT
 } ob_std_effect;
+
+/* glTF 2 alpha modes. */
+typedef enum ob_alpha_mode { OB_ALPHA_OPAQUE = 0, OB_ALPHA_MASK, OB_ALPHA_BLEND } ob_alpha_mode;
+
+/* A texture slot of a PBR material: the texture (owned by its cache, which
+ * must outlive the material) and the uv set it reads. Only TEXCOORD_0 exists
+ * in the extended layout: uv_set 1 is drawn with set 0 and a warning. */
+typedef struct ob_material_texture {
+    const ob_texture *texture;   /* NULL = none */
+    uint32_t uv_set;
+} ob_material_texture;
+
+/* glTF 2 metallic-roughness material. Textures: base colour and emissive
+ * are colour data (load them with srgb = true), the others data maps
+ * (UNORM): metallic-roughness reads B = metallic, G = roughness; occlusion
+ * reads R; the normal map is tangent space (needs the vertex TANGENT). */
+typedef struct ob_material_pbr {
+    float base_color[4];               /* linear RGBA factor */
+    float metallic, roughness;         /* factors in [0, 1] */
+    float emissive[3];                 /* linear factor (may exceed 1) */
+    float normal_scale, occlusion_strength;
+    ob_material_texture base_color_texture, metallic_roughness_texture, normal_texture,
+        occlusion_texture, emissive_texture;
+    ob_alpha_mode alpha_mode;
+    float alpha_cutoff;                /* MASK: alpha below it is cut out */
+    bool double_sided;                 /* no culling; back faces lit with the normal flipped */
+    bool vertex_colors;                /* multiply the base colour by COLOR0 */
+} ob_material_pbr;
+
+/* glTF defaults: base (1,1,1,1), metallic 1, roughness 1, emissive 0,
+ * normal_scale 1, occlusion_strength 1, OPAQUE, cutoff 0.5, single-sided,
+ * no textures, no vertex colours. [any thread] */
+ob_material_pbr ob_material_pbr_defaults(void);
 
 typedef enum ob_std_variant {
     OB_VARIANT_SHADOWS = 1u << 0,  /* lit: shadowed directional light */
@@ -110,6 +154,10 @@ typedef struct ob_material_desc {
     bool casts_shadows;
     bool blended;              /* sorted back to front, drawn with the BLENDED variant */
     uint32_t priority;         /* orders materials within a sort class */
+    /* Read when kind == OB_MATERIAL_PBR (start from ob_material_pbr_defaults():
+     * a zeroed struct is a black, fully metallic surface). blended is then
+     * taken from alpha_mode; reflectivity > 0 asks for an environment map. */
+    ob_material_pbr pbr;
 } ob_material_desc;
 
 /* Called from pre_render for each view type a material needs for an entity
@@ -127,6 +175,11 @@ typedef struct ob_material_library_desc {
     /* Overlay text vertices. NULL → stb_easy_font's 16 bytes: position vec3
      * at location 0, colour R8G8B8A8_UNORM at location 3, offset 12. Copied. */
     const ob_effect_vertex_input *text_layout;
+    /* The extended layout PBR effects use (position @0, normal @12, uv @24,
+     * colour R8G8B8A8_UNORM @32 at location 3, tangent vec4 @36 at location
+     * 4; stride 52). NULL → that built-in copy of geometry's
+     * ob_vertex_layout_extended(). Copied. */
+    const ob_effect_vertex_input *extended_layout;
     /* Shadow depth bias (reversed-Z: negative pushes away from the light).
      * 0 → -1.0 constant, -1.75 slope. */
     float shadow_bias_constant, shadow_bias_slope;
@@ -187,6 +240,15 @@ ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity);
  * the effect failed (logged). */
 ob_effect *ob_material_get_view_effect(ob_material *m, ob_renderer *r, const ob_node *entity,
                                    const ob_view *v, bool create, ob_result *out_result);
+
+/* PBR variants: the defines the material's effect for view v uses, as the
+ * effect's name, e.g. "pbr:base+mask+sh" (base colour texture, alpha mask,
+ * shadows); features a material does not use are left out of its shaders.
+ * ob_material_pbr_left_out writes the features of the PBR feature set that
+ * the material's variants leave out ("metallic-roughness texture, normal
+ * texture, ...") into out (cap bytes, NUL-terminated) for reports; returns
+ * the number left out, 0 for a non-PBR material. [any thread] */
+uint32_t ob_material_pbr_left_out(const ob_material *m, char *out, size_t cap);
 
 /* The engine interface: renders, sort_info, pre_render, apply. Static data. */
 const ob_material_iface *ob_material_iface_get(void);

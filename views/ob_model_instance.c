@@ -16,6 +16,8 @@
 struct ob_model_assets {
     ob_renderer *renderer;
     ob_material_library *library;
+    ob_texture_cache *textures;       /* the desc's, or own_textures */
+    ob_texture_cache *own_textures;   /* made here when the desc gives none */
     ob_model *model;
     char *name;
     uint32_t first_geometry_id;
@@ -34,6 +36,39 @@ bool ob_model_material_has_vertex_colors(const ob_model *model, uint32_t index)
     return false;
 }
 
+/* One texture slot of a model material through the cache. A texture that
+ * does not load is warned about by the cache (model, material, slot and
+ * file) and the slot stays empty: the material falls back to its factor. */
+static ob_material_texture model_texture(const ob_model_material_context *ctx,
+                                         const ob_model_material *mm, const ob_model_texture *t,
+                                         bool srgb, const char *slot)
+{
+    ob_material_texture out = {.uv_set = t->uv_set};
+    const ob_model *model = ctx->model;
+    if (t->image < 0) return out;
+    if ((uint32_t)t->image >= model->image_count) {
+        OB_LOG_W(LOG_MODULE, "%s: material '%s' %s names image %d of %u; drawn without it",
+                 model->path, mm->name, slot, t->image, model->image_count);
+        return out;
+    }
+    if (!ctx->textures) {
+        OB_LOG_W(LOG_MODULE, "%s: material '%s' %s: no texture cache given; drawn without it",
+                 model->path, mm->name, slot);
+        return out;
+    }
+    const ob_model_image *img = &model->images[t->image];
+    char context[384];
+    snprintf(context, sizeof context, "%s: material '%s' %s",
+             ctx->model_name ? ctx->model_name : model->path, mm->name, slot);
+    ob_texture_desc d = {
+        .path = img->path, .data = img->data, .size = img->size, .srgb = srgb,
+        .sampling = ob_texture_sampling_from_gltf(t->sampler.mag_filter, t->sampler.min_filter,
+                                                  t->sampler.wrap_s, t->sampler.wrap_t),
+        .context = context};
+    out.texture = ob_texture_cache_load(ctx->textures, &d, NULL);
+    return out;
+}
+
 ob_material *ob_model_material_to_material(const ob_model_material_context *ctx, uint32_t index,
                                            bool *out_extended_layout, ob_result *out_result)
 {
@@ -48,22 +83,37 @@ ob_material *ob_model_material_to_material(const ob_model_material_context *ctx,
     const ob_model_material *mm = &ctx->model->materials[index];
     char name[256];
     snprintf(name, sizeof name, "%s/%s", ctx->model_name ? ctx->model_name : ctx->model->path, mm->name);
-    const bool blend = mm->alpha_mode == OB_MODEL_ALPHA_BLEND;
-    /* LIT until the PBR material joins: the base colour factor as diffuse,
-     * glTF's default dielectric highlight. */
-    ob_material_desc desc = {.name = name, .kind = OB_MATERIAL_LIT, .blended = blend,
-                             .casts_shadows = !blend, .specular = {0.04f, 0.04f, 0.04f, 32.0f}};
-    memcpy(desc.diffuse, mm->base_color, sizeof desc.diffuse);
+    /* glTF 2 metallic-roughness, as the file gives it: factors, the five
+     * texture slots (colour data sRGB, data maps UNORM), alpha mode and
+     * sidedness; vertex colours when a primitive of the material has them. */
+    ob_material_pbr pbr = ob_material_pbr_defaults();
+    memcpy(pbr.base_color, mm->base_color, sizeof pbr.base_color);
+    memcpy(pbr.emissive, mm->emissive, sizeof pbr.emissive);
+    pbr.metallic = mm->metallic;
+    pbr.roughness = mm->roughness;
+    pbr.normal_scale = mm->normal_scale;
+    pbr.occlusion_strength = mm->occlusion_strength;
+    pbr.alpha_mode = mm->alpha_mode == OB_MODEL_ALPHA_MASK    ? OB_ALPHA_MASK
+                     : mm->alpha_mode == OB_MODEL_ALPHA_BLEND ? OB_ALPHA_BLEND
+                                                              : OB_ALPHA_OPAQUE;
+    pbr.alpha_cutoff = mm->alpha_cutoff;
+    pbr.double_sided = mm->double_sided;
+    pbr.vertex_colors = ob_model_material_has_vertex_colors(ctx->model, index);
+    pbr.base_color_texture = model_texture(ctx, mm, &mm->base_color_texture, true, "baseColorTexture");
+    pbr.metallic_roughness_texture =
+        model_texture(ctx, mm, &mm->metallic_roughness_texture, false, "metallicRoughnessTexture");
+    pbr.normal_texture = model_texture(ctx, mm, &mm->normal_texture, false, "normalTexture");
+    pbr.occlusion_texture = model_texture(ctx, mm, &mm->occlusion_texture, false, "occlusionTexture");
+    pbr.emissive_texture = model_texture(ctx, mm, &mm->emissive_texture, true, "emissiveTexture");
+    ob_material_desc desc = {.name = name, .kind = OB_MATERIAL_PBR, .pbr = pbr,
+                             .casts_shadows = pbr.alpha_mode != OB_ALPHA_BLEND};
     ob_result r;
     ob_material *m = ob_material_create(ctx->library, &desc, &r);
-    /* The library reads an all-zero diffuse as "default" (white): set it as is. */
-    if (m && (r = ob_material_set_diffuse(m, mm->base_color)) != OB_OK) {
-        ob_material_destroy(m);
-        m = NULL;
-    }
     if (!m)
         OB_LOG_E(LOG_MODULE, "%s: material %u '%s' could not be made: %s", ctx->model->path, index,
                  mm->name, ob_result_name(r));
+    else if (out_extended_layout)
+        *out_extended_layout = true;   /* PBR effects read the extended layout */
     if (out_result) *out_result = m ? OB_OK : r;
     return m;
 }
@@ -96,6 +146,7 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
     }
     a->renderer = desc->renderer;
     a->library = desc->materials;
+    a->textures = desc->textures;
     a->model = model;
     a->first_geometry_id = desc->first_geometry_id;
     a->name = ob_strdup(desc->name ? desc->name : base_name(model->path));
@@ -107,8 +158,17 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto fail;
     }
+    if (!a->textures && model->image_count > 0) {
+        a->own_textures = ob_texture_cache_create(ob_renderer_device(a->renderer), &r);
+        if (!a->own_textures) {
+            OB_LOG_E(LOG_MODULE, "%s: no texture cache: %s", model->path, ob_result_name(r));
+            goto fail;
+        }
+        a->textures = a->own_textures;
+    }
     /* One material per model material a primitive uses, in material order. */
-    ob_model_material_context ctx = {.library = a->library, .model = model, .model_name = a->name};
+    ob_model_material_context ctx = {.library = a->library, .textures = a->textures, .model = model,
+                                     .model_name = a->name};
     for (uint32_t m = 0; m < model->material_count; m++) {
         bool used = false;
         for (uint32_t p = 0; p < model->primitive_count && !used; p++)
@@ -134,6 +194,7 @@ void ob_model_assets_destroy(ob_model_assets *a)
         for (uint32_t v = 0; v < VARIANT_COUNT; v++) ob_geometry_destroy(dev, a->geometry[p][v]);
     for (uint32_t m = 0; a->materials && m < a->model->material_count; m++)
         ob_material_destroy(a->materials[m]);
+    ob_texture_cache_destroy(a->own_textures);   /* after the materials that use its textures */
     ob_free(a->geometry);
     ob_free(a->materials);
     ob_free(a->material_extended);

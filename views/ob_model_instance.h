@@ -13,14 +13,18 @@
  * materials: destroy them first.
  *
  * Materials. ob_model_material_to_material is the one place where an
- * ob_model_material becomes an engine material. For now a LIT material:
- * diffuse = base colour factor (rgba), blended for alpha mode BLEND, casting
- * shadows unless blended; textures, metallic-roughness, emissive, MASK and
- * double-sidedness are not drawn yet (the PBR material will take them: this
- * function is what changes). The function also says whether the material's
- * effects read the extended vertex layout; a primitive is uploaded in the
- * layout its material reads (the standard layout for LIT, its tangents and
- * colours left out).
+ * ob_model_material becomes an engine material: a PBR material
+ * (materials/ob_material.h, docs/materials.md) with the file's factors, its
+ * five texture slots loaded through a texture cache (base colour and
+ * emissive as sRGB, the data maps as UNORM, samplers from the file), alpha
+ * mode and cutoff, sidedness, and vertex colours when a primitive of the
+ * material has them; casting shadows unless blended. A texture that does
+ * not load is warned about (model, material, slot, file) and its slot left
+ * empty: the material falls back to its factor and the rest renders. The
+ * function also says whether the material's effects read the extended
+ * vertex layout (PBR does); a primitive is uploaded in the layout its
+ * material reads (the standard layout for an override of a standard kind,
+ * its tangents and colours left out).
  *
  * Mirroring: a primitive whose node transform within the model (the product
  * of the local transforms from the model root) has a negative determinant
@@ -40,15 +44,16 @@
 #include "ob_model.h"
 #include "ob_renderer.h"
 #include "ob_scene.h"
+#include "ob_texture.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* What converting one model material needs (the textures branch adds its
- * texture cache here). */
+/* What converting one model material needs. */
 typedef struct ob_model_material_context {
     ob_material_library *library;
+    ob_texture_cache *textures;   /* where its textures load; NULL: drawn without them (warned) */
     const ob_model *model;     /* the material's model: images, path */
     const char *model_name;    /* for names and messages: "BoxTextured.glb" */
 } ob_model_material_context;
@@ -75,6 +80,10 @@ typedef struct ob_model_assets ob_model_assets;
 typedef struct ob_model_assets_desc {
     ob_renderer *renderer;           /* geometry goes to its device */
     ob_material_library *materials;  /* the one the views draw with */
+    /* Where the model's textures load, shared with other models (identical
+     * images load once); it must outlive the assets. NULL → the assets make
+     * their own cache, destroyed with them. */
+    ob_texture_cache *textures;
     const char *name;                /* for geometry, materials and logs; NULL → the model's file name */
     /* Geometry ids for command hashes: primitive p's variant v (0..3) gets
      * first_geometry_id + 4·p + v, so the model reserves

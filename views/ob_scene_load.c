@@ -173,8 +173,15 @@ static ob_result entity_model(loader *L, const ob_scene_file_entity *e, ob_model
     if (r == OB_OK) {
         uint32_t first = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
         L->ids_used += OB_MODEL_ASSETS_IDS_PER_PRIMITIVE * model->primitive_count;
+        if (model->image_count > 0 && !o->textures) {
+            o->textures = ob_texture_cache_create(ob_renderer_device(L->t.renderer), &r);
+            if (!o->textures) {
+                ob_model_close(model);
+                return fail(L, r, "", "no texture cache");
+            }
+        }
         ob_model_assets_desc ad = {.renderer = L->t.renderer, .materials = L->t.materials,
-                                   .first_geometry_id = first};
+                                   .textures = o->textures, .first_geometry_id = first};
         a = ob_model_assets_create(&ad, model, &r);   /* takes the model */
         /* A model that reads but whose materials cannot be made is left out
          * like one that does not read; the library's error says why. */
@@ -556,6 +563,7 @@ void ob_scene_unload(ob_scene_loaded *l)
     for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->scene, l->lights[i]);
     for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->scene, l->entities[i]);
     for (uint32_t i = l->model_count; i-- > 0;) ob_model_assets_destroy(l->models[i]);
+    ob_texture_cache_destroy(l->textures);   /* after the materials sampling its textures */
     for (uint32_t i = l->material_count; i-- > 0;) ob_material_destroy(l->materials[i]);
     for (uint32_t i = l->geometry_count; i-- > 0;) ob_geometry_destroy(l->device, l->geometry[i]);
     ob_free(l->models);

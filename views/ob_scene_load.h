@@ -103,6 +103,8 @@ typedef struct ob_scene_loaded {
     uint32_t geometry_count;
     ob_model_assets **models;     /* one per distinct model file (NULL where it did not open) */
     uint32_t model_count;
+    ob_texture_cache *textures;   /* the models' textures, shared across them (identical
+                                     images load once); NULL when no model has any */
     uint32_t model_entity_count;  /* entities made under model entities: per model node and
                                      per placed primitive (ob_model_instance.h) */
     ob_material **materials;      /* the file's materials (ob_scene_file order), then "default",

@@ -29,6 +29,7 @@
 #include "ob_renderer.h"
 #include "ob_resources.h"
 #include "ob_scene.h"
+#include "ob_texture.h"
 #include "ob_view.h"
 
 #include "ob_effect.h"

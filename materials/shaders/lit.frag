@@ -3,11 +3,8 @@
 // lit.frag — Blinn-Phong with one directional and four point lights.
 //
 // Variants (each compiled only when a material needs it):
-//   SHADOWS     the directional light is shadowed by "ShadowMap" (depth,
-//               reversed-Z: larger is nearer the light), sampled with a
-//               compare sampler "ShadowMapSampler" whose op is
-//               GREATER_OR_EQUAL, 2x2 PCF. ShadowMatrix maps camera-relative
-//               world positions to the light's clip space.
+//   SHADOWS     the directional light is shadowed by "ShadowMap"
+//               (shadow.glsl: compare sampler, 2x2 PCF).
 //   ENVMAP      reflective surfaces: the reflected view vector samples the
 //               dual-paraboloid "EnvMap" (2D array, layer 0 = +Z of the owner)
 //               rotated by EnvMapMatrix; mixed over the lit colour by
@@ -30,25 +27,7 @@ layout(location = 3) in float vHemisphere;
 layout(location = 0) out vec4 outColor;
 
 #if defined(SHADOWS)
-layout(set = 1, binding = 0) uniform sampler2DShadow ShadowMap;
-
-float ob_shadow_visibility(vec3 p)
-{
-    vec4 clip = ShadowMatrix * vec4(p, 1.0);
-    if (clip.w <= 0.0) return 1.0;
-    vec3 s = clip.xyz / clip.w;
-    vec2 uv = s.xy * 0.5 + 0.5;
-    // Outside the shadow volume nothing was rendered: treat as lit.
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) ||
-        s.z < 0.0 || s.z > 1.0)
-        return 1.0;
-    vec2 texel = 1.0 / vec2(textureSize(ShadowMap, 0));
-    float lit = texture(ShadowMap, vec3(uv + vec2(-0.5, -0.5) * texel, s.z))
-              + texture(ShadowMap, vec3(uv + vec2( 0.5, -0.5) * texel, s.z))
-              + texture(ShadowMap, vec3(uv + vec2(-0.5,  0.5) * texel, s.z))
-              + texture(ShadowMap, vec3(uv + vec2( 0.5,  0.5) * texel, s.z));
-    return lit * 0.25;
-}
+#include "shadow.glsl"
 #endif
 
 #if defined(ENVMAP)

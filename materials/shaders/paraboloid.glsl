@@ -27,4 +27,21 @@ vec3 ob_paraboloid_lookup(vec3 d)
     return vec3(ob_paraboloid_uv(d, side) * 0.5 + 0.5, side > 0.0 ? 0.0 : 1.0);
 }
 
+// Generation: clip position of camera-relative world position `world` in the
+// hemisphere ParaboloidDirection.x picks (+1 layer 0, -1 layer 1), and in
+// *out_hemisphere how far it lies in that hemisphere (< 0: the other one,
+// which the fragment stage discards). ParaboloidDirection.y is the near
+// distance (0 -> 0.05): depth is near/dist, reversed-Z like every other view.
+// (Needs common.glsl's PerView.)
+vec4 ob_paraboloid_position(vec3 world, out float out_hemisphere)
+{
+    vec3 q = mat3(ViewMatrix) * world;
+    float dist = length(q);
+    vec3 d = dist > 1e-12 ? q / dist : vec3(0.0, 0.0, 1.0);
+    float side = ParaboloidDirection.x >= 0.0 ? 1.0 : -1.0;
+    float near_dist = ParaboloidDirection.y > 0.0 ? ParaboloidDirection.y : 0.05;
+    out_hemisphere = d.z * side;
+    return vec4(ob_paraboloid_uv(d, side), near_dist / max(dist, 1e-12), 1.0);
+}
+
 #endif

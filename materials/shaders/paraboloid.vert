@@ -28,11 +28,5 @@ void main()
     vNormal = ob_unit_normal(mat3(NormalMatrix) * inNormal);
     vUV = inUV;
 
-    vec3 q = mat3(ViewMatrix) * world.xyz;
-    float dist = length(q);
-    vec3 d = dist > 1e-12 ? q / dist : vec3(0.0, 0.0, 1.0);
-    float side = ParaboloidDirection.x >= 0.0 ? 1.0 : -1.0;
-    float near_dist = ParaboloidDirection.y > 0.0 ? ParaboloidDirection.y : 0.05;
-    vHemisphere = d.z * side;
-    gl_Position = vec4(ob_paraboloid_uv(d, side), near_dist / max(dist, 1e-12), 1.0);
+    gl_Position = ob_paraboloid_position(world.xyz, vHemisphere);
 }

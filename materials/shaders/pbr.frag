@@ -1,0 +1,193 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// pbr.frag — glTF 2 metallic-roughness material.
+//
+// Lighting model (docs/materials.md has the long form):
+//   colour = emissive
+//          + sum over lights of  pi * (f_diffuse + f_specular) * radiance * NdotL
+//          + ambient:  AmbientColor * occlusion * ((1 - F_a)(1 - metallic) base + F_a)
+//          + ENVMAP:   env(R) * F_a * occlusion * Reflectivity.x * (1 - roughness)^2
+//   with the BRDF of pbr.glsl (Cook-Torrance: GGX D, height-correlated Smith
+//   visibility, Schlick F with F0 = mix(0.04, base, metallic); Lambert
+//   diffuse) for the directional light (shadowed with SHADOWS) and the four
+//   point lights of common.glsl; F_a is Schlick at n.v with roughness-limited
+//   reflectance (ob_fresnel_ambient).
+//   The environment map is one sharp dual-paraboloid image with no
+//   prefiltered mips, so it cannot show the blur of a rough surface: its
+//   mirror image is faded by (1 - roughness)^2 and the ambient term's
+//   specular part (F_a * AmbientColor) stands for the blurred rest. A
+//   smooth metal therefore mirrors its surroundings, a rough one shows a
+//   uniform sheen.
+// Output: linear radiance (no gamma: the composite tone maps and encodes),
+// premultiplied alpha (the blend state is ONE, ONE_MINUS_SRC_ALPHA).
+//
+// Variants (defines; a material compiles only what it uses, so a material
+// without a normal map has no normal-map code and binds no sampler for it):
+//   HAS_BASE_COLOR_TEXTURE          base colour *= BaseColorTexture (sRGB)
+//   HAS_METALLIC_ROUGHNESS_TEXTURE  metallic *= B, roughness *= G
+//   HAS_NORMAL_TEXTURE              tangent-space normal map, xy * normal scale,
+//                                   tangent frame from the vertex TANGENT (w = sign)
+//   HAS_OCCLUSION_TEXTURE           ambient and environment *= 1 + strength * (R - 1)
+//   HAS_EMISSIVE_TEXTURE            emissive *= EmissiveTexture (sRGB)
+//   VERTEX_COLOR                    base colour *= COLOR0
+//   ALPHA_MASK                      discard below the cutoff, alpha 1
+//   BLENDED                         alpha blended (alpha mode BLEND)
+//   DOUBLE_SIDED                    back faces drawn with the normal flipped
+//   SHADOWS, ENVMAP                 as lit.frag
+//   PARABOLOID                      drawn into an environment map (pbr.vert)
+//   DEPTH_ONLY                      shadow pass of an ALPHA_MASK material: the
+//                                   cut-out only, no colour
+#include "common.glsl"
+#include "lighting.glsl"
+#include "pbr.glsl"
+#if defined(ENVMAP)
+#include "paraboloid.glsl"
+#endif
+#if defined(SHADOWS)
+#include "shadow.glsl"
+#endif
+
+layout(set = 0, binding = 3, std140) uniform PbrMaterial {
+    vec4 PbrBaseColor;         // linear rgba factor
+    vec4 PbrFactors;           // x metallic, y roughness, z normal scale, w occlusion strength
+    vec4 PbrEmissive;          // rgb emissive factor, w alpha cutoff
+};
+
+layout(location = 0) in vec3 vPosition;
+layout(location = 1) in vec3 vNormal;
+layout(location = 2) in vec2 vUV;
+#if defined(VERTEX_COLOR)
+layout(location = 3) in vec4 vColor;
+#endif
+#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+layout(location = 4) in vec4 vTangent;
+#endif
+#if defined(PARABOLOID)
+layout(location = 5) in float vHemisphere;
+#endif
+
+#if defined(ENVMAP)
+layout(set = 0, binding = 2, std140) uniform PerEnvMap {
+    mat4 EnvMapMatrix;         // world -> env-map owner frame (rotation)
+};
+layout(set = 1, binding = 1) uniform sampler2DArray EnvMap;
+#endif
+#if defined(HAS_BASE_COLOR_TEXTURE)
+layout(set = 1, binding = 2) uniform sampler2D BaseColorTexture;
+#endif
+#if !defined(DEPTH_ONLY)
+#if defined(HAS_METALLIC_ROUGHNESS_TEXTURE)
+layout(set = 1, binding = 3) uniform sampler2D MetallicRoughnessTexture;
+#endif
+#if defined(HAS_NORMAL_TEXTURE)
+layout(set = 1, binding = 4) uniform sampler2D NormalTexture;
+#endif
+#if defined(HAS_OCCLUSION_TEXTURE)
+layout(set = 1, binding = 5) uniform sampler2D OcclusionTexture;
+#endif
+#if defined(HAS_EMISSIVE_TEXTURE)
+layout(set = 1, binding = 6) uniform sampler2D EmissiveTexture;
+#endif
+layout(location = 0) out vec4 outColor;
+#endif
+
+vec4 ob_base_color()
+{
+    vec4 base = PbrBaseColor;
+#if defined(HAS_BASE_COLOR_TEXTURE)
+    base *= texture(BaseColorTexture, vUV);
+#endif
+#if defined(VERTEX_COLOR)
+    base *= vColor;
+#endif
+    return base;
+}
+
+void main()
+{
+#if defined(PARABOLOID)
+    if (vHemisphere < 0.0) discard;
+#endif
+    vec4 base = ob_base_color();
+#if defined(ALPHA_MASK)
+    if (base.a < PbrEmissive.w) discard;
+    base.a = 1.0;
+#elif !defined(BLENDED)
+    base.a = 1.0;
+#endif
+#if !defined(DEPTH_ONLY)
+    vec3 n = ob_safe_normalize(vNormal);
+    bool back = false;
+#if defined(DOUBLE_SIDED) && !defined(PARABOLOID)
+    back = !gl_FrontFacing;
+    if (back) n = -n;
+#endif
+#if defined(HAS_NORMAL_TEXTURE)
+    // Tangent frame (glTF: bitangent = cross(normal, tangent.xyz) * tangent.w),
+    // made orthogonal to the interpolated normal; reversed with it on back faces.
+    vec3 front_n = back ? -n : n;
+    vec3 t = ob_safe_normalize(vTangent.xyz - front_n * dot(front_n, vTangent.xyz));
+    vec3 b = cross(front_n, t) * vTangent.w;
+    if (back) {
+        t = -t;
+        b = -b;
+    }
+    vec3 tn = texture(NormalTexture, vUV).xyz * 2.0 - 1.0;
+    tn.xy *= PbrFactors.z;
+    vec3 mapped = ob_safe_normalize(mat3(t, b, n) * tn);
+    if (dot(mapped, mapped) > 0.0) n = mapped;
+#endif
+    float metallic = PbrFactors.x;
+    float roughness = PbrFactors.y;
+#if defined(HAS_METALLIC_ROUGHNESS_TEXTURE)
+    vec4 mr = texture(MetallicRoughnessTexture, vUV);
+    metallic *= mr.b;
+    roughness *= mr.g;
+#endif
+    metallic = clamp(metallic, 0.0, 1.0);
+    roughness = clamp(roughness, 0.03, 1.0);
+    float occlusion = 1.0;
+#if defined(HAS_OCCLUSION_TEXTURE)
+    occlusion = 1.0 + PbrFactors.w * (texture(OcclusionTexture, vUV).r - 1.0);
+#endif
+    vec3 emissive = PbrEmissive.rgb;
+#if defined(HAS_EMISSIVE_TEXTURE)
+    emissive *= texture(EmissiveTexture, vUV).rgb;
+#endif
+
+    ob_surface s;
+    s.n = n;
+    s.v = ob_safe_normalize(CameraPosition.xyz - vPosition);
+    s.base = base.rgb;
+    s.metallic = metallic;
+    s.a = roughness * roughness;
+    s.f0 = mix(vec3(0.04), base.rgb, metallic);
+
+    vec3 color = emissive;
+    if (LightColor.w > 0.0) {
+        float visibility = 1.0;
+#if defined(SHADOWS)
+        visibility = ob_shadow_visibility(vPosition);
+#endif
+        color += visibility * ob_pbr_light(s, ob_safe_normalize(LightDirection.xyz), LightColor.rgb * LightColor.w);
+    }
+    vec4 positions[4] = vec4[4](PointLight0Position, PointLight1Position, PointLight2Position, PointLight3Position);
+    vec4 colors[4] = vec4[4](PointLight0Color, PointLight1Color, PointLight2Color, PointLight3Color);
+    for (int i = 0; i < 4; i++) {
+        if (colors[i].w <= 0.0) continue;
+        vec3 to_light = positions[i].xyz - vPosition;
+        float att = ob_point_attenuation(length(to_light), positions[i].w);
+        color += ob_pbr_light(s, ob_safe_normalize(to_light), colors[i].rgb * colors[i].w * att);
+    }
+    vec3 fa = ob_fresnel_ambient(s);
+    vec3 ambient = AmbientColor.rgb * AmbientColor.w;
+    color += ambient * occlusion * ((1.0 - fa) * (1.0 - metallic) * base.rgb + fa);
+#if defined(ENVMAP)
+    vec3 r = reflect(-s.v, n);
+    vec3 env = texture(EnvMap, ob_paraboloid_lookup(mat3(EnvMapMatrix) * r)).rgb;
+    float sharp = (1.0 - roughness) * (1.0 - roughness);
+    color += env * fa * occlusion * sharp * max(Reflectivity.x, 0.0);
+#endif
+    outColor = vec4(color * base.a, base.a);
+#endif
+}

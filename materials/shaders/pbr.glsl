@@ -1,0 +1,82 @@
+// pbr.glsl — the BRDF of the glTF 2 metallic-roughness material (pbr.frag).
+//
+//   f(l, v) = f_diffuse + f_specular, evaluated per light as f * E with
+//   E = radiance * NdotL, where
+//     f_specular = D(h) * Vis(l, v) * F(v, h)               (Cook-Torrance)
+//     D   = a^2 / (pi ((n.h)^2 (a^2 - 1) + 1)^2)            GGX / Trowbridge-Reitz, a = roughness^2
+//     Vis = G / (4 n.l n.v) = 0.5 / (n.l sqrt((n.v)^2 (1 - a^2) + a^2)
+//                                  + n.v sqrt((n.l)^2 (1 - a^2) + a^2))
+//                                                           Smith, height-correlated GGX
+//     F   = F0 + (1 - F0) (1 - v.h)^5                       Schlick, F0 = mix(0.04, base, metallic)
+//     f_diffuse = (1 - F) (1 - metallic) base / pi          Lambert
+//
+// Light units: the engine's lights are given as radiance at normal
+// incidence (LightColor.rgb * w, PointLight<i>Color.rgb * w times the
+// attenuation), and lit.frag shows a white surface under a unit light as
+// white (diffuse * NdotL, no 1/pi). pbr.frag keeps that: every BRDF term is
+// multiplied by pi (the usual "punctual light intensity" convention), so a
+// white dielectric at roughness 1 matches a lit material of the same colour
+// up to the Fresnel and specular terms.
+#ifndef OB_PBR_GLSL
+#define OB_PBR_GLSL
+
+const float OB_PI = 3.14159265358979;
+
+float ob_ggx_d(float ndoth, float a)
+{
+    float a2 = a * a;
+    float d = ndoth * ndoth * (a2 - 1.0) + 1.0;
+    return a2 / max(OB_PI * d * d, 1e-12);
+}
+
+float ob_smith_vis(float ndotl, float ndotv, float a)
+{
+    float a2 = a * a;
+    float gv = ndotl * sqrt(ndotv * ndotv * (1.0 - a2) + a2);
+    float gl = ndotv * sqrt(ndotl * ndotl * (1.0 - a2) + a2);
+    float s = gv + gl;
+    return s > 0.0 ? 0.5 / s : 0.0;
+}
+
+vec3 ob_fresnel_schlick(vec3 f0, float vdoth)
+{
+    return f0 + (1.0 - f0) * pow(clamp(1.0 - vdoth, 0.0, 1.0), 5.0);
+}
+
+// Surface description at one fragment.
+struct ob_surface {
+    vec3 n, v;          // unit normal and direction to the eye
+    vec3 base;          // linear base colour
+    float metallic;
+    float a;            // GGX alpha = roughness^2 (roughness clamped to 0.03 to keep the peak finite)
+    vec3 f0;
+};
+
+// Contribution of one light of `radiance` arriving from unit direction l
+// (pi * f * radiance * NdotL: see the light units above).
+vec3 ob_pbr_light(ob_surface s, vec3 l, vec3 radiance)
+{
+    float ndotl = dot(s.n, l);
+    if (ndotl <= 0.0) return vec3(0.0);
+    float ndotv = max(dot(s.n, s.v), 1e-4);
+    vec3 h = ob_safe_normalize(l + s.v);
+    float ndoth = max(dot(s.n, h), 0.0);
+    float vdoth = max(dot(s.v, h), 0.0);
+    vec3 f = ob_fresnel_schlick(s.f0, vdoth);
+    vec3 spec = ob_ggx_d(ndoth, s.a) * ob_smith_vis(ndotl, ndotv, s.a) * f;
+    vec3 diffuse = (1.0 - f) * (1.0 - s.metallic) * s.base / OB_PI;
+    return OB_PI * (diffuse + spec) * radiance * ndotl;
+}
+
+// Fresnel for the environment and ambient terms, where no single half
+// vector exists: Schlick at n.v with the roughness-limited reflectance
+// (Fdez-Aguera's max(1 - roughness, F0) form).
+vec3 ob_fresnel_ambient(ob_surface s)
+{
+    float ndotv = max(dot(s.n, s.v), 0.0);
+    float roughness = sqrt(s.a);
+    vec3 fmax = max(vec3(1.0 - roughness), s.f0);
+    return s.f0 + (fmax - s.f0) * pow(1.0 - ndotv, 5.0);
+}
+
+#endif

@@ -1,0 +1,63 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// pbr.vert — vertex stage of the glTF metallic-roughness material (pbr.frag).
+// Input: the extended vertex layout (position, normal, uv, colour RGBA8 at
+// location 3, tangent xyz + bitangent sign at location 4; stride 52); only
+// what the variant uses is declared, so unused attributes cost nothing.
+//
+// Variants: VERTEX_COLOR (colour passed on), HAS_NORMAL_TEXTURE (tangent
+// passed on, in world space: it transforms with WorldMatrix, not the normal
+// matrix), PARABOLOID (dual-paraboloid projection as paraboloid.vert does),
+// DEPTH_ONLY (shadow pass of ALPHA_MASK materials: position and uv only).
+#include "common.glsl"
+#if defined(PARABOLOID)
+#include "paraboloid.glsl"
+#endif
+
+layout(location = 0) in vec3 inPosition;
+layout(location = 2) in vec2 inUV;
+#if !defined(DEPTH_ONLY)
+layout(location = 1) in vec3 inNormal;
+#endif
+#if defined(VERTEX_COLOR)
+layout(location = 3) in vec4 inColor;
+#endif
+#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+layout(location = 4) in vec4 inTangent;
+#endif
+
+layout(location = 0) out vec3 vPosition;   // camera-relative world
+layout(location = 1) out vec3 vNormal;     // world, unit (zero for a zero scale)
+layout(location = 2) out vec2 vUV;
+#if defined(VERTEX_COLOR)
+layout(location = 3) out vec4 vColor;
+#endif
+#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+layout(location = 4) out vec4 vTangent;    // world xyz, w = bitangent sign
+#endif
+#if defined(PARABOLOID)
+layout(location = 5) out float vHemisphere;
+#endif
+
+void main()
+{
+    vec4 world = WorldMatrix * vec4(inPosition, 1.0);
+    vPosition = world.xyz;
+    vUV = inUV;
+#if defined(DEPTH_ONLY)
+    vNormal = vec3(0.0);
+#else
+    vNormal = ob_unit_normal(mat3(NormalMatrix) * inNormal);
+#endif
+#if defined(VERTEX_COLOR)
+    vColor = inColor;
+#endif
+#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+    vTangent = vec4(ob_unit_normal(mat3(WorldMatrix) * inTangent.xyz), inTangent.w < 0.0 ? -1.0 : 1.0);
+#endif
+#if defined(PARABOLOID)
+    gl_Position = ob_paraboloid_position(world.xyz, vHemisphere);
+#else
+    gl_Position = ViewProjMatrix * world;
+#endif
+}
