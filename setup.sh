@@ -9,11 +9,17 @@
 #                     The plain suite also installs the build into
 #                     build/package/prefix and builds and runs examples/ against
 #                     it, out of tree (ctest label package, tests/package/)
+#   ./setup.sh golden [NAME...]  install missing packages, build, and regenerate
+#                     the golden images tests/golden/*.png (all, or the NAMEs of
+#                     tests/golden/goldens.cmake), printing per image what changed:
+#                     new, unchanged, or how many pixels differ and by how much
+#                     (docs/testing.md: review, then commit)
 #   ./setup.sh deps | build
 #
 # Options: --sanitize none|address|thread|undefined|fuzz  one build only (none = plain)
 #          --build-dir DIR
-# Anything else is passed on to the demo (demo) or to ctest (test).
+# Anything else is passed on to the demo (demo), to ctest (test) or names the
+# goldens to regenerate (golden).
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -98,5 +104,12 @@ case "$cmd" in
     else
       suite ""; suite address; suite thread; fuzz
     fi ;;
-  *) echo "usage: $0 demo|test|deps|build [--sanitize none|address|thread|undefined|fuzz]" >&2; exit 2 ;;
+  golden)
+    deps; build "$sanitize"
+    dir=$(dir_for "$sanitize")
+    cmake --build "$dir" --target ob_golden >/dev/null
+    only=$(IFS=';'; echo "${extra[*]:-}")
+    cmake -DBIN="$dir"/bin -DTOOL="$dir"/tests/ob_golden -DSRC="$PWD" -DOUT="$dir"/golden-update \
+          -DONLY="$only" -P tests/tools/golden_update.cmake ;;
+  *) echo "usage: $0 demo|test|golden|deps|build [--sanitize none|address|thread|undefined|fuzz]" >&2; exit 2 ;;
 esac

@@ -1,0 +1,30 @@
+# The golden images: one ob_golden(NAME INPUT [obelisk-view options...]) per
+# tests/golden/NAME.png. INPUT is relative to the source tree or absolute
+# (Debian's assimp-testmodels, a dependency in setup.sh). Every golden is
+# rendered headless by obelisk-view at 160x120 (unless its options say
+# otherwise) for the frames given; time is fixed per frame (dt = 1/60), so a
+# frame count fixes the image. Read by tests/CMakeLists.txt (one ctest each,
+# label golden) and by tests/tools/golden_update.cmake (./setup.sh golden),
+# which define ob_golden() before including this file. docs/testing.md says
+# what each covers.
+set(OB_GOLDEN_MODELS /usr/share/assimp/models)
+
+# Scenes: every built-in material kind, shadows, the env-map mirrors and the
+# fountain's particles at a fixed time.
+ob_golden(primitives demos/scenes/primitives.json --frames 3)
+ob_golden(mirror demos/scenes/mirror.json --frames 30)
+ob_golden(models demos/scenes/models.json --frames 3)
+# MSAA 4x resolve on the same scene (edges against the 1x golden above).
+ob_golden(primitives_msaa4 demos/scenes/primitives.json --frames 3 --msaa 4)
+# Real glTF models: a base-colour texture from a .glb, a node hierarchy of
+# many primitives, several materials with normal maps and alpha.
+ob_golden(boxtextured ${OB_GOLDEN_MODELS}/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb --frames 2)
+ob_golden(2cylinderengine ${OB_GOLDEN_MODELS}/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb --frames 2)
+ob_golden(clearcoat ${OB_GOLDEN_MODELS}/glTF2/ClearCoat-glTF/ClearCoatTest.gltf --frames 2)
+ob_golden(texturetransform ${OB_GOLDEN_MODELS}/glTF2/textureTransform/TextureTransformTest.gltf --frames 2)
+# The repo's small files (tests/data/models/make_models.py): OBJ + .mtl
+# textures, glTF alpha MASK and BLEND with hierarchy and instancing, and PLY
+# vertex colours (tests/golden/models/colour_cube.ply).
+ob_golden(mtl_quad tests/data/models/mtl_quad.obj --frames 2)
+ob_golden(features tests/data/models/features.gltf --frames 2)
+ob_golden(colour_cube tests/golden/models/colour_cube.ply --frames 2)
