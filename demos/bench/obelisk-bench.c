@@ -13,7 +13,8 @@
  *   scene200   obelisk-mirror's 200-object scene in ST, MT and auto
  *   quality    env-map and shadow-map sizes: image error against the
  *              highest-quality single-threaded image next to frame time; the
- *              threading modes must give that image byte for byte
+ *              threading modes must give that image byte for byte; MSAA
+ *              sample counts against a supersampled antialiasing reference
  *   stability  numerical precision and extreme cases (ob_stability.h):
  *              each case's error against the bound its test asserts, and its
  *              run time
@@ -558,9 +559,11 @@ static int run(const bench_options *o)
         .rounds = o->quick ? 2 : 3, .flight = o->flight,
         .env_sizes = o->quick ? env_quick : env_full, .env_count = o->quick ? 2 : 4,
         .shadow_sizes = o->quick ? shadow_quick : shadow_full, .shadow_count = o->quick ? 2 : 4,
-        .modes = o->modes, .mode_count = o->mode_count,
+        .modes = o->modes, .mode_count = o->mode_count, .msaa = true,
     };
-    uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1;
+    /* The MSAA series adds its reference (16 times the pixels: weighed as
+     * four configurations) and up to three counts. */
+    uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 4 + 3;
     uint64_t total = 0;
     if (o->perf) {
         total += 3 * (o->warmup + o->rounds + 2 * o->flight + 1) +

@@ -173,9 +173,37 @@ ob_demo_memory ob_demo_memory_now(void)
     return m;
 }
 
+static void lean_note_view(ob_demo_lean *l, const char *name, ob_skip_reason reason)
+{
+    for (uint32_t i = 0; i < l->view_count; i++) {
+        if (l->views[i].reason != reason || strcmp(l->views[i].name, name)) continue;
+        l->views[i].frames++;
+        return;
+    }
+    if (l->view_count == OB_DEMO_LEAN_VIEWS) {
+        l->views_more++;   /* an upper bound: the same one may come again */
+        return;
+    }
+    snprintf(l->views[l->view_count].name, sizeof l->views[0].name, "%s", name);
+    l->views[l->view_count].reason = reason;
+    l->views[l->view_count++].frames = 1;
+}
+
+static void lean_note_frame(ob_demo_lean *l, const ob_frame_stats *st)
+{
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        lean_note_view(l, st->skipped[i].name, st->skipped[i].reason);
+    for (uint32_t i = 0; i < st->view_count; i++)
+        if (st->views[i].skipped != OB_SKIP_NONE)
+            lean_note_view(l, st->views[i].name, st->views[i].skipped);
+    l->pipelines_created += st->pipelines_created;
+    l->variants_created += st->variants_created;
+}
+
 static void on_stats(void *user, const ob_frame_stats *st)
 {
     ob_demo *d = user;
+    lean_note_frame(&d->lean, st);
     if (ob_array_reserve((void **)&d->history, &d->history_cap, d->history_count + 1,
                          sizeof *d->history) == OB_OK)
         d->history[d->history_count++] = (ob_demo_frame_times){
@@ -406,6 +434,56 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
     fputs("}", f);
 }
 
+#define LEAN_MATERIALS 24
+
+void ob_demo_print_lean_report(ob_demo *d, FILE *f)
+{
+    const ob_demo_lean *l = &d->lean;
+    fprintf(f, "lean: %llu shader variants and %llu pipelines created over %u frames\n",
+            (unsigned long long)l->variants_created, (unsigned long long)l->pipelines_created,
+            d->history_count);
+    fputs("lean: views left out:", f);
+    for (uint32_t i = 0; i < l->view_count; i++)
+        fprintf(f, "%s %s (%s, %u frames)", i ? "," : "", l->views[i].name,
+                ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
+    if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
+    fputs(l->view_count ? "\n" : " none\n", f);
+    uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
+    if (samples > 1)
+        fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
+                   "targets, resolved before the composite\n", samples);
+    else
+        fputs("lean: MSAA targets: none (view 'main' is single-sampled)\n", f);
+    /* Each material once, in the order the scene's renderables first use it. */
+    uint32_t count = 0;
+    const ob_render_proxy *proxies = d->scene ? ob_scene_render_proxies(d->scene, &count) : NULL;
+    ob_view *main = d->main ? ob_perspective_view_base(d->main) : NULL;
+    const ob_material *seen[LEAN_MATERIALS];
+    uint32_t seen_count = 0, more = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_material *m = proxies[i].material;
+        bool known = !m;
+        for (uint32_t k = 0; k < seen_count && !known; k++) known = seen[k] == m;
+        if (known) continue;
+        if (seen_count == LEAN_MATERIALS) {
+            more++;  /* an upper bound: counted once per further proxy */
+            continue;
+        }
+        seen[seen_count++] = m;
+        ob_result r = OB_OK;
+        const ob_effect *e = main ? ob_material_get_view_effect(m, d->r, proxies[i].node, main,
+                                                                false, &r)
+                                  : NULL;
+        char left[256];
+        uint32_t n_left = ob_material_pbr_left_out(m, left, sizeof left);
+        fprintf(f, "lean: material %s: %s", ob_material_name(m),
+                e ? ob_effect_name(e) : "(no effect in the main view)");
+        if (n_left) fprintf(f, " (left out: %s)", left);
+        fputc('\n', f);
+    }
+    if (more) fprintf(f, "lean: and up to %u more materials\n", more);
+}
+
 static void print_summary(const ob_demo *d)
 {
     static const struct { const char *name; size_t off; } phases[] = {
@@ -493,6 +571,7 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     }
     if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
     print_summary(d);
+    ob_demo_print_lean_report(d, stdout);
     ob_demo_memory mem = ob_demo_memory_now();
     if (mem.rss_kb)
         printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB, of it "
