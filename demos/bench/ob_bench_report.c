@@ -571,7 +571,7 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
     fputs(",,,,,,,,,,,,,,,,,,,,,,,", f);
     csv_num(f, rep->raw.host_allocs_per_object);
     csv_num(f, rep->raw.commands_per_object);
-    fputc('\n', f);
+    fputs(",,1,1\n", f);   /* vs_round_min_record (none), msaa_samples, supersample */
     return close_out(f, path);
 }
 
