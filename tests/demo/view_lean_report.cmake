@@ -20,11 +20,17 @@ function(count_matches text regex out)
   set(${out} ${n} PARENT_SCOPE)
 endfunction()
 
-execute_process(COMMAND ${BIN}/obelisk-view ${model} --frames 4 --quiet --msaa 4 --threads 0
-                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "obelisk-view --msaa 4 exited ${code}\n${out}\n${err}")
-endif()
+# Runs obelisk-view on the model with the given options; its stdout into out_var.
+function(run_view out_var)
+  execute_process(COMMAND ${BIN}/obelisk-view ${model} --quiet --threads 0 ${ARGN}
+                  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "obelisk-view ${ARGN} exited ${code}\n${out}\n${err}")
+  endif()
+  set(${out_var} "${out}" PARENT_SCOPE)
+endfunction()
+
+run_view(out --frames 4 --msaa 4)
 
 # plain: factors only -- its left-out list names the normal texture.
 set(plain_re "lean: material features.gltf/plain: pbr[^ \n]* \\(left out: [^)\n]*normal texture[^)\n]*\\)")
@@ -56,11 +62,7 @@ if(NOT out MATCHES "lean: MSAA targets: view 'main' draws 4x")
   message(FATAL_ERROR "--msaa 4: the report does not say the main view has 4x MSAA targets\n${out}")
 endif()
 
-execute_process(COMMAND ${BIN}/obelisk-view ${model} --frames 2 --quiet --threads 0
-                RESULT_VARIABLE code OUTPUT_VARIABLE out1 ERROR_VARIABLE err TIMEOUT 300)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "obelisk-view exited ${code}\n${out1}\n${err}")
-endif()
+run_view(out1 --frames 2)
 if(NOT out1 MATCHES "lean: MSAA targets: none")
   message(FATAL_ERROR "without --msaa the report should say there are no MSAA targets\n${out1}")
 endif()
