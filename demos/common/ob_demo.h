@@ -1,7 +1,8 @@
 /* ob_demo.h — the demo runner the demo programs share: options, the
  * standard set-up (an ob_stack from views/ob_stack.h, with the window when
  * --window is given), the frame loop with its ST/MT toggling, per-frame
- * lines, the JSON stats and the summary of medians per mode.
+ * lines, the JSON stats, the summary of medians per mode and the lean-scene
+ * report (what the run left out).
  *
  * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
  * ob_demo_run → ob_demo_shutdown (also after a failed init). Thread rule:
