@@ -436,6 +436,13 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
 
 #define LEAN_MATERIALS 24
 
+/* A line of the report's materials: a material name drawn with one effect. */
+typedef struct lean_row {
+    const char *material, *effect;
+    const ob_material *first;  /* its left-out features stand for the row's */
+    uint32_t entities;
+} lean_row;
+
 void ob_demo_print_lean_report(ob_demo *d, FILE *f)
 {
     const ob_demo_lean *l = &d->lean;
@@ -454,34 +461,46 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
                    "targets, resolved before the composite\n", samples);
     else
         fputs("lean: MSAA targets: none (view 'main' is single-sampled)\n", f);
-    /* Each material once, in the order the scene's renderables first use it. */
-    uint32_t count = 0;
+    /* One line per (material name, effect) in the order the scene's
+     * renderables first use it: many materials of one kind (the mirror
+     * scene's palette) make one line with their entity count. */
+    lean_row rows[LEAN_MATERIALS];
+    uint32_t row_count = 0, other_entities = 0, count = 0;
     const ob_render_proxy *proxies = d->scene ? ob_scene_render_proxies(d->scene, &count) : NULL;
     ob_view *main = d->main ? ob_perspective_view_base(d->main) : NULL;
-    const ob_material *seen[LEAN_MATERIALS];
-    uint32_t seen_count = 0, more = 0;
     for (uint32_t i = 0; i < count; i++) {
         ob_material *m = proxies[i].material;
-        bool known = !m;
-        for (uint32_t k = 0; k < seen_count && !known; k++) known = seen[k] == m;
-        if (known) continue;
-        if (seen_count == LEAN_MATERIALS) {
-            more++;  /* an upper bound: counted once per further proxy */
-            continue;
-        }
-        seen[seen_count++] = m;
+        if (!m) continue;
         ob_result r = OB_OK;
         const ob_effect *e = main ? ob_material_get_view_effect(m, d->r, proxies[i].node, main,
                                                                 false, &r)
                                   : NULL;
+        const char *name = ob_material_name(m), *effect = e ? ob_effect_name(e) : NULL;
+        uint32_t k = 0;
+        while (k < row_count && (strcmp(rows[k].material, name) ||
+                                 (rows[k].effect != effect &&
+                                  (!rows[k].effect || !effect || strcmp(rows[k].effect, effect)))))
+            k++;
+        if (k == row_count) {
+            if (row_count == LEAN_MATERIALS) {
+                other_entities++;
+                continue;
+            }
+            rows[row_count++] = (lean_row){name, effect, m, 0};
+        }
+        rows[k].entities++;
+    }
+    for (uint32_t k = 0; k < row_count; k++) {
         char left[256];
-        uint32_t n_left = ob_material_pbr_left_out(m, left, sizeof left);
-        fprintf(f, "lean: material %s: %s", ob_material_name(m),
-                e ? ob_effect_name(e) : "(no effect in the main view)");
+        uint32_t n_left = ob_material_pbr_left_out(rows[k].first, left, sizeof left);
+        fprintf(f, "lean: material %s: %s", rows[k].material,
+                rows[k].effect ? rows[k].effect : "(no effect in the main view)");
         if (n_left) fprintf(f, " (left out: %s)", left);
+        if (rows[k].entities > 1) fprintf(f, " [%u entities]", rows[k].entities);
         fputc('\n', f);
     }
-    if (more) fprintf(f, "lean: and up to %u more materials\n", more);
+    if (other_entities)
+        fprintf(f, "lean: and %u more entities with other materials\n", other_entities);
 }
 
 static void print_summary(const ob_demo *d)
