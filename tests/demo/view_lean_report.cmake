@@ -4,7 +4,8 @@
 # left out -- "plain" (factors only) leaves out the normal texture it lacks,
 # "masked" (every texture, mask, vertex colours) leaves out only alpha
 # blending and never a feature it has -- and says that the main view has
-# MSAA targets; without --msaa it says there are none.
+# MSAA targets; without --msaa it says there are none. A scene whose shadowed
+# sun has intensity 0 lists that shadow view as left out (not needed).
 # Run by ctest: cmake -DBIN=<build>/bin -DSRC=<source> -DOUT=<dir> -P view_lean_report.cmake
 foreach(var BIN SRC OUT)
   if(NOT DEFINED ${var})
@@ -66,6 +67,17 @@ run_view(out1 --frames 2)
 if(NOT out1 MATCHES "lean: MSAA targets: none")
   message(FATAL_ERROR "without --msaa the report should say there are no MSAA targets\n${out1}")
 endif()
+# A shadowed sun of intensity 0 needs no shadow map: the report names that view.
+file(WRITE ${OUT}/dark.json [=[
+{ "lights": [ { "name": "sun", "type": "directional", "intensity": 0, "shadows": true } ],
+  "entities": [ { "name": "box", "geometry": { "generator": "box" } } ] }
+]=])
+set(model ${OUT}/dark.json)
+run_view(dark --frames 2)
+if(NOT dark MATCHES "lean: views left out: shadow:sun \\(not needed, 2 frames\\)")
+  message(FATAL_ERROR "a sun of intensity 0: the report does not list its shadow view as left out\n${dark}")
+endif()
+
 string(REGEX MATCHALL "lean: [^\n]*" lines "${out}")
 list(JOIN lines "\n  " lines)
 message(STATUS "lean report:\n  ${lines}")
