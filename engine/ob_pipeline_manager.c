@@ -143,7 +143,7 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     pm->dev = desc->device;
     pm->vk = ob_device_vk(desc->device);
     r = ob_params_manager(desc->registry, desc->slot, &pm->params);
-    if (r != OB_OK) goto fail_free;
+    if (r != OB_OK) goto fail_free_pm;
     snprintf(pm->name, sizeof pm->name, "%s", desc->name ? desc->name : "pm");
     pm->frames_in_flight = desc->frames_in_flight ? desc->frames_in_flight : 2;
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
@@ -155,7 +155,7 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     pm->hash = ob_cmd_hash_empty();
     goto done;
 
-fail_free:
+fail_free_pm:
     ob_free(pm);
     pm = NULL;
 done:
@@ -168,57 +168,28 @@ done:
 
 static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
 {
-    if (c->memory) vkUnmapMemory(pm->vk, c->memory);
-    if (c->vk) vkDestroyBuffer(pm->vk, c->vk, NULL);
-    if (c->memory) vkFreeMemory(pm->vk, c->memory, NULL);
+    ob_res_vk_buffer b = {.buffer = c->vk, .memory = c->memory, .mapped = c->mapped};
+    ob_res_vk_buffer_free(pm->dev, &b);
     memset(c, 0, sizeof *c);
 }
 
-/* A host-visible, coherent, persistently mapped uniform buffer. [own thread] */
+/* A host-visible, coherent, persistently mapped uniform buffer, through the
+ * resources' one buffer path. [own thread] */
 static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
 {
-    VkBufferCreateInfo bi = {
-        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
-        .size = pm->chunk_size,
-        .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
-    };
-    VkResult vr = OB_VK_CHECK_CREATE(vkCreateBuffer(pm->vk, &bi, NULL, &c->vk));
-    if (vr != VK_SUCCESS) goto fail;
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(pm->vk, c->vk, &req);
-    uint32_t type = ob_device_memory_type(pm->dev, req.memoryTypeBits,
-                                          VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    if (type == UINT32_MAX) {
-        vr = VK_ERROR_FEATURE_NOT_PRESENT;
-        OB_LOG_E("pm", "pipeline manager '%s': no host-visible coherent memory for its uniform ring",
-                 pm->name);
-        goto fail;
-    }
-    VkMemoryAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-                               .allocationSize = req.size,
-                               .memoryTypeIndex = type};
-    vr = OB_VK_CHECK_CREATE(vkAllocateMemory(pm->vk, &ai, NULL, &c->memory));
-    if (vr != VK_SUCCESS) goto fail;
-    vr = OB_VK_CHECK(vkBindBufferMemory(pm->vk, c->vk, c->memory, 0));
-    if (vr != VK_SUCCESS) goto fail;
-    void *mapped = NULL;
-    vr = OB_VK_CHECK(vkMapMemory(pm->vk, c->memory, 0, VK_WHOLE_SIZE, 0, &mapped));
-    if (vr != VK_SUCCESS) goto fail;
-    c->mapped = mapped;
+    ob_res_vk_buffer b;
+    memset(c, 0, sizeof *c);
+    ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                            VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                        true, "uniform ring of pipeline manager", pm->name, &b);
+    if (r != OB_OK) return r;
+    c->vk = b.buffer;
+    c->memory = b.memory;
+    c->mapped = b.mapped;
     c->size = pm->chunk_size;
-    c->used = 0;
     ob_device_set_name(pm->dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)c->vk, pm->name);
     return OB_OK;
-fail:
-    if (c->memory) {
-        vkFreeMemory(pm->vk, c->memory, NULL);
-        c->memory = VK_NULL_HANDLE;
-    }
-    if (c->vk) vkDestroyBuffer(pm->vk, c->vk, NULL);
-    memset(c, 0, sizeof *c);
-    return vr == VK_ERROR_FEATURE_NOT_PRESENT ? OB_ERR_UNSUPPORTED : ob_result_from_vk(vr);
 }
 
 void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)

@@ -334,14 +334,14 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
     if (!desc) {
         OB_LOG_E("resources", "ob_image_create: desc is NULL");
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     if (ob_device_is_lost(dev)) {
         r = OB_ERR_DEVICE_LOST;
-        goto fail;
+        goto fail_log;
     }
     r = image_desc_check(desc, name, &data_size);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
     uint32_t layers = desc->layers ? desc->layers : 1;
     uint32_t levels = desc->mip_levels ? desc->mip_levels : 1;
     bool blit_mips = desc->data && levels > 1 && !desc->data_mips;
@@ -349,13 +349,13 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
     if (blit_mips) vk_usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     r = image_support_check(dev, name, desc, layers, vk_usage);
     if (r == OB_OK && blit_mips) r = ob_res_mips_blit_check(dev, name, desc->format);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
 
     VkDevice vk = ob_device_vk(dev);
     ob_image_rec *rec = ob_calloc(1, sizeof *rec);
     if (!rec) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     rec->info = (ob_image_info){desc->width, desc->height, layers, desc->format, desc->usage,
                                 format_aspect(desc->format), levels, desc->samples > 1 ? desc->samples : 1};
@@ -411,7 +411,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
 
 fail_free_rec:
     ob_res_image_free(dev, rec);
-fail:
+fail_log:
     OB_LOG_E("resources", "image '%s' not created: %s", name, ob_result_name(r));
     if (out_result) *out_result = r;
     return handle;

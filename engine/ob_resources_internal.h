@@ -56,7 +56,9 @@ typedef struct ob_res_vk_buffer {
  * creates it (exclusive, `usage`), allocates memory of `flags` for it
  * (ob_res_memory_alloc), binds it and, with map, maps all of it. Failure:
  * the error (the VkResult noted on the device), logged as "<what> '<name>'
- * ...", *out zeroed with nothing left behind. [render thread] */
+ * ...", *out zeroed with nothing left behind. [any thread]: it touches no
+ * shared engine state (pipeline managers grow their uniform rings with it
+ * on their workers). */
 ob_result ob_res_vk_buffer_make(ob_device *dev, VkDeviceSize size, VkBufferUsageFlags usage,
                                 VkMemoryPropertyFlags flags, bool map, const char *what,
                                 const char *name, ob_res_vk_buffer *out);

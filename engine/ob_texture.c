@@ -344,7 +344,7 @@ const ob_texture *ob_texture_cache_load(ob_texture_cache *c, const ob_texture_de
         OB_LOG_W("texture", "%s: texture %s not loaded: no cache, no file or bytes, too many bytes, or a "
                             "sampling value out of range", context, what);
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_free_decoded;
     }
     r = reserve_all(c);
     if (r != OB_OK) goto fail_log;
@@ -354,7 +354,7 @@ const ob_texture *ob_texture_cache_load(ob_texture_cache *c, const ob_texture_de
         if (size == 0 || size > (size_t)INT32_MAX) {
             OB_LOG_W("texture", "%s: %s is %s", context, what, size ? "too large" : "empty");
             r = OB_ERR_PARSE;
-            goto fail;
+            goto fail_free_decoded;
         }
         bytes = file;
     } else {
@@ -380,7 +380,7 @@ const ob_texture *ob_texture_cache_load(ob_texture_cache *c, const ob_texture_de
         img->srgb = desc->srgb;
         img->info.hash = hash;
         r = image_create(c, desc, bytes, size, context, what, img);
-        if (r != OB_OK) goto fail; /* logged with the reason */
+        if (r != OB_OK) goto fail_free_decoded; /* logged with the reason */
         c->images[c->image_count++] = img;
     }
     ob_free(file);
@@ -410,7 +410,7 @@ const ob_texture *ob_texture_cache_load(ob_texture_cache *c, const ob_texture_de
 
 fail_log:
     OB_LOG_W("texture", "%s: texture %s not loaded: %s", context, what, ob_result_name(r));
-fail:
+fail_free_decoded:
     if (new_image) ob_free(img);
     ob_free(file);
     if (out_result) *out_result = r;

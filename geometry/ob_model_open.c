@@ -343,12 +343,12 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
     c.model = model;
     if (!model || !(model->path = ob_strdup(path))) {
         r = out_of_memory(&c, "the model");
-        goto fail;
+        goto fail_close_model;
     }
     r = ob_model_read_materials(&c.chk, scene, model);
     if (r == OB_OK) r = build_primitives(&c);
     if (r == OB_OK) r = build_nodes(&c);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_close_model;
 
     if (c.fixed_normals)
         OB_LOG_W(OB_MODEL_LOG, "%s: %u vertices have a zero-length normal (in the file, or "
@@ -369,7 +369,7 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
     *out_model = model;
     return OB_OK;
 
-fail:
+fail_close_model:
     ob_model_report_more(&c.chk);
     ob_free(c.mesh_primitive);
     ob_model_close(model);

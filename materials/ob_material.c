@@ -254,7 +254,7 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     ob_material_library *lib = NULL;
     if (!ctx) {
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     if ((d.standard_layout && d.standard_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES) ||
         (d.text_layout && d.text_layout->attribute_count > OB_EFFECT_MAX_ATTRIBUTES) ||
@@ -262,12 +262,12 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
         OB_LOG_E("material", "material library: a vertex layout has more than %u attributes",
                  OB_EFFECT_MAX_ATTRIBUTES);
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     lib = ob_calloc(1, sizeof *lib);
     if (!lib) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     lib->ctx = ctx;
     lib->dev = ob_effect_context_device(ctx);
@@ -281,13 +281,13 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     r = register_standard_params(lib);
     if (r == OB_OK) r = ob_pbr_register_params(lib);
     if (r == OB_OK) r = create_samplers(lib);
-    if (r != OB_OK) goto fail_destroy;
+    if (r != OB_OK) goto fail_destroy_library;
     if (out_result) *out_result = OB_OK;
     return lib;
 
-fail_destroy:
+fail_destroy_library:
     ob_material_library_destroy(lib);
-fail:
+fail_log:
     OB_LOG_E("material", "material library not created: %s", ob_result_name(r));
     if (out_result) *out_result = r;
     return NULL;
@@ -364,21 +364,21 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
     if (!lib || !desc || (unsigned)desc->kind >= OB_MATERIAL_KIND_COUNT) {
         OB_LOG_E("material", "material '%s': bad library, desc or kind", name);
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail;
+        goto fail_log;
     }
     if (!all_finite(desc->diffuse, 4) || !all_finite(desc->specular, 4) ||
         !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity)) {
         OB_LOG_E("material", "material '%s': non-finite colour or reflectivity", name);
         r = OB_ERR_NON_FINITE;
-        goto fail;
+        goto fail_log;
     }
     r = ob_array_reserve((void **)&lib->materials, &lib->material_cap, lib->material_count + 1,
                          sizeof *lib->materials);
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_log;
     m = ob_calloc(1, sizeof *m);
     if (!m) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_log;
     }
     m->lib = lib;
     snprintf(m->name, sizeof m->name, "%s", name);
@@ -398,7 +398,7 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
         r = ob_pbr_material_init(m, desc);
         if (r != OB_OK) {
             ob_free(m);
-            goto fail;
+            goto fail_log;
         }
         m->blended = desc->pbr.alpha_mode == OB_ALPHA_BLEND;
     }
@@ -409,7 +409,7 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
     if (out_result) *out_result = OB_OK;
     return m;
 
-fail:
+fail_log:
     OB_LOG_E("material", "material '%s' not created: %s", name, ob_result_name(r));
     if (out_result) *out_result = r;
     return NULL;

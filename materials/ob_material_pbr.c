@@ -85,18 +85,18 @@ ob_result ob_pbr_register_params(ob_material_library *lib)
     };
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(list); i++) {
         *list[i].out = ob_param_register(lib->reg, list[i].name, list[i].type, 1, &r);
-        if (!list[i].out->id) goto fail;
+        if (!list[i].out->id) goto fail_log;
     }
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
         char name[64];
         p->textures[i] = ob_param_register(lib->reg, texture_names[i], OB_PARAM_TEXTURE, 1, &r);
-        if (!p->textures[i].id) goto fail;
+        if (!p->textures[i].id) goto fail_log;
         snprintf(name, sizeof name, "%sSampler", texture_names[i]);
         p->samplers[i] = ob_param_register(lib->reg, name, OB_PARAM_SAMPLER, 1, &r);
-        if (!p->samplers[i].id) goto fail;
+        if (!p->samplers[i].id) goto fail_log;
     }
     return OB_OK;
-fail:
+fail_log:
     OB_LOG_E("material", "PBR parameters not registered: %s", ob_result_text(r));
     return r;
 }

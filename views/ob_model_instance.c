@@ -156,13 +156,13 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
     if (!a->name || !a->materials || !a->material_extended || !a->geometry) {
         OB_LOG_E(LOG_MODULE, "%s: out of memory for the model's assets", model->path);
         r = OB_ERR_OUT_OF_HOST_MEMORY;
-        goto fail;
+        goto fail_destroy_assets;
     }
     if (!a->textures && model->image_count > 0) {
         a->own_textures = ob_texture_cache_create(ob_renderer_device(a->renderer), &r);
         if (!a->own_textures) {
             OB_LOG_E(LOG_MODULE, "%s: no texture cache: %s", model->path, ob_result_name(r));
-            goto fail;
+            goto fail_destroy_assets;
         }
         a->textures = a->own_textures;
     }
@@ -175,12 +175,12 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
             used = model->primitives[p].material == m;
         if (!used) continue;
         a->materials[m] = ob_model_material_to_material(&ctx, m, &a->material_extended[m], &r);
-        if (!a->materials[m]) goto fail;
+        if (!a->materials[m]) goto fail_destroy_assets;
     }
     if (out_result) *out_result = OB_OK;
     return a;
 
-fail:
+fail_destroy_assets:
     ob_model_assets_destroy(a);
     if (out_result) *out_result = r;
     return NULL;

@@ -9,24 +9,24 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     ob_stack *s = ob_calloc(1, sizeof *s);
     if (!s) {
         OB_LOG_E("stack", "no memory for the stack");
-        goto fail;
+        goto fail_report;
     }
 
-    if (!(s->renderer = ob_renderer_create(&d.renderer, &r))) goto fail_destroy;
+    if (!(s->renderer = ob_renderer_create(&d.renderer, &r))) goto fail_destroy_stack;
     s->device = ob_renderer_device(s->renderer);
     s->effects = ob_effect_context_create(s->device, ob_renderer_registry(s->renderer),
                                           d.cache_dir, &r);
-    if (!s->effects) goto fail_destroy;
-    if (!(s->materials = ob_material_library_create(s->effects, NULL, &r))) goto fail_destroy;
+    if (!s->effects) goto fail_destroy_stack;
+    if (!(s->materials = ob_material_library_create(s->effects, NULL, &r))) goto fail_destroy_stack;
     ob_views_desc vd = {.renderer = s->renderer, .materials = s->materials,
                         .effects = s->effects, .env_map_size = d.env_map_size,
                         .shadow_map_size = d.shadow_map_size};
     memcpy(vd.ambient, d.ambient, sizeof vd.ambient);
-    if (!(s->views = ob_views_create(&vd, &r))) goto fail_destroy;
+    if (!(s->views = ob_views_create(&vd, &r))) goto fail_destroy_stack;
 
-    if (!(s->scene = ob_scene_create(&r))) goto fail_destroy;
-    if (!(s->camera = ob_node_create(s->scene, NULL, "camera", &r))) goto fail_destroy;
-    if ((r = ob_node_set_camera(s->camera, &d.camera)) != OB_OK) goto fail_destroy;
+    if (!(s->scene = ob_scene_create(&r))) goto fail_destroy_stack;
+    if (!(s->camera = ob_node_create(s->scene, NULL, "camera", &r))) goto fail_destroy_stack;
+    if ((r = ob_node_set_camera(s->camera, &d.camera)) != OB_OK) goto fail_destroy_stack;
     ob_perspective_desc pd = {.name = "main", .camera = s->camera,
                               .width = d.width ? d.width : 640,
                               .height = d.height ? d.height : 480,
@@ -36,24 +36,24 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     static const float no_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     if (memcmp(d.clear_color, no_color, sizeof no_color) != 0)
         memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
-    if (!(s->main = ob_perspective_view_create(s->views, &pd, &r))) goto fail_destroy;
+    if (!(s->main = ob_perspective_view_create(s->views, &pd, &r))) goto fail_destroy_stack;
     s->composite = ob_composite_view_create(s->views, ob_perspective_view_base(s->main), &r);
-    if (!s->composite) goto fail_destroy;
+    if (!s->composite) goto fail_destroy_stack;
     if (d.exposure != 0.0f && !ob_composite_view_set_exposure(s->composite, d.exposure)) {
         r = OB_ERR_INVALID_ARGUMENT;
-        goto fail_destroy;
+        goto fail_destroy_stack;
     }
     s->final_view = ob_composite_view_base(s->composite);
     if (d.overlay) {
-        if (!(s->overlay = ob_overlay_view_create(s->views, s->final_view, &r))) goto fail_destroy;
+        if (!(s->overlay = ob_overlay_view_create(s->views, s->final_view, &r))) goto fail_destroy_stack;
         s->final_view = ob_overlay_view_base(s->overlay);
     }
     if (out_result) *out_result = OB_OK;
     return s;
 
-fail_destroy:
+fail_destroy_stack:
     ob_stack_destroy(s);
-fail:
+fail_report:
     if (out_result) *out_result = r;
     return NULL;
 }
@@ -101,16 +101,16 @@ ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_
     const ob_bounds *b = ob_geometry_bounds(geometry);
     if (!b) {
         OB_LOG_E("stack", "entity '%s': no geometry", name ? name : "");
-        goto out;
+        goto done;
     }
-    if (!(n = ob_node_create(s->scene, parent, name, &r))) goto out;
+    if (!(n = ob_node_create(s->scene, parent, name, &r))) goto done;
     ob_renderable rd = {.material = material, .geometry = geometry, .local_radius = b->radius};
     memcpy(rd.local_center, b->center, sizeof rd.local_center);
     if ((r = ob_node_set_renderable(n, &rd)) != OB_OK) {
         ob_node_destroy(s->scene, n);
         n = NULL;
     }
-out:
+done:
     if (out_result) *out_result = r;
     return n;
 }

@@ -12,6 +12,8 @@ const char *ob_bench_quality_kind_name(ob_bench_quality_kind k)
     case OB_BENCH_QUALITY_ENV: return "env-map";
     case OB_BENCH_QUALITY_SHADOW: return "shadow-map";
     case OB_BENCH_QUALITY_THREADING: return "threading";
+    case OB_BENCH_QUALITY_MSAA_REFERENCE: return "msaa-reference";
+    case OB_BENCH_QUALITY_MSAA: return "msaa";
     }
     return "unknown";
 }
@@ -35,17 +37,75 @@ void ob_bench_image_error(const uint8_t *a, const uint8_t *b, uint32_t w, uint32
     *out_psnr_db = mse > 0.0 ? 10.0 * log10(255.0 * 255.0 / mse) : INFINITY;
 }
 
+static double srgb_to_linear(double c)
+{
+    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+}
+
+static double linear_to_srgb(double c)
+{
+    return c <= 0.0031308 ? c * 12.92 : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+
+void ob_bench_image_downsample_srgb(const uint8_t *src, uint32_t w, uint32_t h, uint32_t scale,
+                                    uint8_t *dst)
+{
+    double lin[256];
+    for (int i = 0; i < 256; i++) lin[i] = srgb_to_linear(i / 255.0);
+    size_t sw = (size_t)w * scale;
+    double inv = 1.0 / ((double)scale * scale);
+    for (uint32_t y = 0; y < h; y++) {
+        for (uint32_t x = 0; x < w; x++) {
+            double sum[3] = {0, 0, 0};
+            for (uint32_t j = 0; j < scale; j++) {
+                const uint8_t *row = src + 4 * (((size_t)y * scale + j) * sw + (size_t)x * scale);
+                for (uint32_t i = 0; i < scale; i++)
+                    for (int c = 0; c < 3; c++) sum[c] += lin[row[4 * i + c]];
+            }
+            uint8_t *out = dst + 4 * ((size_t)y * w + x);
+            for (int c = 0; c < 3; c++) {
+                double v = linear_to_srgb(OB_MIN(OB_MAX(sum[c] * inv, 0.0), 1.0)) * 255.0 + 0.5;
+                out[c] = (uint8_t)OB_MIN(v, 255.0);
+            }
+            out[3] = 255;
+        }
+    }
+}
+
+uint32_t ob_bench_msaa_counts(uint32_t max_offered, uint32_t offered, uint32_t out[4])
+{
+    uint32_t n = 0;
+    for (uint32_t s = 1; s <= 8 && s <= OB_MAX(max_offered, 1u); s <<= 1)
+        if (s == 1 || (offered & s)) out[n++] = s;
+    return n;
+}
+
 /* One rendered configuration: its image, per-frame hashes and timings. */
 typedef struct rendering {
     uint8_t *pixels;
     uint64_t hashes[MAX_IMAGE_FRAMES];
     ob_bench_result timing;
+    uint32_t samples;              /* the main view's, as made */
+    uint32_t offered;              /* sample counts the device's limits offer for colour
+                                      and depth framebuffers (VkSampleCountFlags) */
 } rendering;
 
-static ob_result render_config(const ob_bench_quality_desc *desc, uint32_t env, uint32_t shadow,
-                               const ob_bench_mode *mode, rendering *out)
+/* How one configuration is drawn besides its quality settings. */
+typedef struct render_how {
+    uint32_t msaa;                 /* asked for: 0 or 1 → none */
+    uint32_t scale;                /* size factor per axis: 0 or 1 → the desc's size */
+    bool timed;                    /* timing rounds after the image */
+    bool exact;                    /* draw nothing unless the view got msaa samples */
+} render_how;
+
+static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t env, uint32_t shadow,
+                                  const ob_bench_mode *mode, render_how how, rendering *out)
 {
     ob_demo_options o = desc->base;
+    uint32_t scale = how.scale > 1 ? how.scale : 1;
+    o.width *= scale;
+    o.height *= scale;
+    o.msaa = how.msaa;
     o.env_size = env;
     o.shadow_size = shadow;
     o.threads = (int)desc->pool_workers;
@@ -56,6 +116,17 @@ static ob_result render_config(const ob_bench_quality_desc *desc, uint32_t env, 
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &o);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_MIRROR, .objects = o.objects, .seed = o.seed};
+    if (r == OB_OK) {
+        const VkPhysicalDeviceLimits *lim = &ob_device_properties(ob_renderer_device(d.r))->limits;
+        out->offered = lim->framebufferColorSampleCounts & lim->framebufferDepthSampleCounts;
+        out->samples = ob_perspective_view_samples(d.main);
+        /* The format's own counts may be fewer than the limits say: the
+         * view was made with fewer samples (logged), so there is no row. */
+        if (how.exact && out->samples != OB_MAX(how.msaa, 1u)) {
+            ob_demo_shutdown(&d);
+            return OB_OK;
+        }
+    }
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
     /* Drop the demo's per-frame history: these frames are counted here. */
     if (r == OB_OK) ob_renderer_set_stats_callback(d.r, NULL, NULL);
@@ -74,19 +145,26 @@ static ob_result render_config(const ob_bench_quality_desc *desc, uint32_t env, 
                                               ob_composite_view_target(d.composite), out->pixels)
                         : OB_ERR_OUT_OF_HOST_MEMORY;
     }
-    if (r == OB_OK && (desc->rounds || desc->flight)) {
+    if (r == OB_OK && how.timed && (desc->rounds || desc->flight)) {
         ob_bench_run_desc rd = {.modes = mode, .mode_count = 1, .rounds = desc->rounds,
                                 .flight = desc->flight, .dt = dt, .tick = desc->tick,
                                 .tick_user = desc->tick_user};
         r = ob_bench_run_modes(&s, &rd, &out->timing);
     }
     if (r != OB_OK)
-        OB_LOG_E("bench", "mirror scene with env map %u, shadow map %u, mode %s failed: %s", env,
-                 shadow, mode->name, ob_result_name(r));
+        OB_LOG_E("bench", "mirror scene %ux%u with env map %u, shadow map %u, MSAA %ux, mode %s "
+                 "failed: %s", o.width, o.height, env, shadow, OB_MAX(how.msaa, 1u), mode->name,
+                 ob_result_name(r));
     if (d.r) ob_renderer_wait_idle(d.r);
     ob_bench_scene_release(&s);
     ob_demo_shutdown(&d);
     return r;
+}
+
+static ob_result render_config(const ob_bench_quality_desc *desc, uint32_t env, uint32_t shadow,
+                               const ob_bench_mode *mode, rendering *out)
+{
+    return render_config_as(desc, env, shadow, mode, (render_how){.timed = true}, out);
 }
 
 static void fill_row(ob_bench_quality_row *row, ob_bench_quality_kind kind, uint32_t env,
@@ -94,7 +172,8 @@ static void fill_row(ob_bench_quality_row *row, ob_bench_quality_kind kind, uint
                      const rendering *got, const ob_bench_quality_desc *desc)
 {
     *row = (ob_bench_quality_row){.kind = kind, .env_size = env, .shadow_size = shadow,
-                                  .mode = *mode};
+                                  .mode = *mode, .msaa_samples = OB_MAX(got->samples, 1u),
+                                  .supersample = 1};
     ob_bench_image_error(ref->pixels, got->pixels, desc->base.width, desc->base.height,
                          &row->max_abs_diff, &row->psnr_db);
     row->frame_ms = got->timing.frame_ms;
@@ -108,6 +187,49 @@ static void fill_row(ob_bench_quality_row *row, ob_bench_quality_kind kind, uint
         if (ref->hashes[f] != got->hashes[f]) row->hash_mismatches++;
 }
 
+/* The MSAA rows: the supersampled reference, then each offered count (1x
+ * is the reference rendering ref, drawn with the same settings). */
+static ob_result msaa_series(const ob_bench_quality_desc *desc, uint32_t env, uint32_t shadow,
+                             const ob_bench_mode *st, const rendering *ref,
+                             ob_bench_quality_row *rows, uint32_t *n)
+{
+    uint32_t w = desc->base.width, h = desc->base.height;
+    uint32_t scale = desc->msaa_scale ? desc->msaa_scale : 4;
+    while (scale > 1 && (w * scale > 4096 || h * scale > 4096)) scale--;
+    rendering big = {0};
+    ob_result r = render_config_as(desc, env, shadow, st,
+                                   (render_how){.msaa = 8, .scale = scale}, &big);
+    rendering aa = {.samples = big.samples};
+    if (r == OB_OK) {
+        aa.pixels = ob_malloc((size_t)w * h * 4);
+        if (!aa.pixels) r = OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    if (r == OB_OK) {
+        ob_bench_image_downsample_srgb(big.pixels, w, h, scale, aa.pixels);
+        ob_bench_quality_row *row = &rows[(*n)++];
+        fill_row(row, OB_BENCH_QUALITY_MSAA_REFERENCE, env, shadow, st, &aa, &aa, desc);
+        row->supersample = scale;
+        row->frame_ms = row->gpu_ms = row->record_total_ms = row->cpu_frame_ms = NAN;
+    }
+    ob_free(big.pixels);
+    uint32_t counts[4];
+    uint32_t count = r == OB_OK ? ob_bench_msaa_counts(aa.samples, big.offered, counts) : 0;
+    for (uint32_t i = 0; i < count && r == OB_OK; i++) {
+        if (counts[i] == 1) {
+            fill_row(&rows[(*n)++], OB_BENCH_QUALITY_MSAA, env, shadow, st, &aa, ref, desc);
+            continue;
+        }
+        rendering got = {0};
+        r = render_config_as(desc, env, shadow, st,
+                             (render_how){.msaa = counts[i], .timed = true, .exact = true}, &got);
+        if (r == OB_OK && got.pixels)
+            fill_row(&rows[(*n)++], OB_BENCH_QUALITY_MSAA, env, shadow, st, &aa, &got, desc);
+        ob_free(got.pixels);
+    }
+    ob_free(aa.pixels);
+    return r;
+}
+
 ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quality_row **out_rows,
                                uint32_t *out_count)
 {
@@ -117,7 +239,7 @@ ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quali
         return OB_ERR_INVALID_ARGUMENT;
     uint32_t env_ref = desc->env_sizes[desc->env_count - 1];
     uint32_t shadow_ref = desc->shadow_sizes[desc->shadow_count - 1];
-    uint32_t cap = 1 + desc->env_count + desc->shadow_count + desc->mode_count;
+    uint32_t cap = 1 + desc->env_count + desc->shadow_count + desc->mode_count + (desc->msaa ? 5 : 0);
     ob_bench_quality_row *rows = ob_calloc(cap, sizeof *rows);
     if (!rows) return OB_ERR_OUT_OF_HOST_MEMORY;
     uint32_t n = 0;
@@ -150,6 +272,7 @@ ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quali
                      &got, desc);
         ob_free(got.pixels);
     }
+    if (r == OB_OK && desc->msaa) r = msaa_series(desc, env_ref, shadow_ref, st, &ref, rows, &n);
     ob_free(ref.pixels);
     if (r != OB_OK) {
         ob_free(rows);

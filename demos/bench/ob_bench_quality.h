@@ -12,6 +12,19 @@
  *   threading   every other mode at the reference quality: its image must be
  *               byte-identical to the reference and the command hash of each
  *               of its frames equal to the reference's frame of the same index
+ *   msaa        (desc.msaa) the main view's samples per pixel: each count
+ *               the device offers of 1, 2, 4, 8
+ *               (lavapipe: 1 and 4; a count whose format the device does
+ *               not offer has no row) at the reference quality,
+ *               single-threaded, against the antialiasing reference: the
+ *               same configuration rendered at msaa_scale times the size in
+ *               each axis with the highest MSAA the device offers (8x asked
+ *               for), box-downsampled msaa_scale x msaa_scale in linear
+ *               light (sRGB decoded, averaged, encoded again). That row
+ *               (OB_BENCH_QUALITY_MSAA_REFERENCE) says its samples and scale
+ *               and has no times: it is drawn at another size. The 1x row is
+ *               the reference rendering itself (same configuration), not a
+ *               second run.
  *
  * Lifecycle: one call; rows are ob_malloc'ed, the caller ob_frees them.
  * Thread rule: render thread; creates and destroys its own renderers.
@@ -26,6 +39,8 @@ typedef enum ob_bench_quality_kind {
     OB_BENCH_QUALITY_ENV,
     OB_BENCH_QUALITY_SHADOW,
     OB_BENCH_QUALITY_THREADING,
+    OB_BENCH_QUALITY_MSAA_REFERENCE,
+    OB_BENCH_QUALITY_MSAA,
 } ob_bench_quality_kind;
 
 typedef struct ob_bench_quality_desc {
@@ -39,6 +54,9 @@ typedef struct ob_bench_quality_desc {
     uint32_t shadow_count;
     const ob_bench_mode *modes;    /* modes[0] is the reference mode (single-threaded) */
     uint32_t mode_count;
+    bool msaa;                     /* also the MSAA series */
+    uint32_t msaa_scale;           /* its reference's size factor per axis: 0 → 4; lowered so
+                                      that neither side passes 4096 (at least 1) */
     ob_bench_tick_fn tick;
     void *tick_user;
 } ob_bench_quality_desc;
@@ -53,6 +71,10 @@ typedef struct ob_bench_quality_row {
     uint32_t hash_mismatches;      /* threading rows: frames whose hash differs from the
                                       reference's (0 in other rows) */
     uint32_t draws;
+    uint32_t msaa_samples;         /* main view's samples per pixel as drawn (1 but in the
+                                      MSAA rows) */
+    uint32_t supersample;          /* size factor per axis the image was drawn at before
+                                      the box downsample (1 but in the MSAA reference) */
 } ob_bench_quality_row;
 
 ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quality_row **out_rows,
@@ -61,6 +83,18 @@ ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quali
 /* Error of b against a, RGBA8 images of w*h pixels (alpha ignored). */
 void ob_bench_image_error(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h,
                           uint32_t *out_max_abs, double *out_psnr_db);
+
+/* Box-downsamples src (RGBA8, sRGB-encoded, (w*scale) x (h*scale)) into
+ * dst (w x h): each scale x scale block averaged in linear light, alpha
+ * 255. Any thread; no failure. */
+void ob_bench_image_downsample_srgb(const uint8_t *src, uint32_t w, uint32_t h, uint32_t scale,
+                                    uint8_t *dst);
+
+/* MSAA counts measured for a device whose view got at most max_offered
+ * samples and whose limits offer the VkSampleCountFlags `offered`: 1, then
+ * the powers of two 2..8 up to max_offered that offered has, ascending,
+ * into out (4 entries); returns how many. */
+uint32_t ob_bench_msaa_counts(uint32_t max_offered, uint32_t offered, uint32_t out[4]);
 
 const char *ob_bench_quality_kind_name(ob_bench_quality_kind k);
 

@@ -111,6 +111,23 @@ static void print_spread(FILE *f, const char *name, ob_bench_spread v)
     fprintf(f, "  %-30s %.3f [%.3f, %.3f]", name, v.median, v.p25, v.p75);
 }
 
+/* The MSAA rows: error against the supersampled reference next to frame time. */
+static void print_msaa(FILE *f, const ob_bench_report *rep)
+{
+    for (uint32_t i = 0; i < rep->quality_count; i++) {
+        const ob_bench_quality_row *q = &rep->quality[i];
+        if (q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE)
+            fprintf(f, "\nMSAA: image error against the antialiasing reference (%ux the size per "
+                       "axis, %ux MSAA, box-downsampled in linear light; env %u, shadow %u, %s):\n"
+                       "  %7s %8s %9s %9s %9s %9s\n",
+                    q->supersample, q->msaa_samples, q->env_size, q->shadow_size, q->mode.name,
+                    "samples", "max_abs", "psnr_dB", "frame_ms", "gpu_ms", "rec+asm");
+        else if (q->kind == OB_BENCH_QUALITY_MSAA)
+            fprintf(f, "  %6ux %8u %9.2f %9.2f %9.2f %9.2f\n", q->msaa_samples, q->max_abs_diff,
+                    q->psnr_db, q->frame_ms, q->gpu_ms, q->record_total_ms);
+    }
+}
+
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
     fprintf(f, "sweep: medians (ms) of %u idle frames per mode after %u warm-up, each after "
@@ -140,6 +157,7 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
             "mode", "max_abs", "psnr_dB", "frame_ms", "gpu_ms", "rec+asm", "hashes");
     for (uint32_t i = 0; i < rep->quality_count; i++) {
         const ob_bench_quality_row *q = &rep->quality[i];
+        if (q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE || q->kind == OB_BENCH_QUALITY_MSAA) continue;
         fprintf(f, "  %-10s %5u %6u %-5s %8u %9.2f %9.2f %9.2f %9.2f %s\n",
                 ob_bench_quality_kind_name(q->kind), q->env_size, q->shadow_size, q->mode.name,
                 q->max_abs_diff, q->psnr_db, q->frame_ms, q->gpu_ms, q->record_total_ms,
@@ -147,6 +165,7 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                 : q->hash_mismatches                  ? "MISMATCH"
                                                       : "equal");
     }
+    print_msaa(f, rep);
     const ob_bench_summary *s = &rep->summary;
     fprintf(f, "\nsummary (ratios: median of per-round ratios [p25, p75]):\n");
     print_spread(f, "mt_speedup_record_10k_8views", s->mt_speedup_record_10k_8views);
@@ -302,7 +321,15 @@ static void json_quality(FILE *f, const ob_bench_quality_row *q)
     json_num(f, q->gpu_ms);
     fputs(",\"record_total_ms\":", f);
     json_num(f, q->record_total_ms);
-    fprintf(f, ",\"draws\":%u,\"hash_mismatches\":%u}", q->draws, q->hash_mismatches);
+    fprintf(f, ",\"draws\":%u,\"hash_mismatches\":%u,\"msaa_samples\":%u,\"supersample\":%u",
+            q->draws, q->hash_mismatches, q->msaa_samples, q->supersample);
+    if (q->kind == OB_BENCH_QUALITY_MSAA || q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE)
+        fprintf(f, ",\"against\":\"msaa-reference\"");
+    if (q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE)
+        fprintf(f, ",\"reference\":\"drawn at %ux the size per axis with %ux MSAA (the most the "
+                   "device offers, up to 8x), box-downsampled %ux%u in linear light\"",
+                q->supersample, q->msaa_samples, q->supersample, q->supersample);
+    fputc('}', f);
 }
 
 /* "name":median,"name_p25":p25,"name_p75":p75, */
@@ -496,7 +523,7 @@ static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t ob
                             r->cmd_host_allocs_per_object, r->commands_per_object,
                             r->vs_round_min_record.median};
     for (size_t i = 0; i < OB_ARRAY_COUNT(added); i++) csv_num(f, added[i]);
-    fputc('\n', f);
+    fputs(",1,1\n", f);   /* msaa_samples, supersample: the sweep draws single-sampled */
 }
 
 ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
@@ -510,7 +537,8 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
           "push_constant_iss,vertex_req,vertex_iss,index_req,index_iss,max_abs_diff,psnr_db,"
           "hash_mismatches,speedup_record_p25,speedup_record_p75,vs_best_fixed_record,"
           "record_cpu_render_ms,record_cpu_workers_ms,record_cpu_max_worker_ms,"
-          "cmd_host_allocs_per_object,commands_per_object,vs_round_min_record\n",
+          "cmd_host_allocs_per_object,commands_per_object,vs_round_min_record,msaa_samples,"
+          "supersample\n",
           f);
     for (uint32_t i = 0; i < rep->sweep_count; i++)
         for (uint32_t m = 0; m < rep->sweep[i].mode_count; m++)
@@ -530,7 +558,8 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
         fputs(",,,,,,,,,,,,,,,", f);
         fprintf(f, ",%u", q->max_abs_diff);
         csv_num(f, q->psnr_db);
-        fprintf(f, ",%u,,,,,,,,\n", q->hash_mismatches);
+        /* The nine columns added for the sweep rows, then msaa_samples, supersample. */
+        fprintf(f, ",%u,,,,,,,,,,%u,%u\n", q->hash_mismatches, q->msaa_samples, q->supersample);
     }
     /* Raw: record time in record_ms and record_total_ms, and draws/s. */
     fprintf(f, "raw,%u,%u,,,raw,0,,%u,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
@@ -542,7 +571,7 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
     fputs(",,,,,,,,,,,,,,,,,,,,,,,", f);
     csv_num(f, rep->raw.host_allocs_per_object);
     csv_num(f, rep->raw.commands_per_object);
-    fputc('\n', f);
+    fputs(",,1,1\n", f);   /* vs_round_min_record (none), msaa_samples, supersample */
     return close_out(f, path);
 }
 

@@ -173,9 +173,37 @@ ob_demo_memory ob_demo_memory_now(void)
     return m;
 }
 
+static void lean_note_view(ob_demo_lean *l, const char *name, ob_skip_reason reason)
+{
+    for (uint32_t i = 0; i < l->view_count; i++) {
+        if (l->views[i].reason != reason || strcmp(l->views[i].name, name)) continue;
+        l->views[i].frames++;
+        return;
+    }
+    if (l->view_count == OB_DEMO_LEAN_VIEWS) {
+        l->views_more++;   /* an upper bound: the same one may come again */
+        return;
+    }
+    snprintf(l->views[l->view_count].name, sizeof l->views[0].name, "%s", name);
+    l->views[l->view_count].reason = reason;
+    l->views[l->view_count++].frames = 1;
+}
+
+static void lean_note_frame(ob_demo_lean *l, const ob_frame_stats *st)
+{
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        lean_note_view(l, st->skipped[i].name, st->skipped[i].reason);
+    for (uint32_t i = 0; i < st->view_count; i++)
+        if (st->views[i].skipped != OB_SKIP_NONE)
+            lean_note_view(l, st->views[i].name, st->views[i].skipped);
+    l->pipelines_created += st->pipelines_created;
+    l->variants_created += st->variants_created;
+}
+
 static void on_stats(void *user, const ob_frame_stats *st)
 {
     ob_demo *d = user;
+    lean_note_frame(&d->lean, st);
     if (ob_array_reserve((void **)&d->history, &d->history_cap, d->history_count + 1,
                          sizeof *d->history) == OB_OK)
         d->history[d->history_count++] = (ob_demo_frame_times){
@@ -406,6 +434,75 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
     fputs("}", f);
 }
 
+#define LEAN_MATERIALS 24
+
+/* A line of the report's materials: a material name drawn with one effect. */
+typedef struct lean_row {
+    const char *material, *effect;
+    const ob_material *first;  /* its left-out features stand for the row's */
+    uint32_t entities;
+} lean_row;
+
+void ob_demo_print_lean_report(ob_demo *d, FILE *f)
+{
+    const ob_demo_lean *l = &d->lean;
+    fprintf(f, "lean: %llu shader variants and %llu pipelines created over %u frames\n",
+            (unsigned long long)l->variants_created, (unsigned long long)l->pipelines_created,
+            d->history_count);
+    fputs("lean: views left out:", f);
+    for (uint32_t i = 0; i < l->view_count; i++)
+        fprintf(f, "%s %s (%s, %u frames)", i ? "," : "", l->views[i].name,
+                ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
+    if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
+    fputs(l->view_count ? "\n" : " none\n", f);
+    uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
+    if (samples > 1)
+        fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
+                   "targets, resolved before the composite\n", samples);
+    else
+        fputs("lean: MSAA targets: none (view 'main' is single-sampled)\n", f);
+    /* One line per (material name, effect) in the order the scene's
+     * renderables first use it: many materials of one kind (the mirror
+     * scene's palette) make one line with their entity count. */
+    lean_row rows[LEAN_MATERIALS];
+    uint32_t row_count = 0, other_entities = 0, count = 0;
+    const ob_render_proxy *proxies = d->scene ? ob_scene_render_proxies(d->scene, &count) : NULL;
+    ob_view *main = d->main ? ob_perspective_view_base(d->main) : NULL;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_material *m = proxies[i].material;
+        if (!m) continue;
+        ob_result r = OB_OK;
+        const ob_effect *e = main ? ob_material_get_view_effect(m, d->r, proxies[i].node, main,
+                                                                false, &r)
+                                  : NULL;
+        const char *name = ob_material_name(m), *effect = e ? ob_effect_name(e) : NULL;
+        uint32_t k = 0;
+        while (k < row_count && (strcmp(rows[k].material, name) ||
+                                 (rows[k].effect != effect &&
+                                  (!rows[k].effect || !effect || strcmp(rows[k].effect, effect)))))
+            k++;
+        if (k == row_count) {
+            if (row_count == LEAN_MATERIALS) {
+                other_entities++;
+                continue;
+            }
+            rows[row_count++] = (lean_row){name, effect, m, 0};
+        }
+        rows[k].entities++;
+    }
+    for (uint32_t k = 0; k < row_count; k++) {
+        char left[256];
+        uint32_t n_left = ob_material_pbr_left_out(rows[k].first, left, sizeof left);
+        fprintf(f, "lean: material %s: %s", rows[k].material,
+                rows[k].effect ? rows[k].effect : "(no effect in the main view)");
+        if (n_left) fprintf(f, " (left out: %s)", left);
+        if (rows[k].entities > 1) fprintf(f, " [%u entities]", rows[k].entities);
+        fputc('\n', f);
+    }
+    if (other_entities)
+        fprintf(f, "lean: and %u more entities with other materials\n", other_entities);
+}
+
 static void print_summary(const ob_demo *d)
 {
     static const struct { const char *name; size_t off; } phases[] = {
@@ -493,6 +590,7 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     }
     if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
     print_summary(d);
+    ob_demo_print_lean_report(d, stdout);
     ob_demo_memory mem = ob_demo_memory_now();
     if (mem.rss_kb)
         printf("memory: resident %.1f MiB (peak %.1f MiB), heap in use %.1f MiB, of it "

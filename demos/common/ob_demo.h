@@ -1,7 +1,8 @@
 /* ob_demo.h — the demo runner the demo programs share: options, the
  * standard set-up (an ob_stack from views/ob_stack.h, with the window when
  * --window is given), the frame loop with its ST/MT toggling, per-frame
- * lines, the JSON stats and the summary of medians per mode.
+ * lines, the JSON stats, the summary of medians per mode and the lean-scene
+ * report (what the run left out).
  *
  * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
  * ob_demo_run → ob_demo_shutdown (also after a failed init). Thread rule:
@@ -60,6 +61,17 @@ typedef struct ob_demo_frame_times {
     double gpu_ms;
 } ob_demo_frame_times;
 
+/* What the run's frames left out, for the lean-scene report: each view
+ * that some frame left out (ob_frame_stats.skipped, and views that ran with
+ * nothing to draw), with the reason and the number of frames, and what the
+ * run created. */
+#define OB_DEMO_LEAN_VIEWS 16
+typedef struct ob_demo_lean {
+    struct { char name[48]; ob_skip_reason reason; uint32_t frames; } views[OB_DEMO_LEAN_VIEWS];
+    uint32_t view_count, views_more;  /* views_more: distinct ones past the table */
+    uint64_t pipelines_created, variants_created;
+} ob_demo_lean;
+
 typedef struct ob_demo {
     ob_demo_options opt;
     ob_stack *stack;          /* owns everything below but the window and the systems */
@@ -79,6 +91,7 @@ typedef struct ob_demo {
     FILE *json;
     ob_window *window;        /* --window */
     bool flipped;             /* F1: the mode is the opposite of what the options say */
+    ob_demo_lean lean;
 } ob_demo;
 
 /* The window (--window), then the stack: renderer (worker count from
@@ -109,6 +122,14 @@ typedef void (*ob_demo_update_fn)(ob_demo *d, uint32_t frame, double time, void 
  * wall time), switching modes per --threads / --toggle, printing a line per
  * frame and a summary, writing --stats-json and --out. Returns 0 on success. */
 int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user);
+
+/* Prints the lean-scene report once to f: the views the frames left out and
+ * why, the shader variants and pipelines created, whether the main view has
+ * MSAA targets, and each material the scene draws with its main-view effect
+ * (the PBR variant, e.g. "pbr:base+sh") and the PBR features that variant
+ * leaves out (ob_material_pbr_left_out). ob_demo_run prints it after the
+ * summary; call it after frames have run (variants exist then). */
+void ob_demo_print_lean_report(ob_demo *d, FILE *f);
 
 /* Medians of a phase over the recorded frames of one mode (NAN if none);
  * phase_offset is offsetof(ob_demo_frame_times, <phase>). */

@@ -629,12 +629,12 @@ ob_result ob_stab_long_run_rotation(ob_stab_ctx *c)
     const float rate = 1.3f;
     const double dt = 1.0 / 60.0;
     if (child) r = ob_node_add_rotation_controller(n, axis, rate);
-    if (!child || r != OB_OK) goto fail;
+    if (!child || r != OB_OK) goto fail_destroy_scene;
     ob_node_set_position(child, (const double[3]){0, 1, 0});
     uint64_t t0 = ob_time_ns();
     for (uint32_t i = 0; i < updates && r == OB_OK; i++) r = ob_scene_update(s, dt);
     double ms = (double)(ob_time_ns() - t0) * 1e-6;
-    if (r != OB_OK) goto fail;
+    if (r != OB_OK) goto fail_destroy_scene;
 
     double q[4];
     ob_node_get_rotation(n, q);
@@ -681,7 +681,7 @@ ob_result ob_stab_long_run_rotation(ob_stab_ctx *c)
                         fabs(ob_dvec3_length(p) - 1.0), "units", 1e-9, true, ms, "%s", what);
     return r;
 
-fail:
+fail_destroy_scene:
     OB_LOG_E("bench", "stability: rotation run failed: %s", ob_result_name(r));
     if (s) ob_scene_destroy(s);
     return r;

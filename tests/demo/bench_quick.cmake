@@ -1,5 +1,6 @@
 # obelisk-bench --quick: runs, writes JSON/CSV/charts, has every summary
-# field with a numeric value, every threading mode renders the same image
+# field with a numeric value, an MSAA row with a numeric image error and
+# frame time per offered sample count, every threading mode renders the same image
 # and commands as single-threaded, and every stability case (numerical
 # precision, extreme input and load) is reported and within the bound its
 # test asserts. Times are never judged.
@@ -14,9 +15,11 @@ file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 
 # With validation on (ctest sets OB_VALIDATION=1) recording is several times
-# slower than the plain --quick run: the timeout leaves room for that.
+# slower than the plain --quick run: the timeout leaves room for that. Three
+# idle rounds instead of --quick's 15: this test checks what the bench
+# writes, never its times, and the sanitizer passes run it too.
 execute_process(
-  COMMAND ${BIN}/obelisk-bench --quick --json ${OUT}/bench.json --csv ${OUT}/bench.csv
+  COMMAND ${BIN}/obelisk-bench --quick --rounds 3 --json ${OUT}/bench.json --csv ${OUT}/bench.csv
           --charts ${OUT}/charts
   RESULT_VARIABLE rc
   OUTPUT_FILE ${OUT}/stdout.txt
@@ -104,6 +107,69 @@ endforeach()
 string(JSON identical GET "${json}" summary threading_identical)
 if(NOT identical STREQUAL "ON" AND NOT identical STREQUAL "true")
   message(FATAL_ERROR "summary.threading_identical is '${identical}'")
+endif()
+
+# MSAA rows of the quality section: one antialiasing reference (drawn larger
+# with the most samples the device offers, box-downsampled) and a row per
+# offered sample count, 1x first, each with a numeric image error and frame
+# time; no row has more samples than the reference.
+string(JSON qrows LENGTH "${json}" quality)
+math(EXPR last "${qrows} - 1")
+set(msaa_ref 0)
+set(msaa_counts "")
+foreach(i RANGE ${last})
+  string(JSON kind GET "${json}" quality ${i} kind)
+  if(kind STREQUAL "msaa-reference")
+    math(EXPR msaa_ref "${msaa_ref} + 1")
+    string(JSON ref_samples GET "${json}" quality ${i} msaa_samples)
+    string(JSON ref_scale GET "${json}" quality ${i} supersample)
+    string(JSON ref_text GET "${json}" quality ${i} reference)
+    if(NOT ref_scale GREATER 1 OR NOT ref_samples GREATER 0 OR ref_text STREQUAL "")
+      message(FATAL_ERROR "msaa-reference row: supersample ${ref_scale}, msaa_samples ${ref_samples}, reference '${ref_text}'")
+    endif()
+  elseif(kind STREQUAL "msaa")
+    string(JSON samples GET "${json}" quality ${i} msaa_samples)
+    list(APPEND msaa_counts ${samples})
+    string(JSON msaa_psnr_${samples} GET "${json}" quality ${i} psnr_db)
+    foreach(field max_abs_diff psnr_db frame_ms)
+      string(JSON type ERROR_VARIABLE err TYPE "${json}" quality ${i} ${field})
+      string(JSON value ERROR_VARIABLE err2 GET "${json}" quality ${i} ${field})
+      if(err OR err2 OR NOT type STREQUAL "NUMBER" OR NOT value MATCHES "${number}")
+        message(FATAL_ERROR "quality row ${i} (msaa ${samples}x): ${field} is not a number: '${value}' (${type}) ${err}")
+      endif()
+    endforeach()
+    string(JSON against GET "${json}" quality ${i} against)
+    if(NOT against STREQUAL "msaa-reference")
+      message(FATAL_ERROR "quality row ${i} (msaa ${samples}x) is measured against '${against}'")
+    endif()
+  endif()
+endforeach()
+if(NOT msaa_ref EQUAL 1)
+  message(FATAL_ERROR "quality has ${msaa_ref} msaa-reference rows, expected 1")
+endif()
+list(LENGTH msaa_counts n_msaa)
+list(GET msaa_counts 0 first_count)
+if(n_msaa LESS 1 OR NOT first_count EQUAL 1)
+  message(FATAL_ERROR "MSAA rows for sample counts '${msaa_counts}': expected 1x first")
+endif()
+if(ref_samples GREATER 1 AND n_msaa LESS 2)
+  message(FATAL_ERROR "the device offers ${ref_samples}x but only '${msaa_counts}' were measured")
+endif()
+foreach(samples ${msaa_counts})
+  if(samples GREATER ref_samples)
+    message(FATAL_ERROR "an MSAA row has ${samples}x, more than its reference's ${ref_samples}x")
+  endif()
+endforeach()
+# Image error, not time: the most samples measured come closer to the
+# antialiasing reference than one sample does (lavapipe: 4x by some 5 dB).
+list(GET msaa_counts -1 most)
+if(most GREATER 1 AND NOT msaa_psnr_${most} GREATER msaa_psnr_1)
+  message(FATAL_ERROR "MSAA ${most}x: PSNR ${msaa_psnr_${most}} dB against the reference, not above 1x's ${msaa_psnr_1} dB")
+endif()
+file(STRINGS ${OUT}/bench.csv msaa_csv REGEX "^msaa,")
+list(LENGTH msaa_csv n_csv)
+if(NOT n_csv EQUAL n_msaa)
+  message(FATAL_ERROR "bench.csv has ${n_csv} msaa rows, the JSON ${n_msaa}")
 endif()
 
 # The sweep's frames recorded the same commands in every mode.
