@@ -257,37 +257,6 @@ void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason r
 
 /* ------------------------------------------------------------ frame */
 
-/* A measurement is stale after this many frames recorded the other way. */
-#define AUTO_REMEASURE_FRAMES 32
-
-/* AUTO: record the way that measured cheaper for this scene (per draw, or
- * per frame before any frame had draws); measure a way never measured (or
- * with another worker count) first, and re-measure the other way when its
- * figure is old or the draw count has moved by a quarter since it was taken.
- * The way in use is kept unless the other is cheaper by AUTO_MARGIN_PCT, so
- * two nearly equal ways do not alternate on noise. */
-#define AUTO_MARGIN_PCT 3u
-
-static bool auto_choice(ob_renderer *r)
-{
-    /* Inline against the active worker count's own figure: a frame on
-     * another count says nothing about this one. */
-    const ob_record_cost *way[2] = {&r->measured[0], &r->measured[r->active]};
-    if (way[0]->cost_ns == 0) return false;
-    if (way[1]->cost_ns == 0) return true;
-    bool per_draw = way[0]->per_draw_ps > 0 && way[1]->per_draw_ps > 0;
-    uint64_t cost[2] = {per_draw ? way[0]->per_draw_ps : way[0]->cost_ns,
-                        per_draw ? way[1]->per_draw_ps : way[1]->cost_ns};
-    bool cur = r->auto_multi;
-    bool multi = cur;
-    if (cost[!cur] * (100u + AUTO_MARGIN_PCT) < cost[cur] * 100u) multi = !cur;
-    const ob_record_cost *other = way[!multi], *chosen = way[multi];
-    uint32_t now = chosen->draws, then = other->draws;
-    bool resized = 4ull * (now > then ? now - then : then - now) > (uint64_t)OB_MAX(now, then);
-    if (other->age >= AUTO_REMEASURE_FRAMES || resized) multi = !multi;
-    return multi;
-}
-
 ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 {
     if (r->in_frame) {
@@ -345,7 +314,8 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 
     r->mode = r->pending_mode;
     r->active = r->pending_active;
-    if (r->mode == OB_THREADING_AUTO) r->auto_multi = auto_choice(r);
+    if (r->mode == OB_THREADING_AUTO)
+        r->auto_multi = ob_auto_choose(&r->auto_state, &r->measured[0], &r->measured[r->active]);
     r->scene = scene;
     r->queue_count = 0;
     r->stack_depth = 0;

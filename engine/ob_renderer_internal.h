@@ -8,6 +8,7 @@
 #include <semaphore.h>
 #include <stdatomic.h>
 
+#include "ob_auto_internal.h"
 #include "ob_renderer_layer.h"
 
 #define OB_MAX_VIEW_STACK 32
@@ -49,16 +50,6 @@ typedef struct ob_worker {
     int cpu;                    /* the CPU it is pinned to; -1 = none yet */
     ob_result error;
 } ob_worker;
-
-/* What recording a scene one way (inline or on workers) cost. */
-typedef struct ob_record_cost {
-    uint64_t cost_ns;           /* moving average of a frame's; 0 = never measured */
-    uint64_t per_draw_ps;       /* median of the last three frames' cost per draw */
-    uint64_t recent_ps[3];      /* those frames' (frames with draws), a ring */
-    uint32_t recent_count;
-    uint32_t draws;             /* moving average */
-    uint32_t age;               /* frames of the other way since this was taken */
-} ob_record_cost;
 
 typedef struct ob_frame_slot {
     VkCommandPool pool;
@@ -108,7 +99,8 @@ struct ob_renderer {
 
     ob_threading mode, pending_mode;
     uint32_t active, pending_active;
-    bool auto_multi;            /* AUTO's decision for this frame */
+    bool auto_multi;            /* AUTO's way for this frame (a probe or its choice) */
+    ob_auto_state auto_state;
     /* Measured recording cost (wall time from the start of recording to the
      * primary's end) of each way of recording this scene, [0] inline and [1]
      * with the active workers: a moving average over the frames recorded

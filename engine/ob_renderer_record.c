@@ -591,28 +591,10 @@ static uint64_t cmd_allocations(ob_renderer *r)
     return n;
 }
 
-/* The measured cost of recording this frame's way (see auto_choice): an
- * average that follows a changed scene within a few frames. */
+/* The measured cost of recording this frame's way (engine/ob_auto.c). */
 static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
 {
-    ob_record_cost *m = &r->measured[multi ? workers : 0];
-    bool fresh = m->cost_ns == 0;
-    m->cost_ns = fresh ? ns : (3 * m->cost_ns + ns) / 4;
-    m->cost_ns = OB_MAX(m->cost_ns, (uint64_t)1);
-    if (draws > 0) {
-        /* Per draw, so that frames that add views now and then (an env map
-         * refreshed every few frames) compare with those that do not; the
-         * median of three, so that one slow frame (a pipeline compiled, a
-         * late wake-up) neither decides nor lingers. */
-        m->recent_ps[m->recent_count++ % 3] = OB_MAX(ns * 1000u / draws, (uint64_t)1);
-        uint64_t a = m->recent_ps[0], b = m->recent_ps[1], c = m->recent_ps[2];
-        if (m->recent_count == 1) m->per_draw_ps = a;
-        else if (m->recent_count == 2) m->per_draw_ps = (a + b) / 2;
-        else m->per_draw_ps = OB_MAX(OB_MIN(a, b), OB_MIN(OB_MAX(a, b), c));
-    }
-    /* Smoothed too: a view refreshed every few frames is not a new scene. */
-    m->draws = fresh ? draws : (uint32_t)((3ull * m->draws + draws) / 4);
-    m->age = 0;
+    ob_record_cost_note(&r->measured[multi ? workers : 0], ns, draws);
     /* The other way AUTO weighs against this one ages. */
     r->measured[multi ? 0 : r->active].age++;
 }

@@ -1,0 +1,119 @@
+/* OB_THREADING_AUTO's choice (engine/ob_auto.c), driven the way the renderer
+ * drives it, with made-up costs: which way it takes, how often it pays for
+ * re-measuring the other, and how fast it follows a change. */
+#include "ob_test.h"
+
+#include "ob_auto_internal.h"
+
+#include <stdint.h>
+
+typedef struct sim {
+    ob_auto_state s;
+    ob_record_cost way[2];      /* [0] inline, [1] workers */
+    uint32_t probes;
+} sim;
+
+/* One AUTO frame of `draws` draws, each way costing its ps per draw: the
+ * choice, then the frame's cost noted as the renderer notes it. Returns the
+ * way the frame recorded (true = the workers). */
+static bool frame(sim *m, uint64_t inline_ps, uint64_t workers_ps, uint32_t draws)
+{
+    bool workers = ob_auto_choose(&m->s, &m->way[0], &m->way[1]);
+    if (m->s.probing) m->probes++;
+    uint64_t ps = workers ? workers_ps : inline_ps;
+    ob_record_cost_note(&m->way[workers], ps * draws / 1000u, draws);
+    m->way[!workers].age++;
+    return workers;
+}
+
+/* Each way is measured once first; then the cheaper one is kept. */
+static void measures_both_ways_then_keeps_the_cheaper(void **state)
+{
+    (void)state;
+    sim m = {0};
+    assert_false(frame(&m, 180000, 100000, 1000));
+    assert_true(frame(&m, 180000, 100000, 1000));
+    for (int f = 0; f < 20; f++) assert_true(frame(&m, 180000, 100000, 1000));
+    m = (sim){0};
+    frame(&m, 100000, 180000, 1000);
+    frame(&m, 100000, 180000, 1000);
+    for (int f = 0; f < 20; f++) assert_false(frame(&m, 100000, 180000, 1000));
+}
+
+/* A choice every probe confirms by a wide margin is re-measured less and
+ * less often (32, 64, ... 512 frames): over 4000 frames some ten probes,
+ * where a fixed 32-frame interval takes some 120, each at the dearer way's
+ * cost. It never stops re-measuring. */
+static void a_clear_choice_is_re_measured_less_often(void **state)
+{
+    (void)state;
+    sim m = {0};
+    uint32_t inline_frames = 0;
+    for (int f = 0; f < 4000; f++) inline_frames += !frame(&m, 180000, 100000, 1000);
+    assert_true(m.probes >= 5);
+    assert_true(m.probes <= 12);
+    assert_int_equal(inline_frames, m.probes + 1);   /* the first frame measured inline */
+    assert_int_equal(ob_auto_remeasure_interval(&m.s), 512);
+}
+
+/* Ways within the clear margin (10% apart) keep the short interval: a
+ * change there could turn the choice any frame. */
+static void close_ways_keep_the_short_interval(void **state)
+{
+    (void)state;
+    sim m = {0};
+    for (int f = 0; f < 4000; f++) {
+        bool workers = frame(&m, 110000, 100000, 1000);
+        assert_true(workers || m.s.probing || f == 0);
+    }
+    assert_int_equal(ob_auto_remeasure_interval(&m.s), 32);
+    assert_true(m.probes >= 100);
+}
+
+/* After backing off, a way that became cheaper is still found: the probe
+ * that finds it closer shortens the interval again, and the next probes
+ * move the figure (a median of three frames, so one frame does not). */
+static void a_change_is_followed_after_backing_off(void **state)
+{
+    (void)state;
+    sim m = {0};
+    for (int f = 0; f < 2000; f++) frame(&m, 180000, 100000, 1000);
+    assert_int_equal(ob_auto_remeasure_interval(&m.s), 512);
+    int switched = -1;
+    for (int f = 0; f < 1200 && switched < 0; f++) {
+        frame(&m, 60000, 100000, 1000);
+        if (!m.s.way) switched = f;
+    }
+    assert_true(switched >= 0);
+    assert_true(switched <= 512 + 2 * 32 + 2);
+    /* It stays there. */
+    for (int f = 0; f < 100; f++) {
+        bool workers = frame(&m, 60000, 100000, 1000);
+        assert_true(!workers || m.s.probing);
+    }
+}
+
+/* A scene that changes size re-measures the other way within a few
+ * frames (the draw count is smoothed), whatever the interval had grown to. */
+static void a_resized_scene_is_re_measured_at_once(void **state)
+{
+    (void)state;
+    sim m = {0};
+    for (int f = 0; f < 2000; f++) frame(&m, 180000, 100000, 1000);
+    assert_int_equal(ob_auto_remeasure_interval(&m.s), 512);
+    uint32_t before = m.probes;
+    for (int f = 0; f < 4; f++) frame(&m, 180000, 100000, 3000);
+    assert_true(m.probes > before);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(measures_both_ways_then_keeps_the_cheaper),
+        cmocka_unit_test(a_clear_choice_is_re_measured_less_often),
+        cmocka_unit_test(close_ways_keep_the_short_interval),
+        cmocka_unit_test(a_change_is_followed_after_backing_off),
+        cmocka_unit_test(a_resized_scene_is_re_measured_at_once),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
