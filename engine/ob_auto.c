@@ -71,13 +71,14 @@ void ob_record_cost_note(ob_record_cost *m, uint64_t ns, uint32_t draws)
     if (draws > 0) {
         /* Per draw, so that frames that add views now and then (an env map
          * refreshed every few frames) compare with those that do not; the
-         * median of three, so that one slow frame (a pipeline compiled, a
-         * late wake-up) neither decides nor lingers. */
+         * fastest of the last three, since interference (a preempted
+         * thread, a late wake-up, a pipeline compiled) only ever adds
+         * time: slow frames decide nothing unless three in a row are slow,
+         * and a way that became cheaper shows in its first frame. */
         m->recent_ps[m->recent_count++ % 3] = OB_MAX(ns * 1000u / draws, (uint64_t)1);
-        uint64_t a = m->recent_ps[0], b = m->recent_ps[1], c = m->recent_ps[2];
-        if (m->recent_count == 1) m->per_draw_ps = a;
-        else if (m->recent_count == 2) m->per_draw_ps = (a + b) / 2;
-        else m->per_draw_ps = OB_MAX(OB_MIN(a, b), OB_MIN(OB_MAX(a, b), c));
+        uint32_t n = OB_MIN(m->recent_count, 3u);
+        m->per_draw_ps = m->recent_ps[0];
+        for (uint32_t i = 1; i < n; i++) m->per_draw_ps = OB_MIN(m->per_draw_ps, m->recent_ps[i]);
     }
     /* Smoothed too: a view refreshed every few frames is not a new scene. */
     m->draws = fresh ? draws : (uint32_t)((3ull * m->draws + draws) / 4);

@@ -11,7 +11,7 @@
 /* What recording a scene one way (inline or on n workers) cost. */
 typedef struct ob_record_cost {
     uint64_t cost_ns;           /* moving average of a frame's; 0 = never measured */
-    uint64_t per_draw_ps;       /* median of the last three frames' cost per draw */
+    uint64_t per_draw_ps;       /* the lowest of the last three frames' cost per draw */
     uint64_t recent_ps[3];      /* those frames' (frames with draws), a ring */
     uint32_t recent_count;
     uint32_t draws;             /* moving average */

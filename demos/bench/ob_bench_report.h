@@ -68,6 +68,7 @@ typedef struct ob_bench_report {
     bool validation;
     ob_gpu_timing gpu_timing;                      /* --gpu-timing */
     uint32_t warmup, rounds, flight;               /* sweep frame counts per mode */
+    uint32_t passes;                               /* frames per mode and idle round */
     uint32_t settle;                               /* ob_bench_run_desc.settle */
     uint32_t big_draws;                            /* frames of more draws (estimated) use */
     uint32_t big_warmup, big_rounds, big_flight;   /* these counts instead */

@@ -2,14 +2,19 @@
  *
  * Two loops, both over every mode of the list, in the same process on the
  * same scene (so ratios between modes come from one run):
- *   idle     rounds of one frame per mode; before each frame the device is
- *            waited idle (ob_renderer_wait_idle), so recording never competes
- *            with lavapipe executing the previous frame on the same cores.
- *            Within a round the scene is advanced once (by the round's
- *            first frame) and re-rendered untouched by the others, so every
- *            mode records exactly the same commands and their hashes must be
- *            equal. The mode order rotates by one each round, so no mode
- *            always follows the update or the same other mode.
+ *   idle     rounds of `passes` passes of one frame per mode; before each
+ *            frame the device is waited idle (ob_renderer_wait_idle), so
+ *            recording never competes with lavapipe executing the previous
+ *            frame on the same cores. Within a round the scene is advanced
+ *            once (by the round's first frame) and re-rendered untouched by
+ *            the others, so every mode records exactly the same commands and
+ *            their hashes must be equal. The mode order steps through all
+ *            orders of the modes, a new one each pass, so no mode always
+ *            follows the update or the same other mode. A mode's figure for the round is its fastest
+ *            pass: interference on this VM (a preempted thread, a late
+ *            wake-up) only ever adds time, so the fastest of a few frames of
+ *            the same commands is the steadiest estimate of their cost; the
+ *            slower passes are checked for hashes and otherwise dropped.
  *            Gives the CPU phases, GPU time (timestamps), binds.
  *   flight   per mode, consecutive frames without waiting (frames in
  *            flight, the normal way to run): gives the frame period.
@@ -18,8 +23,8 @@
  * ratio from the same round, so a slow spell of the machine divides out),
  * with their quartiles. The in-flight loop runs the modes one after another,
  * so its ratio (speedup_frame) stays a ratio of medians.
- * An optional hook runs after the modes of every idle round with the device
- * idle, given that round's recording times: a baseline measured there (the
+ * An optional hook runs after every pass of every idle round with the device
+ * idle, given that pass's recording times: a baseline measured there (the
  * raw Vulkan loop) shares the rounds' conditions.
  *
  * Lifecycle: fill ob_bench_run_desc → ob_bench_run_modes → read results.
@@ -49,10 +54,10 @@ typedef struct ob_bench_round_sample {
     uint32_t draws;
 } ob_bench_round_sample;
 
-/* After the modes of idle round `round` (warm-up rounds first, measured
- * false), device idle; modes[m] is mode m's frame of the round. [render
+/* After pass `pass` of idle round `round` (warm-up rounds first, measured
+ * false), device idle; modes[m] is mode m's frame of that pass. [render
  * thread]. A result other than OB_OK stops the run with that result. */
-typedef ob_result (*ob_bench_round_fn)(void *user, uint32_t round, bool measured,
+typedef ob_result (*ob_bench_round_fn)(void *user, uint32_t round, uint32_t pass, bool measured,
                                        const ob_bench_round_sample *modes);
 
 /* Median and quartiles of values taken one per round. */
@@ -64,7 +69,8 @@ typedef struct ob_bench_run_desc {
     const ob_bench_mode *modes;
     uint32_t mode_count;       /* the first mode is the reference for hashes and speedups */
     uint32_t warmup;           /* idle frames per mode before measuring */
-    uint32_t rounds;           /* measured idle frames per mode */
+    uint32_t rounds;           /* measured idle rounds */
+    uint32_t passes;           /* frames per mode and round, the fastest kept (0 = 1) */
     /* Unmeasured idle frames of a mode right before each of its measured
      * ones (0: the measured frame is the first after switching modes). */
     uint32_t settle;

@@ -50,6 +50,7 @@ typedef struct bench_options {
     char mode_names[OB_BENCH_MAX_MODES][8];
     uint32_t mode_count;
     uint32_t warmup, rounds, flight;
+    uint32_t passes;           /* --passes N */
     uint32_t settle;           /* --settle N */
     uint32_t view_width, view_height, image_width, image_height;
     uint32_t raw_objects;
@@ -70,7 +71,9 @@ static const char usage_text[] =
     "  --views LIST       perspective views per frame (default 1,4,8,16)\n"
     "  --objects LIST     objects (default 1000,10000,50000; at most 100000)\n"
     "  --modes LIST       ST, worker counts, auto (default ST,1,2,4,auto)\n"
-    "  --warmup N --rounds N --flight N   frames per mode: warm-up, idle, in flight\n"
+    "  --warmup N --rounds N --flight N   idle rounds (warm-up 3, measured 15 quick / 7),\n"
+    "                     in-flight frames per mode (2 quick / 5)\n"
+    "  --passes N         frames per mode in each idle round, the fastest kept (3)\n"
     "  --settle N         unmeasured frames of a mode before each measured idle one (0)\n"
     "  --view-size WxH    size of each sweep view (default 256x192)\n"
     "  --size WxH         size of the quality images (default 640x480)\n"
@@ -137,10 +140,18 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
     const char *views = quick ? "1,8" : "1,4,8,16";
     const char *objects = "1000,10000,50000";
     const char *modes = quick ? "ST,2,auto" : "ST,1,2,4,auto";
-    o->warmup = quick ? 1 : 2;
+    /* Warm-up rounds until the workers' own state (uniform rings, set
+     * caches, command pool arenas: per worker and frame slot) is made: in
+     * the first rounds a frame on the workers records slower than it will,
+     * and AUTO, measuring it, rightly records inline there. */
+    o->warmup = 3;
     /* Medians of per-round ratios need rounds to hold still from run to
-     * run; the in-flight loop feeds no summary ratio, so --quick keeps it short. */
-    o->rounds = quick ? 15 : 5;
+     * run: each round's figure of a mode is the fastest of 3 frames, the
+     * modes in a new order each pass (docs/benchmark.md has how still the
+     * figures hold). The in-flight loop feeds no summary ratio, so --quick
+     * keeps it short. */
+    o->rounds = quick ? 15 : 7;
+    o->passes = 3;
     o->flight = quick ? 2 : 5;
     o->settle = 0;
     *out_exit = 2;
@@ -176,15 +187,16 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
         } else if (!strcmp(a, "--modes")) {
             modes = v;
         } else if (!strcmp(a, "--warmup") || !strcmp(a, "--rounds") || !strcmp(a, "--flight") ||
-                   !strcmp(a, "--settle") || !strcmp(a, "--seed")) {
+                   !strcmp(a, "--settle") || !strcmp(a, "--seed") || !strcmp(a, "--passes")) {
             char *end;
             unsigned long n = strtoul(v, &end, 10);
             ok = *v && !*end && n <= 1000;
             uint32_t *dst = !strcmp(a, "--warmup") ? &o->warmup : !strcmp(a, "--rounds") ? &o->rounds
                             : !strcmp(a, "--flight") ? &o->flight
-                            : !strcmp(a, "--settle") ? &o->settle : &o->seed;
+                            : !strcmp(a, "--settle") ? &o->settle
+                            : !strcmp(a, "--passes") ? &o->passes : &o->seed;
             *dst = (uint32_t)n;
-            if (dst == &o->rounds) ok = ok && n > 0;
+            if (dst == &o->rounds || dst == &o->passes) ok = ok && n > 0;
         } else if (!strcmp(a, "--gpu-timing")) {
             ok = true;
             if (!strcmp(v, "sampled"))
@@ -255,13 +267,21 @@ static bool big_frame(uint32_t views, uint32_t objects)
     return (uint64_t)views * objects / 3 > BIG_FRAME_DRAWS;
 }
 
-static void frame_counts(const bench_options *o, uint32_t views, uint32_t objects,
-                         uint32_t *warmup, uint32_t *rounds, uint32_t *flight)
+typedef struct frame_counts {
+    uint32_t warmup, rounds, passes, settle, flight;
+} frame_counts;
+
+/* Big frames take seconds each in lavapipe: one pass, no settle frame. */
+static frame_counts counts_for(const bench_options *o, uint32_t views, uint32_t objects)
 {
     bool big = big_frame(views, objects);
-    *warmup = big ? OB_MIN(o->warmup, 1u) : o->warmup;
-    *rounds = big ? OB_MIN(o->rounds, 3u) : o->rounds;
-    *flight = big ? OB_MIN(o->flight, 2u) : o->flight;
+    return (frame_counts){
+        .warmup = big ? OB_MIN(o->warmup, 1u) : o->warmup,
+        .rounds = big ? OB_MIN(o->rounds, 3u) : o->rounds,
+        .passes = big ? 1u : o->passes,
+        .settle = big ? 0u : o->settle,
+        .flight = big ? OB_MIN(o->flight, 2u) : o->flight,
+    };
 }
 
 /* --quick measures 50k objects in one view only (the per-object growth
@@ -279,19 +299,23 @@ static uint64_t frame_weight(uint32_t views, uint32_t objects)
 }
 
 /* The raw baseline inside the sweep's idle rounds: after the engine's
- * frames of every round, one raw recording of the same draw list, so the
+ * frames of every pass, one raw recording of the same draw list, so the
  * engine and the raw loop are priced under the same state of the machine
- * and their ratio is taken per round. */
+ * and their ratio is taken per round, each side's fastest pass, as the
+ * engine's modes are compared. */
 typedef struct raw_rounds {
     ob_demo *demo;
     const ob_view *view;
     ob_bench_raw *raw;         /* made at the first round, once the view has a draw list */
     ob_bench_raw_sample last;
+    uint32_t passes;
+    double round_raw_ns, round_engine_ms;  /* this round's fastest so far */
+    uint32_t round_engine_draws;
     double *raw_ms, *allocs_per_draw, *engine_vs_raw;  /* one per measured round */
     uint32_t n, cap;
 } raw_rounds;
 
-static ob_result raw_round(void *user, uint32_t round, bool measured,
+static ob_result raw_round(void *user, uint32_t round, uint32_t pass, bool measured,
                            const ob_bench_round_sample *modes)
 {
     (void)round;
@@ -305,9 +329,16 @@ static ob_result raw_round(void *user, uint32_t round, bool measured,
     }
     r = ob_bench_raw_record(rr->raw, &rr->last);
     if (r != OB_OK || !measured || rr->n >= rr->cap || rr->last.draws == 0) return r;
-    double raw_ns = (double)rr->last.ns / rr->last.draws;
-    double engine_ns = modes[0].draws ? modes[0].record_total_ms * 1e6 / modes[0].draws : NAN;
-    rr->raw_ms[rr->n] = rr->last.ns * 1e-6;
+    if (pass == 0 || (double)rr->last.ns < rr->round_raw_ns) rr->round_raw_ns = (double)rr->last.ns;
+    if (pass == 0 || modes[0].record_total_ms < rr->round_engine_ms) {
+        rr->round_engine_ms = modes[0].record_total_ms;
+        rr->round_engine_draws = modes[0].draws;
+    }
+    if (pass + 1 < rr->passes) return OB_OK;
+    double raw_ns = rr->round_raw_ns / rr->last.draws;
+    double engine_ns = rr->round_engine_draws ? rr->round_engine_ms * 1e6 / rr->round_engine_draws
+                                              : NAN;
+    rr->raw_ms[rr->n] = rr->round_raw_ns * 1e-6;
     rr->allocs_per_draw[rr->n] = (double)rr->last.host_allocs / rr->last.draws;
     rr->engine_vs_raw[rr->n] = engine_ns / raw_ns;
     rr->n++;
@@ -351,10 +382,14 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
     ob_bench_run_desc rd = {.modes = o->modes, .mode_count = o->mode_count, .dt = 1.0 / 60.0,
                             .tick = ob_bench_progress_tick, .tick_user = prog};
-    frame_counts(o, views, objects, &rd.warmup, &rd.rounds, &rd.flight);
-    rd.settle = o->settle;
+    frame_counts fc = counts_for(o, views, objects);
+    rd.warmup = fc.warmup;
+    rd.rounds = fc.rounds;
+    rd.passes = fc.passes;
+    rd.settle = fc.settle;
+    rd.flight = fc.flight;
     *out = (ob_bench_sweep_entry){.views = views, .objects = objects, .mode_count = o->mode_count};
-    raw_rounds rr = {.demo = &d};
+    raw_rounds rr = {.demo = &d, .passes = rd.passes};
     bool raw = views == 1 && objects == o->raw_objects;
     if (r == OB_OK && raw) {
         rr.view = s.views[0];
@@ -397,7 +432,8 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
                               {"MT", OB_THREADING_MULTI, rep->cores},
                               {"auto", OB_THREADING_AUTO, rep->cores}};
     ob_bench_run_desc rd = {.modes = modes, .mode_count = 3, .warmup = o->warmup,
-                            .rounds = o->rounds, .settle = o->settle, .flight = 2 * o->flight,
+                            .rounds = o->rounds, .passes = o->passes, .settle = o->settle,
+                            .flight = 2 * o->flight,
                             .dt = 1.0 / 60.0,
                             .tick = ob_bench_progress_tick, .tick_user = prog};
     rep->scene200 = (ob_bench_sweep_entry){.views = 1, .objects = 200, .mode_count = 3};
@@ -535,8 +571,8 @@ static int run(const bench_options *o)
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     ob_bench_report rep = {.quick = o->quick, .gpu_timing = o->gpu_timing,
                            .seed = o->seed, .cores = ncpu > 0 ? (uint32_t)ncpu : 1,
-                           .warmup = o->warmup, .rounds = o->rounds, .settle = o->settle,
-                           .flight = o->flight,
+                           .warmup = o->warmup, .rounds = o->rounds, .passes = o->passes,
+                           .settle = o->settle, .flight = o->flight,
                            .view_width = o->view_width, .view_height = o->view_height,
                            .image_width = o->image_width, .image_height = o->image_height,
                            .image_frames = o->quick ? 3 : 4};
@@ -548,7 +584,10 @@ static int run(const bench_options *o)
                                     .commands_per_object = NAN, .host_allocs_per_object = NAN};
     rep.engine_ns_per_draw = NAN;
     rep.big_draws = BIG_FRAME_DRAWS;
-    frame_counts(o, 1000, 1000000, &rep.big_warmup, &rep.big_rounds, &rep.big_flight);
+    frame_counts big = counts_for(o, 1000, 1000000);
+    rep.big_warmup = big.warmup;
+    rep.big_rounds = big.rounds;
+    rep.big_flight = big.flight;
     uint64_t t0 = ob_time_ns();
     rep.load_start = load_average();
     static const uint32_t env_full[] = {64, 128, 256, 512}, shadow_full[] = {256, 512, 1024, 2048};
@@ -567,14 +606,14 @@ static int run(const bench_options *o)
     uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3;
     uint64_t total = 0;
     if (o->perf) {
-        total += 3 * (o->warmup + o->rounds + 2 * o->flight + 1) +
+        total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
                  quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) + qd.image_frames;
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
                 if (!config_runs(o, o->views[v], o->objects[n])) continue;
-                uint32_t w, r, f;
-                frame_counts(o, o->views[v], o->objects[n], &w, &r, &f);
-                total += (uint64_t)o->mode_count * (w + r + f + 1) *
+                frame_counts fc = counts_for(o, o->views[v], o->objects[n]);
+                total += (uint64_t)o->mode_count *
+                         ((fc.warmup + fc.rounds) * fc.passes * (fc.settle + 1) + fc.flight + 1) *
                          frame_weight(o->views[v], o->objects[n]);
             }
         }
