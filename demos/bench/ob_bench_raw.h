@@ -39,7 +39,7 @@ typedef struct ob_bench_raw_sample {
 /* What a run of recordings gave (filled by the caller from the samples). */
 typedef struct ob_bench_raw_result {
     uint32_t draws;
-    uint32_t reps;             /* measured recordings */
+    uint32_t reps;             /* measured rounds (each its fastest pass) */
     uint32_t buffer_binds;     /* vertex + index binds per recording */
     double record_ms;          /* median recording time */
     double ns_per_draw;        /* median over recordings of ns / draws */

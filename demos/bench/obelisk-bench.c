@@ -58,7 +58,7 @@ typedef struct bench_options {
 
 static const char usage_text[] =
     "usage: obelisk-bench [options]\n"
-    "  --quick            a reduced run (one to two minutes on 2 cores; views 1,8, modes\n"
+    "  --quick            a reduced run (two to three minutes on 2 cores; views 1,8, modes\n"
     "                     ST,2,auto, and 50000 objects in 1 view only)\n"
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
@@ -285,7 +285,7 @@ static frame_counts counts_for(const bench_options *o, uint32_t views, uint32_t 
 }
 
 /* --quick measures 50k objects in one view only (the per-object growth
- * from 1k to 50k), not in several: that keeps it near a minute. */
+ * from 1k to 50k), not in several: that keeps it to a few minutes. */
 static bool config_runs(const bench_options *o, uint32_t views, uint32_t objects)
 {
     return !(o->quick && views > 1 && objects > 10000);
