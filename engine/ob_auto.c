@@ -47,8 +47,8 @@ bool ob_auto_choose(ob_auto_state *s, const ob_record_cost *inline_way,
     bool multi = cur;
     if (cost[!cur] * (100u + AUTO_MARGIN_PCT) < cost[cur] * 100u) multi = !cur;
     const ob_record_cost *other = way[!multi], *chosen = way[multi];
-    /* What the last probe found: its own frame, not the smoothed figure,
-     * which one frame does not move. */
+    /* What the last probe found: its own frame, not the way's figure (the
+     * fastest of three), which a probe that came out dearer does not move. */
     if (multi != cur) {
         s->confirmed = 0;
     } else if (was_probing) {
