@@ -68,6 +68,7 @@ ob_result ob_node_add_rotation_controller(ob_node *n, const float axis[3], float
     ob_dvec3_copy(a, st->axis);
     st->rate = radians_per_second;
     return ob_node_add_controller(n, &(ob_controller_desc){.fn = rotation_step, .user = st,
+                                                           .parallel = true,
                                                            .release = ob_free});
 }
 
@@ -104,6 +105,7 @@ ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const
     st->rate = radians_per_second;
     st->angle = phase;
     return ob_node_add_controller(n, &(ob_controller_desc){.fn = orbit_step, .user = st,
+                                                           .parallel = true,
                                                            .release = ob_free});
 }
 

@@ -206,6 +206,34 @@ double ob_median(double *v, uint32_t n);
 /* CPU time the calling thread has used, in nanoseconds. */
 uint64_t ob_thread_cpu_ns(void);
 
+/* One index of a parallel loop. `thread` (0 .. threads-1; 0 is the calling
+ * thread) names the thread running it, for per-thread scratch: two calls
+ * with the same thread never overlap. Results that must not depend on the
+ * thread count are written per index and combined in index order. */
+typedef void (*ob_task_fn)(void *user, uint32_t index, uint32_t thread);
+
+/* A way to run a parallel loop: run(ctx, count, fn, user) calls fn once for
+ * every index in [0, count), on at most `threads` threads, and returns when
+ * all calls are done. The renderer lends its worker pool this way
+ * (ob_renderer_parallel); threads = 1 means everything runs on the caller. */
+typedef struct ob_parallel {
+    void (*run)(void *ctx, uint32_t count, ob_task_fn fn, void *user);
+    void *ctx;
+    uint32_t threads;
+} ob_parallel;
+
+/* Runs the loop through par, or on the caller when par is NULL or has one
+ * thread (or count < 2). [any thread] */
+static inline void ob_parallel_run(const ob_parallel *par, uint32_t count, ob_task_fn fn,
+                                   void *user)
+{
+    if (par && par->run && par->threads > 1 && count > 1) {
+        par->run(par->ctx, count, fn, user);
+        return;
+    }
+    for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
+}
+
 /* Read a whole file into a NUL-terminated buffer (ob_free it). On failure
  * returns NULL, logs the path and the OS error, and sets *out_result. */
 char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result);

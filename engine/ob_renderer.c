@@ -244,6 +244,26 @@ const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r) { return &
 
 void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns) { r->cur.update_ns = ns; }
 
+ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
+{
+    if (r->in_frame) {
+        OB_LOG_E("renderer", "ob_renderer_update_scene inside a frame (between begin_frame and "
+                 "end_frame); refused");
+        return OB_ERR_WRONG_STATE;
+    }
+    uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
+    r->update.cpu_render_parallel = r->update.cpu_pool = 0;
+    r->acc_render_parallel = &r->update.cpu_render_parallel;
+    r->acc_pool = &r->update.cpu_pool;
+    ob_parallel par = ob_renderer_parallel(r);
+    ob_result res = ob_scene_update_parallel(s, dt, &par);
+    r->acc_render_parallel = r->acc_pool = NULL;
+    r->update.cpu_render = ob_thread_cpu_ns() - c0;
+    r->update.ns = ob_time_ns() - t0;
+    r->update.valid = true;
+    return res;
+}
+
 void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason)
 {
     ob_frame_stats *st = &r->cur;
@@ -323,6 +343,16 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     memset(&r->cur, 0, sizeof r->cur);
     r->cur.frame = r->serial;
     r->cur.mode = r->mode;
+    if (r->update.valid) {
+        r->cur.update_ns = r->update.ns;
+        r->cur.cpu_render_ns = r->update.cpu_render;
+        r->cur.cpu_render_parallel_ns = r->update.cpu_render_parallel;
+        r->cur.cpu_pool_ns = r->update.cpu_pool;
+        r->update.valid = false;
+    }
+    r->acc_render_parallel = &r->cur.cpu_render_parallel_ns;
+    r->acc_pool = &r->cur.cpu_pool_ns;
+    r->frame_cpu0 = ob_thread_cpu_ns();
     r->frame_start_ns = t0;
     r->in_frame = true;
     r->submitted = false;
@@ -495,6 +525,7 @@ ob_result ob_renderer_end_frame(ob_renderer *r)
      * its swapchain image: the present waits on what was submitted. */
     ob_result pres = ob_renderer_present_queue(r);
     r->in_frame = false;
+    r->acc_render_parallel = r->acc_pool = NULL;
     if (res != OB_OK) return res;
     r->cur.frame_ns = ob_time_ns() - r->frame_start_ns + r->cur.update_ns;
     r->frames[r->slot].stats = r->cur;

@@ -127,6 +127,14 @@ typedef struct ob_frame_stats {
     /* Host allocations the driver made through the command pools'
      * allocation callbacks while this frame was recorded, all threads. */
     uint64_t cmd_host_allocs;
+    /* CPU time (CLOCK_THREAD_CPUTIME_ID) of the frame's CPU phases, from the
+     * update (when made through ob_renderer_update_scene) to the submission:
+     * cpu_render_ns on the render thread in all, cpu_render_parallel_ns the
+     * part of it inside parallel sections (parallel update, culling, the
+     * jobs it records itself), cpu_pool_ns the pool threads' (all of it in
+     * parallel sections). The serial part is cpu_render_ns -
+     * cpu_render_parallel_ns; the frame's total cpu_render_ns + cpu_pool_ns. */
+    uint64_t cpu_render_ns, cpu_render_parallel_ns, cpu_pool_ns;
     uint32_t pipelines_created, variants_created;
     uint64_t frame_hash;         /* all view hashes in order */
 } ob_frame_stats;
@@ -164,8 +172,19 @@ ob_result ob_renderer_process_views(ob_renderer *r);
  * ob_renderer_internal.h), larger values are clamped. [render thread] */
 void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth);
 
-/* Time the application spent updating the scene, for the stats. */
+/* Time the application spent updating the scene, for the stats (a program
+ * that calls ob_scene_update itself; ob_renderer_update_scene notes its own). */
 void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns);
+
+/* ob_scene_update(s, dt) on the renderer's worker pool: controllers that
+ * declared themselves parallel-safe, world transforms and bounds, and the
+ * snapshot run in chunks on the pool threads and the render thread; other
+ * controllers on the render thread, in the order ob_scene_update runs them.
+ * The result is exactly ob_scene_update's. It follows the threading mode the
+ * next begin_frame applies (single-threaded: all on the calling thread).
+ * Call it before begin_frame: its wall time and CPU time are that frame's
+ * update figures (ob_frame_stats.update_ns, cpu_*). [render thread] */
+ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt);
 
 /* Called with each frame's final stats (GPU times included) once the frame
  * is known complete, in frame order. [render thread] */

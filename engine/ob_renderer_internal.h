@@ -46,6 +46,7 @@ typedef struct ob_worker {
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
     uint64_t cpu_ns;            /* thread CPU time of its last batch */
+    uint64_t task_cpu_ns;       /* thread CPU time of its share of the last parallel loop */
     ob_arena_allocator alloc[OB_MAX_FRAMES_IN_FLIGHT];  /* one per pool */
     int cpu;                    /* the CPU it is pinned to; -1 = none yet */
     ob_result error;
@@ -130,6 +131,23 @@ struct ob_renderer {
     uint32_t undo_count;
     bool undo_overflow;
 
+    /* The parallel loop being run (ob_renderer_parallel): a pool thread
+     * woken while task_fn is set runs loop indices instead of jobs. */
+    ob_task_fn task_fn;
+    void *task_user;
+    uint32_t task_count;
+    atomic_uint next_task;
+    bool in_parallel;           /* a loop is running: a nested one runs inline */
+    /* Where the CPU time of parallel sections is added: the frame's stats,
+     * or the pending update's before begin_frame. */
+    uint64_t *acc_render_parallel, *acc_pool;
+    uint64_t frame_cpu0;        /* render thread CPU at begin_frame */
+    /* ob_renderer_update_scene's figures, for the next begin_frame. */
+    struct {
+        bool valid;
+        uint64_t ns, cpu_render, cpu_render_parallel, cpu_pool;
+    } update;
+
     sem_t done;                 /* each pool thread posts it when its batch is recorded */
     bool done_ready;
     atomic_uint next_job;
@@ -145,6 +163,9 @@ struct ob_renderer {
 };
 
 /* ob_renderer_record.c */
+/* The threads a parallel loop gets now: 1 single-threaded, else the active
+ * workers (the pending mode's outside a frame). */
+uint32_t ob_renderer_parallel_threads(const ob_renderer *r);
 ob_result ob_renderer_workers_start(ob_renderer *r);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);

@@ -46,6 +46,12 @@ struct ob_material_iface {
      * (env maps, ...), and make the pipeline for v's targets exist.
      * [render thread, PreRender] */
     void (*pre_render)(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v);
+    /* Optional. Whether pre_render of m in a view of this type depends on
+     * the entity (it queues something per entity, like an env map). When
+     * false, a view calls pre_render once per material, for the first of
+     * its items with it in draw order, instead of once per item. NULL: per
+     * item. [any thread] */
+    bool (*pre_render_per_entity)(const struct ob_material *m, ob_view_type type);
     /* Set the pipeline and the material's parameters for v. Views draw the
      * entities of a state group one after another and apply once per run of
      * the same material when it answers OB_APPLY_MATERIAL. [recording thread:
@@ -92,6 +98,13 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
  * or for NULL; nested deeper than OB_MAX_VIEW_STACK it records
  * OB_SKIP_RECURSION and does not run v. [render thread, PreRender] */
 void ob_renderer_pre_render(ob_renderer *r, ob_view *v);
+/* The renderer's worker pool as a parallel loop (ob_parallel, ob_core.h),
+ * for PreRender work split over chunks: as many threads as the frame's
+ * threading mode gives (1 single-threaded: the loop runs on the caller).
+ * The loop's functions must not call the renderer; a loop started inside
+ * one runs on its caller. The CPU time spent in it counts as parallel in
+ * the frame's stats. [render thread] */
+ob_parallel ob_renderer_parallel(ob_renderer *r);
 /* Nesting of the running pre_render: 0 for a root view, 1 for a view it
  * started, ... (0 outside PreRender). [render thread] */
 uint32_t ob_renderer_recursion_depth(const ob_renderer *r);

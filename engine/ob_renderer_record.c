@@ -173,6 +173,18 @@ static void record_batch(ob_renderer *r, ob_worker *w)
     w->cpu_ns = ob_thread_cpu_ns() - c0;
 }
 
+/* Indices of the running parallel loop, taken one at a time from the
+ * shared counter until none is left. `thread` is the caller's loop thread
+ * number (0 = the render thread). */
+static void run_tasks(ob_renderer *r, uint32_t thread)
+{
+    for (;;) {
+        uint32_t i = atomic_fetch_add_explicit(&r->next_task, 1, memory_order_relaxed);
+        if (i >= r->task_count) break;
+        r->task_fn(r->task_user, i, thread);
+    }
+}
+
 static void *worker_main(void *arg)
 {
     ob_worker *w = arg;
@@ -180,10 +192,66 @@ static void *worker_main(void *arg)
     for (;;) {
         while (sem_wait(&w->go) != 0) {} /* EINTR */
         if (r->quit) break;
-        record_batch(r, w);
+        if (r->task_fn) {
+            uint64_t c0 = ob_thread_cpu_ns();
+            run_tasks(r, w->index);
+            w->task_cpu_ns = ob_thread_cpu_ns() - c0;
+        } else {
+            record_batch(r, w);
+        }
         sem_post(&r->done);
     }
     return NULL;
+}
+
+uint32_t ob_renderer_parallel_threads(const ob_renderer *r)
+{
+    ob_threading mode = r->in_frame ? r->mode : r->pending_mode;
+    uint32_t active = r->in_frame ? r->active : r->pending_active;
+    if (mode == OB_THREADING_SINGLE || r->worker_count == 0) return 1;
+    return OB_MAX(1u, OB_MIN(active, r->worker_count));
+}
+
+static void place_workers(ob_renderer *r, uint32_t helpers);
+
+/* ob_parallel's run for the pool: pool threads 1..threads-1 (only as many as
+ * there are indices) are woken, the render thread takes indices too, and
+ * the call returns when every index is done. A loop started from inside a
+ * loop, or from a pool thread, runs on the caller. */
+static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
+{
+    ob_renderer *r = ctx;
+    uint32_t threads = ob_renderer_parallel_threads(r);
+    if (r->in_parallel || threads < 2 || count < 2) {
+        for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
+        return;
+    }
+    uint64_t c0 = ob_thread_cpu_ns();
+    uint32_t helpers = OB_MIN(threads - 1, count - 1);
+    r->in_parallel = true;
+    r->task_fn = fn;
+    r->task_user = user;
+    r->task_count = count;
+    atomic_store_explicit(&r->next_task, 0, memory_order_relaxed);
+    place_workers(r, helpers);
+    for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
+    run_tasks(r, 0);
+    for (uint32_t i = 0; i < helpers; i++)
+        while (sem_wait(&r->done) != 0) {} /* EINTR */
+    r->task_fn = NULL;
+    r->in_parallel = false;
+    uint64_t pool = 0;
+    for (uint32_t i = 0; i < helpers; i++) {
+        pool += r->workers[i].task_cpu_ns;
+        r->workers[i].task_cpu_ns = 0;
+    }
+    if (r->acc_pool) *r->acc_pool += pool;
+    if (r->acc_render_parallel) *r->acc_render_parallel += ob_thread_cpu_ns() - c0;
+}
+
+ob_parallel ob_renderer_parallel(ob_renderer *r)
+{
+    return (ob_parallel){.run = pool_run, .ctx = r, .threads = ob_renderer_parallel_threads(r)};
 }
 
 ob_result ob_renderer_workers_start(ob_renderer *r)
@@ -255,6 +323,7 @@ static void place_workers(ob_renderer *r, uint32_t helpers)
  * the last active worker's share instead of sleeping. */
 static void run_jobs(ob_renderer *r, uint32_t active)
 {
+    uint64_t c0 = ob_thread_cpu_ns();
     atomic_store_explicit(&r->next_job, 0, memory_order_relaxed);
     uint32_t helpers = OB_MIN(active - 1, r->job_count - 1);
     place_workers(r, helpers);
@@ -262,6 +331,8 @@ static void run_jobs(ob_renderer *r, uint32_t active)
     record_batch(r, &r->workers[active - 1]);
     for (uint32_t i = 0; i < helpers; i++)
         while (sem_wait(&r->done) != 0) {} /* EINTR */
+    for (uint32_t i = 0; i < helpers; i++) r->cur.cpu_pool_ns += r->workers[i].cpu_ns;
+    r->cur.cpu_render_parallel_ns += ob_thread_cpu_ns() - c0;
 }
 
 /* ------------------------------------------------------------ jobs */
@@ -779,6 +850,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         return ob_result_from_vk(vr);
     }
     st->submit_ns = ob_time_ns() - t_submit;
+    st->cpu_render_ns += ob_thread_cpu_ns() - r->frame_cpu0;
     fs->pending = true;
     fs->view_queries = view_stamps ? count : 0;
     return res;

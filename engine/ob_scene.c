@@ -41,6 +41,8 @@ struct ob_node {
     ob_light_desc light;
     ob_controller_slot *controllers;
     uint32_t controller_count, controller_cap;
+    uint32_t parallel_controllers; /* the leading parallel-safe ones */
+    uint32_t depth;                /* in the hierarchy: the root is 0 */
     void *user;
 
     bool hidden, has_renderable, has_camera, has_light;
@@ -50,8 +52,128 @@ struct ob_node {
     bool fault_reported;     /* an error line about this node's own transform is out */
     bool dying;              /* marked while its subtree is being destroyed */
     uint32_t proxy_index;    /* in the snapshot's proxies while renderable_now */
+    uint32_t material_index, geometry_index; /* interned (scene->materials, ->geometries);
+                                                0 without a renderable */
     char name[];
 };
+
+/* ------------------------------------------------------------- interning */
+
+/* Distinct pointers (materials, geometries) numbered densely, so that the
+ * snapshot can carry a small index per renderable and culling can keep a
+ * table per index instead of asking an interface per entity. Index 0 is
+ * "none". An index is counted by the renderables that use it; at zero it
+ * stays mapped (the same pointer set again revives it) until enough are
+ * unused, then they are freed for reuse and the map is rebuilt. Render
+ * thread only (set_renderable, destroy, update's start). */
+typedef struct intern_table {
+    void **ptr;                 /* index -> pointer; NULL = free */
+    uint32_t *refs;
+    uint32_t count, cap, refs_cap; /* indices [0, count) exist */
+    uint32_t *free_list;
+    uint32_t free_count, free_cap;
+    uint32_t unused;            /* mapped indices with refs == 0 */
+    uint32_t *map;              /* open addressing: index, 0 = empty */
+    uint32_t map_cap;           /* power of two, or 0 */
+} intern_table;
+
+static uint32_t intern_hash(const void *p, uint32_t mask)
+{
+    return (uint32_t)(ob_hash_u64(OB_HASH_SEED, (uint64_t)(uintptr_t)p) & mask);
+}
+
+static void intern_map_put(intern_table *t, uint32_t index)
+{
+    uint32_t mask = t->map_cap - 1;
+    for (uint32_t h = intern_hash(t->ptr[index], mask);; h = (h + 1) & mask) {
+        if (!t->map[h]) {
+            t->map[h] = index;
+            return;
+        }
+    }
+}
+
+static ob_result intern_map_rebuild(intern_table *t, uint32_t cap)
+{
+    uint32_t *map = ob_calloc(cap, sizeof *map);
+    if (!map) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_free(t->map);
+    t->map = map;
+    t->map_cap = cap;
+    for (uint32_t i = 1; i < t->count; i++)
+        if (t->ptr[i]) intern_map_put(t, i);
+    return OB_OK;
+}
+
+/* p's index, counted once more (0 for NULL). 0 with *out set on failure. */
+static uint32_t intern_acquire(intern_table *t, void *p, ob_result *out)
+{
+    *out = OB_OK;
+    if (!p) return 0;
+    if (t->map_cap) {
+        uint32_t mask = t->map_cap - 1;
+        for (uint32_t h = intern_hash(p, mask); t->map[h]; h = (h + 1) & mask) {
+            uint32_t i = t->map[h];
+            if (t->ptr[i] != p) continue;
+            if (t->refs[i]++ == 0) t->unused--;
+            return i;
+        }
+    }
+    if (t->count == 0) t->count = 1; /* index 0: none */
+    uint32_t mapped = t->count - 1 - t->free_count;
+    if (2 * (mapped + 1) > t->map_cap) {
+        *out = intern_map_rebuild(t, t->map_cap ? 2 * t->map_cap : 64);
+        if (*out != OB_OK) return 0;
+    }
+    uint32_t i;
+    if (t->free_count) {
+        i = t->free_list[--t->free_count];
+    } else {
+        *out = ob_array_reserve((void **)&t->ptr, &t->cap, t->count + 1, sizeof *t->ptr);
+        if (*out == OB_OK)
+            *out = ob_array_reserve((void **)&t->refs, &t->refs_cap, t->count + 1, sizeof *t->refs);
+        if (*out != OB_OK) return 0;
+        i = t->count++;
+    }
+    t->ptr[i] = p;
+    t->refs[i] = 1;
+    intern_map_put(t, i);
+    return i;
+}
+
+static void intern_release(intern_table *t, uint32_t i)
+{
+    if (i && --t->refs[i] == 0) t->unused++;
+}
+
+/* Frees the unused indices for reuse once they outnumber the used ones. */
+static void intern_trim(intern_table *t)
+{
+    uint32_t used = t->count ? t->count - 1 - t->free_count - t->unused : 0;
+    if (t->unused < 32 || t->unused < used) return;
+    if (ob_array_reserve((void **)&t->free_list, &t->free_cap, t->free_count + t->unused,
+                         sizeof *t->free_list) != OB_OK)
+        return; /* tried again at the next update */
+    for (uint32_t i = 1; i < t->count; i++) {
+        if (t->ptr[i] && t->refs[i] == 0) {
+            t->ptr[i] = NULL;
+            t->free_list[t->free_count++] = i;
+        }
+    }
+    t->unused = 0;
+    /* Without memory for a new map the old one stays: probing skips the
+     * freed indices (their pointer no longer matches). */
+    (void)intern_map_rebuild(t, t->map_cap);
+}
+
+static void intern_release_all(intern_table *t)
+{
+    ob_free(t->ptr);
+    ob_free(t->refs);
+    ob_free(t->free_list);
+    ob_free(t->map);
+    memset(t, 0, sizeof *t);
+}
 
 struct ob_scene {
     ob_node *root;
@@ -64,11 +186,26 @@ struct ob_scene {
     uint32_t by_id_count, by_id_cap, by_id_holes;
     ob_node **order;
     uint32_t order_count, order_cap;
+    /* The nodes by hierarchy level (depth), pre-order within a level:
+     * level d is by_level[level_start[d] .. level_start[d + 1]). Rebuilt
+     * with order; a level's transforms only read the level above. */
+    ob_node **by_level;
+    uint32_t by_level_cap;
+    uint32_t *level_start;
+    uint32_t level_count, level_start_cap;
     ob_node **renderables;
     uint32_t renderable_count, renderable_cap;
     ob_render_proxy *proxies;   /* parallel to renderables */
     ob_render_bound *bounds;    /* parallel to renderables */
     uint32_t proxy_cap, bound_cap;
+    /* The snapshot's culling data in structure-of-arrays form, parallel
+     * to renderables (ob_render_soa). */
+    double *soa_x, *soa_y, *soa_z;
+    float *soa_radius;
+    uint8_t *soa_flags;
+    uint32_t *soa_material, *soa_geometry, *soa_node_id;
+    uint32_t soa_cap;
+    intern_table materials, geometries;
     ob_node **lights;
     uint32_t light_count, light_cap;
 };
@@ -110,6 +247,8 @@ static ob_node *node_alloc(ob_scene *s, const char *name, ob_result *out_result)
 
 static void node_free(ob_node *n)
 {
+    intern_release(&n->scene->materials, n->material_index);
+    intern_release(&n->scene->geometries, n->geometry_index);
     for (uint32_t i = 0; i < n->controller_count; i++) {
         if (n->controllers[i].release) n->controllers[i].release(n->controllers[i].user);
     }
@@ -216,10 +355,22 @@ void ob_scene_destroy(ob_scene *s)
     }
     ob_free(s->by_id);
     ob_free(s->order);
+    ob_free(s->by_level);
+    ob_free(s->level_start);
     ob_free(s->renderables);
     ob_aligned_free(s->proxies);
     ob_free(s->bounds);
     ob_free(s->lights);
+    ob_free(s->soa_x);
+    ob_free(s->soa_y);
+    ob_free(s->soa_z);
+    ob_free(s->soa_radius);
+    ob_free(s->soa_flags);
+    ob_free(s->soa_material);
+    ob_free(s->soa_geometry);
+    ob_free(s->soa_node_id);
+    intern_release_all(&s->materials);
+    intern_release_all(&s->geometries);
     ob_free(s);
 }
 
@@ -249,6 +400,35 @@ const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_
     *out_count = s->renderable_count;
     return s->proxies ? s->proxies : none;
 }
+
+void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out)
+{
+    static const double none_d[1];
+    static const float none_f[1];
+    static const uint8_t none_b[1];
+    static const uint32_t none_u[1];
+    bool any = s->soa_x != NULL;
+    *out = (ob_render_soa){
+        .count = s->renderable_count,
+        .x = any ? s->soa_x : none_d, .y = any ? s->soa_y : none_d, .z = any ? s->soa_z : none_d,
+        .radius = any ? s->soa_radius : none_f, .flags = any ? s->soa_flags : none_b,
+        .material = any ? s->soa_material : none_u, .geometry = any ? s->soa_geometry : none_u,
+        .node_id = any ? s->soa_node_id : none_u,
+    };
+}
+
+struct ob_material *ob_scene_material(const ob_scene *s, uint32_t index)
+{
+    return index && index < s->materials.count && s->materials.refs[index] ? s->materials.ptr[index]
+                                                                       : NULL;
+}
+struct ob_geometry *ob_scene_geometry(const ob_scene *s, uint32_t index)
+{
+    return index && index < s->geometries.count && s->geometries.refs[index]
+               ? s->geometries.ptr[index] : NULL;
+}
+uint32_t ob_scene_material_count(const ob_scene *s) { return OB_MAX(s->materials.count, 1u); }
+uint32_t ob_scene_geometry_count(const ob_scene *s) { return OB_MAX(s->geometries.count, 1u); }
 
 const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count)
 {
@@ -318,6 +498,14 @@ static void filter_dying_renderables(ob_scene *s)
         s->renderables[w] = n;
         s->proxies[w] = s->proxies[r];
         s->bounds[w] = s->bounds[r];
+        s->soa_x[w] = s->soa_x[r];
+        s->soa_y[w] = s->soa_y[r];
+        s->soa_z[w] = s->soa_z[r];
+        s->soa_radius[w] = s->soa_radius[r];
+        s->soa_flags[w] = s->soa_flags[r];
+        s->soa_material[w] = s->soa_material[r];
+        s->soa_geometry[w] = s->soa_geometry[r];
+        s->soa_node_id[w] = s->soa_node_id[r];
         n->proxy_index = w++;
     }
     s->renderable_count = w;
@@ -332,10 +520,15 @@ static bool floats_finite(const float *v, int count)
 
 static void proxy_set_renderable(ob_scene *s, const ob_node *n)
 {
-    ob_render_proxy *p = &s->proxies[n->proxy_index];
+    uint32_t i = n->proxy_index;
+    ob_render_proxy *p = &s->proxies[i];
     p->material = n->has_renderable ? n->renderable.material : NULL;
     p->geometry = n->has_renderable ? n->renderable.geometry : NULL;
-    s->bounds[n->proxy_index].local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
+    s->bounds[i].local_radius = n->has_renderable ? n->renderable.local_radius : 0.0f;
+    s->soa_material[i] = n->material_index;
+    s->soa_geometry[i] = n->geometry_index;
+    s->soa_flags[i] = s->bounds[i].radius == 0.0f && s->bounds[i].local_radius > 0.0f
+                          ? OB_RENDER_ZERO_SCALE : 0u;
 }
 
 _Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
@@ -361,6 +554,12 @@ static void proxy_fill(ob_scene *s, ob_node *n)
     b->radius = n->world_radius;
     p->node = n;
     p->node_id = n->id;
+    uint32_t i = n->proxy_index;
+    s->soa_x[i] = b->center[0];
+    s->soa_y[i] = b->center[1];
+    s->soa_z[i] = b->center[2];
+    s->soa_radius[i] = b->radius;
+    s->soa_node_id[i] = n->id;
     proxy_set_renderable(s, n);
 }
 
@@ -485,9 +684,13 @@ bool ob_node_is_hidden(const ob_node *n) { return n->hidden; }
 
 ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
 {
+    ob_scene *s = n->scene;
     if (!r) {
         n->has_renderable = false;
         memset(&n->renderable, 0, sizeof n->renderable);
+        intern_release(&s->materials, n->material_index);
+        intern_release(&s->geometries, n->geometry_index);
+        n->material_index = n->geometry_index = 0;
         if (n->renderable_now) proxy_set_renderable(n->scene, n);
         return OB_OK;
     }
@@ -496,6 +699,21 @@ ob_result ob_node_set_renderable(ob_node *n, const ob_renderable *r)
                  "radius >= 0 (got radius %g); refused", n->name, n->id, (double)r->local_radius);
         return OB_ERR_INVALID_ARGUMENT;
     }
+    ob_result res;
+    uint32_t mi = intern_acquire(&s->materials, r->material, &res), gi = 0;
+    if (res == OB_OK) {
+        gi = intern_acquire(&s->geometries, r->geometry, &res);
+        if (res != OB_OK) intern_release(&s->materials, mi);
+    }
+    if (res != OB_OK) {
+        OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): renderable not set: %s", n->name, n->id,
+                 ob_result_text(res));
+        return res;
+    }
+    intern_release(&s->materials, n->material_index);
+    intern_release(&s->geometries, n->geometry_index);
+    n->material_index = mi;
+    n->geometry_index = gi;
     n->renderable = *r;
     n->has_renderable = true;
     if (n->renderable_now) proxy_set_renderable(n->scene, n);
@@ -582,11 +800,25 @@ static void update_node(ob_node *n)
     }
 }
 
+/* order in pre-order, and by_level: a counting sort of it by depth. */
 static void order_rebuild(ob_scene *s)
 {
-    uint32_t count = 0;
-    for (ob_node *n = s->root; n; n = preorder_next(n, s->root)) s->order[count++] = n;
+    uint32_t count = 0, levels = 0;
+    for (ob_node *n = s->root; n; n = preorder_next(n, s->root)) {
+        n->depth = n->parent ? n->parent->depth + 1 : 0;
+        if (n->depth + 1 > levels) levels = n->depth + 1;
+        s->order[count++] = n;
+    }
     s->order_count = count;
+    s->level_count = levels;
+    uint32_t *start = s->level_start;
+    memset(start, 0, sizeof *start * (levels + 1));
+    for (uint32_t i = 0; i < count; i++) start[s->order[i]->depth + 1]++;
+    for (uint32_t d = 0; d < levels; d++) start[d + 1] += start[d];
+    /* start[d] is now where level d begins; fill, then shift back. */
+    for (uint32_t i = 0; i < count; i++) s->by_level[start[s->order[i]->depth]++] = s->order[i];
+    for (uint32_t d = levels; d > 0; d--) start[d] = start[d - 1];
+    start[0] = 0;
     s->order_dirty = false;
 }
 
@@ -594,6 +826,11 @@ static ob_result update_reserve(ob_scene *s)
 {
     uint32_t need = s->node_count;
     ob_result r = ob_array_reserve((void **)&s->order, &s->order_cap, need, sizeof *s->order);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->by_level, &s->by_level_cap, need, sizeof *s->by_level);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->level_start, &s->level_start_cap, need + 1,
+                             sizeof *s->level_start);
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->renderables, &s->renderable_cap, need,
                              sizeof *s->renderables);
@@ -604,13 +841,110 @@ static ob_result update_reserve(ob_scene *s)
         r = ob_array_reserve((void **)&s->bounds, &s->bound_cap, need, sizeof *s->bounds);
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
+    if (r == OB_OK && s->soa_cap < need) {
+        /* All the arrays grow together to the same capacity. */
+        uint32_t cap = OB_MAX(need, 2 * s->soa_cap);
+        void *x = ob_realloc(s->soa_x, sizeof(double) * cap);
+        if (x) s->soa_x = x;
+        void *y = x ? ob_realloc(s->soa_y, sizeof(double) * cap) : NULL;
+        if (y) s->soa_y = y;
+        void *z = y ? ob_realloc(s->soa_z, sizeof(double) * cap) : NULL;
+        if (z) s->soa_z = z;
+        void *rad = z ? ob_realloc(s->soa_radius, sizeof(float) * cap) : NULL;
+        if (rad) s->soa_radius = rad;
+        void *fl = rad ? ob_realloc(s->soa_flags, cap) : NULL;
+        if (fl) s->soa_flags = fl;
+        void *m = fl ? ob_realloc(s->soa_material, sizeof(uint32_t) * cap) : NULL;
+        if (m) s->soa_material = m;
+        void *g = m ? ob_realloc(s->soa_geometry, sizeof(uint32_t) * cap) : NULL;
+        if (g) s->soa_geometry = g;
+        void *id = g ? ob_realloc(s->soa_node_id, sizeof(uint32_t) * cap) : NULL;
+        if (id) {
+            s->soa_node_id = id;
+            s->soa_cap = cap;
+        } else {
+            r = OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+    }
     if (r != OB_OK)
         OB_LOG_E(SCENE_LOG, "scene update of %u nodes: %s; scene left as it was", need,
                  ob_result_text(r));
     return r;
 }
 
-ob_result ob_scene_update(ob_scene *s, double dt)
+/* Nodes per index of the update's parallel loops: a few microseconds of
+ * work each, so a loop's hand-out costs little beside it. */
+#define UPDATE_GRAIN 1024u
+
+typedef struct update_ctx {
+    ob_scene *s;
+    double dt;
+    ob_node **nodes;            /* the current loop's nodes */
+    uint32_t count;
+    uint32_t *counts;           /* snapshot: per chunk, renderables then lights */
+} update_ctx;
+
+static uint32_t chunks_of(uint32_t count) { return (count + UPDATE_GRAIN - 1) / UPDATE_GRAIN; }
+
+static void run_parallel_controllers(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    uint32_t end = OB_MIN(c->count, (chunk + 1) * UPDATE_GRAIN);
+    for (uint32_t i = chunk * UPDATE_GRAIN; i < end; i++) {
+        ob_node *n = c->nodes[i];
+        for (uint32_t k = 0; k < n->parallel_controllers; k++)
+            n->controllers[k].fn(n, c->dt, n->controllers[k].user);
+    }
+}
+
+static void run_update_nodes(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    uint32_t end = OB_MIN(c->count, (chunk + 1) * UPDATE_GRAIN);
+    for (uint32_t i = chunk * UPDATE_GRAIN; i < end; i++) update_node(c->nodes[i]);
+}
+
+/* Snapshot, first pass: which nodes are in it, counted per chunk of by_id. */
+static void run_snapshot_count(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    uint32_t end = OB_MIN(c->s->by_id_count, (chunk + 1) * UPDATE_GRAIN), rc = 0, lc = 0;
+    for (uint32_t i = chunk * UPDATE_GRAIN; i < end; i++) {
+        ob_node *n = c->s->by_id[i];
+        bool visible = n->world_valid && !n->effective_hidden;
+        n->renderable_now = visible && n->has_renderable;
+        rc += n->renderable_now;
+        lc += visible && n->has_light;
+    }
+    c->counts[2 * chunk] = rc;
+    c->counts[2 * chunk + 1] = lc;
+}
+
+/* Second pass: each chunk fills its part, from the prefix sums in counts. */
+static void run_snapshot_fill(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    ob_scene *s = c->s;
+    uint32_t end = OB_MIN(s->by_id_count, (chunk + 1) * UPDATE_GRAIN);
+    uint32_t rc = c->counts[2 * chunk], lc = c->counts[2 * chunk + 1];
+    for (uint32_t i = chunk * UPDATE_GRAIN; i < end; i++) {
+        ob_node *n = s->by_id[i];
+        if (n->renderable_now) {
+            n->proxy_index = rc;
+            proxy_fill(s, n);
+            s->renderables[rc++] = n;
+        }
+        if (n->world_valid && !n->effective_hidden && n->has_light) s->lights[lc++] = n;
+    }
+}
+
+ob_result ob_scene_update(ob_scene *s, double dt) { return ob_scene_update_parallel(s, dt, NULL); }
+
+ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *par)
 {
     if (!isfinite(dt) || dt < 0.0) {
         OB_LOG_E(SCENE_LOG, "scene update: dt must be finite and >= 0 (got %g)", dt);
@@ -622,33 +956,49 @@ ob_result ob_scene_update(ob_scene *s, double dt)
     }
     ob_result r = update_reserve(s);
     if (r != OB_OK) return r;
+    intern_trim(&s->materials);
+    intern_trim(&s->geometries);
     by_id_compact(s);
     if (s->order_dirty) order_rebuild(s);
+    uint32_t chunks = chunks_of(s->by_id_count);
+    uint32_t *counts = ob_malloc(sizeof *counts * 2 * (chunks + 1));
+    if (!counts) {
+        OB_LOG_E(SCENE_LOG, "scene update of %u nodes: out of host memory; scene left as it was",
+                 s->node_count);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
 
     s->in_update = true;
+    update_ctx c = {.s = s, .dt = dt, .nodes = s->order, .count = s->order_count};
+    ob_parallel_run(par, chunks_of(c.count), run_parallel_controllers, &c);
     for (uint32_t i = 0; i < s->order_count; i++) {
         ob_node *n = s->order[i];
         /* Re-read the array each time: a controller may add controllers. */
         uint32_t count = n->controller_count;
-        for (uint32_t c = 0; c < count; c++) n->controllers[c].fn(n, dt, n->controllers[c].user);
+        for (uint32_t k = n->parallel_controllers; k < count; k++)
+            n->controllers[k].fn(n, dt, n->controllers[k].user);
     }
-    for (uint32_t i = 0; i < s->order_count; i++) update_node(s->order[i]);
+    for (uint32_t d = 0; d < s->level_count; d++) {
+        c.nodes = s->by_level + s->level_start[d];
+        c.count = s->level_start[d + 1] - s->level_start[d];
+        ob_parallel_run(par, chunks_of(c.count), run_update_nodes, &c);
+    }
     s->in_update = false;
 
+    c.counts = counts;
+    ob_parallel_run(par, chunks, run_snapshot_count, &c);
     uint32_t rc = 0, lc = 0;
-    for (uint32_t i = 0; i < s->by_id_count; i++) {
-        ob_node *n = s->by_id[i];
-        bool visible = n->world_valid && !n->effective_hidden;
-        n->renderable_now = visible && n->has_renderable;
-        if (n->renderable_now) {
-            n->proxy_index = rc;
-            proxy_fill(s, n);
-            s->renderables[rc++] = n;
-        }
-        if (visible && n->has_light) s->lights[lc++] = n;
+    for (uint32_t k = 0; k < chunks; k++) {
+        uint32_t nr = counts[2 * k], nl = counts[2 * k + 1];
+        counts[2 * k] = rc;
+        counts[2 * k + 1] = lc;
+        rc += nr;
+        lc += nl;
     }
+    ob_parallel_run(par, chunks, run_snapshot_fill, &c);
     s->renderable_count = rc;
     s->light_count = lc;
+    ob_free(counts);
     return OB_OK;
 }
 
@@ -773,6 +1123,8 @@ ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)
         if (d->release) d->release(d->user);
         return r;
     }
+    if (d->parallel && n->parallel_controllers == n->controller_count)
+        n->parallel_controllers++;
     n->controllers[n->controller_count++] =
         (ob_controller_slot){.fn = d->fn, .user = d->user, .release = d->release};
     return OB_OK;

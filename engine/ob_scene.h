@@ -65,13 +65,22 @@ uint32_t ob_scene_node_count(const ob_scene *s);
 /* First node (lowest id) with that name, or NULL. Linear in the node count. */
 ob_node *ob_scene_find(const ob_scene *s, const char *name);
 
-/* Runs controllers (per node in the order added, parents before children),
- * then recomputes local and world transforms and world bounds, then rebuilds
- * the snapshot. dt in seconds, finite and >= 0. Errors: OB_ERR_INVALID_ARGUMENT
+/* Runs controllers, then recomputes local and world transforms and world
+ * bounds, then rebuilds the snapshot. Controllers run per node in the order
+ * added, parents before children, in two passes: first each node's leading
+ * parallel-safe controllers (ob_controller_desc.parallel: those added
+ * before its first other one), then every other controller. dt in seconds,
+ * finite and >= 0. Errors: OB_ERR_INVALID_ARGUMENT
  * (bad dt), OB_ERR_WRONG_STATE (called from a controller),
  * OB_ERR_OUT_OF_HOST_MEMORY (nothing changed). Bad transforms are not errors
  * of the update: they are logged and those nodes skipped. */
 ob_result ob_scene_update(ob_scene *s, double dt);
+/* ob_scene_update with its per-node work in parallel loops run through par
+ * (parallel-safe controllers, then transforms level by level of the
+ * hierarchy, then the snapshot in chunks of the id order); everything else
+ * on the caller. Gives exactly ob_scene_update's result whatever the
+ * thread count. par NULL: ob_scene_update. */
+ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *par);
 
 /* The frame's snapshot: renderable nodes (ob_node_is_renderable) in ascending
  * id order, and visible light nodes (has a light, not hidden, transform valid)
@@ -109,6 +118,29 @@ typedef struct ob_render_bound {
  * destruction. [any thread, while no mutation runs] */
 const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_count);
 const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count);
+
+/* The snapshot's culling data as a structure of arrays, parallel to the
+ * proxies (index i is proxy i, ascending node id), for loops that touch
+ * every renderable in every view: the world bound, a flag byte, and the
+ * renderable's material and geometry as small dense indices (interned when
+ * the renderable is set: ob_scene_material / ob_scene_geometry give the
+ * pointer back; 0 is none). Valid like the proxies. */
+#define OB_RENDER_ZERO_SCALE 1u  /* a bound with a local radius but none in the world */
+typedef struct ob_render_soa {
+    uint32_t count;
+    const double *x, *y, *z;      /* world bound centre */
+    const float *radius;          /* world bound radius */
+    const uint8_t *flags;
+    const uint32_t *material, *geometry;
+    const uint32_t *node_id;
+} ob_render_soa;
+void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out);
+/* The pointer behind an index of ob_render_soa (NULL for 0 or an index no
+ * renderable of the snapshot uses), and how many indices there are. */
+struct ob_material *ob_scene_material(const ob_scene *s, uint32_t index);
+struct ob_geometry *ob_scene_geometry(const ob_scene *s, uint32_t index);
+uint32_t ob_scene_material_count(const ob_scene *s);
+uint32_t ob_scene_geometry_count(const ob_scene *s);
 
 /* The standard per-draw block of a proxy: its world matrix relative to
  * origin (as ob_node_world_relative gives it for the node) in dest[0..15] and
@@ -219,6 +251,14 @@ typedef struct ob_controller_desc {
     /* Optional. The node owns user from the call on: release(user) runs once
      * when the node is destroyed, and at once if adding fails. */
     void (*release)(void *user);
+    /* Safe to run in parallel with other nodes' controllers: it reads and
+     * writes only its own node's transform (ob_node_get/set_position,
+     * _rotation, _scale, _euler, look_at) and its own user data, and
+     * creates, destroys or re-parents nothing. Those of every node run
+     * first, on the worker pool when the update is given one
+     * (ob_renderer_update_scene); the rest run after them on the calling
+     * thread. The built-in rotation and orbit controllers are. */
+    bool parallel;
 } ob_controller_desc;
 
 /* General form of the three below. Controllers of a node run in the order

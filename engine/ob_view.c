@@ -8,6 +8,11 @@
 
 #include "ob_math.h"
 
+#include <float.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 const char *ob_view_type_name(ob_view_type t)
 {
     static const char *const names[OB_VIEW_TYPE_COUNT] = {
@@ -67,11 +72,14 @@ void ob_view_release(ob_view *v)
 {
     if (!v) return;
     ob_free(v->items);
-    ob_free(v->sort_scratch);
+    ob_free(v->materials);
+    ob_aligned_free(v->cull_mem);
     v->items = NULL;
-    v->sort_scratch = NULL;
-    v->sort_scratch_cap = 0;
+    v->materials = NULL;
+    v->cull_mem = NULL;
+    v->cull_mem_size = 0;
     v->item_count = v->item_cap = 0;
+    v->material_count = v->material_cap = 0;
 }
 
 void ob_view_add_dependency(ob_view *v, ob_view *dep)
@@ -94,51 +102,244 @@ void ob_view_add_dependency(ob_view *v, ob_view *dep)
  * other while the front-to-back order survives between bands; for blended
  * items the full depth, back to front, then state group and mesh. dist2 is
  * >= 0, and positive floats order like their bits. */
-static void item_key(ob_draw_item *it, uint32_t cls, uint32_t priority, uint32_t state,
-                     uint32_t mesh, float dist2)
+static uint64_t item_key(uint32_t sort_hi, uint32_t state, uint32_t mesh, float dist2)
 {
     uint32_t bits;
     memcpy(&bits, &dist2, sizeof bits);
-    it->sort_hi = ((cls & 1u) << 31) | (priority & 0x7fffffffu);
-    if (cls & 1u) {
-        it->sort_key = ((uint64_t)~bits << 32) | ((uint64_t)(state & 0xffffu) << 16) | (mesh & 0xffffu);
-    } else {
-        uint64_t band = bits >> 25;            /* sign 0, top 6 bits of the exponent */
-        uint64_t fine = (bits >> 5) & 0xfffffu; /* the rest of the depth, 20 bits */
-        it->sort_key = (band << 58) | ((uint64_t)(state & 0xfffu) << 46) |
-                       ((uint64_t)(mesh & 0x3ffffu) << 28) | (fine << 8);
+    if (sort_hi >> 31)
+        return ((uint64_t)~bits << 32) | ((uint64_t)(state & 0xffffu) << 16) | (mesh & 0xffffu);
+    uint64_t band = bits >> 25;            /* sign 0, top 6 bits of the exponent */
+    uint64_t fine = (bits >> 5) & 0xfffffu; /* the rest of the depth, 20 bits */
+    return (band << 58) | ((uint64_t)(state & 0xfffu) << 46) | ((uint64_t)(mesh & 0x3ffffu) << 28) |
+           (fine << 8);
+}
+
+/* What the sort moves: 16 bytes per visible item. The snapshot index
+ * breaks ties: the snapshot is in ascending entity id, each chunk emits
+ * its items in that order and the sort is stable, so equal keys stay in id
+ * order without sorting on it. */
+typedef struct cull_pair {
+    uint64_t key;
+    uint32_t hi;
+    uint32_t index;
+} cull_pair;
+
+static uint32_t pair_digit(const cull_pair *p, uint32_t d)
+{
+    return d < 8 ? (uint32_t)(p->key >> (8 * d)) & 0xffu : (p->hi >> (8 * (d - 8))) & 0xffu;
+}
+
+/* Stable LSD radix sort on (hi, key), a byte per pass. One read counts
+ * every digit; a digit whose byte is the same for every item needs no pass
+ * (the low byte of an opaque key always, and most of hi). Returns the
+ * buffer that holds the result (a or b). */
+static cull_pair *sort_pairs(cull_pair *a, cull_pair *b, uint32_t n)
+{
+    uint32_t count[12][256];
+    memset(count, 0, sizeof count);
+    for (uint32_t i = 0; i < n; i++) {
+        uint64_t k = a[i].key;
+        uint32_t h = a[i].hi;
+        for (uint32_t d = 0; d < 8; d++) count[d][(k >> (8 * d)) & 0xffu]++;
+        for (uint32_t d = 0; d < 4; d++) count[8 + d][(h >> (8 * d)) & 0xffu]++;
     }
-}
-
-static uint32_t item_digit(const ob_draw_item *it, uint32_t pass)
-{
-    if (pass < 4) return (it->node_id >> (8 * pass)) & 0xffu;
-    if (pass < 12) return (uint32_t)(it->sort_key >> (8 * (pass - 4))) & 0xffu;
-    return (it->sort_hi >> (8 * (pass - 12))) & 0xffu;
-}
-
-/* Stable LSD radix sort on (sort_hi, sort_key, node_id), a byte per pass:
- * linear in the item count, no comparator calls. A pass in which every item
- * has the same byte is skipped (most of the high bytes in practice). */
-static void sort_items(ob_draw_item *items, ob_draw_item *scratch, uint32_t n)
-{
-    ob_draw_item *src = items, *dst = scratch;
-    for (uint32_t pass = 0; pass < 16; pass++) {
-        uint32_t count[256] = {0};
-        for (uint32_t i = 0; i < n; i++) count[item_digit(&src[i], pass)]++;
-        if (count[item_digit(&src[0], pass)] == n) continue;
+    cull_pair *src = a, *dst = b;
+    for (uint32_t d = 0; d < 12; d++) {
+        uint32_t *c = count[d];
+        if (c[pair_digit(&src[0], d)] == n) continue;
         uint32_t sum = 0;
-        for (uint32_t b = 0; b < 256; b++) {
-            uint32_t c = count[b];
-            count[b] = sum;
-            sum += c;
+        for (uint32_t k = 0; k < 256; k++) {
+            uint32_t x = c[k];
+            c[k] = sum;
+            sum += x;
         }
-        for (uint32_t i = 0; i < n; i++) dst[count[item_digit(&src[i], pass)]++] = src[i];
-        ob_draw_item *t = src;
+        for (uint32_t i = 0; i < n; i++) dst[c[pair_digit(&src[i], d)]++] = src[i];
+        cull_pair *t = src;
         src = dst;
         dst = t;
     }
-    if (src != items) memcpy(items, src, sizeof *items * n);
+    return src;
+}
+
+/* Entities per index of the culling loop: ~10-20 us of work each. */
+#define CULL_GRAIN 4096u
+/* Entities tested per block: the frustum pass writes a byte and a float
+ * per entity into the block's stack scratch, the pass after it keys the
+ * visible ones. */
+#define CULL_BLOCK 256u
+/* Entities beyond float range a chunk keeps to log by name. */
+#define CULL_LOG_MAX 4u
+
+typedef struct cull_chunk {
+    uint32_t kept, culled;
+    uint32_t far_count;                 /* beyond float range */
+    uint32_t far[CULL_LOG_MAX];         /* the first ones, snapshot indices */
+} cull_chunk;
+
+typedef struct cull_ctx {
+    const ob_view *v;
+    ob_render_soa soa;
+    const ob_view_material *mt;
+    const uint32_t *mesh;               /* per geometry index */
+    uint32_t exclude_id;                /* 0: none (ids start at 1) */
+    float planes[6][4];                 /* unused planes test nothing */
+    cull_pair *pairs;                   /* chunk c writes from c * CULL_GRAIN */
+    cull_chunk *chunks;
+} cull_ctx;
+
+/* Frustum and range test of a block: vis[j] 1 inside, 0 outside, 2 not
+ * finite in float relative to the origin; d2[j] the squared distance. The
+ * arithmetic is ob_frustum_test_sphere's, operation for operation, so the
+ * SIMD and scalar forms keep exactly the same entities. */
+static void cull_block(const cull_ctx *c, uint32_t first, uint32_t n, uint8_t *vis, float *d2)
+{
+    const double *x = c->soa.x + first, *y = c->soa.y + first, *z = c->soa.z + first;
+    const float *rad = c->soa.radius + first;
+    const double ox = c->v->origin[0], oy = c->v->origin[1], oz = c->v->origin[2];
+    uint32_t j = 0;
+#if defined(__SSE2__)
+    const __m128d vox = _mm_set1_pd(ox), voy = _mm_set1_pd(oy), voz = _mm_set1_pd(oz);
+    const __m128 big = _mm_set1_ps(FLT_MAX), sign = _mm_set1_ps(-0.0f);
+    __m128 pl[6][4];
+    for (int p = 0; p < 6; p++)
+        for (int k = 0; k < 4; k++) pl[p][k] = _mm_set1_ps(c->planes[p][k]);
+    for (; j + 4 <= n; j += 4) {
+        __m128 rx = _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(x + j), vox)),
+                                  _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(x + j + 2), vox)));
+        __m128 ry = _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(y + j), voy)),
+                                  _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(y + j + 2), voy)));
+        __m128 rz = _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(z + j), voz)),
+                                  _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(z + j + 2), voz)));
+        __m128 r = _mm_loadu_ps(rad + j), nr = _mm_xor_ps(r, sign);
+        /* |v| <= FLT_MAX is false for infinities and NaN. */
+        __m128 fin = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(_mm_andnot_ps(sign, rx), big),
+                                           _mm_cmple_ps(_mm_andnot_ps(sign, ry), big)),
+                                _mm_and_ps(_mm_cmple_ps(_mm_andnot_ps(sign, rz), big),
+                                           _mm_cmple_ps(_mm_andnot_ps(sign, r), big)));
+        __m128 out = _mm_setzero_ps();
+        for (int p = 0; p < 6; p++) {
+            __m128 d = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(pl[p][0], rx),
+                                                        _mm_mul_ps(pl[p][1], ry)),
+                                             _mm_mul_ps(pl[p][2], rz)),
+                                  pl[p][3]);
+            out = _mm_or_ps(out, _mm_cmplt_ps(d, nr));
+        }
+        int fm = _mm_movemask_ps(fin), om = _mm_movemask_ps(out);
+        _mm_storeu_ps(d2 + j, _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)),
+                                         _mm_mul_ps(rz, rz)));
+        for (int k = 0; k < 4; k++)
+            vis[j + k] = (uint8_t)(!(fm >> k & 1) ? 2u : !(om >> k & 1));
+    }
+#endif
+    for (; j < n; j++) {
+        float rx = (float)(x[j] - ox), ry = (float)(y[j] - oy), rz = (float)(z[j] - oz);
+        float r = rad[j];
+        if (!(fabsf(rx) <= FLT_MAX && fabsf(ry) <= FLT_MAX && fabsf(rz) <= FLT_MAX &&
+              fabsf(r) <= FLT_MAX)) {
+            vis[j] = 2;
+            d2[j] = 0.0f;
+            continue;
+        }
+        bool in = true;
+        for (int p = 0; p < 6; p++) {
+            const float *q = c->planes[p];
+            float d = q[0] * rx + q[1] * ry + q[2] * rz + q[3];
+            in &= !(d < -r);
+        }
+        vis[j] = in;
+        d2[j] = rx * rx + ry * ry + rz * rz;
+    }
+}
+
+/* One chunk of the snapshot: test, then key the entities the view keeps
+ * into the chunk's part of the pair array, in snapshot order. */
+static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const cull_ctx *c = user;
+    uint32_t first = chunk * CULL_GRAIN, end = OB_MIN(c->soa.count, first + CULL_GRAIN);
+    uint32_t type_bit = 1u << c->v->type;
+    cull_chunk *out = &c->chunks[chunk];
+    cull_pair *pairs = c->pairs + first;
+    *out = (cull_chunk){0};
+    uint8_t vis[CULL_BLOCK];
+    _Alignas(16) float d2[CULL_BLOCK];
+    for (uint32_t b = first; b < end; b += CULL_BLOCK) {
+        uint32_t n = OB_MIN(CULL_BLOCK, end - b);
+        cull_block(c, b, n, vis, d2);
+        for (uint32_t j = 0; j < n; j++) {
+            uint32_t i = b + j;
+            const ob_view_material *m = &c->mt[c->soa.material[i]];
+            /* The order of the reasons is the log's: an entity that is
+             * neither drawn here nor of any size is not reported as far. */
+            if (!(m->mask & type_bit) || c->soa.node_id[i] == c->exclude_id ||
+                (c->soa.flags[i] & OB_RENDER_ZERO_SCALE) || vis[j] == 0) {
+                out->culled++;
+                continue;
+            }
+            if (vis[j] == 2) {
+                if (out->far_count < CULL_LOG_MAX) out->far[out->far_count] = i;
+                out->far_count++;
+                out->culled++;
+                continue;
+            }
+            pairs[out->kept++] = (cull_pair){
+                .key = item_key(m->sort_hi, m->state, c->mesh[c->soa.geometry[i]], d2[j]),
+                .hi = m->sort_hi,
+                .index = i,
+            };
+        }
+    }
+}
+
+/* The view's table of the snapshot's materials and the meshes' ids: one
+ * interface call per material and geometry, not per entity. */
+static ob_result cull_tables(ob_view *v, const ob_scene *scene, const ob_material_iface *mi,
+                             const ob_geometry_iface *gi, uint32_t **out_mesh)
+{
+    uint32_t mc = ob_scene_material_count(scene), gc = ob_scene_geometry_count(scene);
+    ob_result res = ob_array_reserve((void **)&v->materials, &v->material_cap, mc,
+                                     sizeof *v->materials);
+    if (res != OB_OK) return res;
+    v->material_count = mc;
+    for (uint32_t k = 0; k < mc; k++) {
+        struct ob_material *m = ob_scene_material(scene, k);
+        ob_view_material *e = &v->materials[k];
+        *e = (ob_view_material){0};
+        if (!m) continue;
+        for (uint32_t t = 0; t < OB_VIEW_TYPE_COUNT; t++)
+            e->mask |= (uint8_t)(mi->renders(m, (ob_view_type)t) ? 1u << t : 0u);
+        uint32_t cls = 0, priority = 0, state = 0;
+        mi->sort_info(m, v->type, &cls, &priority, &state);
+        e->sort_hi = ((cls & 1u) << 31) | (priority & 0x7fffffffu);
+        e->state = state;
+        e->per_entity = !mi->pre_render_per_entity || mi->pre_render_per_entity(m, v->type);
+    }
+    /* The mesh ids live in the working memory, after the pairs. */
+    uint32_t *mesh = (uint32_t *)((char *)v->cull_mem + v->cull_mem_size) - gc;
+    for (uint32_t k = 0; k < gc; k++) {
+        struct ob_geometry *g = ob_scene_geometry(scene, k);
+        mesh[k] = gi && g ? gi->id(g) : 0;
+    }
+    *out_mesh = mesh;
+    return OB_OK;
+}
+
+/* Working memory: two pair arrays of `count` (the chunks' output and the
+ * sort's other buffer), the chunk records, the mesh ids. */
+static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks, uint32_t meshes)
+{
+    size_t need = 2 * sizeof(cull_pair) * (size_t)OB_MAX(count, 1u) +
+                  sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u) + sizeof(uint32_t) * meshes;
+    need = (need + 63) & ~(size_t)63;
+    if (need <= v->cull_mem_size) return OB_OK;
+    size_t size = OB_MAX(need, v->cull_mem_size + v->cull_mem_size / 2);
+    void *mem = ob_aligned_alloc(OB_CACHE_LINE, size);
+    if (!mem) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_aligned_free(v->cull_mem);
+    v->cull_mem = mem;
+    v->cull_mem_size = size;
+    return OB_OK;
 }
 
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
@@ -147,73 +348,126 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
     const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     uint64_t t0 = ob_time_ns();
     uint32_t count = 0;
-    const ob_render_proxy *proxies = ob_scene_render_proxies(scene, &count);
-    const ob_render_bound *bounds = ob_scene_render_bounds(scene, &count);
-    v->proxies = proxies;
+    v->proxies = ob_scene_render_proxies(scene, &count);
+    ob_scene_render_soa(scene, &v->soa);
     v->item_count = 0;
     v->culled = 0;
+    v->material_count = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
+    uint32_t chunks = (count + CULL_GRAIN - 1) / CULL_GRAIN;
+    uint32_t *mesh = NULL;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
-    if (res == OB_OK)
-        res = ob_array_reserve((void **)&v->sort_scratch, &v->sort_scratch_cap, count,
-                               sizeof *v->sort_scratch);
+    if (res == OB_OK) res = cull_reserve(v, count, chunks, ob_scene_geometry_count(scene));
+    if (res == OB_OK) res = cull_tables(v, scene, mi, gi, &mesh);
     if (res != OB_OK) {
         /* The view goes on empty this frame; the next frame tries again. */
         OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",
                  v->name, count, ob_result_name(res));
         ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        v->material_count = 0;
         return res;
     }
-    ob_frustum frustum;
-    ob_frustum_from_matrix(v->view_proj, &frustum);
-    bool out_of_range = false;
-    for (uint32_t i = 0; i < count; i++) {
-        const ob_render_proxy *p = &proxies[i];
-        if (p->node == exclude || !p->material || !mi->renders(p->material, v->type)) {
-            v->culled++;
-            continue;
-        }
-        const double *c = bounds[i].center;
-        float radius = bounds[i].radius;
-        /* A bound that is not empty locally but zero in the world: the world
-         * transform has zero scale, every triangle has zero area. Drawing it
-         * yields nothing, but keeping it would still queue its env map and
-         * stretch a shadow map's fit to its position. */
-        if (radius == 0.0f && bounds[i].local_radius > 0.0f) {
-            v->culled++;
-            continue;
-        }
-        float rel[3] = {(float)(c[0] - v->origin[0]), (float)(c[1] - v->origin[1]),
-                        (float)(c[2] - v->origin[2])};
-        if (!isfinite(rel[0]) || !isfinite(rel[1]) || !isfinite(rel[2]) || !isfinite(radius)) {
+    cull_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
+    cull_ctx c = {
+        .v = v, .soa = v->soa, .mt = v->materials, .mesh = mesh,
+        .exclude_id = exclude ? ob_node_id(exclude) : 0u,
+        .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
+    };
+    /* Planes the frustum lacks (all of them without one) test nothing. */
+    for (int p = 0; p < 6; p++) {
+        c.planes[p][0] = c.planes[p][1] = c.planes[p][2] = 0.0f;
+        c.planes[p][3] = FLT_MAX;
+    }
+    if (!v->no_frustum) {
+        ob_frustum frustum;
+        ob_frustum_from_matrix(v->view_proj, &frustum);
+        memcpy(c.planes, frustum.planes, sizeof(float) * 4 * frustum.plane_count);
+    }
+    ob_parallel par = ob_renderer_parallel(r);
+    ob_parallel_run(&par, chunks, cull_chunk_run, &c);
+
+    /* The chunks' items, in chunk order (ascending id), side by side. */
+    uint32_t n = 0;
+    bool far = false;
+    for (uint32_t k = 0; k < chunks; k++) {
+        const cull_chunk *ch = &c.chunks[k];
+        if (n != k * CULL_GRAIN) memmove(pairs + n, pairs + (size_t)k * CULL_GRAIN, sizeof *pairs * ch->kept);
+        n += ch->kept;
+        v->culled += ch->culled;
+        for (uint32_t f = 0; f < OB_MIN(ch->far_count, CULL_LOG_MAX) && !v->range_reported; f++) {
+            uint32_t i = ch->far[f];
+            const ob_render_proxy *p = &v->proxies[i];
             /* Finite in double, not in float: no matrix the GPU could take
              * places it, and as a "visible" shadow caster it would blow up
              * the light's fit. */
-            if (!v->range_reported)
-                OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
-                         "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
-                         v->name, ob_node_name(p->node), p->node_id, c[0] - v->origin[0],
-                         c[1] - v->origin[1], c[2] - v->origin[2], (double)radius);
-            out_of_range = true;
-            v->range_reported = true;
-            v->culled++;
-            continue;
+            OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
+                     "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
+                     v->name, ob_node_name(p->node), p->node_id, v->soa.x[i] - v->origin[0],
+                     v->soa.y[i] - v->origin[1], v->soa.z[i] - v->origin[2],
+                     (double)v->soa.radius[i]);
         }
-        if (!v->no_frustum && !ob_frustum_test_sphere(&frustum, rel, radius)) {
-            v->culled++;
-            continue;
-        }
-        uint32_t cls = 0, priority = 0, state = 0;
-        mi->sort_info(p->material, v->type, &cls, &priority, &state);
-        float d2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
-        ob_draw_item *it = &v->items[v->item_count++];
-        *it = (ob_draw_item){.node_id = p->node_id, .node = p->node, .proxy = i};
-        item_key(it, cls, priority, state, gi && p->geometry ? gi->id(p->geometry) : 0, d2);
+        if (ch->far_count > CULL_LOG_MAX && !v->range_reported)
+            OB_LOG_E("view", "view '%s': %u more entities after id %u lie beyond float range "
+                     "from the view's origin; not drawn", v->name, ch->far_count - CULL_LOG_MAX,
+                     v->proxies[ch->far[CULL_LOG_MAX - 1]].node_id);
+        far |= ch->far_count > 0;
     }
-    if (!out_of_range) v->range_reported = false;
-    if (v->item_count > 1) sort_items(v->items, v->sort_scratch, v->item_count);
+    if (far) v->range_reported = true;
+    else v->range_reported = false;
+
+    cull_pair *sorted = n > 1 ? sort_pairs(pairs, other, n) : pairs;
+    for (uint32_t k = 0; k < n; k++) {
+        const ob_render_proxy *p = &v->proxies[sorted[k].index];
+        v->items[k] = (ob_draw_item){.sort_key = sorted[k].key, .sort_hi = sorted[k].hi,
+                                     .node_id = v->soa.node_id[sorted[k].index],
+                                     .node = p->node, .proxy = sorted[k].index};
+    }
+    v->item_count = n;
     v->cull_ns = ob_time_ns() - t0;
     return OB_OK;
+}
+
+uint32_t ob_view_item_material(const ob_view *v, uint32_t item)
+{
+    return v->soa.material[v->items[item].proxy];
+}
+
+void ob_view_item_sphere(const ob_view *v, uint32_t item, double center[3], float *radius)
+{
+    uint32_t i = v->items[item].proxy;
+    center[0] = v->soa.x[i];
+    center[1] = v->soa.y[i];
+    center[2] = v->soa.z[i];
+    *radius = v->soa.radius[i];
+}
+
+void ob_view_for_each_material_item(ob_view *v, void (*fn)(void *user, ob_view *v, uint32_t item),
+                                    void *user)
+{
+    if (!v->material_count) {
+        /* Not culled through ob_view_cull (a custom list): every item. */
+        for (uint32_t i = 0; i < v->item_count; i++) fn(user, v, i);
+        return;
+    }
+    for (uint32_t k = 0; k < v->material_count; k++) v->materials[k].seen = 0;
+    for (uint32_t i = 0; i < v->item_count; i++) {
+        ob_view_material *m = &v->materials[ob_view_item_material(v, i)];
+        if (m->seen && !m->per_entity) continue;
+        m->seen = 1;
+        fn(user, v, i);
+    }
+}
+
+typedef struct pre_render_ctx {
+    const ob_material_iface *mi;
+    ob_renderer *r;
+} pre_render_ctx;
+
+static void pre_render_item(void *user, ob_view *v, uint32_t i)
+{
+    const pre_render_ctx *c = user;
+    ob_node *n = v->items[i].node;
+    c->mi->pre_render(ob_node_get_renderable(n)->material, n, c->r, v);
 }
 
 void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
@@ -221,10 +475,8 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
     const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     if (!mi || !mi->pre_render) return;
     /* Items can be appended to other views during this loop, never to v. */
-    for (uint32_t i = 0; i < v->item_count; i++) {
-        ob_node *n = v->items[i].node;
-        mi->pre_render(ob_node_get_renderable(n)->material, n, r, v);
-    }
+    pre_render_ctx c = {mi, r};
+    ob_view_for_each_material_item(v, pre_render_item, &c);
 }
 
 /* Items ahead of the one being drawn whose proxy is prefetched. */

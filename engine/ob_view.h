@@ -62,6 +62,16 @@ typedef struct ob_draw_item {
     uint32_t proxy;         /* index in the view's proxies (the scene snapshot's) */
 } ob_draw_item;
 
+/* What culling knows of one material (by its scene index, ob_render_soa)
+ * in one view: asked of the material interface once per view and frame,
+ * never per entity. */
+typedef struct ob_view_material {
+    uint32_t sort_hi, state;  /* class and priority, state group, for this view's type */
+    uint8_t mask;             /* bit t: the material renders in views of type t */
+    uint8_t per_entity;       /* its pre_render depends on the entity here */
+    uint8_t seen;             /* scratch of ob_view_for_each_material_item */
+} ob_view_material;
+
 typedef struct ob_view_vtbl {
     const char *type_name;
     void (*pre_render)(ob_view *v, ob_renderer *r);
@@ -118,8 +128,11 @@ struct ob_view {
     ob_draw_item *items;
     uint32_t item_count, item_cap;
     const ob_render_proxy *proxies; /* the snapshot culled from (items index it) */
-    ob_draw_item *sort_scratch;     /* the radix sort's other buffer */
-    uint32_t sort_scratch_cap;
+    ob_render_soa soa;                /* its culling data (items' proxy indexes it too) */
+    ob_view_material *materials;      /* per material index of the snapshot */
+    uint32_t material_count, material_cap;
+    void *cull_mem;                   /* culling's working memory */
+    size_t cull_mem_size;
     uint32_t culled;                  /* entities rejected by frustum or render flag */
     uint32_t recursion_depth;         /* how deep in the PreRender chain it was queued */
     ob_view *deps[OB_VIEW_MAX_DEPS];  /* views that must execute before this one */
@@ -177,8 +190,24 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
 void ob_view_record_draw_list(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                               uint32_t layer, uint32_t first, uint32_t count);
 
-/* Let the material of every item queue the views it needs. [render thread] */
+/* Let the material of every item queue the views it needs: once per
+ * material, or per item for a material whose pre_render depends on the
+ * entity (ob_material_iface.pre_render_per_entity). [render thread] */
 void ob_view_pre_render_items(ob_view *v, ob_renderer *r);
+
+/* Calls fn(user, v, i) for item i of v's draw list when it is the first
+ * item of its material, or its material's PreRender depends on the entity;
+ * in draw order. For per-material work over a draw list (preparing
+ * pipelines) without a call per item. [render thread, after ob_view_cull] */
+void ob_view_for_each_material_item(ob_view *v, void (*fn)(void *user, ob_view *v, uint32_t item),
+                                    void *user);
+
+/* Item i's world bounding sphere (from the snapshot it was culled from).
+ * [any thread, after ob_view_cull] */
+void ob_view_item_sphere(const ob_view *v, uint32_t item, double center[3], float *radius);
+/* The material index (ob_render_soa) of item i: v->materials[index] holds
+ * what culling knew of it. [any thread, after ob_view_cull] */
+uint32_t ob_view_item_material(const ob_view *v, uint32_t item);
 
 /* v cannot run before dep has: add the dependency edge (deduplicated). */
 void ob_view_add_dependency(ob_view *v, ob_view *dep);

@@ -626,16 +626,28 @@ static void prepare(ob_material *m, ob_renderer *r, ob_node *entity, const ob_vi
     if (e) ob_effect_pipeline_for(e, targets, NULL);
 }
 
+typedef struct prepare_ctx {
+    ob_material_library *lib;
+    ob_renderer *r;
+    ob_effect_targets targets;
+} prepare_ctx;
+
+static void prepare_item(void *user, ob_view *v, uint32_t i)
+{
+    const prepare_ctx *c = user;
+    ob_node *n = v->items[i].node;
+    const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
+    if (!rd || !rd->material || rd->material->lib != c->lib) return;
+    prepare(rd->material, c->r, n, v, &c->targets);
+}
+
 void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v)
 {
     if (!lib || !v) return;
-    ob_effect_targets targets = view_targets(lib->dev, v);
-    for (uint32_t i = 0; i < v->item_count; i++) {
-        ob_node *n = v->items[i].node;
-        const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
-        if (!rd || !rd->material || rd->material->lib != lib) continue;
-        prepare(rd->material, r, n, v, &targets);
-    }
+    /* Once per material, per entity only where the entity decides the
+     * effect (its own env map). */
+    prepare_ctx c = {lib, r, view_targets(lib->dev, v)};
+    ob_view_for_each_material_item(v, prepare_item, &c);
 }
 
 /* ------------------------------------------------------ engine interface */
@@ -654,12 +666,25 @@ static void iface_sort_info(const struct ob_material *m, ob_view_type type,
     *out_state = m->id;
 }
 
+/* A reflective surface in a camera asks for its own entity's env map, and
+ * its effect variant depends on whether that map renders. */
+static bool wants_env_map(const ob_material *m, ob_view_type type)
+{
+    bool reflective = m->kind == OB_MATERIAL_REFLECTIVE ||
+                      (m->kind == OB_MATERIAL_PBR && m->reflectivity[0] > 0.0f);
+    return reflective && !m->custom[type] && type == OB_VIEW_PERSPECTIVE;
+}
+
+static bool iface_pre_render_per_entity(const struct ob_material *m, ob_view_type type)
+{
+    return renders(m, type) && wants_env_map(m, type);
+}
+
 static void iface_pre_render(struct ob_material *m, ob_node *entity, ob_renderer *r, ob_view *v)
 {
     if (!renders(m, v->type)) return;
     ob_material_library *lib = m->lib;
-    bool wants_env = m->kind == OB_MATERIAL_REFLECTIVE || (m->kind == OB_MATERIAL_PBR && m->reflectivity[0] > 0.0f);
-    if (wants_env && !m->custom[v->type] && v->type == OB_VIEW_PERSPECTIVE && lib->queue_fn)
+    if (wants_env_map(m, v->type) && lib->queue_fn)
         lib->queue_fn(lib->queue_user, entity, r, v, OB_VIEW_PARABOLOID);
     ob_effect_targets targets = view_targets(lib->dev, v);
     prepare(m, r, entity, v, &targets);
@@ -708,6 +733,7 @@ static const ob_material_iface material_iface = {
     .renders = iface_renders,
     .sort_info = iface_sort_info,
     .pre_render = iface_pre_render,
+    .pre_render_per_entity = iface_pre_render_per_entity,
     .apply = iface_apply,
 };
 

@@ -42,7 +42,7 @@ static void paraboloid_reach(ob_paraboloid_view *pv)
     for (uint32_t i = 0; i < v->item_count; i++) {
         double c[3];
         float radius;
-        ob_node_world_sphere(v->items[i].node, c, &radius);
+        ob_view_item_sphere(v, i, c, &radius);
         double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
         double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
         double reach = (double)radius + ((double)radius + dist) * 1e-5 + 1e-6;

@@ -31,13 +31,18 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
 
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     uint32_t casters = 0;
+    /* The consumer's culling already asked every material where it renders
+     * (a list not made by ob_view_cull asks the interface per item). */
+    bool culled = c->material_count > 0;
     for (uint32_t i = 0; i < c->item_count; i++) {
-        ob_node *n = c->items[i].node;
-        const ob_renderable *rd = ob_node_get_renderable(n);
-        if (!mi->renders(rd->material, OB_VIEW_SHADOW)) continue;
+        bool casts = culled ? c->materials[ob_view_item_material(c, i)].mask & (1u << OB_VIEW_SHADOW)
+                            : mi->renders(ob_node_get_renderable(c->items[i].node)->material,
+                                          OB_VIEW_SHADOW);
+        if (!casts) continue;
         double wc[3];
         float radius;
-        ob_node_world_sphere(n, wc, &radius);
+        if (culled) ob_view_item_sphere(c, i, wc, &radius);
+        else ob_node_world_sphere(c->items[i].node, wc, &radius);
         float rel[3] = {(float)(wc[0] - v->origin[0]), (float)(wc[1] - v->origin[1]),
                         (float)(wc[2] - v->origin[2])};
         for (int k = 0; k < 3; k++) {

@@ -379,6 +379,7 @@ void ob_views_remove_system(ob_views *ctx, ob_particle_system *ps)
 
 void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer)
 {
+    if (ctx->system_count == 0) return;
     for (uint32_t i = 0; i < consumer->item_count; i++) {
         ob_views_entry *e = find_entry(ctx->systems, ctx->system_count,
                                        ob_node_id(consumer->items[i].node));
