@@ -53,6 +53,15 @@ void ob_dquat_mul(const double a[4], const double b[4], double dest[4])
 
 bool ob_dquat_normalize(const double q[4], double dest[4])
 {
+    double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    /* The usual case (a near-unit rotation, every update of every node):
+     * the squares neither overflow nor underflow, so no rescaling (four
+     * divisions) is needed. A NaN or infinite component fails the test. */
+    if (n2 > 0x1p-900 && n2 < 0x1p900) {
+        double inv = 1.0 / sqrt(n2);
+        for (int i = 0; i < 4; i++) dest[i] = q[i] * inv;
+        return true;
+    }
     if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2]) || !isfinite(q[3])) return false;
     double big = fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3])));
     if (big == 0.0) return false;

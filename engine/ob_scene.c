@@ -204,6 +204,7 @@ struct ob_scene {
     float *soa_radius;
     uint8_t *soa_flags;
     uint32_t *soa_material, *soa_geometry, *soa_node_id;
+    ob_node **soa_node;
     uint32_t soa_cap;
     intern_table materials, geometries;
     ob_node **lights;
@@ -369,6 +370,7 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->soa_material);
     ob_free(s->soa_geometry);
     ob_free(s->soa_node_id);
+    ob_free(s->soa_node);
     intern_release_all(&s->materials);
     intern_release_all(&s->geometries);
     ob_free(s);
@@ -407,13 +409,14 @@ void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out)
     static const float none_f[1];
     static const uint8_t none_b[1];
     static const uint32_t none_u[1];
+    static ob_node *const none_n[1];
     bool any = s->soa_x != NULL;
     *out = (ob_render_soa){
         .count = s->renderable_count,
         .x = any ? s->soa_x : none_d, .y = any ? s->soa_y : none_d, .z = any ? s->soa_z : none_d,
         .radius = any ? s->soa_radius : none_f, .flags = any ? s->soa_flags : none_b,
         .material = any ? s->soa_material : none_u, .geometry = any ? s->soa_geometry : none_u,
-        .node_id = any ? s->soa_node_id : none_u,
+        .node_id = any ? s->soa_node_id : none_u, .node = any ? s->soa_node : none_n,
     };
 }
 
@@ -506,6 +509,7 @@ static void filter_dying_renderables(ob_scene *s)
         s->soa_material[w] = s->soa_material[r];
         s->soa_geometry[w] = s->soa_geometry[r];
         s->soa_node_id[w] = s->soa_node_id[r];
+        s->soa_node[w] = s->soa_node[r];
         n->proxy_index = w++;
     }
     s->renderable_count = w;
@@ -560,6 +564,7 @@ static void proxy_fill(ob_scene *s, ob_node *n)
     s->soa_z[i] = b->center[2];
     s->soa_radius[i] = b->radius;
     s->soa_node_id[i] = n->id;
+    s->soa_node[i] = n;
     proxy_set_renderable(s, n);
 }
 
@@ -859,8 +864,10 @@ static ob_result update_reserve(ob_scene *s)
         void *g = m ? ob_realloc(s->soa_geometry, sizeof(uint32_t) * cap) : NULL;
         if (g) s->soa_geometry = g;
         void *id = g ? ob_realloc(s->soa_node_id, sizeof(uint32_t) * cap) : NULL;
-        if (id) {
-            s->soa_node_id = id;
+        if (id) s->soa_node_id = id;
+        void *nodes = id ? ob_realloc(s->soa_node, sizeof(ob_node *) * cap) : NULL;
+        if (nodes) {
+            s->soa_node = nodes;
             s->soa_cap = cap;
         } else {
             r = OB_ERR_OUT_OF_HOST_MEMORY;

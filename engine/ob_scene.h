@@ -133,6 +133,7 @@ typedef struct ob_render_soa {
     const uint8_t *flags;
     const uint32_t *material, *geometry;
     const uint32_t *node_id;
+    ob_node *const *node;
 } ob_render_soa;
 void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out);
 /* The pointer behind an index of ob_render_soa (NULL for 0 or an index no

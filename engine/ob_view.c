@@ -124,36 +124,73 @@ typedef struct cull_pair {
     uint32_t index;
 } cull_pair;
 
-static uint32_t pair_digit(const cull_pair *p, uint32_t d)
+/* Stable insertion sort on (hi, key), for short lists where the radix
+ * sort's counting tables cost more than the items. */
+static void sort_pairs_short(cull_pair *a, uint32_t n)
 {
-    return d < 8 ? (uint32_t)(p->key >> (8 * d)) & 0xffu : (p->hi >> (8 * (d - 8))) & 0xffu;
+    for (uint32_t i = 1; i < n; i++) {
+        cull_pair x = a[i];
+        uint32_t j = i;
+        while (j > 0 && (a[j - 1].hi > x.hi || (a[j - 1].hi == x.hi && a[j - 1].key > x.key))) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = x;
+    }
 }
 
-/* Stable LSD radix sort on (hi, key), a byte per pass. One read counts
- * every digit; a digit whose byte is the same for every item needs no pass
- * (the low byte of an opaque key always, and most of hi). Returns the
- * buffer that holds the result (a or b). */
+/* Stable LSD radix sort on (hi, key), a byte per pass. A byte that is the
+ * same in every item (the low byte of an opaque key, most of hi) needs
+ * neither counting nor a pass: one cheap read finds them (the bits where
+ * the OR and the AND of all keys differ). Returns the buffer that holds
+ * the result (a or b). */
 static cull_pair *sort_pairs(cull_pair *a, cull_pair *b, uint32_t n)
 {
-    uint32_t count[12][256];
-    memset(count, 0, sizeof count);
+    if (n <= 48) {
+        sort_pairs_short(a, n);
+        return a;
+    }
+    uint64_t kor = 0, kand = ~(uint64_t)0;
+    uint32_t hor = 0, hand = ~0u;
     for (uint32_t i = 0; i < n; i++) {
-        uint64_t k = a[i].key;
-        uint32_t h = a[i].hi;
-        for (uint32_t d = 0; d < 8; d++) count[d][(k >> (8 * d)) & 0xffu]++;
-        for (uint32_t d = 0; d < 4; d++) count[8 + d][(h >> (8 * d)) & 0xffu]++;
+        kor |= a[i].key;
+        kand &= a[i].key;
+        hor |= a[i].hi;
+        hand &= a[i].hi;
+    }
+    uint64_t kdiff = kor ^ kand;
+    uint32_t hdiff = hor ^ hand;
+    uint32_t digits[12], nd = 0;
+    for (uint32_t d = 0; d < 8; d++)
+        if ((kdiff >> (8 * d)) & 0xffu) digits[nd++] = d;
+    for (uint32_t d = 0; d < 4; d++)
+        if ((hdiff >> (8 * d)) & 0xffu) digits[nd++] = 8 + d;
+    uint32_t count[12][256];
+    for (uint32_t k = 0; k < nd; k++) memset(count[k], 0, sizeof count[k]);
+    for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t k = 0; k < nd; k++) {
+            uint32_t d = digits[k];
+            uint32_t byte = d < 8 ? (uint32_t)(a[i].key >> (8 * d)) & 0xffu
+                                  : (a[i].hi >> (8 * (d - 8))) & 0xffu;
+            count[k][byte]++;
+        }
     }
     cull_pair *src = a, *dst = b;
-    for (uint32_t d = 0; d < 12; d++) {
-        uint32_t *c = count[d];
-        if (c[pair_digit(&src[0], d)] == n) continue;
-        uint32_t sum = 0;
-        for (uint32_t k = 0; k < 256; k++) {
-            uint32_t x = c[k];
-            c[k] = sum;
-            sum += x;
+    for (uint32_t k = 0; k < nd; k++) {
+        uint32_t *c = count[k], sum = 0;
+        for (uint32_t x = 0; x < 256; x++) {
+            uint32_t t = c[x];
+            c[x] = sum;
+            sum += t;
         }
-        for (uint32_t i = 0; i < n; i++) dst[c[pair_digit(&src[i], d)]++] = src[i];
+        uint32_t d = digits[k];
+        if (d < 8) {
+            uint32_t shift = 8 * d;
+            for (uint32_t i = 0; i < n; i++) dst[c[(src[i].key >> shift) & 0xffu]++] = src[i];
+        } else {
+            uint32_t shift = 8 * (d - 8);
+            for (uint32_t i = 0; i < n; i++) dst[c[(src[i].hi >> shift) & 0xffu]++] = src[i];
+        }
         cull_pair *t = src;
         src = dst;
         dst = t;
@@ -270,24 +307,25 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         for (uint32_t j = 0; j < n; j++) {
             uint32_t i = b + j;
             const ob_view_material *m = &c->mt[c->soa.material[i]];
-            /* The order of the reasons is the log's: an entity that is
-             * neither drawn here nor of any size is not reported as far. */
-            if (!(m->mask & type_bit) || c->soa.node_id[i] == c->exclude_id ||
-                (c->soa.flags[i] & OB_RENDER_ZERO_SCALE) || vis[j] == 0) {
-                out->culled++;
-                continue;
-            }
-            if (vis[j] == 2) {
+            /* Branch-free: the pair is written either way and kept by
+             * counting it. The order of the reasons is the log's: an entity
+             * not drawn here or of no size is not reported as far. */
+            uint32_t ok = ((m->mask & type_bit) != 0) & (c->soa.node_id[i] != c->exclude_id) &
+                          ((c->soa.flags[i] & OB_RENDER_ZERO_SCALE) == 0);
+            if (__builtin_expect(ok & (vis[j] == 2), 0)) {
                 if (out->far_count < CULL_LOG_MAX) out->far[out->far_count] = i;
                 out->far_count++;
                 out->culled++;
                 continue;
             }
-            pairs[out->kept++] = (cull_pair){
+            uint32_t keep = ok & (vis[j] == 1);
+            pairs[out->kept] = (cull_pair){
                 .key = item_key(m->sort_hi, m->state, c->mesh[c->soa.geometry[i]], d2[j]),
                 .hi = m->sort_hi,
                 .index = i,
             };
+            out->kept += keep;
+            out->culled += keep ^ 1u;
         }
     }
 }
@@ -383,7 +421,10 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         ob_frustum_from_matrix(v->view_proj, &frustum);
         memcpy(c.planes, frustum.planes, sizeof(float) * 4 * frustum.plane_count);
     }
+    /* Handing chunks to the pool costs some 30-50 us on a 2-core VM (the
+     * wake-up): worth it only when each thread gets a couple of chunks. */
     ob_parallel par = ob_renderer_parallel(r);
+    if (chunks < 2 * par.threads) par.threads = 1;
     ob_parallel_run(&par, chunks, cull_chunk_run, &c);
 
     /* The chunks' items, in chunk order (ascending id), side by side. */
@@ -417,10 +458,10 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
 
     cull_pair *sorted = n > 1 ? sort_pairs(pairs, other, n) : pairs;
     for (uint32_t k = 0; k < n; k++) {
-        const ob_render_proxy *p = &v->proxies[sorted[k].index];
+        uint32_t i = sorted[k].index;
         v->items[k] = (ob_draw_item){.sort_key = sorted[k].key, .sort_hi = sorted[k].hi,
-                                     .node_id = v->soa.node_id[sorted[k].index],
-                                     .node = p->node, .proxy = sorted[k].index};
+                                     .node_id = v->soa.node_id[i], .node = v->soa.node[i],
+                                     .proxy = i};
     }
     v->item_count = n;
     v->cull_ns = ob_time_ns() - t0;
