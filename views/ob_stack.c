@@ -120,14 +120,12 @@ ob_result ob_stack_frame_begin(ob_stack *s, double dt)
     double time = s->time;
     bool first = s->frames++ == 0;
     s->time += dt;
-    uint64_t t0 = ob_time_ns();
-    ob_result r = ob_scene_update(s->scene, first ? 0.0 : dt);
+    /* On the worker pool as the mode set for this frame says; the update's
+     * time and CPU time go to this frame's stats. */
+    ob_result r = ob_renderer_update_scene(s->renderer, s->scene, first ? 0.0 : dt);
     if (r != OB_OK) return r;
     ob_views_set_time(s->views, time, dt);
-    uint64_t update_ns = ob_time_ns() - t0;
-    if ((r = ob_renderer_begin_frame(s->renderer, s->scene)) != OB_OK) return r;
-    ob_renderer_note_update_ns(s->renderer, update_ns);
-    return OB_OK;
+    return ob_renderer_begin_frame(s->renderer, s->scene);
 }
 
 ob_result ob_stack_frame(ob_stack *s, double dt)

@@ -175,8 +175,18 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     print_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
     fprintf(f, " (recording; in-flight frames %.3f)\n", s->auto_vs_best_200_frame);
     print_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
-    fprintf(f, "\n  %-30s %.3f (200), %.3f (10k x 8): against each round's lower of ST and MT",
+    fprintf(f, "\n  %-30s %.3f (200), %.3f (10k x 8): against each round's lower of ST and MT\n",
             "auto_vs_round_min", s->auto_vs_round_min_200, s->auto_vs_round_min_10k_8views);
+    const char *split = s->frame_cpu_mode ? s->frame_cpu_mode : "-";
+    print_spread(f, "frame_cpu_speedup_10k_8views", s->frame_cpu_speedup_10k_8views);
+    fprintf(f, " (ST / %s: update + pre-render + record + assemble + submit)\n", split);
+    print_spread(f, "serial_fraction_10k_8views", s->serial_fraction_10k_8views);
+    fprintf(f, " (%s: serial / total CPU of a frame with its update; Amdahl on 16 cores %.2fx)\n",
+            split, s->amdahl_speedup_16_cores);
+    print_spread(f, "prerender_ns_per_object_view", s->prerender_ns_per_object_view);
+    fputs(" (ST, 10k x 8)\n", f);
+    print_spread(f, "update_ns_per_object", s->update_ns_per_object);
+    fputs(" (ST, 50k objects, 1 view)", f);
     fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
                "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
             "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
@@ -270,7 +280,11 @@ static void json_result(FILE *f, const ob_bench_result *r)
                                         "vs_best_fixed_record_p25", "vs_best_fixed_record_p75",
                                         "record_cpu_render_ms", "record_cpu_workers_ms",
                                         "record_cpu_max_worker_ms", "cmd_host_allocs_per_object",
-                                        "commands_per_object", "vs_round_min_record"};
+                                        "commands_per_object", "vs_round_min_record",
+                                        "update_cpu_ms", "frame_cpu_speedup",
+                                        "frame_cpu_speedup_p25", "frame_cpu_speedup_p75",
+                                        "serial_fraction", "serial_fraction_p25",
+                                        "serial_fraction_p75"};
     const double values[] = {r->update_ms, r->pre_render_ms, r->record_ms, r->assemble_ms,
                              r->submit_ms, r->record_total_ms, r->cpu_frame_ms, r->gpu_ms,
                              r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame,
@@ -279,7 +293,10 @@ static void json_result(FILE *f, const ob_bench_result *r)
                              r->vs_best_fixed_record.p75, r->record_cpu_render_ms,
                              r->record_cpu_workers_ms, r->record_cpu_max_worker_ms,
                              r->cmd_host_allocs_per_object, r->commands_per_object,
-                             r->vs_round_min_record.median};
+                             r->vs_round_min_record.median, r->update_cpu_ms,
+                             r->frame_cpu_speedup.median, r->frame_cpu_speedup.p25,
+                             r->frame_cpu_speedup.p75, r->serial_fraction.median,
+                             r->serial_fraction.p25, r->serial_fraction.p75};
     _Static_assert(OB_ARRAY_COUNT(names) == OB_ARRAY_COUNT(values), "a name per value");
     for (size_t i = 0; i < OB_ARRAY_COUNT(names); i++) {
         fprintf(f, ",\"%s\":", names[i]);
@@ -351,14 +368,20 @@ static void json_field(FILE *f, const char *name, double v)
     fputc(',', f);
 }
 
+/* "name":"text", (an empty string for NULL) */
+static void json_text_field(FILE *f, const char *name, const char *text)
+{
+    fprintf(f, "\"%s\":", name);
+    json_str(f, text ? text : "");
+    fputc(',', f);
+}
+
 static void json_summary(FILE *f, const ob_bench_report *rep)
 {
     const ob_bench_summary *s = &rep->summary;
     fputs("\"summary\":{", f);
     json_spread(f, "mt_speedup_record_10k_8views", s->mt_speedup_record_10k_8views);
-    fputs("\"mt_speedup_best_mode\":", f);
-    json_str(f, s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "");
-    fputc(',', f);
+    json_text_field(f, "mt_speedup_best_mode", s->mt_speedup_best_mode);
     json_field(f, "engine_vs_raw_per_draw", s->engine_vs_raw_per_draw);
     json_spread(f, "engine_vs_raw_per_object", s->engine_vs_raw_per_object);
     json_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
@@ -367,6 +390,12 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "auto_vs_round_min_200", s->auto_vs_round_min_200);
     json_field(f, "auto_vs_round_min_10k_8views", s->auto_vs_round_min_10k_8views);
     json_field(f, "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k);
+    json_spread(f, "frame_cpu_speedup_10k_8views", s->frame_cpu_speedup_10k_8views);
+    json_text_field(f, "frame_cpu_mode", s->frame_cpu_mode);
+    json_spread(f, "serial_fraction_10k_8views", s->serial_fraction_10k_8views);
+    json_field(f, "amdahl_speedup_16_cores", s->amdahl_speedup_16_cores);
+    json_spread(f, "prerender_ns_per_object_view", s->prerender_ns_per_object_view);
+    json_spread(f, "update_ns_per_object", s->update_ns_per_object);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
     json_field(f, "commands_per_object_raw", s->commands_per_object_raw);
     json_field(f, "host_allocs_per_object_engine", s->host_allocs_per_object_engine);
@@ -524,8 +553,17 @@ static void csv_result(FILE *f, const char *section, uint32_t views, uint32_t ob
                             r->cmd_host_allocs_per_object, r->commands_per_object,
                             r->vs_round_min_record.median};
     for (size_t i = 0; i < OB_ARRAY_COUNT(added); i++) csv_num(f, added[i]);
-    fputs(",1,1\n", f);   /* msaa_samples, supersample: the sweep draws single-sampled */
+    fputs(",1,1", f);   /* msaa_samples, supersample: the sweep draws single-sampled */
+    const double frame[] = {r->frame_cpu_speedup.median, r->frame_cpu_speedup.p25,
+                            r->frame_cpu_speedup.p75, r->serial_fraction.median,
+                            r->pre_render_round_ms.median * 1e6 / ((double)objects * views),
+                            r->update_round_ms.median * 1e6 / objects, r->update_cpu_ms};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(frame); i++) csv_num(f, frame[i]);
+    fputc('\n', f);
 }
+
+/* The columns after supersample that only sweep and scene200 rows fill. */
+#define CSV_FRAME_COLUMNS ",,,,,,,"
 
 ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
 {
@@ -539,7 +577,8 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
           "hash_mismatches,speedup_record_p25,speedup_record_p75,vs_best_fixed_record,"
           "record_cpu_render_ms,record_cpu_workers_ms,record_cpu_max_worker_ms,"
           "cmd_host_allocs_per_object,commands_per_object,vs_round_min_record,msaa_samples,"
-          "supersample\n",
+          "supersample,frame_cpu_speedup,frame_cpu_speedup_p25,frame_cpu_speedup_p75,"
+          "serial_fraction,prerender_ns_per_object_view,update_ns_per_object,update_cpu_ms\n",
           f);
     for (uint32_t i = 0; i < rep->sweep_count; i++)
         for (uint32_t m = 0; m < rep->sweep[i].mode_count; m++)
@@ -559,8 +598,10 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
         fputs(",,,,,,,,,,,,,,,", f);
         fprintf(f, ",%u", q->max_abs_diff);
         csv_num(f, q->psnr_db);
-        /* The nine columns added for the sweep rows, then msaa_samples, supersample. */
-        fprintf(f, ",%u,,,,,,,,,,%u,%u\n", q->hash_mismatches, q->msaa_samples, q->supersample);
+        /* The nine columns added for the sweep rows, then msaa_samples, supersample,
+         * then the frame columns (sweep rows only). */
+        fprintf(f, ",%u,,,,,,,,,,%u,%u" CSV_FRAME_COLUMNS "\n", q->hash_mismatches, q->msaa_samples,
+                q->supersample);
     }
     /* Raw: record time in record_ms and record_total_ms, and draws/s. */
     fprintf(f, "raw,%u,%u,,,raw,0,,%u,,", rep->raw_views, rep->raw_objects, rep->raw.draws);
@@ -572,7 +613,8 @@ ob_result ob_bench_report_csv(const ob_bench_report *rep, const char *path)
     fputs(",,,,,,,,,,,,,,,,,,,,,,,", f);
     csv_num(f, rep->raw.host_allocs_per_object);
     csv_num(f, rep->raw.commands_per_object);
-    fputs(",,1,1\n", f);   /* vs_round_min_record (none), msaa_samples, supersample */
+    /* vs_round_min_record (none), msaa_samples, supersample, then none of the frame columns */
+    fputs(",,1,1" CSV_FRAME_COLUMNS "\n", f);
     return close_out(f, path);
 }
 

@@ -47,6 +47,21 @@ typedef struct ob_bench_summary {
     /* ST record per draw, 1 view: 50k objects / 1k objects (ratio of medians:
      * different scenes share no round) */
     double per_object_growth_50k_vs_1k;
+    /* 10k objects, 8 views, the split mode (ob_bench_split_mode: the
+     * multi-threaded mode of most workers; frame_cpu_mode names it): median
+     * over rounds of ST's (update + pre-render + record + assemble + submit)
+     * / that mode's (ob_bench_result.frame_cpu_speedup), and its frames'
+     * serial CPU share, update included (ob_bench_result.serial_fraction),
+     * with the speedup Amdahl's law gives that share on 16 cores,
+     * 1 / (s + (1 - s) / 16), from the median. */
+    ob_bench_spread frame_cpu_speedup_10k_8views;
+    const char *frame_cpu_mode;
+    ob_bench_spread serial_fraction_10k_8views;
+    double amdahl_speedup_16_cores;
+    /* ST, per round: pre-render ns / (objects x views) at 10k objects x 8
+     * views; update ns / objects at 50k objects, 1 view. */
+    ob_bench_spread prerender_ns_per_object_view;
+    ob_bench_spread update_ns_per_object;
     /* vkCmd calls per visible object: the engine's estimated from the
      * pipeline manager's issued counters, the raw loop's counted; in the raw
      * configuration, ST */

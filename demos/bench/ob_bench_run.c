@@ -6,17 +6,19 @@
 
 /* SAMPLE_SETTLE frames are rendered and not kept; SAMPLE_SLOWER_PASS ones
  * are idle frames slower than their mode's fastest of the round, kept only
- * for the hash check. */
+ * for the hash check; SAMPLE_SPLIT is the split mode's frame after the
+ * round's updates, kept for its CPU split. */
 typedef enum sample_kind {
-    SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT, SAMPLE_SETTLE, SAMPLE_SLOWER_PASS
+    SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT, SAMPLE_SETTLE, SAMPLE_SLOWER_PASS, SAMPLE_SPLIT
 } sample_kind;
 
 typedef struct sample {
     uint64_t serial;
     uint32_t mode, round, pass;
     sample_kind kind;
-    double update_ms, pre_render_ms, record_ms, assemble_ms, submit_ms, cpu_frame_ms;
-    double cpu_no_update_ms, record_total_ms, gpu_ms, wall_ms;
+    double update_ms, update_cpu_ms, pre_render_ms, record_ms, assemble_ms, submit_ms;
+    double cpu_frame_ms, cpu_no_update_ms, record_total_ms, gpu_ms, wall_ms;
+    double serial_fraction;
     double draws, views;
     double cpu_render_ms, cpu_workers_ms, cpu_max_worker_ms, host_allocs_per_object;
     uint32_t workers;
@@ -24,9 +26,15 @@ typedef struct sample {
     uint64_t hash;
 } sample;
 
+/* A mode's update of an idle round, timed around the call. */
+typedef struct round_update {
+    double wall_ms, cpu_ms;
+} round_update;
+
 typedef struct collector {
     sample *samples;
     uint32_t count, cap;
+    round_update *updates;     /* [round * mode_count + mode], warm-up rounds first */
 } collector;
 
 /* Final stats arrive in frame order once a frame is known complete: attach
@@ -40,6 +48,16 @@ static void on_stats(void *user, const ob_frame_stats *st)
             return;
         }
     }
+}
+
+uint32_t ob_bench_split_mode(const ob_bench_mode *modes, uint32_t count)
+{
+    uint32_t best = UINT32_MAX;
+    for (uint32_t m = 0; m < count; m++)
+        if (modes[m].threading == OB_THREADING_MULTI &&
+            (best == UINT32_MAX || modes[m].workers > modes[best].workers))
+            best = m;
+    return best;
 }
 
 void ob_bench_set_mode(ob_renderer *r, const ob_bench_mode *m)
@@ -68,8 +86,19 @@ static void cpu_figures(const ob_frame_stats *st, sample *p)
     p->host_allocs_per_object = st->draws ? (double)st->cmd_host_allocs / st->draws : NAN;
 }
 
+/* The serial share of the frame's CPU time, update included (the frame's
+ * figures start at an update made through ob_renderer_update_scene); NAN
+ * when the engine does not measure it. */
+static double serial_fraction(const ob_frame_stats *st)
+{
+    double total = (double)st->cpu_render_ns + (double)st->cpu_pool_ns;
+    if (st->cpu_render_ns == 0 || total <= 0.0) return NAN;
+    return ((double)st->cpu_render_ns - (double)st->cpu_render_parallel_ns) / total;
+}
+
 /* One frame in mode m, its CPU stats kept as a sample unless kind is
- * SAMPLE_SETTLE. */
+ * SAMPLE_SETTLE. An advancing frame (in flight) carries its own update in
+ * its stats; an idle one gets its mode's update of the round. */
 static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                        uint32_t mode, uint32_t round, uint32_t pass, sample_kind kind, bool advance)
 {
@@ -82,14 +111,20 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
     sample *p = &c->samples[c->count++];
     *p = (sample){
         .serial = st->frame, .mode = mode, .round = round, .pass = pass, .kind = kind,
-        .update_ms = advance ? st->update_ns * 1e-6 : NAN,
+        .update_ms = advance ? st->update_ns * 1e-6 : NAN, .update_cpu_ms = NAN,
         .cpu_no_update_ms = (st->frame_ns - st->update_ns) * 1e-6, .pre_render_ms = st->pre_render_ns * 1e-6,
         .record_ms = st->record_ns * 1e-6, .assemble_ms = st->assemble_ns * 1e-6,
         .submit_ms = st->submit_ns * 1e-6, .cpu_frame_ms = st->frame_ns * 1e-6,
         .record_total_ms = (st->record_ns + st->assemble_ns) * 1e-6,
         .gpu_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
+        .serial_fraction = serial_fraction(st),
     };
+    if (!advance) {
+        const round_update *u = &c->updates[round * desc->mode_count + mode];
+        p->update_ms = u->wall_ms;
+        p->update_cpu_ms = u->cpu_ms;
+    }
     cpu_figures(st, p);
     return OB_OK;
 }
@@ -130,6 +165,35 @@ static void order_of(uint64_t k, uint32_t n, uint32_t *out)
     }
 }
 
+/* The round's updates, device idle: each mode in the round's order (the
+ * split mode last) moves the scene on once under its own threading, timed
+ * here. The renderer hands an update's figures to the next begin_frame
+ * only, so the split mode then renders one frame whose stats carry its
+ * update with its CPU split; it renders the round's final state, which the
+ * passes render again. */
+static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
+                               uint32_t round, const uint32_t *order)
+{
+    ob_renderer *r = s->demo->r;
+    uint32_t split = ob_bench_split_mode(desc->modes, desc->mode_count);
+    uint32_t seq[OB_BENCH_MAX_MODES], n = 0;
+    for (uint32_t i = 0; i < desc->mode_count; i++)
+        if (order[i] != split) seq[n++] = order[i];
+    if (split != UINT32_MAX) seq[n++] = split;
+    ob_result res = ob_renderer_wait_idle(r);
+    for (uint32_t i = 0; i < n && res == OB_OK; i++) {
+        ob_bench_set_mode(r, &desc->modes[seq[i]]);
+        uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
+        res = ob_bench_scene_advance(s, desc->dt);
+        uint64_t c1 = ob_thread_cpu_ns(), t1 = ob_time_ns();
+        c->updates[round * desc->mode_count + seq[i]] = (round_update){(t1 - t0) * 1e-6,
+                                                                        (c1 - c0) * 1e-6};
+    }
+    if (res == OB_OK && split != UINT32_MAX)
+        res = frame(s, desc, c, split, round, 0, SAMPLE_SPLIT, false);
+    return res;
+}
+
 static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c)
 {
     ob_renderer *r = s->demo->r;
@@ -139,12 +203,15 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
         sample_kind kind = round < desc->warmup ? SAMPLE_WARMUP : SAMPLE_IDLE;
         for (uint32_t pass = 0; pass < passes; pass++) {
             /* A new order each pass, so every mode takes every place and
-               follows every other mode equally often: a mode is not always the
-               one right after the scene moves on (its caches warm from the
-               update) or right after the workers ran (theirs warm from
+               follows every other mode equally often: a mode is not always
+               right after the workers ran (their caches warm from
                recording). */
             uint32_t order[OB_BENCH_MAX_MODES];
             order_of((uint64_t)round * passes + pass, desc->mode_count, order);
+            if (pass == 0) {
+                ob_result res = round_updates(s, desc, c, round, order);
+                if (res != OB_OK) return res;
+            }
             for (uint32_t i = 0; i < desc->mode_count; i++) {
                 uint32_t m = order[i];
                 /* Settle frames first: the measured one then finds the mode
@@ -154,8 +221,7 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
                     ob_result res = ob_renderer_wait_idle(r);
                     if (res == OB_OK)
                         res = frame(s, desc, c, m, round, pass,
-                                    k < desc->settle ? SAMPLE_SETTLE : kind,
-                                    pass == 0 && i == 0 && k == 0);
+                                    k < desc->settle ? SAMPLE_SETTLE : kind, false);
                     if (res != OB_OK) return res;
                 }
             }
@@ -220,14 +286,56 @@ void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out)
     out->p75 = q[1];
 }
 
-/* The idle frame of a mode in a round; NULL if it is missing. */
-static const sample *idle_sample(const collector *c, uint32_t mode, uint32_t round)
+/* The frame of a kind of a mode in a round; NULL if it is missing. */
+static const sample *round_sample(const collector *c, sample_kind kind, uint32_t mode,
+                                  uint32_t round)
 {
     for (uint32_t i = 0; i < c->count; i++) {
         const sample *p = &c->samples[i];
-        if (p->kind == SAMPLE_IDLE && p->mode == mode && p->round == round) return p;
+        if (p->kind == kind && p->mode == mode && p->round == round) return p;
     }
     return NULL;
+}
+
+/* The idle frame of a mode in a round (its kept pass); NULL if it is missing. */
+static const sample *idle_sample(const collector *c, uint32_t mode, uint32_t round)
+{
+    return round_sample(c, SAMPLE_IDLE, mode, round);
+}
+
+/* The frame's CPU phases after the update, wall time. */
+static double frame_phases_ms(const sample *p)
+{
+    return p->pre_render_ms + p->record_ms + p->assemble_ms + p->submit_ms;
+}
+
+static double pre_render_ms(const sample *p) { return p->pre_render_ms; }
+
+/* The lowest figure of a mode's passes of a measured round (kept or
+ * slower by recording time): interference only ever adds time, so each
+ * figure takes its own fastest pass (keep_fastest_passes). NAN if none. */
+static double fastest_pass(const collector *c, uint32_t mode, uint32_t round,
+                           double (*figure)(const sample *))
+{
+    double best = NAN;
+    for (uint32_t i = 0; i < c->count; i++) {
+        const sample *p = &c->samples[i];
+        if ((p->kind != SAMPLE_IDLE && p->kind != SAMPLE_SLOWER_PASS) || p->mode != mode ||
+            p->round != round)
+            continue;
+        double v = figure(p);
+        if (isnan(best) || v < best) best = v;
+    }
+    return best;
+}
+
+/* A mode's CPU phases of a round's frame: its update of the round + the
+ * fastest pass of the rest. */
+static double round_frame_ms(const ob_bench_run_desc *desc, const collector *c, uint32_t mode,
+                             uint32_t round)
+{
+    return c->updates[round * desc->mode_count + mode].wall_ms +
+           fastest_pass(c, mode, round, frame_phases_ms);
 }
 
 /* Ratios within each idle round, then their median: both frames of a ratio
@@ -280,6 +388,23 @@ static void round_ratios(const ob_bench_run_desc *desc, const collector *c, doub
             buf[k] = p && isfinite(round_min[k]) ? p->record_total_ms / round_min[k] : NAN;
         }
         ob_bench_spread_of(buf, desc->rounds, &out[m].vs_round_min_record);
+        for (uint32_t k = 0; k < desc->rounds; k++)
+            buf[k] = round_frame_ms(desc, c, 0, desc->warmup + k) /
+                     round_frame_ms(desc, c, m, desc->warmup + k);
+        ob_bench_spread_of(buf, desc->rounds, &out[m].frame_cpu_speedup);
+        for (uint32_t k = 0; k < desc->rounds; k++) {
+            const sample *p = idle_sample(c, m, desc->warmup + k);
+            buf[k] = p ? p->update_ms : NAN;
+        }
+        ob_bench_spread_of(buf, desc->rounds, &out[m].update_round_ms);
+        for (uint32_t k = 0; k < desc->rounds; k++)
+            buf[k] = fastest_pass(c, m, desc->warmup + k, pre_render_ms);
+        ob_bench_spread_of(buf, desc->rounds, &out[m].pre_render_round_ms);
+        for (uint32_t k = 0; k < desc->rounds; k++) {
+            const sample *p = round_sample(c, SAMPLE_SPLIT, m, desc->warmup + k);
+            buf[k] = p ? p->serial_fraction : NAN;
+        }
+        ob_bench_spread_of(buf, desc->rounds, &out[m].serial_fraction);
     }
 }
 
@@ -339,10 +464,9 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->workers_used = n ? workers / n : 0.0;
         o->draws = (uint32_t)MEDIAN(m, SAMPLE_IDLE, draws);
         o->views = (uint32_t)MEDIAN(m, SAMPLE_IDLE, views);
-        /* Only the first frame of an idle round moves the scene on; every
-         * in-flight frame does, so the update is measured there. */
-        o->update_ms = MEDIAN(m, SAMPLE_FLIGHT, update_ms);
-        if (isnan(o->update_ms)) o->update_ms = MEDIAN(m, SAMPLE_IDLE, update_ms);
+        /* Each kept idle frame carries its mode's update of the round. */
+        o->update_ms = MEDIAN(m, SAMPLE_IDLE, update_ms);
+        o->update_cpu_ms = MEDIAN(m, SAMPLE_IDLE, update_cpu_ms);
         o->pre_render_ms = MEDIAN(m, SAMPLE_IDLE, pre_render_ms);
         o->record_ms = MEDIAN(m, SAMPLE_IDLE, record_ms);
         o->assemble_ms = MEDIAN(m, SAMPLE_IDLE, assemble_ms);
@@ -362,6 +486,8 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
                             p->push_constant_issued + p->vertex_binds_issued + p->index_binds_issued;
         o->commands_per_object = p->draws ? (double)commands / p->draws : NAN;
     }
+    uint32_t split = ob_bench_split_mode(desc->modes, desc->mode_count);
+    if (split != UINT32_MAX) out[split].split = true;
     /* The flight loop runs the modes one after another: no rounds to pair. */
     for (uint32_t m = 0; m < desc->mode_count; m++)
         out[m].speedup_frame = out[0].frame_ms / out[m].frame_ms;
@@ -375,12 +501,16 @@ ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
     if (desc->mode_count == 0 || desc->mode_count > OB_BENCH_MAX_MODES)
         return OB_ERR_INVALID_ARGUMENT;
     collector c = {0};
-    c.cap = desc->mode_count * ((desc->warmup + desc->rounds) * OB_MAX(desc->passes, 1u) + desc->flight + 1);
+    uint32_t rounds = desc->warmup + desc->rounds;
+    /* Per mode its idle and in-flight frames, and a split frame a round. */
+    c.cap = desc->mode_count * (rounds * OB_MAX(desc->passes, 1u) + desc->flight + 1) + rounds;
     c.samples = ob_calloc(c.cap, sizeof *c.samples);
+    c.updates = ob_calloc((size_t)OB_MAX(rounds, 1u) * desc->mode_count, sizeof *c.updates);
     /* Medians take up to cap values; round ratios two arrays of rounds. */
     double *buf = ob_calloc(OB_MAX(c.cap, 2 * desc->rounds), sizeof *buf);
-    if (!c.samples || !buf) {
+    if (!c.samples || !c.updates || !buf) {
         ob_free(c.samples);
+        ob_free(c.updates);
         ob_free(buf);
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
@@ -391,6 +521,7 @@ ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
     ob_renderer_set_stats_callback(r, NULL, NULL);
     if (res == OB_OK) summarize(desc, &c, buf, out);
     ob_free(c.samples);
+    ob_free(c.updates);
     ob_free(buf);
     return res;
 }

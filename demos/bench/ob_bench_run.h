@@ -5,19 +5,39 @@
  *   idle     rounds of `passes` passes of one frame per mode; before each
  *            frame the device is waited idle (ob_renderer_wait_idle), so
  *            recording never competes with lavapipe executing the previous
- *            frame on the same cores. Within a round the scene is advanced
- *            once (by the round's first frame) and re-rendered untouched by
- *            the others, so every mode records exactly the same commands and
- *            their hashes must be equal. The mode order steps through all
- *            orders of the modes, a new one each pass, so no mode always
- *            follows the update or the same other mode. A mode's figure for the round is its fastest
+ *            frame on the same cores.
+ *            Each round starts with the updates: device idle, every mode in
+ *            turn (the round's order, the split mode below last) is set
+ *            and moves the scene on once through ob_renderer_update_scene,
+ *            under its own threading; the bench times each call itself
+ *            (ob_time_ns, ob_thread_cpu_ns on the render thread) and keeps
+ *            it as that mode's update of the round. The scene thus advances
+ *            once per mode per round, and every pass of the round renders
+ *            the same state untouched, so every mode records exactly the
+ *            same commands and their hashes must be equal. A mode's frames
+ *            of the round are reported with its own update of the round
+ *            (update_ms), not with the renderer's stats of the frame: the
+ *            renderer gives an update's figures to the next begin_frame
+ *            only, whichever mode that frame is of.
+ *            The split mode (ob_bench_split_mode: the multi-threaded mode of
+ *            most workers) updates last and then renders one unmeasured
+ *            frame, whose stats thus carry its update: its CPU split
+ *            (cpu_render_ns, cpu_render_parallel_ns, cpu_pool_ns, update
+ *            included) gives serial_fraction. That is the only way to the
+ *            pool's share of an update, which no timer on the render thread
+ *            sees; the frame renders the round's final state, and no
+ *            measured frame follows the updates directly.
+ *            The mode order steps through all orders of the modes, a new one
+ *            each pass, so no mode always follows the same other mode. A
+ *            mode's figure for the round is its fastest
  *            pass: interference on this VM (a preempted thread, a late
  *            wake-up) only ever adds time, so the fastest of a few frames of
  *            the same commands is the steadiest estimate of their cost; the
  *            slower passes are checked for hashes and otherwise dropped.
  *            Gives the CPU phases, GPU time (timestamps), binds.
  *   flight   per mode, consecutive frames without waiting (frames in
- *            flight, the normal way to run): gives the frame period.
+ *            flight, the normal way to run; each advances the scene): gives
+ *            the frame period.
  * Warm-up frames (idle, round-robin) come first. Reported values are medians;
  * ratios between modes are medians of per-round ratios (both frames of a
  * ratio from the same round, so a slow spell of the machine divides out),
@@ -89,11 +109,12 @@ typedef struct ob_bench_result {
     uint32_t views;            /* views recorded per frame (median) */
     double workers_used;       /* mean active workers of the measured frames (auto varies) */
     /* medians, milliseconds, idle loop */
-    double update_ms;          /* from the in-flight frames, which all advance the scene */
+    double update_ms;          /* the mode's own update of each round (wall) */
+    double update_cpu_ms;      /* its render thread CPU time */
     double pre_render_ms, record_ms, assemble_ms, submit_ms;
     double record_total_ms;    /* record + assemble: start of recording to primary complete */
     double cpu_frame_ms;       /* the renderer's frame_ns with the device idle (its update
-                                  replaced by update_ms: see ob_bench_run.c) */
+                                  replaced by update_ms) */
     double gpu_ms;             /* timestamps (NAN if unavailable) */
     double draws_per_s;        /* draws / record_total */
     double frame_ms;           /* in-flight frame period (median), NAN without the loop */
@@ -112,6 +133,21 @@ typedef struct ob_bench_result {
      * time, so even a mode that always ran the better one scores above 1:
      * kept to compare with older runs, not to judge auto by. */
     ob_bench_spread vs_round_min_record;
+    /* Over idle rounds: the mode's update of each round, and each round's
+     * fastest pre-render of its passes (it may be another pass than the
+     * kept one, which is the fastest by recording time). */
+    ob_bench_spread update_round_ms, pre_render_round_ms;
+    /* Median over idle rounds of the reference mode's CPU phases of the
+     * frame / this mode's, both of the same round. A mode's phases of a
+     * round: its update of the round + the fastest of its passes' pre-render
+     * + record + assemble + submit (wall time). */
+    ob_bench_spread frame_cpu_speedup;
+    /* The split mode only (NAN for the others): median over idle rounds of
+     * the serial CPU share of its split frame, update included:
+     * (cpu_render - cpu_render_parallel) / (cpu_render + cpu_pool), from
+     * thread CPU clocks (ob_frame_stats). */
+    bool split;
+    ob_bench_spread serial_fraction;
     /* Recording CPU time (ob_frame_stats.record_cpu_ns), medians over idle
      * frames: render thread, sum over workers, busiest worker. NAN when the
      * engine does not report it (every frame read 0). Next to the wall times
@@ -137,6 +173,11 @@ ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
 /* Median and quartiles (linear interpolation) of the non-NAN values; sorts
  * them in place. [any thread]. No value: every field NAN. */
 void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out);
+
+/* The mode whose rounds carry the split frame: the multi-threaded mode of
+ * most workers (the first of them on a tie); UINT32_MAX when there is none.
+ * It renders one more frame per idle round. [any thread] */
+uint32_t ob_bench_split_mode(const ob_bench_mode *modes, uint32_t count);
 
 /* Sets the renderer's threading mode for the next frame. */
 void ob_bench_set_mode(ob_renderer *r, const ob_bench_mode *m);

@@ -115,22 +115,24 @@ void ob_bench_scene_release(ob_bench_scene *s)
     memset(s, 0, sizeof *s);
 }
 
+ob_result ob_bench_scene_advance(ob_bench_scene *s, double dt)
+{
+    ob_demo *d = s->demo;
+    s->time += dt;
+    if (s->kind == OB_BENCH_SCENE_MIRROR) ob_mirror_scene_camera(d->camera, s->time);
+    return ob_renderer_update_scene(d->r, d->scene, dt);
+}
+
 ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt)
 {
     ob_demo *d = s->demo;
-    uint64_t update_ns = 0;
     if (advance) {
-        uint64_t t0 = ob_time_ns();
-        s->time += dt;
-        if (s->kind == OB_BENCH_SCENE_MIRROR) ob_mirror_scene_camera(d->camera, s->time);
-        ob_result r = ob_scene_update(d->scene, dt);
+        ob_result r = ob_bench_scene_advance(s, dt);
         if (r != OB_OK) return r;
-        update_ns = ob_time_ns() - t0;
     }
     ob_views_set_time(d->views, s->time, dt);
     ob_result r = ob_renderer_begin_frame(d->r, d->scene);
     if (r != OB_OK) return r;
-    ob_renderer_note_update_ns(d->r, update_ns);
     for (uint32_t k = 1; k < s->view_count; k++) ob_views_render(d->views, s->views[k]);
     ob_views_render(d->views, ob_composite_view_base(d->composite));
     return ob_renderer_end_frame(d->r);

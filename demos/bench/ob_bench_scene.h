@@ -59,13 +59,20 @@ ob_result ob_bench_scene_build(ob_bench_scene *s, ob_demo *d, const ob_bench_sce
 /* Destroys the extra views (the device must be idle). Zeroed s ok. */
 void ob_bench_scene_release(ob_bench_scene *s);
 
-/* One frame. advance: move the scene on by dt (controllers, transforms) and
- * time it as the frame's update; otherwise render the last state again
- * without touching the scene (an update with dt 0 would still renormalize
- * rotations and change low bits of the matrices). The views get
- * (time, dt) either way. Then begin, pre-render every view, end (submit).
- * The caller picks the threading mode before. Returns the first failing
- * result (logged by the engine). */
+/* Moves the scene on by dt (controllers, transforms, the mirror scene's
+ * camera) through ob_renderer_update_scene: on the renderer's worker pool
+ * as the threading mode set for the next frame says. Its figures go to the
+ * next frame's stats (update_ns, cpu_*). Outside a frame. Returns the
+ * update's result. */
+ob_result ob_bench_scene_advance(ob_bench_scene *s, double dt);
+
+/* One frame. advance: ob_bench_scene_advance(s, dt) first, so the frame's
+ * stats carry the update; otherwise render the last state again without
+ * touching the scene (an update with dt 0 would still renormalize
+ * rotations and change low bits of the matrices). The views get (time, dt)
+ * either way. Then begin, pre-render every view, end (submit). The caller
+ * picks the threading mode before. Returns the first failing result
+ * (logged by the engine). */
 ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt);
 
 #endif /* OB_BENCH_SCENE_H */

@@ -460,6 +460,12 @@ static const ob_bench_result *auto_result(const ob_bench_sweep_entry *e)
     return NULL;
 }
 
+/* v with every value times k. */
+static ob_bench_spread spread_scaled(ob_bench_spread v, double k)
+{
+    return (ob_bench_spread){v.median * k, v.p25 * k, v.p75 * k};
+}
+
 /* ST recording time per draw (ratio of the medians). */
 static double st_ns_per_draw(const ob_bench_sweep_entry *e)
 {
@@ -486,6 +492,25 @@ static void summarize(ob_bench_report *rep)
                                                             r->speedup_record_p75};
         s->mt_speedup_best_mode = r->mode.name;
     }
+    /* The whole frame's CPU phases and their serial share, for the mode
+     * whose rounds carry the split frame (the one of most workers). */
+    const ob_bench_spread none = {NAN, NAN, NAN};
+    s->frame_cpu_speedup_10k_8views = s->serial_fraction_10k_8views = none;
+    for (uint32_t m = 0; e8 && m < e8->mode_count; m++) {
+        const ob_bench_result *r = &e8->results[m];
+        if (!r->split) continue;
+        s->frame_cpu_speedup_10k_8views = r->frame_cpu_speedup;
+        s->serial_fraction_10k_8views = r->serial_fraction;
+        s->frame_cpu_mode = r->mode.name;
+    }
+    double serial = s->serial_fraction_10k_8views.median;
+    s->amdahl_speedup_16_cores = 1.0 / (serial + (1.0 - serial) / 16.0);
+    double object_views = e8 ? (double)e8->objects * e8->views : NAN;
+    s->prerender_ns_per_object_view =
+        e8 ? spread_scaled(e8->results[0].pre_render_round_ms, 1e6 / object_views) : none;
+    const ob_bench_sweep_entry *e50 = find_entry(rep, 1, 50000);
+    s->update_ns_per_object =
+        e50 ? spread_scaled(e50->results[0].update_round_ms, 1e6 / e50->objects) : none;
     const ob_bench_result *a8 = auto_result(e8);
     s->auto_vs_best_10k_8views = a8 ? a8->vs_best_fixed_record : (ob_bench_spread){NAN, NAN, NAN};
     s->auto_vs_round_min_10k_8views = a8 ? a8->vs_round_min_record.median : NAN;
@@ -606,15 +631,20 @@ static int run(const bench_options *o)
     uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3;
     uint64_t total = 0;
     if (o->perf) {
+        /* scene200: three modes, MT's split frame a round. */
         total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
+                 o->warmup + o->rounds +
                  quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) + qd.image_frames;
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
                 if (!config_runs(o, o->views[v], o->objects[n])) continue;
                 frame_counts fc = counts_for(o, o->views[v], o->objects[n]);
-                total += (uint64_t)o->mode_count *
-                         ((fc.warmup + fc.rounds) * fc.passes * (fc.settle + 1) + fc.flight + 1) *
-                         frame_weight(o->views[v], o->objects[n]);
+                /* Per mode its frames, and the split frame a round. */
+                uint64_t rounds = fc.warmup + fc.rounds;
+                uint64_t frames = (uint64_t)o->mode_count *
+                                  (rounds * fc.passes * (fc.settle + 1) + fc.flight + 1);
+                if (ob_bench_split_mode(o->modes, o->mode_count) != UINT32_MAX) frames += rounds;
+                total += frames * frame_weight(o->views[v], o->objects[n]);
             }
         }
     }

@@ -64,8 +64,31 @@ foreach(field ${positive})
     message(FATAL_ERROR "summary.${field} is not a positive number: '${value}' (${type}) ${err}")
   endif()
 endforeach()
+# The whole frame's CPU phases (update included) and their serial share, the
+# per-object pre-render and update costs: each a number, or null where the
+# run could not compute it.
+set(frame_fields amdahl_speedup_16_cores)
+foreach(field frame_cpu_speedup_10k_8views serial_fraction_10k_8views prerender_ns_per_object_view
+        update_ns_per_object)
+  list(APPEND frame_fields ${field} ${field}_p25 ${field}_p75)
+endforeach()
+foreach(field ${frame_fields})
+  string(JSON type ERROR_VARIABLE err TYPE "${json}" summary ${field})
+  string(JSON value ERROR_VARIABLE err2 GET "${json}" summary ${field})
+  if(err OR NOT (type STREQUAL "NULL" OR (type STREQUAL "NUMBER" AND value MATCHES "${number}")))
+    message(FATAL_ERROR "summary.${field} is missing or not a number: '${value}' (${type}) ${err}")
+  endif()
+endforeach()
+# Spreads in order (p25 <= median <= p75) wherever all three are numbers.
 foreach(spread mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_best_200
-        auto_vs_best_10k_8views)
+        auto_vs_best_10k_8views frame_cpu_speedup_10k_8views serial_fraction_10k_8views
+        prerender_ns_per_object_view update_ns_per_object)
+  string(JSON t_lo TYPE "${json}" summary ${spread}_p25)
+  string(JSON t_mid TYPE "${json}" summary ${spread})
+  string(JSON t_hi TYPE "${json}" summary ${spread}_p75)
+  if(NOT t_lo STREQUAL "NUMBER" OR NOT t_mid STREQUAL "NUMBER" OR NOT t_hi STREQUAL "NUMBER")
+    continue()
+  endif()
   string(JSON lo GET "${json}" summary ${spread}_p25)
   string(JSON mid GET "${json}" summary ${spread})
   string(JSON hi GET "${json}" summary ${spread}_p75)
@@ -73,6 +96,10 @@ foreach(spread mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_bes
     message(FATAL_ERROR "summary.${spread}: p25 ${lo}, median ${mid}, p75 ${hi} are out of order")
   endif()
 endforeach()
+string(JSON type ERROR_VARIABLE err TYPE "${json}" summary frame_cpu_mode)
+if(err OR NOT type STREQUAL "STRING")
+  message(FATAL_ERROR "summary.frame_cpu_mode is missing or not a string: ${type} ${err}")
+endif()
 # Host allocations: the raw loop counts its own (a driver may make none); the
 # engine's are null until the recording path reports them.
 foreach(field host_allocs_per_object_raw host_allocs_per_object_engine)
@@ -89,7 +116,8 @@ endif()
 # engine reports them) sit next to the wall times.
 foreach(field speedup_record_p25 speedup_record_p75 vs_best_fixed_record record_cpu_render_ms
         record_cpu_workers_ms record_cpu_max_worker_ms cmd_host_allocs_per_object
-        commands_per_object)
+        commands_per_object update_cpu_ms frame_cpu_speedup frame_cpu_speedup_p25
+        frame_cpu_speedup_p75 serial_fraction serial_fraction_p25 serial_fraction_p75)
   string(JSON type ERROR_VARIABLE err TYPE "${json}" sweep 0 modes 0 ${field})
   if(err OR NOT (type STREQUAL "NUMBER" OR type STREQUAL "NULL"))
     message(FATAL_ERROR "sweep[0].modes[0].${field} is missing: ${type} ${err}")
@@ -269,6 +297,21 @@ list(LENGTH csv_lines csv_count)
 if(csv_count LESS 10)
   message(FATAL_ERROR "bench.csv has only ${csv_count} lines")
 endif()
+# Every row has as many columns as the header, which names the frame columns.
+list(GET csv_lines 0 csv_header)
+foreach(column frame_cpu_speedup serial_fraction prerender_ns_per_object_view
+        update_ns_per_object update_cpu_ms)
+  if(NOT ",${csv_header}," MATCHES ",${column},")
+    message(FATAL_ERROR "bench.csv has no column ${column}")
+  endif()
+endforeach()
+string(REGEX REPLACE "[^,]" "" header_commas "${csv_header}")
+foreach(line ${csv_lines})
+  string(REGEX REPLACE "[^,]" "" line_commas "${line}")
+  if(NOT line_commas STREQUAL header_commas)
+    message(FATAL_ERROR "bench.csv row '${line}' has another column count than the header")
+  endif()
+endforeach()
 foreach(png speedup.png error.png)
   if(NOT EXISTS ${OUT}/charts/${png})
     message(FATAL_ERROR "chart ${png} was not written")
