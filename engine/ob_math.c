@@ -179,18 +179,34 @@ void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double d
     ob_dvec3_copy(r, dest);
 }
 
+/* Branch-free: an exponent of all ones (Inf, NaN) plus one carries into the
+ * sign bit, no other exponent does; OR-ed over values, the sign bit says
+ * whether any is not finite. */
+static uint64_t non_finite_bits(const double *v, int count)
+{
+    uint64_t bad = 0;
+    for (int i = 0; i < count; i++) {
+        union { double d; uint64_t u; } b = {.d = v[i]};
+        bad |= (b.u & 0x7ff0000000000000u) + 0x0010000000000000u;
+    }
+    return bad;
+}
+
 bool ob_daffine_is_finite(const ob_daffine *a)
 {
-    for (int i = 0; i < 9; i++)
-        if (!isfinite(a->m[i])) return false;
-    return ob_dvec3_is_finite(a->t);
+    return !((non_finite_bits(a->m, 9) | non_finite_bits(a->t, 3)) >> 63);
 }
 
 double ob_daffine_max_scale(const ob_daffine *a)
 {
+    /* sqrt is correctly rounded, so monotonic: the root of the largest
+     * squared length is the largest of the roots. */
     double best = 0.0;
-    for (int c = 0; c < 3; c++) best = fmax(best, ob_dvec3_length(&a->m[c * 3]));
-    return best;
+    for (int c = 0; c < 3; c++) {
+        const double *col = &a->m[c * 3];
+        best = fmax(best, ob_dvec3_dot(col, col));
+    }
+    return sqrt(best);
 }
 
 void ob_daffine_to_relative(const ob_daffine *a, const double origin[3], float dest[16])
@@ -221,28 +237,41 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16])
     memcpy(dest, r, sizeof r);
 }
 
-void ob_mat4_normal_cofactor(const float w[16], float dest[16])
+void ob_mat3_normal_cofactor(const float m[9], float dest[9])
 {
-    float c[3][3], largest = 0.0f;
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) {
-            c[i][k] = w[i * 4 + k];
-            float a = c[i][k] < 0.0f ? -c[i][k] : c[i][k];
-            largest = a > largest ? a : largest;
-        }
+    float c[9], largest = 0.0f;
+    for (int i = 0; i < 9; i++) {
+        c[i] = m[i];
+        float a = c[i] < 0.0f ? -c[i] : c[i];
+        largest = a > largest ? a : largest;
+    }
     if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
         int exponent;
         frexpf(largest, &exponent);
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++) c[i][k] = ldexpf(c[i][k], -exponent);
+        for (int i = 0; i < 9; i++) c[i] = ldexpf(c[i], -exponent);
     }
-    /* Column i is c[i+1] x c[i+2]. */
-    for (int i = 0; i < 3; i++) {
-        const float *a = c[(i + 1) % 3], *b = c[(i + 2) % 3];
-        dest[i * 4 + 0] = a[1] * b[2] - a[2] * b[1];
-        dest[i * 4 + 1] = a[2] * b[0] - a[0] * b[2];
-        dest[i * 4 + 2] = a[0] * b[1] - a[1] * b[0];
-        dest[i * 4 + 3] = 0.0f;
+    /* Column i is column i+1 x column i+2. */
+    const float *c0 = &c[0], *c1 = &c[3], *c2 = &c[6];
+    dest[0] = c1[1] * c2[2] - c1[2] * c2[1];
+    dest[1] = c1[2] * c2[0] - c1[0] * c2[2];
+    dest[2] = c1[0] * c2[1] - c1[1] * c2[0];
+    dest[3] = c2[1] * c0[2] - c2[2] * c0[1];
+    dest[4] = c2[2] * c0[0] - c2[0] * c0[2];
+    dest[5] = c2[0] * c0[1] - c2[1] * c0[0];
+    dest[6] = c0[1] * c1[2] - c0[2] * c1[1];
+    dest[7] = c0[2] * c1[0] - c0[0] * c1[2];
+    dest[8] = c0[0] * c1[1] - c0[1] * c1[0];
+}
+
+void ob_mat4_normal_cofactor(const float w[16], float dest[16])
+{
+    float m[9], n[9];
+    for (int c = 0; c < 3; c++)
+        for (int r = 0; r < 3; r++) m[c * 3 + r] = w[c * 4 + r];
+    ob_mat3_normal_cofactor(m, n);
+    for (int c = 0; c < 3; c++) {
+        for (int r = 0; r < 3; r++) dest[c * 4 + r] = n[c * 3 + r];
+        dest[c * 4 + 3] = 0.0f;
     }
     dest[12] = dest[13] = dest[14] = 0.0f;
     dest[15] = 1.0f;

@@ -146,6 +146,10 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
  * overflows nor turns denormal for any finite w. Row and column 3 are those
  * of the identity. */
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
+/* The same for a column-major 3x3 m (the upper 3x3 of w): dest is the
+ * upper 3x3 of ob_mat4_normal_cofactor's result, bit for bit. dest must not
+ * alias m. */
+void ob_mat3_normal_cofactor(const float m[9], float dest[9]);
 
 /* Infinite reversed-Z perspective for Vulkan clip space: a view-space point
  * at z = -znear gets depth 1, depth → 0 as -z → infinity, and +Y up in view

@@ -244,6 +244,12 @@ const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r) { return &
 
 void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns) { r->cur.update_ns = ns; }
 
+void ob_renderer_last_update_stats(const ob_renderer *r, ob_update_stats *out)
+{
+    *out = (ob_update_stats){r->update.ns, r->update.cpu_render, r->update.cpu_render_parallel,
+                             r->update.cpu_pool};
+}
+
 ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
 {
     if (r->in_frame) {
@@ -339,15 +345,17 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     r->scene = scene;
     r->queue_count = 0;
     r->stack_depth = 0;
+    r->wave_count = 0;
     r->attachment_count = 0;
     memset(&r->cur, 0, sizeof r->cur);
     r->cur.frame = r->serial;
     r->cur.mode = r->mode;
     if (r->update.valid) {
         r->cur.update_ns = r->update.ns;
-        r->cur.cpu_render_ns = r->update.cpu_render;
-        r->cur.cpu_render_parallel_ns = r->update.cpu_render_parallel;
-        r->cur.cpu_pool_ns = r->update.cpu_pool;
+        r->cur.cpu_render_ns = r->cur.update_cpu_render_ns = r->update.cpu_render;
+        r->cur.cpu_render_parallel_ns = r->cur.update_cpu_render_parallel_ns =
+            r->update.cpu_render_parallel;
+        r->cur.cpu_pool_ns = r->cur.update_cpu_pool_ns = r->update.cpu_pool;
         r->update.valid = false;
     }
     r->acc_render_parallel = &r->cur.cpu_render_parallel_ns;
@@ -416,19 +424,67 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     return true;
 }
 
-void ob_renderer_pre_render(ob_renderer *r, ob_view *v)
+/* Starts v's PreRender with v current. A view with pre_cull/post_cull runs
+ * its first half now and waits in r->wave for its culling. */
+static void pre_render_start(ob_renderer *r, ob_view *v)
 {
-    if (!r->in_frame || !v || !v->vtbl || !v->vtbl->pre_render) return;
+    if (!v || !v->vtbl || (!v->vtbl->pre_render && !v->vtbl->pre_cull)) return;
     if (r->stack_depth >= OB_MAX_VIEW_STACK) {
         ob_renderer_note_skipped(r, v->name, OB_SKIP_RECURSION);
         return;
     }
-    uint64_t t0 = r->stack_depth == 0 ? ob_time_ns() : 0;
     r->stack[r->stack_depth++] = v;
-    v->vtbl->pre_render(v, r);
+    if (!v->vtbl->pre_cull) {
+        v->vtbl->pre_render(v, r);
+    } else if (v->vtbl->pre_cull(v, r) && v->queued_frame == r->serial) {
+        /* Queued views only: each at most once a frame, so the wave holds
+         * at most OB_MAX_FRAME_VIEWS. */
+        ob_pending_cull *p = &r->wave[r->wave_count++];
+        p->view = v;
+        p->depth = r->stack_depth;
+        memcpy(p->stack, r->stack, sizeof *p->stack * r->stack_depth);
+    }
     r->stack_depth--;
-    if (t0) r->cur.pre_render_ns += ob_time_ns() - t0;
 }
+
+/* Culls the waiting views together (ob_view_cull_many: on the pool), then
+ * runs their post_cull in the order they were queued, each with its chain
+ * current again; the views those queue make the next wave. */
+static void pre_render_waves(ob_renderer *r)
+{
+    r->flushing = true;
+    while (r->wave_count > 0) {
+        uint32_t n = r->wave_count;
+        memcpy(r->current_wave, r->wave, sizeof *r->wave * n);
+        r->wave_count = 0;
+        ob_view *views[OB_MAX_FRAME_VIEWS];
+        for (uint32_t i = 0; i < n; i++) views[i] = r->current_wave[i].view;
+        ob_view_cull_many(r, r->scene, views, n);
+        for (uint32_t i = 0; i < n; i++) {
+            const ob_pending_cull *p = &r->current_wave[i];
+            memcpy(r->stack, p->stack, sizeof *p->stack * p->depth);
+            r->stack_depth = p->depth;
+            if (p->view->vtbl->post_cull) p->view->vtbl->post_cull(p->view, r);
+        }
+        r->stack_depth = 0;
+    }
+    r->flushing = false;
+}
+
+void ob_renderer_pre_render_many(ob_renderer *r, ob_view *const *roots, uint32_t count)
+{
+    if (!r->in_frame || r->flushing || r->stack_depth > 0) {
+        /* Inside a PreRender: each view joins the running one. */
+        for (uint32_t i = 0; r->in_frame && i < count; i++) pre_render_start(r, roots[i]);
+        return;
+    }
+    uint64_t t0 = ob_time_ns();
+    for (uint32_t i = 0; i < count; i++) pre_render_start(r, roots[i]);
+    pre_render_waves(r);
+    r->cur.pre_render_ns += ob_time_ns() - t0;
+}
+
+void ob_renderer_pre_render(ob_renderer *r, ob_view *v) { ob_renderer_pre_render_many(r, &v, 1); }
 
 uint32_t ob_renderer_recursion_depth(const ob_renderer *r)
 {

@@ -135,6 +135,9 @@ typedef struct ob_frame_stats {
      * parallel sections). The serial part is cpu_render_ns -
      * cpu_render_parallel_ns; the frame's total cpu_render_ns + cpu_pool_ns. */
     uint64_t cpu_render_ns, cpu_render_parallel_ns, cpu_pool_ns;
+    /* The update's part of each of the three (0 without an update through
+     * ob_renderer_update_scene before this frame's begin_frame). */
+    uint64_t update_cpu_render_ns, update_cpu_render_parallel_ns, update_cpu_pool_ns;
     uint32_t pipelines_created, variants_created;
     uint64_t frame_hash;         /* all view hashes in order */
 } ob_frame_stats;
@@ -185,6 +188,14 @@ void ob_renderer_note_update_ns(ob_renderer *r, uint64_t ns);
  * Call it before begin_frame: its wall time and CPU time are that frame's
  * update figures (ob_frame_stats.update_ns, cpu_*). [render thread] */
 ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt);
+
+/* The figures of the last ob_renderer_update_scene: wall time, and CPU
+ * time as in ob_frame_stats (render thread, its part in parallel loops,
+ * pool threads). */
+typedef struct ob_update_stats {
+    uint64_t ns, cpu_render_ns, cpu_render_parallel_ns, cpu_pool_ns;
+} ob_update_stats;
+void ob_renderer_last_update_stats(const ob_renderer *r, ob_update_stats *out);
 
 /* Called with each frame's final stats (GPU times included) once the frame
  * is known complete, in frame order. [render thread] */

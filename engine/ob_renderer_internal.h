@@ -75,6 +75,15 @@ typedef struct ob_image_undo {
 
 typedef struct ob_present ob_present;
 
+/* A view whose pre_cull has run and whose culling and post_cull wait for
+ * its wave: the PreRender chain that queued it, itself included, to be
+ * current again for post_cull. */
+typedef struct ob_pending_cull {
+    ob_view *view;
+    uint32_t depth;
+    ob_view *stack[OB_MAX_VIEW_STACK];
+} ob_pending_cull;
+
 typedef struct ob_attachment {
     uint32_t node_id;
     ob_view *view;
@@ -121,6 +130,12 @@ struct ob_renderer {
     uint32_t queue_count;
     ob_view *stack[OB_MAX_VIEW_STACK];
     uint32_t stack_depth, max_recursion;
+    /* PreRender in waves (ob_view_vtbl.pre_cull): the views waiting for the
+     * next wave's culling, and the one being finished. */
+    ob_pending_cull wave[OB_MAX_FRAME_VIEWS];
+    uint32_t wave_count;
+    ob_pending_cull current_wave[OB_MAX_FRAME_VIEWS];
+    bool flushing;
     ob_attachment *attachments;
     uint32_t attachment_count, attachment_cap;
 

@@ -98,6 +98,14 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v);
  * or for NULL; nested deeper than OB_MAX_VIEW_STACK it records
  * OB_SKIP_RECURSION and does not run v. [render thread, PreRender] */
 void ob_renderer_pre_render(ob_renderer *r, ob_view *v);
+/* ob_renderer_pre_render of several root views as one PreRender: the
+ * views that split theirs (ob_view_vtbl.pre_cull) are culled together, in
+ * waves on the worker pool, and finished in the order they were queued.
+ * Views queued during a view's post_cull are culled in the next wave. A
+ * frame's result (queue, order, draw lists, hashes) is the same in every
+ * threading mode. Inside a running PreRender the views simply join it.
+ * [render thread, PreRender] */
+void ob_renderer_pre_render_many(ob_renderer *r, ob_view *const *roots, uint32_t count);
 /* The renderer's worker pool as a parallel loop (ob_parallel, ob_core.h),
  * for PreRender work split over chunks: as many threads as the frame's
  * threading mode gives (1 single-threaded: the loop runs on the caller).

@@ -208,6 +208,7 @@ static cull_pair *sort_pairs(cull_pair *a, cull_pair *b, uint32_t n)
 #define CULL_LOG_MAX 4u
 
 typedef struct cull_chunk {
+    uint64_t ns;                        /* the chunk's time */
     uint32_t kept, culled;
     uint32_t far_count;                 /* beyond float range */
     uint32_t far[CULL_LOG_MAX];         /* the first ones, snapshot indices */
@@ -299,6 +300,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     cull_chunk *out = &c->chunks[chunk];
     cull_pair *pairs = c->pairs + first;
     *out = (cull_chunk){0};
+    if (first >= end) return;
     uint8_t vis[CULL_BLOCK];
     _Alignas(16) float d2[CULL_BLOCK];
     for (uint32_t b = first; b < end; b += CULL_BLOCK) {
@@ -380,17 +382,37 @@ static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks, uint3
     return OB_OK;
 }
 
-ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
+/* One view of a wave being culled. */
+typedef struct cull_view {
+    ob_view *v;
+    cull_ctx c;
+    uint32_t count, chunks;
+    uint64_t ns;                /* its tasks' time, summed */
+    ob_result res;
+} cull_view;
+
+typedef struct cull_wave {
+    cull_view *views;
+    uint32_t n;
+    uint32_t *task_view;        /* chunk task -> view of the wave */
+    uint32_t *task_first;       /* chunk task -> its view's first task */
+} cull_wave;
+
+/* Sets up view k of a wave on the render thread: its snapshot, working
+ * memory, material and mesh tables and planes. */
+static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene,
+                            const ob_material_iface *mi, const ob_geometry_iface *gi)
 {
-    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
-    const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
-    uint64_t t0 = ob_time_ns();
+    ob_view *v = cv->v;
     uint32_t count = 0;
     v->proxies = ob_scene_render_proxies(scene, &count);
     ob_scene_render_soa(scene, &v->soa);
     v->item_count = 0;
     v->culled = 0;
     v->material_count = 0;
+    v->cull_ns = 0;
+    cv->count = count;
+    cv->chunks = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
     uint32_t chunks = (count + CULL_GRAIN - 1) / CULL_GRAIN;
     uint32_t *mesh = NULL;
@@ -406,66 +428,147 @@ ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const 
         return res;
     }
     cull_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
-    cull_ctx c = {
+    cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .mesh = mesh,
-        .exclude_id = exclude ? ob_node_id(exclude) : 0u,
+        .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
         .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
     };
     /* Planes the frustum lacks (all of them without one) test nothing. */
     for (int p = 0; p < 6; p++) {
-        c.planes[p][0] = c.planes[p][1] = c.planes[p][2] = 0.0f;
-        c.planes[p][3] = FLT_MAX;
+        cv->c.planes[p][0] = cv->c.planes[p][1] = cv->c.planes[p][2] = 0.0f;
+        cv->c.planes[p][3] = FLT_MAX;
     }
     if (!v->no_frustum) {
         ob_frustum frustum;
         ob_frustum_from_matrix(v->view_proj, &frustum);
-        memcpy(c.planes, frustum.planes, sizeof(float) * 4 * frustum.plane_count);
+        memcpy(cv->c.planes, frustum.planes, sizeof(float) * 4 * frustum.plane_count);
     }
-    /* Handing chunks to the pool costs some 30-50 us on a 2-core VM (the
-     * wake-up): worth it only when each thread gets a couple of chunks. */
-    ob_parallel par = ob_renderer_parallel(r);
-    if (chunks < 2 * par.threads) par.threads = 1;
-    ob_parallel_run(&par, chunks, cull_chunk_run, &c);
+    cv->chunks = chunks;
+    return OB_OK;
+}
 
-    /* The chunks' items, in chunk order (ascending id), side by side. */
+static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
+{
+    const cull_wave *w = user;
+    cull_view *cv = &w->views[w->task_view[task]];
+    uint64_t t0 = ob_time_ns();
+    cull_chunk_run(&cv->c, task - w->task_first[task], thread);
+    cv->c.chunks[task - w->task_first[task]].ns = ob_time_ns() - t0;
+}
+
+/* A view's chunks side by side (in chunk order, so ascending id), the log
+ * of entities beyond float range, the sort and the draw items. */
+static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
+{
+    (void)thread;
+    const cull_wave *w = user;
+    cull_view *cv = &w->views[k];
+    ob_view *v = cv->v;
+    if (cv->res != OB_OK) return;
+    uint64_t t0 = ob_time_ns();
+    cull_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
     uint32_t n = 0;
     bool far = false;
-    for (uint32_t k = 0; k < chunks; k++) {
-        const cull_chunk *ch = &c.chunks[k];
-        if (n != k * CULL_GRAIN) memmove(pairs + n, pairs + (size_t)k * CULL_GRAIN, sizeof *pairs * ch->kept);
+    uint64_t chunk_ns = 0;
+    for (uint32_t k2 = 0; k2 < cv->chunks; k2++) {
+        const cull_chunk *ch = &cv->c.chunks[k2];
+        chunk_ns += ch->ns;
+        if (n != k2 * CULL_GRAIN)
+            memmove(pairs + n, pairs + (size_t)k2 * CULL_GRAIN, sizeof *pairs * ch->kept);
         n += ch->kept;
         v->culled += ch->culled;
         for (uint32_t f = 0; f < OB_MIN(ch->far_count, CULL_LOG_MAX) && !v->range_reported; f++) {
             uint32_t i = ch->far[f];
-            const ob_render_proxy *p = &v->proxies[i];
             /* Finite in double, not in float: no matrix the GPU could take
              * places it, and as a "visible" shadow caster it would blow up
              * the light's fit. */
             OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
                      "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
-                     v->name, ob_node_name(p->node), p->node_id, v->soa.x[i] - v->origin[0],
-                     v->soa.y[i] - v->origin[1], v->soa.z[i] - v->origin[2],
-                     (double)v->soa.radius[i]);
+                     v->name, ob_node_name(v->soa.node[i]), v->soa.node_id[i],
+                     v->soa.x[i] - v->origin[0], v->soa.y[i] - v->origin[1],
+                     v->soa.z[i] - v->origin[2], (double)v->soa.radius[i]);
         }
         if (ch->far_count > CULL_LOG_MAX && !v->range_reported)
             OB_LOG_E("view", "view '%s': %u more entities after id %u lie beyond float range "
                      "from the view's origin; not drawn", v->name, ch->far_count - CULL_LOG_MAX,
-                     v->proxies[ch->far[CULL_LOG_MAX - 1]].node_id);
+                     v->soa.node_id[ch->far[CULL_LOG_MAX - 1]]);
         far |= ch->far_count > 0;
     }
-    if (far) v->range_reported = true;
-    else v->range_reported = false;
-
+    v->range_reported = far;
     cull_pair *sorted = n > 1 ? sort_pairs(pairs, other, n) : pairs;
-    for (uint32_t k = 0; k < n; k++) {
-        uint32_t i = sorted[k].index;
-        v->items[k] = (ob_draw_item){.sort_key = sorted[k].key, .sort_hi = sorted[k].hi,
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t i = sorted[j].index;
+        v->items[j] = (ob_draw_item){.sort_key = sorted[j].key, .sort_hi = sorted[j].hi,
                                      .node_id = v->soa.node_id[i], .node = v->soa.node[i],
                                      .proxy = i};
     }
     v->item_count = n;
-    v->cull_ns = ob_time_ns() - t0;
-    return OB_OK;
+    cv->ns = chunk_ns + (ob_time_ns() - t0);
+}
+
+/* Entities a wave must hold per thread before it goes to the pool: a
+ * hand-out costs some 30-50 us on a 2-core VM (the wake-up), so smaller
+ * waves are culled on the caller. */
+#define CULL_PARALLEL_MIN (2u * CULL_GRAIN)
+
+ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *const *views,
+                            uint32_t count)
+{
+    const ob_material_iface *mi = ob_renderer_get_material_iface(r);
+    const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
+    if (count == 0) return OB_OK;
+    cull_wave w = {.n = count};
+    w.views = ob_calloc(count, sizeof *w.views);
+    if (!w.views) {
+        OB_LOG_E("view", "%u views not culled: out of host memory; they draw nothing this frame",
+                 count);
+        for (uint32_t k = 0; k < count; k++) {
+            views[k]->item_count = 0;
+            ob_renderer_note_skipped(r, views[k]->name, OB_SKIP_ERROR);
+        }
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    ob_result first_error = OB_OK;
+    uint32_t tasks = 0, entities = 0;
+    for (uint32_t k = 0; k < count; k++) {
+        cull_view *cv = &w.views[k];
+        cv->v = views[k];
+        cv->res = cull_setup(cv, r, scene, mi, gi);
+        if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
+        tasks += cv->chunks;
+        entities += cv->count;
+    }
+    w.task_view = ob_malloc(sizeof *w.task_view * 2 * OB_MAX(tasks, 1u));
+    ob_parallel par = ob_renderer_parallel(r);
+    if (entities < CULL_PARALLEL_MIN * par.threads) par.threads = 1;
+    if (!w.task_view) {
+        /* No task table: cull view by view on this thread instead. */
+        for (uint32_t k = 0; k < count; k++) {
+            cull_view *cv = &w.views[k];
+            for (uint32_t c = 0; c < cv->chunks; c++) cull_chunk_run(&cv->c, c, 0);
+            wave_finish_task(&w, k, 0);
+        }
+    } else {
+        w.task_first = w.task_view + OB_MAX(tasks, 1u);
+        for (uint32_t k = 0, t = 0; k < count; k++) {
+            for (uint32_t c = 0; c < w.views[k].chunks; c++, t++) {
+                w.task_view[t] = k;
+                w.task_first[t] = t - c;
+            }
+        }
+        ob_parallel_run(&par, tasks, wave_chunk_task, &w);
+        ob_parallel_run(&par, count, wave_finish_task, &w);
+    }
+    for (uint32_t k = 0; k < count; k++) w.views[k].v->cull_ns = w.views[k].ns;
+    ob_free(w.task_view);
+    ob_free(w.views);
+    return first_error;
+}
+
+ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude)
+{
+    v->cull_exclude = exclude;
+    return ob_view_cull_many(r, scene, &v, 1);
 }
 
 uint32_t ob_view_item_material(const ob_view *v, uint32_t item)

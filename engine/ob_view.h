@@ -88,6 +88,17 @@ typedef struct ob_view_vtbl {
      * count = 0 and record their dispatches with layer 0. */
     void (*record)(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                    uint32_t layer, uint32_t first, uint32_t count);
+    /* Optional: PreRender in two halves, so that the renderer can cull the
+     * views of a frame together, on the worker pool (in waves: the views
+     * queued by one wave's post_cull are culled as the next wave). pre_cull
+     * queues the view and sets what culling reads (origin, view_proj,
+     * no_frustum, cull_exclude); it returns true when the view wants its
+     * draw list culled. The renderer then culls it (ob_view_cull_many) and
+     * calls post_cull with the view current again at the same depth: the
+     * rest of PreRender (views its items need, pipelines). A view with
+     * them leaves pre_render NULL. [render thread] */
+    bool (*pre_cull)(ob_view *v, ob_renderer *r);
+    void (*post_cull)(ob_view *v, ob_renderer *r);
 } ob_view_vtbl;
 
 struct ob_view {
@@ -117,6 +128,7 @@ struct ob_view {
     bool custom_record;               /* records its own draws (overlay, composite):
                                          record() runs once per layer with count 0 */
     bool no_frustum;                  /* cull by render flag only (environment maps) */
+    const ob_node *cull_exclude;      /* an entity culling leaves out (an env map's owner) */
 
     /* Images read by this view's draws besides its dependencies' targets. */
     uint32_t input_count;
@@ -178,6 +190,14 @@ void ob_view_release(ob_view *v);
  * the list (opaque front to back, blended back to front, priority, id).
  * [render thread] */
 ob_result ob_view_cull(ob_view *v, ob_renderer *r, const ob_scene *scene, const ob_node *exclude);
+/* ob_view_cull of several views at once, each with its own cull_exclude:
+ * the chunks of every view's entities in one parallel loop on the
+ * renderer's pool, then each view's sort in another (on the caller when
+ * the views hold few entities or the frame is single-threaded). The draw
+ * lists are the same as culling each view alone. Returns the first error;
+ * a view that fails goes on empty (logged). [render thread] */
+ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *const *views,
+                            uint32_t count);
 
 /* Record v->items[first..first+count) with the renderer's material and geometry
  * interfaces: per item, set WorldMatrix (camera-relative), apply the material

@@ -50,14 +50,20 @@ static void paraboloid_reach(ob_paraboloid_view *pv)
     }
 }
 
-static void paraboloid_pre_render(ob_view *v, ob_renderer *r)
+static bool paraboloid_pre_cull(ob_view *v, ob_renderer *r)
 {
     ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
-    if (!ob_renderer_queue_view(r, v)) return;
+    if (!ob_renderer_queue_view(r, v)) return false;
     float radius;
     ob_node_world_sphere(pv->owner, v->origin, &radius);
     ob_mat4_identity(v->view_proj);
-    ob_view_cull(v, r, ob_renderer_scene(r), pv->owner);
+    v->cull_exclude = pv->owner;
+    return true;
+}
+
+static void paraboloid_post_cull(ob_view *v, ob_renderer *r)
+{
+    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
     paraboloid_reach(pv);
     ob_view_pre_render_items(v, r);
     /* A particle system the map sees must step before the map draws it and
@@ -108,7 +114,8 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
 
 static const ob_view_vtbl paraboloid_vtbl = {
     .type_name = "paraboloid",
-    .pre_render = paraboloid_pre_render,
+    .pre_cull = paraboloid_pre_cull,
+    .post_cull = paraboloid_post_cull,
     .set_render_params = paraboloid_render_params,
     .set_usage_params = paraboloid_usage_params,
     .record = paraboloid_record,

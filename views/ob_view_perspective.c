@@ -11,10 +11,10 @@ struct ob_perspective_view {
     bool warned_degenerate;
 };
 
-static void perspective_pre_render(ob_view *v, ob_renderer *r)
+static bool perspective_pre_cull(ob_view *v, ob_renderer *r)
 {
     ob_perspective_view *pv = (ob_perspective_view *)v;
-    if (!ob_renderer_queue_view(r, v)) return;
+    if (!ob_renderer_queue_view(r, v)) return false;
     ob_views_apply_resize(pv->ctx, v);
     ob_scene *scene = ob_renderer_scene(r);
     const ob_camera_desc *cam = pv->camera ? ob_node_get_camera(pv->camera) : NULL;
@@ -26,7 +26,7 @@ static void perspective_pre_render(ob_view *v, ob_renderer *r)
                      pv->camera ? ob_node_name(pv->camera) : "(none)", pv->camera ? "'" : "");
         pv->warned_degenerate = true;
         v->item_count = 0;
-        return;
+        return false;
     }
     ob_node_world_position(pv->camera, v->origin);
     ob_node_view_relative(pv->camera, v->origin, pv->view);
@@ -36,7 +36,15 @@ static void perspective_pre_render(ob_view *v, ob_renderer *r)
     float znear = cam->znear > 0.0f ? cam->znear : 0.1f;
     ob_math_perspective_reverse_z(fovy, aspect, znear, pv->proj);
     ob_mat4_mul(pv->proj, pv->view, v->view_proj);
-    ob_view_cull(v, r, scene, NULL);
+    v->cull_exclude = NULL;
+    return true;
+}
+
+/* After culling: shadow maps for the lights, the views the visible items'
+ * materials need, simulations, pipelines. */
+static void perspective_post_cull(ob_view *v, ob_renderer *r)
+{
+    ob_perspective_view *pv = (ob_perspective_view *)v;
     ob_views_queue_shadows(pv->ctx, r, v);
     ob_view_pre_render_items(v, r);
     /* After the items' PreRender: an environment map queued there that sees
@@ -55,7 +63,8 @@ static void perspective_render_params(ob_view *v, ob_renderer *r, ob_params *par
 
 static const ob_view_vtbl perspective_vtbl = {
     .type_name = "perspective",
-    .pre_render = perspective_pre_render,
+    .pre_cull = perspective_pre_cull,
+    .post_cull = perspective_post_cull,
     .set_render_params = perspective_render_params,
     .record = ob_view_record_draw_list,
 };

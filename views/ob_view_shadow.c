@@ -69,15 +69,21 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
     return true;
 }
 
-static void shadow_pre_render(ob_view *v, ob_renderer *r)
+static bool shadow_pre_cull(ob_view *v, ob_renderer *r)
 {
     ob_shadow_view *sv = (ob_shadow_view *)v;
     if (!sv->consumer || !fit_to_casters(sv, r)) {
         ob_renderer_note_skipped(r, v->name, OB_SKIP_NO_CASTERS);
-        return;
+        return false;
     }
-    if (!ob_renderer_queue_view(r, v)) return;
-    ob_view_cull(v, r, ob_renderer_scene(r), NULL);
+    if (!ob_renderer_queue_view(r, v)) return false;
+    v->cull_exclude = NULL;
+    return true;
+}
+
+static void shadow_post_cull(ob_view *v, ob_renderer *r)
+{
+    ob_shadow_view *sv = (ob_shadow_view *)v;
     ob_material_library_prepare_view(sv->ctx->materials, r, v);
 }
 
@@ -110,7 +116,8 @@ static void shadow_usage_params(ob_view *v, ob_renderer *r, ob_params *params,
 
 static const ob_view_vtbl shadow_vtbl = {
     .type_name = "shadow",
-    .pre_render = shadow_pre_render,
+    .pre_cull = shadow_pre_cull,
+    .post_cull = shadow_post_cull,
     .set_render_params = shadow_render_params,
     .set_usage_params = shadow_usage_params,
     .record = ob_view_record_draw_list,

@@ -502,7 +502,12 @@ void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
 
 void ob_views_render(ob_views *ctx, ob_view *final_view)
 {
-    ob_renderer_pre_render(ctx->r, final_view);
+    ob_views_render_many(ctx, &final_view, 1);
+}
+
+void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
+{
+    ob_renderer_pre_render_many(ctx->r, roots, count);
     /* Variants and pipelines are created on first need during PreRender
      * (and rarely while recording): report what this frame added. */
     ob_effect_counters now = ob_effect_context_counters(ctx->effects);

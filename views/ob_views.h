@@ -165,6 +165,12 @@ ob_node *ob_particle_system_node(ob_particle_system *ps);
  * shader variants this created to the frame's stats. [render thread, between
  * begin_frame and end_frame] */
 void ob_views_render(ob_views *ctx, ob_view *final_view);
+/* ob_views_render of several root views as one PreRender: the standard
+ * views among them and all they need are culled together, in waves on the
+ * renderer's worker pool (ob_renderer_pre_render_many). Prefer it to
+ * calling ob_views_render per root when a frame has several. [render
+ * thread, between begin_frame and end_frame] */
+void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count);
 
 /* Standard vertex layout of geometry, as an effect's vertex input: a
  * constant the library owns, made on first use. [any thread] */

@@ -1,0 +1,190 @@
+/* ob_scene_internal.h — the scene's structs, shared by ob_scene.c (nodes,
+ * their API and the interning of materials and geometries) and
+ * ob_scene_update.c (the per-frame update and its snapshot). Not installed.
+ *
+ * Storage: one ob_malloc per node (name inline), so node pointers are stable;
+ * what the update reads and writes per node lives in the scene instead, in
+ * dense arrays indexed by the node's slot (its index in by_id), so that the
+ * update streams through memory and never follows a node pointer for a node
+ * that has no controller. by_id is in creation (= id) order, with holes left
+ * by destroy and compacted at the next update (all slot arrays move
+ * together), so the snapshot comes out sorted by id without a sort.
+ */
+#ifndef OB_SCENE_INTERNAL_H
+#define OB_SCENE_INTERNAL_H
+
+#include "ob_scene.h"
+
+#define SCENE_LOG "scene"
+#define NO_SLOT UINT32_MAX
+
+/* Nodes per index of the update's parallel loops: a few microseconds of
+ * work each, so a loop's hand-out costs little beside it. */
+#define UPDATE_GRAIN 1024u
+
+typedef struct ob_controller_slot {
+    ob_controller_fn fn;
+    void *user;
+    void (*release)(void *user);
+} ob_controller_slot;
+
+/* node_xf.flags */
+enum {
+    XF_HIDDEN = 1u << 0,            /* the node's own flag */
+    XF_EFFECTIVE_HIDDEN = 1u << 1,  /* hidden itself or through an ancestor */
+    XF_WORLD_VALID = 1u << 2,       /* it and every ancestor finite at the last evaluation */
+    XF_HAS_RENDERABLE = 1u << 3,
+    XF_HAS_LIGHT = 1u << 4,
+    XF_FAULT_REPORTED = 1u << 5,    /* an error line about its own transform is out */
+    XF_HAS_CHILDREN = 1u << 6,      /* as of the last order rebuild */
+    XF_IDENTITY = 1u << 7,          /* world and world rotation exactly the identity
+                                       (tracked for nodes with children only) */
+};
+
+/* A node's transform data: four cache lines, everything its evaluation
+ * reads or writes except the parent's. */
+typedef struct node_xf {
+    _Alignas(OB_CACHE_LINE) double position[3];
+    double rotation[4];         /* as set: need not be unit */
+    ob_daffine world;           /* last valid world transform */
+    double world_rotation[4];   /* rotations alone: axes survive zero scale */
+    double world_center[3];
+    float scale[3];             /* set from floats only, so float holds it exactly */
+    float world_radius;
+    float local_center[3], local_radius; /* the renderable's bound; zero without one */
+    uint32_t flags;             /* XF_* */
+    uint32_t proxy_index;       /* in the snapshot's proxies while NODE_IN_RENDERABLES */
+} node_xf;
+
+_Static_assert(sizeof(node_xf) == 4 * OB_CACHE_LINE, "node_xf is four cache lines");
+
+/* scene->state: one byte per slot, what the update's loops test before they
+ * touch anything else of a node. */
+enum {
+    NODE_DIRTY = 1u << 0,           /* its local transform, hidden flag, renderable or
+                                       light changed since its last evaluation */
+    NODE_CHANGED = 1u << 1,         /* evaluated in this update: its children must be */
+    NODE_IN_RENDERABLES = 1u << 2,  /* in the snapshot's renderables (ob_node_is_renderable) */
+    NODE_IN_LIGHTS = 1u << 3,       /* in the snapshot's lights */
+    NODE_PARALLEL = 1u << 4,        /* has leading parallel-safe controllers */
+    NODE_SERIAL = 1u << 5,          /* has other controllers */
+};
+
+/* The renderable's pointers and their interned indices (0 without one). */
+typedef struct node_draw {
+    struct ob_material *material;
+    struct ob_geometry *geometry;
+    uint32_t material_index, geometry_index;
+} node_draw;
+
+/* An entry of the update's level order: a node and its parent, by slot. */
+typedef struct level_item {
+    uint32_t slot, parent;      /* parent NO_SLOT for the root */
+} level_item;
+
+/* Distinct pointers (materials, geometries) numbered densely; see ob_scene.c. */
+typedef struct intern_table {
+    void **ptr;                 /* index -> pointer; NULL = free */
+    uint32_t *refs;
+    uint32_t count, cap, refs_cap; /* indices [0, count) exist */
+    uint32_t *free_list;
+    uint32_t free_count, free_cap;
+    uint32_t unused;            /* mapped indices with refs == 0 */
+    uint32_t *map;              /* open addressing: index, 0 = empty */
+    uint32_t map_cap;           /* power of two, or 0 */
+} intern_table;
+
+struct ob_node {
+    /* What a controller's calls into the node API read: the first line. */
+    ob_scene *scene;
+    uint32_t by_id_index;          /* its slot */
+    uint32_t controller_count;
+    ob_controller_slot *controllers;
+    uint32_t parallel_controllers; /* the leading parallel-safe ones */
+    uint32_t controller_cap;
+
+    uint32_t id;
+    uint32_t depth;                /* in the hierarchy: the root is 0 */
+    ob_node *parent, *first_child, *last_child, *prev_sibling, *next_sibling;
+    ob_renderable renderable;      /* as set (ob_node_get_renderable) */
+    ob_camera_desc camera;
+    ob_light_desc light;
+    void *user;
+    bool has_camera;
+    bool dying;                    /* marked while its subtree is being destroyed */
+    char name[];
+};
+
+struct ob_scene {
+    ob_node *root;
+    uint32_t next_id;
+    uint32_t node_count;
+    bool in_update;
+    bool order_dirty;
+    bool snapshot_dirty;           /* the next update rebuilds the whole snapshot */
+    uint32_t serial_nodes;         /* nodes with a controller that is not parallel-safe */
+
+    /* Slot arrays, by_id_count long (holes: by_id NULL). */
+    ob_node **by_id;
+    node_xf *xf;
+    uint8_t *state;                /* NODE_* */
+    uint32_t *slot_id;             /* the node's id */
+    node_draw *draw;
+    uint32_t by_id_count, by_id_holes;
+    uint32_t by_id_cap, xf_cap, state_cap, slot_id_cap, draw_cap;
+
+    /* order: slots in pre-order (parents first), for serial controllers;
+     * by_level: the same nodes by hierarchy level (depth), pre-order within
+     * a level: level d is by_level[level_start[d] .. level_start[d + 1]).
+     * Rebuilt when the structure changed; a level's transforms only read
+     * the level above. */
+    uint32_t *order;
+    uint32_t order_count, order_cap;
+    level_item *by_level;
+    uint32_t by_level_cap;
+    uint32_t *level_start;
+    uint32_t level_count, level_start_cap;
+    uint32_t *chunk_counts;        /* the update's per-chunk figures */
+    uint32_t chunk_counts_cap;
+
+    /* The snapshot. */
+    ob_node **renderables;
+    uint32_t renderable_count, renderable_cap;
+    ob_render_proxy *proxies;   /* parallel to renderables */
+    ob_render_bound *bounds;    /* parallel to renderables */
+    uint32_t proxy_cap, bound_cap;
+    /* The snapshot's culling data in structure-of-arrays form, parallel
+     * to renderables (ob_render_soa). */
+    double *soa_x, *soa_y, *soa_z;
+    float *soa_radius;
+    uint8_t *soa_flags;
+    uint32_t *soa_material, *soa_geometry, *soa_node_id;
+    ob_node **soa_node;
+    uint32_t soa_cap;
+    intern_table materials, geometries;
+    ob_node **lights;
+    uint32_t light_count, light_cap;
+};
+
+static inline node_xf *node_xf_of(const ob_node *n) { return &n->scene->xf[n->by_id_index]; }
+
+typedef enum local_status { LOCAL_OK, LOCAL_NON_FINITE, LOCAL_ZERO_ROTATION } local_status;
+
+/* ob_scene.c */
+/* Closes the holes of by_id (and every slot array) left by destroy. */
+void ob_scene_compact(ob_scene *s);
+/* Frees unused material and geometry indices for reuse (see interning). */
+void ob_scene_intern_trim(ob_scene *s);
+/* Next node in pre-order after n, staying inside the subtree of top. */
+ob_node *ob_scene_preorder_next(const ob_node *n, const ob_node *top);
+
+/* ob_scene_update.c */
+/* Local transform of a node, with its unit rotation. [any thread] */
+local_status ob_scene_xf_local(const node_xf *x, ob_daffine *dest, double unit_q[4]);
+/* The proxy of a node in the snapshot follows its renderable (material,
+ * geometry, local radius). */
+void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot);
+/* Drops the marked (dying) nodes from the snapshot. */
+void ob_scene_snapshot_drop_dying(ob_scene *s);
+
+#endif /* OB_SCENE_INTERNAL_H */
