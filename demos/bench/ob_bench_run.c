@@ -6,10 +6,9 @@
 
 /* SAMPLE_SETTLE frames are rendered and not kept; SAMPLE_SLOWER_PASS ones
  * are idle frames slower than their mode's fastest of the round, kept only
- * for the hash check; SAMPLE_SPLIT is the split mode's frame after the
- * round's updates, kept for its CPU split. */
+ * for the hash check. */
 typedef enum sample_kind {
-    SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT, SAMPLE_SETTLE, SAMPLE_SLOWER_PASS, SAMPLE_SPLIT
+    SAMPLE_WARMUP, SAMPLE_IDLE, SAMPLE_FLIGHT, SAMPLE_SETTLE, SAMPLE_SLOWER_PASS
 } sample_kind;
 
 typedef struct sample {
@@ -29,6 +28,7 @@ typedef struct sample {
 /* A mode's update of an idle round, timed around the call. */
 typedef struct round_update {
     double wall_ms, cpu_ms;
+    ob_update_stats st;        /* the renderer's figures of the call */
 } round_update;
 
 typedef struct collector {
@@ -86,14 +86,18 @@ static void cpu_figures(const ob_frame_stats *st, sample *p)
     p->host_allocs_per_object = st->draws ? (double)st->cmd_host_allocs / st->draws : NAN;
 }
 
-/* The serial share of the frame's CPU time, update included (the frame's
- * figures start at an update made through ob_renderer_update_scene); NAN
- * when the engine does not measure it. */
-static double serial_fraction(const ob_frame_stats *st)
+/* The serial share of the CPU time of a frame with its mode's update of
+ * the round: the frame's own figures (less an update the renderer gave it,
+ * which may be another mode's) and the update's; NAN when the engine does
+ * not measure them. */
+static double serial_fraction(const ob_frame_stats *st, const ob_update_stats *u)
 {
-    double total = (double)st->cpu_render_ns + (double)st->cpu_pool_ns;
+    double render = (double)(st->cpu_render_ns - st->update_cpu_render_ns) + (double)u->cpu_render_ns;
+    double parallel = (double)(st->cpu_render_parallel_ns - st->update_cpu_render_parallel_ns) +
+                      (double)u->cpu_render_parallel_ns;
+    double total = render + (double)(st->cpu_pool_ns - st->update_cpu_pool_ns) + (double)u->cpu_pool_ns;
     if (st->cpu_render_ns == 0 || total <= 0.0) return NAN;
-    return ((double)st->cpu_render_ns - (double)st->cpu_render_parallel_ns) / total;
+    return (render - parallel) / total;
 }
 
 /* One frame in mode m, its CPU stats kept as a sample unless kind is
@@ -118,12 +122,13 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
         .record_total_ms = (st->record_ns + st->assemble_ns) * 1e-6,
         .gpu_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
-        .serial_fraction = serial_fraction(st),
+        .serial_fraction = NAN,
     };
     if (!advance) {
         const round_update *u = &c->updates[round * desc->mode_count + mode];
         p->update_ms = u->wall_ms;
         p->update_cpu_ms = u->cpu_ms;
+        p->serial_fraction = serial_fraction(st, &u->st);
     }
     cpu_figures(st, p);
     return OB_OK;
@@ -165,32 +170,24 @@ static void order_of(uint64_t k, uint32_t n, uint32_t *out)
     }
 }
 
-/* The round's updates, device idle: each mode in the round's order (the
- * split mode last) moves the scene on once under its own threading, timed
- * here. The renderer hands an update's figures to the next begin_frame
- * only, so the split mode then renders one frame whose stats carry its
- * update with its CPU split; it renders the round's final state, which the
- * passes render again. */
+/* The round's updates, device idle: each mode in the round's order moves
+ * the scene on once under its own threading, timed here; the renderer's
+ * figures of the call (ob_renderer_last_update_stats) give its CPU split. */
 static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                                uint32_t round, const uint32_t *order)
 {
     ob_renderer *r = s->demo->r;
-    uint32_t split = ob_bench_split_mode(desc->modes, desc->mode_count);
-    uint32_t seq[OB_BENCH_MAX_MODES], n = 0;
-    for (uint32_t i = 0; i < desc->mode_count; i++)
-        if (order[i] != split) seq[n++] = order[i];
-    if (split != UINT32_MAX) seq[n++] = split;
     ob_result res = ob_renderer_wait_idle(r);
-    for (uint32_t i = 0; i < n && res == OB_OK; i++) {
-        ob_bench_set_mode(r, &desc->modes[seq[i]]);
+    for (uint32_t i = 0; i < desc->mode_count && res == OB_OK; i++) {
+        uint32_t m = order[i];
+        ob_bench_set_mode(r, &desc->modes[m]);
         uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
         res = ob_bench_scene_advance(s, desc->dt);
         uint64_t c1 = ob_thread_cpu_ns(), t1 = ob_time_ns();
-        c->updates[round * desc->mode_count + seq[i]] = (round_update){(t1 - t0) * 1e-6,
-                                                                        (c1 - c0) * 1e-6};
+        round_update *u = &c->updates[round * desc->mode_count + m];
+        *u = (round_update){(t1 - t0) * 1e-6, (c1 - c0) * 1e-6, {0}};
+        ob_renderer_last_update_stats(r, &u->st);
     }
-    if (res == OB_OK && split != UINT32_MAX)
-        res = frame(s, desc, c, split, round, 0, SAMPLE_SPLIT, false);
     return res;
 }
 
@@ -209,7 +206,12 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
             uint32_t order[OB_BENCH_MAX_MODES];
             order_of((uint64_t)round * passes + pass, desc->mode_count, order);
             if (pass == 0) {
-                ob_result res = round_updates(s, desc, c, round, order);
+                /* The updates step through all orders by round (the passes'
+                 * orders repeat with the pass count), so that no mode
+                 * always updates first, on caches the frames left cold. */
+                uint32_t update_order[OB_BENCH_MAX_MODES];
+                order_of(round, desc->mode_count, update_order);
+                ob_result res = round_updates(s, desc, c, round, update_order);
                 if (res != OB_OK) return res;
             }
             for (uint32_t i = 0; i < desc->mode_count; i++) {
@@ -401,7 +403,7 @@ static void round_ratios(const ob_bench_run_desc *desc, const collector *c, doub
             buf[k] = fastest_pass(c, m, desc->warmup + k, pre_render_ms);
         ob_bench_spread_of(buf, desc->rounds, &out[m].pre_render_round_ms);
         for (uint32_t k = 0; k < desc->rounds; k++) {
-            const sample *p = round_sample(c, SAMPLE_SPLIT, m, desc->warmup + k);
+            const sample *p = idle_sample(c, m, desc->warmup + k);
             buf[k] = p ? p->serial_fraction : NAN;
         }
         ob_bench_spread_of(buf, desc->rounds, &out[m].serial_fraction);
@@ -502,8 +504,8 @@ ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
         return OB_ERR_INVALID_ARGUMENT;
     collector c = {0};
     uint32_t rounds = desc->warmup + desc->rounds;
-    /* Per mode its idle and in-flight frames, and a split frame a round. */
-    c.cap = desc->mode_count * (rounds * OB_MAX(desc->passes, 1u) + desc->flight + 1) + rounds;
+    /* Per mode its idle and in-flight frames. */
+    c.cap = desc->mode_count * (rounds * OB_MAX(desc->passes, 1u) + desc->flight + 1);
     c.samples = ob_calloc(c.cap, sizeof *c.samples);
     c.updates = ob_calloc((size_t)OB_MAX(rounds, 1u) * desc->mode_count, sizeof *c.updates);
     /* Medians take up to cap values; round ratios two arrays of rounds. */

@@ -7,26 +7,19 @@
  *            recording never competes with lavapipe executing the previous
  *            frame on the same cores.
  *            Each round starts with the updates: device idle, every mode in
- *            turn (the round's order, the split mode below last) is set
- *            and moves the scene on once through ob_renderer_update_scene,
- *            under its own threading; the bench times each call itself
- *            (ob_time_ns, ob_thread_cpu_ns on the render thread) and keeps
- *            it as that mode's update of the round. The scene thus advances
- *            once per mode per round, and every pass of the round renders
- *            the same state untouched, so every mode records exactly the
- *            same commands and their hashes must be equal. A mode's frames
- *            of the round are reported with its own update of the round
- *            (update_ms), not with the renderer's stats of the frame: the
- *            renderer gives an update's figures to the next begin_frame
- *            only, whichever mode that frame is of.
- *            The split mode (ob_bench_split_mode: the multi-threaded mode of
- *            most workers) updates last and then renders one unmeasured
- *            frame, whose stats thus carry its update: its CPU split
- *            (cpu_render_ns, cpu_render_parallel_ns, cpu_pool_ns, update
- *            included) gives serial_fraction. That is the only way to the
- *            pool's share of an update, which no timer on the render thread
- *            sees; the frame renders the round's final state, and no
- *            measured frame follows the updates directly.
+ *            turn (the round's order) is set and moves the scene on once
+ *            through ob_renderer_update_scene, under its own threading; the
+ *            bench times each call itself (ob_time_ns, ob_thread_cpu_ns on
+ *            the render thread) and takes the renderer's CPU split of it
+ *            (ob_renderer_last_update_stats: render thread, its part in
+ *            parallel loops, pool threads), and keeps them as that mode's
+ *            update of the round. The scene thus advances once per mode per
+ *            round, and every pass of the round renders the same state
+ *            untouched, so every mode records exactly the same commands and
+ *            their hashes must be equal. A mode's frames of the round are
+ *            reported with its own update of the round (update_ms,
+ *            serial_fraction), not with the one the renderer's stats of
+ *            the frame carry (the last update's, whichever mode made it).
  *            The mode order steps through all orders of the modes, a new one
  *            each pass, so no mode always follows the same other mode. A
  *            mode's figure for the round is its fastest
@@ -142,10 +135,11 @@ typedef struct ob_bench_result {
      * round: its update of the round + the fastest of its passes' pre-render
      * + record + assemble + submit (wall time). */
     ob_bench_spread frame_cpu_speedup;
-    /* The split mode only (NAN for the others): median over idle rounds of
-     * the serial CPU share of its split frame, update included:
-     * (cpu_render - cpu_render_parallel) / (cpu_render + cpu_pool), from
-     * thread CPU clocks (ob_frame_stats). */
+    /* Median over idle rounds of the serial CPU share of the mode's frame
+     * with its update of the round: (cpu_render - cpu_render_parallel) /
+     * (cpu_render + cpu_pool), from thread CPU clocks (ob_frame_stats,
+     * ob_update_stats). split: the mode the summary reports it for (the
+     * multi-threaded mode of most workers, ob_bench_split_mode). */
     bool split;
     ob_bench_spread serial_fraction;
     /* Recording CPU time (ob_frame_stats.record_cpu_ns), medians over idle
@@ -174,9 +168,9 @@ ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
  * them in place. [any thread]. No value: every field NAN. */
 void ob_bench_spread_of(double *values, uint32_t n, ob_bench_spread *out);
 
-/* The mode whose rounds carry the split frame: the multi-threaded mode of
+/* The mode the summary reports the frame figures for: the multi-threaded mode of
  * most workers (the first of them on a tie); UINT32_MAX when there is none.
- * It renders one more frame per idle round. [any thread] */
+ * [any thread] */
 uint32_t ob_bench_split_mode(const ob_bench_mode *modes, uint32_t count);
 
 /* Sets the renderer's threading mode for the next frame. */

@@ -133,7 +133,12 @@ ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt)
     ob_views_set_time(d->views, s->time, dt);
     ob_result r = ob_renderer_begin_frame(d->r, d->scene);
     if (r != OB_OK) return r;
-    for (uint32_t k = 1; k < s->view_count; k++) ob_views_render(d->views, s->views[k]);
-    ob_views_render(d->views, ob_composite_view_base(d->composite));
+    /* Every root of the frame in one PreRender, so that their culling
+     * shares the worker pool: the extra cameras, then the final image. */
+    ob_view *roots[OB_BENCH_MAX_VIEWS + 1];
+    uint32_t n = 0;
+    for (uint32_t k = 1; k < s->view_count; k++) roots[n++] = s->views[k];
+    roots[n++] = ob_composite_view_base(d->composite);
+    ob_views_render_many(d->views, roots, n);
     return ob_renderer_end_frame(d->r);
 }

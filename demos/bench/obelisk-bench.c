@@ -492,8 +492,8 @@ static void summarize(ob_bench_report *rep)
                                                             r->speedup_record_p75};
         s->mt_speedup_best_mode = r->mode.name;
     }
-    /* The whole frame's CPU phases and their serial share, for the mode
-     * whose rounds carry the split frame (the one of most workers). */
+    /* The whole frame's CPU phases and their serial share, for the
+     * multi-threaded mode of most workers (ob_bench_split_mode). */
     const ob_bench_spread none = {NAN, NAN, NAN};
     s->frame_cpu_speedup_10k_8views = s->serial_fraction_10k_8views = none;
     for (uint32_t m = 0; e8 && m < e8->mode_count; m++) {
@@ -631,19 +631,17 @@ static int run(const bench_options *o)
     uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3;
     uint64_t total = 0;
     if (o->perf) {
-        /* scene200: three modes, MT's split frame a round. */
+        /* scene200: three modes. */
         total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
-                 o->warmup + o->rounds +
                  quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) + qd.image_frames;
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
                 if (!config_runs(o, o->views[v], o->objects[n])) continue;
                 frame_counts fc = counts_for(o, o->views[v], o->objects[n]);
-                /* Per mode its frames, and the split frame a round. */
+                /* Per mode its frames. */
                 uint64_t rounds = fc.warmup + fc.rounds;
                 uint64_t frames = (uint64_t)o->mode_count *
                                   (rounds * fc.passes * (fc.settle + 1) + fc.flight + 1);
-                if (ob_bench_split_mode(o->modes, o->mode_count) != UINT32_MAX) frames += rounds;
                 total += frames * frame_weight(o->views[v], o->objects[n]);
             }
         }
