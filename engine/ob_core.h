@@ -220,6 +220,10 @@ typedef struct ob_parallel {
     void (*run)(void *ctx, uint32_t count, ob_task_fn fn, void *user);
     void *ctx;
     uint32_t threads;
+    /* Items (entities, nodes) per loop index the caller should take, and
+     * half of what each thread must get for a loop worth handing out; 0:
+     * the caller's own default. */
+    uint32_t grain;
 } ob_parallel;
 
 /* Runs the loop through par, or on the caller when par is NULL or has one

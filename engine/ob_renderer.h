@@ -72,6 +72,12 @@ typedef struct ob_renderer_desc {
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
     ob_threading threading;      /* initial mode */
     uint32_t chunk_draws;        /* target draws per job when splitting a view; 0 → 2048 */
+    /* Entities (nodes) per index of the parallel loops of PreRender and of
+     * ob_renderer_update_scene; a loop goes to the pool only when each
+     * thread gets two indices' worth. 0 → 4096 for culling, 1024 for the
+     * update. Small values (tests) put the parallel paths to work on small
+     * scenes. */
+    uint32_t parallel_grain;
     /* The pool's threads are pinned, each to a CPU other than the one the
      * render thread is recording on (re-pinned only when that changes):
      * without it the scheduler often wakes a worker onto the render

@@ -101,6 +101,7 @@ struct ob_renderer {
     bool no_affinity;           /* desc.no_thread_affinity */
     ob_gpu_timing gpu_timing;   /* desc.gpu_timing */
     uint32_t chunk_draws;
+    uint32_t parallel_grain;    /* desc.parallel_grain (0: each loop's own) */
 
     ob_frame_slot frames[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t frames_in_flight, slot;

@@ -251,7 +251,8 @@ static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
 
 ob_parallel ob_renderer_parallel(ob_renderer *r)
 {
-    return (ob_parallel){.run = pool_run, .ctx = r, .threads = ob_renderer_parallel_threads(r)};
+    return (ob_parallel){.run = pool_run, .ctx = r, .threads = ob_renderer_parallel_threads(r),
+                         .grain = r->parallel_grain};
 }
 
 ob_result ob_renderer_workers_start(ob_renderer *r)

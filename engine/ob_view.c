@@ -221,7 +221,8 @@ typedef struct cull_ctx {
     const uint32_t *mesh;               /* per geometry index */
     uint32_t exclude_id;                /* 0: none (ids start at 1) */
     float planes[6][4];                 /* unused planes test nothing */
-    cull_pair *pairs;                   /* chunk c writes from c * CULL_GRAIN */
+    uint32_t grain;                     /* entities per chunk */
+    cull_pair *pairs;                   /* chunk c writes from c * grain */
     cull_chunk *chunks;
 } cull_ctx;
 
@@ -295,7 +296,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
 {
     (void)thread;
     const cull_ctx *c = user;
-    uint32_t first = chunk * CULL_GRAIN, end = OB_MIN(c->soa.count, first + CULL_GRAIN);
+    uint32_t first = chunk * c->grain, end = OB_MIN(c->soa.count, first + c->grain);
     uint32_t type_bit = 1u << c->v->type;
     cull_chunk *out = &c->chunks[chunk];
     cull_pair *pairs = c->pairs + first;
@@ -306,29 +307,34 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     for (uint32_t b = first; b < end; b += CULL_BLOCK) {
         uint32_t n = OB_MIN(CULL_BLOCK, end - b);
         cull_block(c, b, n, vis, d2);
+        /* Which entities the view keeps, without branches (a third or so
+         * are, in no order a predictor could learn), then keys for those
+         * only. The order of the reasons is the log's: an entity not drawn
+         * here or of no size is not reported as far. */
+        uint16_t keep[CULL_BLOCK];
+        uint32_t nk = 0;
         for (uint32_t j = 0; j < n; j++) {
             uint32_t i = b + j;
             const ob_view_material *m = &c->mt[c->soa.material[i]];
-            /* Branch-free: the pair is written either way and kept by
-             * counting it. The order of the reasons is the log's: an entity
-             * not drawn here or of no size is not reported as far. */
             uint32_t ok = ((m->mask & type_bit) != 0) & (c->soa.node_id[i] != c->exclude_id) &
                           ((c->soa.flags[i] & OB_RENDER_ZERO_SCALE) == 0);
             if (__builtin_expect(ok & (vis[j] == 2), 0)) {
                 if (out->far_count < CULL_LOG_MAX) out->far[out->far_count] = i;
                 out->far_count++;
-                out->culled++;
-                continue;
             }
-            uint32_t keep = ok & (vis[j] == 1);
-            pairs[out->kept] = (cull_pair){
+            keep[nk] = (uint16_t)j;
+            nk += ok & (vis[j] == 1);
+        }
+        for (uint32_t t = 0; t < nk; t++) {
+            uint32_t j = keep[t], i = b + j;
+            const ob_view_material *m = &c->mt[c->soa.material[i]];
+            pairs[out->kept++] = (cull_pair){
                 .key = item_key(m->sort_hi, m->state, c->mesh[c->soa.geometry[i]], d2[j]),
                 .hi = m->sort_hi,
                 .index = i,
             };
-            out->kept += keep;
-            out->culled += keep ^ 1u;
         }
+        out->culled += n - nk;
     }
 }
 
@@ -401,7 +407,8 @@ typedef struct cull_wave {
 /* Sets up view k of a wave on the render thread: its snapshot, working
  * memory, material and mesh tables and planes. */
 static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene,
-                            const ob_material_iface *mi, const ob_geometry_iface *gi)
+                            const ob_material_iface *mi, const ob_geometry_iface *gi,
+                            uint32_t grain)
 {
     ob_view *v = cv->v;
     uint32_t count = 0;
@@ -414,7 +421,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     cv->count = count;
     cv->chunks = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
-    uint32_t chunks = (count + CULL_GRAIN - 1) / CULL_GRAIN;
+    uint32_t chunks = (count + grain - 1) / grain;
     uint32_t *mesh = NULL;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
     if (res == OB_OK) res = cull_reserve(v, count, chunks, ob_scene_geometry_count(scene));
@@ -431,7 +438,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .mesh = mesh,
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
-        .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
+        .grain = grain, .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
     };
     /* Planes the frustum lacks (all of them without one) test nothing. */
     for (int p = 0; p < 6; p++) {
@@ -473,8 +480,8 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     for (uint32_t k2 = 0; k2 < cv->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
         chunk_ns += ch->ns;
-        if (n != k2 * CULL_GRAIN)
-            memmove(pairs + n, pairs + (size_t)k2 * CULL_GRAIN, sizeof *pairs * ch->kept);
+        if (n != k2 * cv->c.grain)
+            memmove(pairs + n, pairs + (size_t)k2 * cv->c.grain, sizeof *pairs * ch->kept);
         n += ch->kept;
         v->culled += ch->culled;
         for (uint32_t f = 0; f < OB_MIN(ch->far_count, CULL_LOG_MAX) && !v->range_reported; f++) {
@@ -506,10 +513,6 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     cv->ns = chunk_ns + (ob_time_ns() - t0);
 }
 
-/* Entities a wave must hold per thread before it goes to the pool: a
- * hand-out costs some 30-50 us on a 2-core VM (the wake-up), so smaller
- * waves are culled on the caller. */
-#define CULL_PARALLEL_MIN (2u * CULL_GRAIN)
 
 ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *const *views,
                             uint32_t count)
@@ -528,19 +531,22 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         }
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
+    ob_parallel par = ob_renderer_parallel(r);
+    uint32_t grain = par.grain ? par.grain : CULL_GRAIN;
     ob_result first_error = OB_OK;
     uint32_t tasks = 0, entities = 0;
     for (uint32_t k = 0; k < count; k++) {
         cull_view *cv = &w.views[k];
         cv->v = views[k];
-        cv->res = cull_setup(cv, r, scene, mi, gi);
+        cv->res = cull_setup(cv, r, scene, mi, gi, grain);
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
         tasks += cv->chunks;
         entities += cv->count;
     }
     w.task_view = ob_malloc(sizeof *w.task_view * 2 * OB_MAX(tasks, 1u));
-    ob_parallel par = ob_renderer_parallel(r);
-    if (entities < CULL_PARALLEL_MIN * par.threads) par.threads = 1;
+    /* A hand-out costs some 30-50 us on a 2-core VM (the wake-up): a wave
+     * goes to the pool only with two chunks' worth of entities a thread. */
+    if (entities < 2 * grain * par.threads) par.threads = 1;
     if (!w.task_view) {
         /* No task table: cull view by view on this thread instead. */
         for (uint32_t k = 0; k < count; k++) {

@@ -19,7 +19,8 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     w->height = d.height ? d.height : 120;
     ob_stack_desc sd = {
         .renderer = {.device = {.app_name = "obelisk-test", .validation = 1},
-                     .worker_count = d.workers ? d.workers : 4, .chunk_draws = d.chunk_draws},
+                     .worker_count = d.workers ? d.workers : 4, .chunk_draws = d.chunk_draws,
+                     .parallel_grain = d.parallel_grain},
         .width = w->width, .height = w->height,
         .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
         .camera = {.fovy = 1.0f, .znear = 0.1f},

@@ -24,6 +24,7 @@ typedef struct ob_test_world_desc {
     uint32_t shadow_map_size;  /* 0 → 256 */
     float clear_color[4];      /* zero → opaque dark blue (0.1, 0.2, 0.3, 1) */
     uint32_t chunk_draws;      /* renderer's draws per job; 0 → the renderer's default */
+    uint32_t parallel_grain;   /* renderer's entities per parallel-loop index; 0 → default */
     uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
 } ob_test_world_desc;
 

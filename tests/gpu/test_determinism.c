@@ -8,7 +8,10 @@
  * carry state from frame to frame). The renderer always has 8 workers;
  * ob_renderer_set_threading picks how many record. Views are cut into
  * chunks of 64 draws so that the main, shadow and env-map views are spread
- * over several workers. */
+ * over several workers, and the parallel loops of the update and of
+ * PreRender's culling take 16 entities an index, so that with workers
+ * every wave of views and the update run on the pool, several chunks a
+ * view. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -99,7 +102,8 @@ static void run(const run_plan *plan, run_result *out)
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 8, .width = WIDTH,
                                                    .height = HEIGHT, .env_map_size = 32,
-                                                   .shadow_map_size = 128, .chunk_draws = 64});
+                                                   .shadow_map_size = 128, .chunk_draws = 64,
+                                                   .parallel_grain = 16});
     assert_int_equal(ob_renderer_worker_count(w.r), 8);
     ob_particle_system *ps = NULL;
     build_scene(&w, &ps);
