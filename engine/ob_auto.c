@@ -20,6 +20,10 @@
 #define AUTO_REMEASURE_FRAMES 32u
 #define AUTO_CLEAR_PCT 25u
 #define AUTO_BACKOFF_STEPS 4u
+/* Worker counts next to the chosen one are re-measured less often than the
+ * other way (a count changes what recording costs less than inline against
+ * the workers does), and when the scene has grown or shrunk by a quarter. */
+#define AUTO_COUNT_REMEASURE_FRAMES 256u
 
 /* The last frame's cost of a way (per draw when both ways have one). */
 static uint64_t latest_cost(const ob_record_cost *m, bool per_draw)
@@ -61,6 +65,60 @@ bool ob_auto_choose(ob_auto_state *s, const ob_record_cost *inline_way,
     if (resized) s->confirmed = 0;
     s->probing = other->age >= ob_auto_remeasure_interval(s) || resized;
     return s->probing ? !multi : multi;
+}
+
+/* The candidate worker counts: 2, 4, 8, ... below active, and active. */
+static uint32_t candidates(uint32_t active, uint32_t out[32])
+{
+    uint32_t n = 0;
+    for (uint32_t c = 2; c < active && n < 31; c *= 2) out[n++] = c;
+    out[n++] = active;
+    return n;
+}
+
+static uint64_t count_cost(const ob_record_cost *m)
+{
+    return m->per_draw_ps ? m->per_draw_ps : m->cost_ns;
+}
+
+uint32_t ob_auto_best_workers(ob_auto_state *s, const ob_record_cost *measured, uint32_t active)
+{
+    uint32_t c[32], n = candidates(active, c);
+    uint32_t cur = s->workers;
+    bool known = false;
+    for (uint32_t i = 0; i < n; i++) known |= c[i] == cur;
+    if (!known || count_cost(&measured[cur]) == 0) cur = active;
+    uint32_t best = cur;
+    for (uint32_t i = 0; i < n; i++) {
+        uint64_t cost = count_cost(&measured[c[i]]);
+        if (cost == 0 || c[i] == best) continue;
+        uint64_t best_cost = count_cost(&measured[best]);
+        if (best_cost == 0 || cost * (100u + AUTO_MARGIN_PCT) < best_cost * 100u) best = c[i];
+    }
+    s->workers = best;
+    return best;
+}
+
+uint32_t ob_auto_probe_workers(ob_auto_state *s, const ob_record_cost *measured, uint32_t active)
+{
+    uint32_t c[32], n = candidates(active, c), at = n;
+    s->count_probing = false;
+    for (uint32_t i = 0; i < n; i++)
+        if (c[i] == s->workers) at = i;
+    if (at == n) return s->workers ? s->workers : active;
+    /* Up first: more workers is where a bigger scene goes. */
+    const uint32_t next[2] = {at + 1 < n ? c[at + 1] : 0, at > 0 ? c[at - 1] : 0};
+    for (uint32_t k = 0; k < 2; k++) {
+        if (!next[k]) continue;
+        const ob_record_cost *m = &measured[next[k]];
+        uint32_t now = measured[s->workers].draws, then = m->draws;
+        bool resized = 4ull * (now > then ? now - then : then - now) > (uint64_t)OB_MAX(now, then);
+        if (m->cost_ns == 0 || m->age >= AUTO_COUNT_REMEASURE_FRAMES || resized) {
+            s->count_probing = true;
+            return next[k];
+        }
+    }
+    return s->workers;
 }
 
 void ob_record_cost_note(ob_record_cost *m, uint64_t ns, uint32_t draws)

@@ -22,6 +22,8 @@ typedef struct ob_auto_state {
     bool way;                   /* the choice: true = the workers */
     bool probing;               /* the last frame re-measured the way not chosen */
     uint32_t confirmed;         /* probes in a row that left the choice clear */
+    uint32_t workers;           /* worker count of the workers' way (0: not chosen yet) */
+    bool count_probing;         /* the last frame re-measured another worker count */
 } ob_auto_state;
 
 /* A frame recorded this way took ns (recording wall time) for draws draws.
@@ -35,5 +37,16 @@ bool ob_auto_choose(ob_auto_state *s, const ob_record_cost *inline_way,
 
 /* Frames of the chosen way before the other is re-measured, now. */
 uint32_t ob_auto_remeasure_interval(const ob_auto_state *s);
+
+/* The worker count of the workers' way: among 2, 4, 8, ... below `active`
+ * and `active` itself (the most the frame may use), the one measured
+ * cheapest per draw (kept unless another is cheaper by the margin), in
+ * s->workers. measured[n] is the way of n workers (n = 0..active). [any] */
+uint32_t ob_auto_best_workers(ob_auto_state *s, const ob_record_cost *measured, uint32_t active);
+/* The count a frame that records on the workers uses: s->workers, or, one
+ * frame at a time, the next count above or below it when that one was
+ * never measured, is stale (256 frames old) or was measured at a draw
+ * count a quarter away, so the choice follows the scene. [any] */
+uint32_t ob_auto_probe_workers(ob_auto_state *s, const ob_record_cost *measured, uint32_t active);
 
 #endif

@@ -341,8 +341,15 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
 
     r->mode = r->pending_mode;
     r->active = r->pending_active;
-    if (r->mode == OB_THREADING_AUTO)
-        r->auto_multi = ob_auto_choose(&r->auto_state, &r->measured[0], &r->measured[r->active]);
+    if (r->mode == OB_THREADING_AUTO) {
+        /* The workers' way at its cheapest count, against inline; then,
+         * recording on the workers, now and then a count next to it. */
+        uint32_t best = ob_auto_best_workers(&r->auto_state, r->measured, r->active);
+        r->auto_multi = ob_auto_choose(&r->auto_state, &r->measured[0], &r->measured[best]);
+        r->auto_workers = r->auto_multi && !r->auto_state.probing
+                              ? ob_auto_probe_workers(&r->auto_state, r->measured, r->active)
+                              : best;
+    }
     r->scene = scene;
     r->queue_count = 0;
     r->stack_depth = 0;

@@ -111,6 +111,7 @@ struct ob_renderer {
     ob_threading mode, pending_mode;
     uint32_t active, pending_active;
     bool auto_multi;            /* AUTO's way for this frame (a probe or its choice) */
+    uint32_t auto_workers;      /* and its worker count when that is the workers */
     ob_auto_state auto_state;
     /* Measured recording cost (wall time from the start of recording to the
      * primary's end) of each way of recording this scene, [0] inline and [1]

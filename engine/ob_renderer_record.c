@@ -666,9 +666,11 @@ static uint64_t cmd_allocations(ob_renderer *r)
 /* The measured cost of recording this frame's way (engine/ob_auto.c). */
 static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
 {
-    ob_record_cost_note(&r->measured[multi ? workers : 0], ns, draws);
-    /* The other way AUTO weighs against this one ages. */
-    r->measured[multi ? 0 : r->active].age++;
+    uint32_t way = multi ? workers : 0;
+    ob_record_cost_note(&r->measured[way], ns, draws);
+    /* Every other way AUTO weighs against this one ages. */
+    for (uint32_t i = 0; i <= r->worker_count; i++)
+        if (i != way) r->measured[i].age++;
 }
 
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count)
@@ -679,8 +681,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkResult vr;
     uint64_t cpu0 = ob_thread_cpu_ns();
     uint64_t allocs0 = cmd_allocations(r);
-    bool multi = r->mode == OB_THREADING_MULTI || (r->mode == OB_THREADING_AUTO && r->auto_multi);
-    uint32_t active = multi ? r->active : 0;
+    bool is_auto = r->mode == OB_THREADING_AUTO;
+    bool multi = r->mode == OB_THREADING_MULTI || (is_auto && r->auto_multi);
+    uint32_t active = !multi ? 0 : is_auto && r->auto_workers ? r->auto_workers : r->active;
     st->workers = active;
     st->view_count = count;
     for (uint32_t i = 0; i < count; i++) stat_view(st, i, order[i]);

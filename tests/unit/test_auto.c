@@ -124,6 +124,71 @@ static void a_resized_scene_is_re_measured_at_once(void **state)
     assert_true(m.probes > before);
 }
 
+/* A 16-core machine as the renderer drives AUTO with 16 workers: recording
+ * on n workers costs work/n plus a hand-out cost that grows with n, so the
+ * cheapest count lies inside the range, and inline costs the work alone. */
+typedef struct count_sim {
+    ob_auto_state s;
+    ob_record_cost measured[17];   /* [0] inline, [n] n workers */
+    uint32_t frames_at[17];
+} count_sim;
+
+static uint64_t cost_on(uint32_t workers, uint64_t work_ps, uint64_t per_worker_ps)
+{
+    return workers ? work_ps / workers + per_worker_ps * workers : work_ps;
+}
+
+/* One AUTO frame as begin_frame and the recording take it (ob_renderer.c,
+ * ob_renderer_record.c); returns the worker count it recorded with (0:
+ * inline). */
+static uint32_t count_frame(count_sim *m, uint64_t work_ps, uint64_t per_worker_ps,
+                            uint32_t draws)
+{
+    uint32_t best = ob_auto_best_workers(&m->s, m->measured, 16);
+    bool multi = ob_auto_choose(&m->s, &m->measured[0], &m->measured[best]);
+    uint32_t n = multi && !m->s.probing ? ob_auto_probe_workers(&m->s, m->measured, 16)
+                                        : best;
+    uint32_t way = multi ? n : 0;
+    ob_record_cost_note(&m->measured[way], cost_on(way, work_ps, per_worker_ps) * draws / 1000u,
+                        draws);
+    for (uint32_t i = 0; i <= 16; i++)
+        if (i != way) m->measured[i].age++;
+    m->frames_at[way]++;
+    return way;
+}
+
+/* With 16 workers allowed and 8 the cheapest, AUTO measures its way down
+ * from 16 to the cheapest count and records almost every frame there;
+ * inline is measured first and then only re-measured with the usual
+ * backing off (32, 64, ... 512 frames). */
+static void auto_finds_the_cheapest_worker_count(void **state)
+{
+    (void)state;
+    count_sim m = {0};
+    /* work 1 600 000 ps, 20 000 ps per worker: 2 -> 840k, 4 -> 480k,
+     * 8 -> 360k, 16 -> 420k (per 1000 draws' ps, as cost_on gives). */
+    for (int f = 0; f < 2000; f++) count_frame(&m, 1600000, 20000, 1000);
+    assert_int_equal(m.s.workers, 8);
+    assert_true(m.frames_at[8] > 1900);
+    assert_true(m.frames_at[0] >= 1 && m.frames_at[0] <= 10);
+    /* The neighbours are re-measured now and then, never the far counts. */
+    assert_true(m.frames_at[4] >= 2 && m.frames_at[4] <= 12);
+    assert_true(m.frames_at[16] >= 2 && m.frames_at[16] <= 12);
+    assert_true(m.frames_at[2] <= 3);
+}
+
+/* When the scene grows so that more workers pay, the count follows. */
+static void the_worker_count_follows_a_growing_scene(void **state)
+{
+    (void)state;
+    count_sim m = {0};
+    for (int f = 0; f < 600; f++) count_frame(&m, 1600000, 20000, 1000);
+    assert_int_equal(m.s.workers, 8);
+    /* Four times the draws, each four times the work: 16 workers win. */
+    for (int f = 0; f < 600; f++) count_frame(&m, 6400000, 20000, 4000);
+    assert_int_equal(m.s.workers, 16);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -133,6 +198,8 @@ int main(void)
         cmocka_unit_test(close_ways_keep_the_short_interval),
         cmocka_unit_test(a_change_is_followed_after_backing_off),
         cmocka_unit_test(a_resized_scene_is_re_measured_at_once),
+        cmocka_unit_test(auto_finds_the_cheapest_worker_count),
+        cmocka_unit_test(the_worker_count_follows_a_growing_scene),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
