@@ -73,9 +73,13 @@ void ob_view_release(ob_view *v)
     if (!v) return;
     ob_free(v->items);
     ob_free(v->materials);
+    ob_free(v->material_items);
     ob_aligned_free(v->cull_mem);
     v->items = NULL;
     v->materials = NULL;
+    v->material_items = NULL;
+    v->material_item_count = v->material_item_cap = 0;
+    v->material_items_valid = false;
     v->cull_mem = NULL;
     v->cull_mem_size = 0;
     v->item_count = v->item_cap = 0;
@@ -417,6 +421,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     v->item_count = 0;
     v->culled = 0;
     v->material_count = 0;
+    v->material_items_valid = false;
     v->cull_ns = 0;
     cv->count = count;
     cv->chunks = 0;
@@ -510,6 +515,25 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
                                      .proxy = i};
     }
     v->item_count = n;
+    /* The items the view's post-cull work visits (for_each_material_item):
+     * a short list, found here on the pool rather than by a pass over the
+     * draw list per use on the render thread. */
+    v->material_item_count = 0;
+    v->material_items_valid =
+        ob_array_reserve((void **)&v->material_items, &v->material_item_cap, OB_MAX(n, 1u),
+                         sizeof *v->material_items) == OB_OK;
+    if (!v->material_items_valid)
+        OB_LOG_W("view", "view '%s': no memory for its list of one item per material; its "
+                 "PreRender asks every item's material this frame", v->name);
+    if (v->material_items_valid) {
+        for (uint32_t k2 = 0; k2 < v->material_count; k2++) v->materials[k2].seen = 0;
+        for (uint32_t j = 0; j < n; j++) {
+            ob_view_material *m = &v->materials[v->soa.material[v->items[j].proxy]];
+            if (m->seen && !m->per_entity) continue;
+            m->seen = 1;
+            v->material_items[v->material_item_count++] = j;
+        }
+    }
     cv->ns = chunk_ns + (ob_time_ns() - t0);
 }
 
@@ -549,6 +573,8 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
     if (entities < 2 * grain * par.threads) par.threads = 1;
     if (!w.task_view) {
         /* No task table: cull view by view on this thread instead. */
+        OB_LOG_W("view", "%u views culled on the render thread alone this frame: no memory "
+                 "for the task table", count);
         for (uint32_t k = 0; k < count; k++) {
             cull_view *cv = &w.views[k];
             for (uint32_t c = 0; c < cv->chunks; c++) cull_chunk_run(&cv->c, c, 0);
@@ -594,18 +620,14 @@ void ob_view_item_sphere(const ob_view *v, uint32_t item, double center[3], floa
 void ob_view_for_each_material_item(ob_view *v, void (*fn)(void *user, ob_view *v, uint32_t item),
                                     void *user)
 {
-    if (!v->material_count) {
-        /* Not culled through ob_view_cull (a custom list): every item. */
+    if (!v->material_count || !v->material_items_valid) {
+        /* Not culled through ob_view_cull (a custom list), or no memory
+         * for the short list: every item. */
         for (uint32_t i = 0; i < v->item_count; i++) fn(user, v, i);
         return;
     }
-    for (uint32_t k = 0; k < v->material_count; k++) v->materials[k].seen = 0;
-    for (uint32_t i = 0; i < v->item_count; i++) {
-        ob_view_material *m = &v->materials[ob_view_item_material(v, i)];
-        if (m->seen && !m->per_entity) continue;
-        m->seen = 1;
-        fn(user, v, i);
-    }
+    for (uint32_t k = 0; k < v->material_item_count; k++)
+        if (v->material_items[k] < v->item_count) fn(user, v, v->material_items[k]);
 }
 
 typedef struct pre_render_ctx {

@@ -69,7 +69,7 @@ typedef struct ob_view_material {
     uint32_t sort_hi, state;  /* class and priority, state group, for this view's type */
     uint8_t mask;             /* bit t: the material renders in views of type t */
     uint8_t per_entity;       /* its pre_render depends on the entity here */
-    uint8_t seen;             /* scratch of ob_view_for_each_material_item */
+    uint8_t seen;             /* culling's scratch (the material's first item found) */
 } ob_view_material;
 
 typedef struct ob_view_vtbl {
@@ -143,6 +143,13 @@ struct ob_view {
     ob_render_soa soa;                /* its culling data (items' proxy indexes it too) */
     ob_view_material *materials;      /* per material index of the snapshot */
     uint32_t material_count, material_cap;
+    /* The items ob_view_for_each_material_item visits, found by culling:
+     * the first of each material and every one of a per-entity material,
+     * in draw order. Not valid (all items visited) while material_items
+     * is NULL after a failed allocation. */
+    uint32_t *material_items;
+    uint32_t material_item_count, material_item_cap;
+    bool material_items_valid;
     void *cull_mem;                   /* culling's working memory */
     size_t cull_mem_size;
     uint32_t culled;                  /* entities rejected by frustum or render flag */
