@@ -1,48 +1,22 @@
-/* ob_controllers.c — the built-in controllers (rotation, orbit, script),
- * written on the public node API (ob_node_add_controller) like any user
- * controller would be. State is kept in double so long runs do not drift. */
-#include "ob_scene.h"
+/* ob_controllers.c — the built-in controllers (rotation, orbit, script).
+ * The rotation and orbit controllers keep their state in the node
+ * (ob_node_add_controller_state), in double so long runs do not drift;
+ * their steps are kernels on the node's slot data
+ * (ob_controllers_internal.h), which the update runs in its own loop. */
+#include "ob_controllers_internal.h"
 
 #define CONTROLLER_LOG "scene"
 
-typedef struct rotation_state {
-    double axis[3];   /* unit */
-    double rate;      /* radians per second */
-} rotation_state;
-
-typedef struct orbit_state {
-    double center[3];
-    double u[3], v[3];   /* orthonormal basis of the orbit plane, v = axis x u */
-    double radius;
-    double rate;
-    double angle;        /* kept in (-2pi, 2pi) so it never loses precision */
-} orbit_state;
-
-static void rotation_step(ob_node *n, double dt, void *user)
+void ob_rotation_controller_step(ob_node *n, double dt, void *user)
 {
-    const rotation_state *st = user;
-    double q[4], dq[4];
-    ob_node_get_rotation(n, q);
-    ob_dquat_from_axis_angle(st->axis, st->rate * dt, dq);
-    ob_dquat_mul(q, dq, q);
-    /* Renormalizing every step keeps |q| = 1 to rounding for any number of
-     * updates. A non-finite q is stored as is, so the update names the node. */
-    ob_dquat_normalize(q, q);
-    ob_node_set_rotation_d(n, q);
+    ob_rotation_kernel(node_xf_of(n), user, dt);
+    node_touch(n);
 }
 
-static void orbit_place(ob_node *n, const orbit_state *st)
+void ob_orbit_controller_step(ob_node *n, double dt, void *user)
 {
-    double c = cos(st->angle) * st->radius, s = sin(st->angle) * st->radius, p[3];
-    for (int i = 0; i < 3; i++) p[i] = st->center[i] + c * st->u[i] + s * st->v[i];
-    ob_node_set_position(n, p);
-}
-
-static void orbit_step(ob_node *n, double dt, void *user)
-{
-    orbit_state *st = user;
-    st->angle = fmod(st->angle + st->rate * dt, 2.0 * OB_PI);
-    orbit_place(n, st);
+    ob_orbit_kernel(node_xf_of(n), user, dt);
+    node_touch(n);
 }
 
 static bool axis_from_floats(const float axis[3], double dest[3])
@@ -59,17 +33,11 @@ ob_result ob_node_add_rotation_controller(ob_node *n, const float axis[3], float
                  "finite axis and a finite rate; refused", ob_node_name(n), ob_node_id(n));
         return OB_ERR_INVALID_ARGUMENT;
     }
-    rotation_state *st = ob_malloc(sizeof *st);
-    if (!st) {
-        OB_LOG_E(CONTROLLER_LOG, "entity '%s' (id %u): cannot add a rotation controller: out "
-                 "of host memory", ob_node_name(n), ob_node_id(n));
-        return OB_ERR_OUT_OF_HOST_MEMORY;
-    }
-    ob_dvec3_copy(a, st->axis);
-    st->rate = radians_per_second;
-    return ob_node_add_controller(n, &(ob_controller_desc){.fn = rotation_step, .user = st,
-                                                           .parallel = true,
-                                                           .release = ob_free});
+    ob_rotation_state st = {.axis = {a[0], a[1], a[2]}, .rate = radians_per_second,
+                            .step_dt = NAN};
+    return ob_node_add_controller_state(
+        n, &(ob_controller_desc){.fn = ob_rotation_controller_step, .parallel = true}, &st,
+        sizeof st);
 }
 
 ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const float axis[3],
@@ -83,12 +51,7 @@ ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const
                  ob_node_name(n), ob_node_id(n));
         return OB_ERR_INVALID_ARGUMENT;
     }
-    orbit_state *st = ob_malloc(sizeof *st);
-    if (!st) {
-        OB_LOG_E(CONTROLLER_LOG, "entity '%s' (id %u): cannot add an orbit controller: out of "
-                 "host memory", ob_node_name(n), ob_node_id(n));
-        return OB_ERR_OUT_OF_HOST_MEMORY;
-    }
+    ob_orbit_state state, *st = &state;
     /* Angle 0 lies along the world axis least aligned with the orbit axis
      * (ties: X, then Y, then Z), projected into the plane: X for a Y axis. */
     int k = 0;
@@ -104,9 +67,9 @@ ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const
     st->radius = radius;
     st->rate = radians_per_second;
     st->angle = phase;
-    return ob_node_add_controller(n, &(ob_controller_desc){.fn = orbit_step, .user = st,
-                                                           .parallel = true,
-                                                           .release = ob_free});
+    return ob_node_add_controller_state(
+        n, &(ob_controller_desc){.fn = ob_orbit_controller_step, .parallel = true}, st,
+        sizeof *st);
 }
 
 ob_result ob_node_add_script_controller(ob_node *n, ob_controller_fn fn, void *user)

@@ -4,6 +4,19 @@
 
 #include <string.h>
 
+/* The external definitions of the inline functions of ob_math.h. */
+extern inline void ob_dquat_mul(const double a[4], const double b[4], double dest[4]);
+extern inline bool ob_dquat_normalize(const double q[4], double dest[4]);
+extern inline void ob_dquat_to_mat3(const double q[4], double dest[9]);
+extern inline void ob_daffine_from_trs(const double t[3], const double q[4], const double s[3],
+                                       ob_daffine *dest);
+extern inline void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine *dest);
+extern inline void ob_daffine_transform_point(const ob_daffine *a, const double p[3],
+                                              double dest[3]);
+extern inline bool ob_daffine_is_finite(const ob_daffine *a);
+extern inline double ob_daffine_max_scale(const ob_daffine *a);
+extern inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9]);
+
 bool ob_dvec3_normalize(const double a[3], double dest[3])
 {
     if (!ob_dvec3_is_finite(a)) return false;
@@ -39,38 +52,6 @@ void ob_dquat_from_axis_angle(const double axis[3], double angle, double dest[4]
     dest[3] = cos(angle * 0.5);
 }
 
-void ob_dquat_mul(const double a[4], const double b[4], double dest[4])
-{
-    double x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
-    double y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
-    double z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
-    double w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
-    dest[0] = x;
-    dest[1] = y;
-    dest[2] = z;
-    dest[3] = w;
-}
-
-bool ob_dquat_normalize(const double q[4], double dest[4])
-{
-    double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    /* The usual case (a near-unit rotation, every update of every node):
-     * the squares neither overflow nor underflow, so no rescaling (four
-     * divisions) is needed. A NaN or infinite component fails the test. */
-    if (n2 > 0x1p-900 && n2 < 0x1p900) {
-        double inv = 1.0 / sqrt(n2);
-        for (int i = 0; i < 4; i++) dest[i] = q[i] * inv;
-        return true;
-    }
-    if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2]) || !isfinite(q[3])) return false;
-    double big = fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3])));
-    if (big == 0.0) return false;
-    double s[4] = {q[0] / big, q[1] / big, q[2] / big, q[3] / big};
-    double inv = 1.0 / sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + s[3] * s[3]);
-    for (int i = 0; i < 4; i++) dest[i] = s[i] * inv;
-    return true;
-}
-
 void ob_dquat_rotate(const double q[4], const double v[3], double dest[3])
 {
     /* v' = v + w t + q.xyz x t, with t = 2 q.xyz x v: fewer roundings than
@@ -85,23 +66,6 @@ void ob_dquat_rotate(const double q[4], const double v[3], double dest[3])
     dest[0] = x;
     dest[1] = y;
     dest[2] = z;
-}
-
-void ob_dquat_to_mat3(const double q[4], double dest[9])
-{
-    double x = q[0], y = q[1], z = q[2], w = q[3];
-    double xx = x * x, yy = y * y, zz = z * z;
-    double xy = x * y, xz = x * z, yz = y * z;
-    double wx = w * x, wy = w * y, wz = w * z;
-    dest[0] = 1.0 - 2.0 * (yy + zz);
-    dest[1] = 2.0 * (xy + wz);
-    dest[2] = 2.0 * (xz - wy);
-    dest[3] = 2.0 * (xy - wz);
-    dest[4] = 1.0 - 2.0 * (xx + zz);
-    dest[5] = 2.0 * (yz + wx);
-    dest[6] = 2.0 * (xz + wy);
-    dest[7] = 2.0 * (yz - wx);
-    dest[8] = 1.0 - 2.0 * (xx + yy);
 }
 
 void ob_dmat3_to_dquat(const double m[9], double dest[4])
@@ -148,67 +112,6 @@ void ob_daffine_identity(ob_daffine *dest)
     dest->m[0] = dest->m[4] = dest->m[8] = 1.0;
 }
 
-void ob_daffine_from_trs(const double t[3], const double q[4], const double s[3], ob_daffine *dest)
-{
-    double r[9];
-    ob_dquat_to_mat3(q, r);
-    for (int c = 0; c < 3; c++)
-        for (int k = 0; k < 3; k++) dest->m[c * 3 + k] = r[c * 3 + k] * s[c];
-    ob_dvec3_copy(t, dest->t);
-}
-
-void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine *dest)
-{
-    ob_daffine r;
-    for (int c = 0; c < 3; c++) {
-        for (int k = 0; k < 3; k++) {
-            r.m[c * 3 + k] = a->m[k] * b->m[c * 3] + a->m[3 + k] * b->m[c * 3 + 1] +
-                             a->m[6 + k] * b->m[c * 3 + 2];
-        }
-    }
-    for (int k = 0; k < 3; k++)
-        r.t[k] = a->m[k] * b->t[0] + a->m[3 + k] * b->t[1] + a->m[6 + k] * b->t[2] + a->t[k];
-    *dest = r;
-}
-
-void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double dest[3])
-{
-    double r[3];
-    for (int k = 0; k < 3; k++)
-        r[k] = a->m[k] * p[0] + a->m[3 + k] * p[1] + a->m[6 + k] * p[2] + a->t[k];
-    ob_dvec3_copy(r, dest);
-}
-
-/* Branch-free: an exponent of all ones (Inf, NaN) plus one carries into the
- * sign bit, no other exponent does; OR-ed over values, the sign bit says
- * whether any is not finite. */
-static uint64_t non_finite_bits(const double *v, int count)
-{
-    uint64_t bad = 0;
-    for (int i = 0; i < count; i++) {
-        union { double d; uint64_t u; } b = {.d = v[i]};
-        bad |= (b.u & 0x7ff0000000000000u) + 0x0010000000000000u;
-    }
-    return bad;
-}
-
-bool ob_daffine_is_finite(const ob_daffine *a)
-{
-    return !((non_finite_bits(a->m, 9) | non_finite_bits(a->t, 3)) >> 63);
-}
-
-double ob_daffine_max_scale(const ob_daffine *a)
-{
-    /* sqrt is correctly rounded, so monotonic: the root of the largest
-     * squared length is the largest of the roots. */
-    double best = 0.0;
-    for (int c = 0; c < 3; c++) {
-        const double *col = &a->m[c * 3];
-        best = fmax(best, ob_dvec3_dot(col, col));
-    }
-    return sqrt(best);
-}
-
 void ob_daffine_to_relative(const ob_daffine *a, const double origin[3], float dest[16])
 {
     for (int c = 0; c < 3; c++) {
@@ -235,32 +138,6 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16])
             r[c * 4 + k] = a[k] * b[c * 4] + a[4 + k] * b[c * 4 + 1] + a[8 + k] * b[c * 4 + 2] +
                            a[12 + k] * b[c * 4 + 3];
     memcpy(dest, r, sizeof r);
-}
-
-void ob_mat3_normal_cofactor(const float m[9], float dest[9])
-{
-    float c[9], largest = 0.0f;
-    for (int i = 0; i < 9; i++) {
-        c[i] = m[i];
-        float a = c[i] < 0.0f ? -c[i] : c[i];
-        largest = a > largest ? a : largest;
-    }
-    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
-        int exponent;
-        frexpf(largest, &exponent);
-        for (int i = 0; i < 9; i++) c[i] = ldexpf(c[i], -exponent);
-    }
-    /* Column i is column i+1 x column i+2. */
-    const float *c0 = &c[0], *c1 = &c[3], *c2 = &c[6];
-    dest[0] = c1[1] * c2[2] - c1[2] * c2[1];
-    dest[1] = c1[2] * c2[0] - c1[0] * c2[2];
-    dest[2] = c1[0] * c2[1] - c1[1] * c2[0];
-    dest[3] = c2[1] * c0[2] - c2[2] * c0[1];
-    dest[4] = c2[2] * c0[0] - c2[0] * c0[2];
-    dest[5] = c2[0] * c0[1] - c2[1] * c0[0];
-    dest[6] = c0[1] * c1[2] - c0[2] * c1[1];
-    dest[7] = c0[2] * c1[0] - c0[0] * c1[2];
-    dest[8] = c0[0] * c1[1] - c0[1] * c1[0];
 }
 
 void ob_mat4_normal_cofactor(const float w[16], float dest[16])

@@ -17,7 +17,9 @@
  * Depth is reversed everywhere (near → 1, far → 0): clear depth to 0 and use
  * VK_COMPARE_OP_GREATER_OR_EQUAL.
  *
- * Lifecycle: none (pure functions, no allocation).
+ * Lifecycle: none (pure functions, no allocation). The small functions the
+ * scene update runs per node are inline definitions here (C99 inline: the
+ * library still exports each, from ob_math.c).
  * Thread rule: every function is [any thread]; outputs may alias inputs only
  * where a function says so.
  */
@@ -98,14 +100,67 @@ void ob_dquat_identity(double dest[4]);
  * gives the identity). */
 void ob_dquat_from_axis_angle(const double axis[3], double angle, double dest[4]);
 /* dest = a * b (b applied first). dest may alias a or b. */
-void ob_dquat_mul(const double a[4], const double b[4], double dest[4]);
+inline void ob_dquat_mul(const double a[4], const double b[4], double dest[4])
+{
+    double x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
+    double y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
+    double z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
+    double w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    dest[0] = x;
+    dest[1] = y;
+    dest[2] = z;
+    dest[3] = w;
+}
 /* Unit quaternion along q. Returns false (dest untouched) when q is zero or
  * not finite. dest may alias q. */
-bool ob_dquat_normalize(const double q[4], double dest[4]);
+inline bool ob_dquat_normalize(const double q[4], double dest[4])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    double n2 = x * x + y * y + z * z + w * w;
+    /* The usual case (a near-unit rotation, every update of every node):
+     * the squares neither overflow nor underflow, so no rescaling (four
+     * divisions) is needed. A NaN or infinite component fails the test. */
+    if (n2 > 0x1p-900 && n2 < 0x1p900) {
+        double inv = 1.0 / sqrt(n2);
+        dest[0] = x * inv;
+        dest[1] = y * inv;
+        dest[2] = z * inv;
+        dest[3] = w * inv;
+        return true;
+    }
+    if (!isfinite(x) || !isfinite(y) || !isfinite(z) || !isfinite(w)) return false;
+    double big = fmax(fmax(fabs(x), fabs(y)), fmax(fabs(z), fabs(w)));
+    if (big == 0.0) return false;
+    x /= big;
+    y /= big;
+    z /= big;
+    w /= big;
+    double inv = 1.0 / sqrt(x * x + y * y + z * z + w * w);
+    dest[0] = x * inv;
+    dest[1] = y * inv;
+    dest[2] = z * inv;
+    dest[3] = w * inv;
+    return true;
+}
 /* q must be unit. dest may alias v. */
 void ob_dquat_rotate(const double q[4], const double v[3], double dest[3]);
 /* Column-major rotation matrix of unit q. */
-void ob_dquat_to_mat3(const double q[4], double dest[9]);
+inline void ob_dquat_to_mat3(const double q[4], double dest[9])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    double xx = x * x, yy = y * y, zz = z * z;
+    double xy = x * y, xz = x * z, yz = y * z;
+    double wx = w * x, wy = w * y, wz = w * z;
+    dest[0] = 1.0 - 2.0 * (yy + zz);
+    dest[1] = 2.0 * (xy + wz);
+    dest[2] = 2.0 * (xz - wy);
+    dest[3] = 2.0 * (xy - wz);
+    dest[4] = 1.0 - 2.0 * (xx + zz);
+    dest[5] = 2.0 * (yz + wx);
+    dest[6] = 2.0 * (xz + wy);
+    dest[7] = 2.0 * (yz - wx);
+    dest[8] = 1.0 - 2.0 * (xx + yy);
+}
 /* Unit quaternion of an orthonormal, right-handed column-major matrix. */
 void ob_dmat3_to_dquat(const double m[9], double dest[4]);
 
@@ -119,15 +174,75 @@ typedef struct ob_daffine {
 
 void ob_daffine_identity(ob_daffine *dest);
 /* T * R * S; q must be unit. */
-void ob_daffine_from_trs(const double t[3], const double q[4], const double s[3], ob_daffine *dest);
+inline void ob_daffine_from_trs(const double t[3], const double q[4], const double s[3],
+                                ob_daffine *dest)
+{
+    double r[9];
+    ob_dquat_to_mat3(q, r);
+    double s0 = s[0], s1 = s[1], s2 = s[2];
+    dest->m[0] = r[0] * s0;
+    dest->m[1] = r[1] * s0;
+    dest->m[2] = r[2] * s0;
+    dest->m[3] = r[3] * s1;
+    dest->m[4] = r[4] * s1;
+    dest->m[5] = r[5] * s1;
+    dest->m[6] = r[6] * s2;
+    dest->m[7] = r[7] * s2;
+    dest->m[8] = r[8] * s2;
+    dest->t[0] = t[0];
+    dest->t[1] = t[1];
+    dest->t[2] = t[2];
+}
 /* dest = a * b (b applied first). dest may alias a or b. */
-void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine *dest);
+inline void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine *dest)
+{
+    ob_daffine r;
+    for (int c = 0; c < 3; c++) {
+        for (int k = 0; k < 3; k++) {
+            r.m[c * 3 + k] = a->m[k] * b->m[c * 3] + a->m[3 + k] * b->m[c * 3 + 1] +
+                             a->m[6 + k] * b->m[c * 3 + 2];
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        r.t[k] = a->m[k] * b->t[0] + a->m[3 + k] * b->t[1] + a->m[6 + k] * b->t[2] + a->t[k];
+    *dest = r;
+}
 /* dest may alias p. */
-void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double dest[3]);
-bool ob_daffine_is_finite(const ob_daffine *a);
+inline void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double dest[3])
+{
+    double x = p[0], y = p[1], z = p[2];
+    double r0 = a->m[0] * x + a->m[3] * y + a->m[6] * z + a->t[0];
+    double r1 = a->m[1] * x + a->m[4] * y + a->m[7] * z + a->t[1];
+    double r2 = a->m[2] * x + a->m[5] * y + a->m[8] * z + a->t[2];
+    dest[0] = r0;
+    dest[1] = r1;
+    dest[2] = r2;
+}
+inline bool ob_daffine_is_finite(const ob_daffine *a)
+{
+    /* Branch-free: x - x is 0 for a finite x and NaN for Inf or NaN, and a
+     * sum with a NaN in it is NaN. */
+    const double *m = a->m, *t = a->t;
+    double z = ((m[0] - m[0]) + (m[1] - m[1])) + ((m[2] - m[2]) + (m[3] - m[3])) +
+               ((m[4] - m[4]) + (m[5] - m[5])) + ((m[6] - m[6]) + (m[7] - m[7])) +
+               ((m[8] - m[8]) + (t[0] - t[0])) + ((t[1] - t[1]) + (t[2] - t[2]));
+    return z == z;
+}
 /* Largest column length of the linear part: the factor a bounding sphere's
  * radius grows by. */
-double ob_daffine_max_scale(const ob_daffine *a);
+inline double ob_daffine_max_scale(const ob_daffine *a)
+{
+    /* sqrt is correctly rounded, so monotonic: the root of the largest
+     * squared length is the largest of the roots. A NaN length is passed
+     * over (as fmax would). */
+    double best = 0.0;
+    for (int c = 0; c < 3; c++) {
+        const double *col = &a->m[c * 3];
+        double d = col[0] * col[0] + col[1] * col[1] + col[2] * col[2];
+        best = d > best ? d : best;
+    }
+    return sqrt(best);
+}
 /* The float matrix the GPU sees for a world transform rendered relative to
  * `origin` (usually the camera's world position): the translation is
  * (a->t - origin) in double, then cast, so large coordinates lose nothing. */
@@ -148,8 +263,54 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
 /* The same for a column-major 3x3 m (the upper 3x3 of w): dest is the
  * upper 3x3 of ob_mat4_normal_cofactor's result, bit for bit. dest must not
- * alias m. */
-void ob_mat3_normal_cofactor(const float m[9], float dest[9]);
+ * alias m. Returns whether every value of m is finite; then so is every
+ * value of dest (the rescaling keeps the products in range). */
+inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
+{
+    float c0 = m[0], c1 = m[1], c2 = m[2], c3 = m[3], c4 = m[4], c5 = m[5], c6 = m[6],
+          c7 = m[7], c8 = m[8];
+    /* The largest magnitude (a NaN passed over), as a tree, not a chain. */
+    bool nan = c0 != c0 || c1 != c1 || c2 != c2 || c3 != c3 || c4 != c4 || c5 != c5 ||
+               c6 != c6 || c7 != c7 || c8 != c8;
+    float largest = 0.0f;
+    if (!nan) {
+        float a0 = fabsf(c0), a1 = fabsf(c1), a2 = fabsf(c2), a3 = fabsf(c3), a4 = fabsf(c4);
+        float a5 = fabsf(c5), a6 = fabsf(c6), a7 = fabsf(c7), a8 = fabsf(c8);
+        float m01 = a0 > a1 ? a0 : a1, m23 = a2 > a3 ? a2 : a3, m45 = a4 > a5 ? a4 : a5;
+        float m67 = a6 > a7 ? a6 : a7, m03 = m01 > m23 ? m01 : m23, m47 = m45 > m67 ? m45 : m67;
+        float m07 = m03 > m47 ? m03 : m47;
+        largest = m07 > a8 ? m07 : a8;
+    } else {
+        for (int i = 0; i < 9; i++) {
+            float a = fabsf(m[i]);
+            largest = a > largest ? a : largest;
+        }
+    }
+    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
+        int e;
+        frexpf(largest, &e);
+        c0 = ldexpf(c0, -e);
+        c1 = ldexpf(c1, -e);
+        c2 = ldexpf(c2, -e);
+        c3 = ldexpf(c3, -e);
+        c4 = ldexpf(c4, -e);
+        c5 = ldexpf(c5, -e);
+        c6 = ldexpf(c6, -e);
+        c7 = ldexpf(c7, -e);
+        c8 = ldexpf(c8, -e);
+    }
+    /* Column i is column i+1 x column i+2. */
+    dest[0] = c4 * c8 - c5 * c7;
+    dest[1] = c5 * c6 - c3 * c8;
+    dest[2] = c3 * c7 - c4 * c6;
+    dest[3] = c7 * c2 - c8 * c1;
+    dest[4] = c8 * c0 - c6 * c2;
+    dest[5] = c6 * c1 - c7 * c0;
+    dest[6] = c1 * c5 - c2 * c4;
+    dest[7] = c2 * c3 - c0 * c5;
+    dest[8] = c0 * c4 - c1 * c3;
+    return !nan && largest <= 0x1.fffffep127f;
+}
 
 /* Infinite reversed-Z perspective for Vulkan clip space: a view-space point
  * at z = -znear gets depth 1, depth → 0 as -z → infinity, and +Y up in view

@@ -155,12 +155,25 @@ static ob_node *node_alloc(ob_scene *s, const char *name, ob_result *out_result)
     return n;
 }
 
+/* Frees n and what its slot owns (its controllers); the slot itself is
+ * left to the caller. */
 static void node_free(ob_node *n)
 {
-    for (uint32_t i = 0; i < n->controller_count; i++) {
-        if (n->controllers[i].release) n->controllers[i].release(n->controllers[i].user);
+    if (n->by_id_index != NO_SLOT) {
+        ob_scene *s = n->scene;
+        node_controllers *ctl = &s->ctl[n->by_id_index];
+        for (uint32_t i = 0; i < ctl->count; i++) {
+            ob_controller_slot *c = &ctl->slots[i];
+            if (c->release) c->release(controller_user(c));
+        }
+        if (ctl->pooled) {
+            s->ctl_loose += ctl->count; /* unused until the next repack */
+        } else {
+            s->ctl_loose -= ctl->count;
+            ob_free(ctl->slots);
+        }
+        *ctl = (node_controllers){0};
     }
-    ob_free(n->controllers);
     ob_free(n);
 }
 
@@ -178,6 +191,7 @@ void ob_scene_compact(ob_scene *s)
             s->state[w] = s->state[r];
             s->slot_id[w] = s->slot_id[r];
             s->draw[w] = s->draw[r];
+            s->ctl[w] = s->ctl[r];
         }
         w++;
     }
@@ -201,6 +215,7 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->slot_id, &s->slot_id_cap, need, sizeof *s->slot_id);
     if (r == OB_OK) r = ob_array_reserve((void **)&s->draw, &s->draw_cap, need, sizeof *s->draw);
+    if (r == OB_OK) r = ob_array_reserve((void **)&s->ctl, &s->ctl_cap, need, sizeof *s->ctl);
     if (r != OB_OK) {
         OB_LOG_E(SCENE_LOG, "cannot create entity '%s': %s", n->name, ob_result_text(r));
         return r;
@@ -218,6 +233,7 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
     s->state[slot] = NODE_DIRTY;
     s->slot_id[slot] = n->id;
     s->draw[slot] = (node_draw){0};
+    s->ctl[slot] = (node_controllers){0};
     s->node_count++;
     return OB_OK;
 }
@@ -250,9 +266,6 @@ ob_node *ob_scene_preorder_next(const ob_node *n, const ob_node *top)
     return n == top ? NULL : n->next_sibling;
 }
 
-/* Marks n for the next update: its evaluation reads what changed. */
-static void node_touch(const ob_node *n) { n->scene->state[n->by_id_index] |= NODE_DIRTY; }
-
 /* ------------------------------------------------------------------ scene */
 
 ob_scene *ob_scene_create(ob_result *out_result)
@@ -283,6 +296,7 @@ fail_free_scene:
     ob_free(s->state);
     ob_free(s->slot_id);
     ob_free(s->draw);
+    ob_free(s->ctl);
     ob_free(s);
     set_result(out_result, r);
     return NULL;
@@ -299,6 +313,9 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->state);
     ob_free(s->slot_id);
     ob_free(s->draw);
+    ob_free(s->ctl);
+    ob_free(s->ctl_pool);
+    ob_free(s->retired);
     ob_free(s->order);
     ob_free(s->by_level);
     ob_free(s->level_start);
@@ -511,18 +528,24 @@ void ob_node_set_position(ob_node *n, const double p[3])
     node_touch(n);
 }
 
+/* A rotation set from outside is normalized by the update. */
+static double *rotation_for_set(ob_node *n)
+{
+    node_xf *x = node_xf_of(n);
+    x->flags &= ~(uint32_t)XF_ROTATION_UNIT;
+    node_touch(n);
+    return x->rotation;
+}
+
 void ob_node_set_rotation(ob_node *n, const float q[4])
 {
-    double *rotation = node_xf_of(n)->rotation;
+    double *rotation = rotation_for_set(n);
     for (int i = 0; i < 4; i++) rotation[i] = q[i];
-    node_touch(n);
 }
 
 void ob_node_set_rotation_d(ob_node *n, const double q[4])
 {
-    double *rotation = node_xf_of(n)->rotation;
-    for (int i = 0; i < 4; i++) rotation[i] = q[i];
-    node_touch(n);
+    memcpy(rotation_for_set(n), q, sizeof node_xf_of(n)->rotation);
 }
 
 void ob_node_set_scale(ob_node *n, const float s[3])
@@ -535,13 +558,12 @@ void ob_node_set_scale(ob_node *n, const float s[3])
 void ob_node_set_euler(ob_node *n, float pitch, float yaw, float roll)
 {
     static const double x_axis[3] = {1, 0, 0}, y_axis[3] = {0, 1, 0}, z_axis[3] = {0, 0, 1};
-    double qy[4], qx[4], qz[4], *rotation = node_xf_of(n)->rotation;
+    double qy[4], qx[4], qz[4], *rotation = rotation_for_set(n);
     ob_dquat_from_axis_angle(y_axis, yaw, qy);
     ob_dquat_from_axis_angle(x_axis, pitch, qx);
     ob_dquat_from_axis_angle(z_axis, roll, qz);
     ob_dquat_mul(qy, qx, rotation);
     ob_dquat_mul(rotation, qz, rotation);
-    node_touch(n);
 }
 
 void ob_node_get_position(const ob_node *n, double dest[3])
@@ -549,10 +571,11 @@ void ob_node_get_position(const ob_node *n, double dest[3])
     ob_dvec3_copy(node_xf_of(n)->position, dest);
 }
 
+/* Copied whole (not element by element), so that a caller reading the
+ * copy as pairs finds them in whole stores. */
 void ob_node_get_rotation(const ob_node *n, double dest[4])
 {
-    const double *rotation = node_xf_of(n)->rotation;
-    for (int i = 0; i < 4; i++) dest[i] = rotation[i];
+    memcpy(dest, node_xf_of(n)->rotation, sizeof node_xf_of(n)->rotation);
 }
 
 void ob_node_get_scale(const ob_node *n, float dest[3])
@@ -725,7 +748,7 @@ ob_result ob_node_look_at(ob_node *n, const double target[3], const double up[3]
                  "or not finite; rotation unchanged", n->name, n->id);
         return OB_ERR_INVALID_ARGUMENT;
     }
-    double basis[9], world_q[4], inv_parent[4], *rotation = node_xf_of(n)->rotation;
+    double basis[9], world_q[4], inv_parent[4];
     ob_look_status st = ob_math_look_rotation(dir, up, basis);
     if (st & OB_LOOK_UP_REPLACED)
         OB_LOG_W(SCENE_LOG, "entity '%s' (id %u): look_at up vector (%g, %g, %g) is parallel to "
@@ -737,9 +760,9 @@ ob_result ob_node_look_at(ob_node *n, const double target[3], const double up[3]
     inv_parent[1] = -parent_q[1];
     inv_parent[2] = -parent_q[2];
     inv_parent[3] = parent_q[3];
+    double *rotation = rotation_for_set(n);
     ob_dquat_mul(inv_parent, world_q, rotation);
     ob_dquat_normalize(rotation, rotation);
-    node_touch(n);
     return OB_OK;
 
 fail_log_non_finite:
@@ -750,6 +773,53 @@ fail_log_non_finite:
 
 /* ------------------------------------------------------------ controllers */
 
+static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const void *state,
+                                size_t size)
+{
+    void *release_arg = state ? (void *)state : d->user;
+    ob_scene *s = n->scene;
+    node_controllers *ctl = &s->ctl[n->by_id_index];
+    if (ctl->count == ctl->cap) {
+        /* Slots are large (their inline state): grow one at a time from one.
+         * During an update the running controller may be one of this node's
+         * (a serial one): its old block is freed only after the update. */
+        uint32_t cap = ctl->cap ? 2 * ctl->cap : 1;
+        bool retire = s->in_update && !ctl->pooled && ctl->slots;
+        ob_result r = retire ? ob_array_reserve((void **)&s->retired, &s->retired_cap,
+                                                s->retired_count + 1, sizeof *s->retired)
+                             : OB_OK;
+        ob_controller_slot *grown = r == OB_OK ? ob_malloc(sizeof *grown * cap) : NULL;
+        if (!grown) {
+            OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): cannot add a controller: %s", n->name,
+                     n->id, ob_result_text(OB_ERR_OUT_OF_HOST_MEMORY));
+            if (d->release) d->release(release_arg);
+            return OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+        if (ctl->count) memcpy(grown, ctl->slots, sizeof *grown * ctl->count);
+        if (ctl->pooled) s->ctl_loose += 2 * ctl->count; /* unused in the pool, copied out */
+        else if (retire) s->retired[s->retired_count++] = ctl->slots;
+        else ob_free(ctl->slots);
+        ctl->slots = grown;
+        ctl->cap = cap;
+        ctl->pooled = false;
+    }
+    s->ctl_loose++;
+    if (d->parallel && ctl->parallel == ctl->count) ctl->parallel++;
+    ob_controller_slot *c = &ctl->slots[ctl->count++];
+    c->fn = d->fn;
+    c->user = state ? NULL : d->user;
+    c->release = d->release;
+    c->inline_state = state != NULL;
+    if (state) memcpy(c->state, state, size);
+    uint8_t *st = &s->state[n->by_id_index];
+    if (ctl->parallel) *st |= NODE_PARALLEL;
+    if (ctl->count > ctl->parallel && !(*st & NODE_SERIAL)) {
+        *st |= NODE_SERIAL;
+        s->serial_nodes++;
+    }
+    return OB_OK;
+}
+
 ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)
 {
     if (!d || !d->fn) {
@@ -758,25 +828,20 @@ ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)
         if (d && d->release) d->release(d->user);
         return OB_ERR_INVALID_ARGUMENT;
     }
-    ob_result r = ob_array_reserve((void **)&n->controllers, &n->controller_cap,
-                                   n->controller_count + 1, sizeof *n->controllers);
-    if (r != OB_OK) {
-        OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): cannot add a controller: %s", n->name, n->id,
-                 ob_result_text(r));
-        if (d->release) d->release(d->user);
-        return r;
+    return controller_add(n, d, NULL, 0);
+}
+
+ob_result ob_node_add_controller_state(ob_node *n, const ob_controller_desc *d, const void *state,
+                                       size_t size)
+{
+    if (!d || !d->fn || !state || size > OB_CONTROLLER_STATE_SIZE) {
+        OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): controller without a function or a state, "
+                 "or with a state over %u bytes (%zu); refused", n->name, n->id,
+                 OB_CONTROLLER_STATE_SIZE, size);
+        if (d && d->release && state) d->release((void *)state);
+        return OB_ERR_INVALID_ARGUMENT;
     }
-    if (d->parallel && n->parallel_controllers == n->controller_count)
-        n->parallel_controllers++;
-    n->controllers[n->controller_count++] =
-        (ob_controller_slot){.fn = d->fn, .user = d->user, .release = d->release};
-    uint8_t *st = &n->scene->state[n->by_id_index];
-    if (n->parallel_controllers) *st |= NODE_PARALLEL;
-    if (n->controller_count > n->parallel_controllers && !(*st & NODE_SERIAL)) {
-        *st |= NODE_SERIAL;
-        n->scene->serial_nodes++;
-    }
-    return OB_OK;
+    return controller_add(n, d, state, size);
 }
 
 /* ------------------------------------------------------ cameras and lights */

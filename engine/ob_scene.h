@@ -17,6 +17,12 @@
  *
  * Traversal never recurses: 100,000-level chains update with no stack growth.
  *
+ * Cost: an update evaluates only the nodes whose local transform,
+ * visibility or renderable changed since the last one (a setter was
+ * called, a controller ran) and their descendants; a static node costs two
+ * bytes read. What the update touches per node lives in dense arrays of
+ * the scene, not in the node.
+ *
  * Thread rule: every mutating function (create/destroy/set_* /add_* /update)
  * is [render thread] and must not run while workers read the scene. Queries
  * (world_*, renderable, camera, light, snapshots, find) are [any thread]
@@ -75,11 +81,16 @@ ob_node *ob_scene_find(const ob_scene *s, const char *name);
  * OB_ERR_OUT_OF_HOST_MEMORY (nothing changed). Bad transforms are not errors
  * of the update: they are logged and those nodes skipped. */
 ob_result ob_scene_update(ob_scene *s, double dt);
-/* ob_scene_update with its per-node work in parallel loops run through par
- * (parallel-safe controllers, then transforms level by level of the
- * hierarchy, then the snapshot in chunks of the id order); everything else
- * on the caller. Gives exactly ob_scene_update's result whatever the
- * thread count. par NULL: ob_scene_update. */
+/* ob_scene_update with its per-node work in parallel loops run through par,
+ * par->grain nodes per index (0: 1024), each loop handed out only when every
+ * thread gets two indices' worth: one loop per level of the hierarchy (its
+ * nodes' parallel-safe controllers, then their transforms and their part of
+ * the snapshot) when no node has another kind of controller; otherwise a
+ * loop of the parallel-safe controllers, the others on the caller, then the
+ * levels. Only when a node entered or left the snapshot is it rebuilt (one
+ * more loop, in chunks of the id order). Everything else runs on the
+ * caller. Gives exactly ob_scene_update's result whatever the thread count
+ * or grain. par NULL: ob_scene_update. */
 ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *par);
 
 /* The frame's snapshot: renderable nodes (ob_node_is_renderable) in ascending
@@ -258,13 +269,35 @@ typedef struct ob_controller_desc {
      * creates, destroys or re-parents nothing. Those of every node run
      * first, on the worker pool when the update is given one
      * (ob_renderer_update_scene); the rest run after them on the calling
-     * thread. The built-in rotation and orbit controllers are. */
+     * thread. When no node has any of the rest, each node's run right
+     * before its own transform is computed, level by level of the
+     * hierarchy (a node's own world is still the last update's then).
+     * The built-in rotation and orbit controllers are. */
     bool parallel;
 } ob_controller_desc;
 
 /* General form of the three below. Controllers of a node run in the order
  * added. Errors: OB_ERR_INVALID_ARGUMENT (NULL fn), OB_ERR_OUT_OF_HOST_MEMORY. */
 ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d);
+
+/* The largest state ob_node_add_controller_state takes, in bytes. */
+#define OB_CONTROLLER_STATE_SIZE 96u
+
+/* ob_node_add_controller for a controller whose state is small plain data:
+ * the scene keeps a copy of the size bytes at state (size at most
+ * OB_CONTROLLER_STATE_SIZE) with the node's controllers, aligned for any
+ * type, and passes that copy to fn as user (d->user is ignored). No
+ * allocation of its own, and the update reads the states of all nodes'
+ * controllers as one stream instead of wherever the heap put them. The
+ * copy may move between calls (keep no pointer to it): adding a controller
+ * to a node during an update copies that node's states, so a controller
+ * that adds one to its own node must not touch its state afterwards in
+ * that call. d->release, if set, gets the copy when the node is destroyed
+ * (the caller's state at once if adding fails). Errors: those of
+ * ob_node_add_controller, and OB_ERR_INVALID_ARGUMENT for a size over the
+ * limit or a NULL state. */
+ob_result ob_node_add_controller_state(ob_node *n, const ob_controller_desc *d, const void *state,
+                                       size_t size);
 
 /* Spins the node about its local axis: q = q * dq(axis, rate * dt) each update,
  * renormalized every time (double), so it stays unit indefinitely. */

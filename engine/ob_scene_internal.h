@@ -15,18 +15,40 @@
 
 #include "ob_scene.h"
 
+#include <stddef.h>
+
 #define SCENE_LOG "scene"
 #define NO_SLOT UINT32_MAX
 
-/* Nodes per index of the update's parallel loops: a few microseconds of
- * work each, so a loop's hand-out costs little beside it. */
+/* Nodes per index of the update's parallel loops unless ob_parallel.grain
+ * says otherwise: a few microseconds of work each, so a loop's hand-out
+ * costs little beside it. */
 #define UPDATE_GRAIN 1024u
 
 typedef struct ob_controller_slot {
     ob_controller_fn fn;
-    void *user;
+    void *user;                 /* unless the state is inline */
     void (*release)(void *user);
+    bool inline_state;          /* user is state (ob_node_add_controller_state) */
+    _Alignas(max_align_t) unsigned char state[OB_CONTROLLER_STATE_SIZE];
 } ob_controller_slot;
+
+static inline void *controller_user(ob_controller_slot *c)
+{
+    return c->inline_state ? c->state : c->user;
+}
+
+/* A node's controllers, kept by slot so that the update reaches them (and,
+ * for the built-in ones, the state they move) without the node. They lie
+ * in the scene's pool, every node's one after another in level order
+ * (repacked at an update once enough lie elsewhere), or, once the node got
+ * one more since, in a block of their own. */
+typedef struct node_controllers {
+    ob_controller_slot *slots;
+    uint32_t count, cap;        /* pooled: cap == count */
+    uint32_t parallel;          /* the leading parallel-safe ones */
+    bool pooled;
+} node_controllers;
 
 /* node_xf.flags */
 enum {
@@ -39,6 +61,8 @@ enum {
     XF_HAS_CHILDREN = 1u << 6,      /* as of the last order rebuild */
     XF_IDENTITY = 1u << 7,          /* world and world rotation exactly the identity
                                        (tracked for nodes with children only) */
+    XF_ROTATION_UNIT = 1u << 8,     /* rotation is unit as ob_dquat_normalize made it
+                                       (the rotation controller's): used as is */
 };
 
 /* A node's transform data: four cache lines, everything its evaluation
@@ -95,14 +119,9 @@ typedef struct intern_table {
 } intern_table;
 
 struct ob_node {
-    /* What a controller's calls into the node API read: the first line. */
+    /* What the node API reads to find the node's slot data. */
     ob_scene *scene;
     uint32_t by_id_index;          /* its slot */
-    uint32_t controller_count;
-    ob_controller_slot *controllers;
-    uint32_t parallel_controllers; /* the leading parallel-safe ones */
-    uint32_t controller_cap;
-
     uint32_t id;
     uint32_t depth;                /* in the hierarchy: the root is 0 */
     ob_node *parent, *first_child, *last_child, *prev_sibling, *next_sibling;
@@ -130,8 +149,9 @@ struct ob_scene {
     uint8_t *state;                /* NODE_* */
     uint32_t *slot_id;             /* the node's id */
     node_draw *draw;
+    node_controllers *ctl;
     uint32_t by_id_count, by_id_holes;
-    uint32_t by_id_cap, xf_cap, state_cap, slot_id_cap, draw_cap;
+    uint32_t by_id_cap, xf_cap, state_cap, slot_id_cap, draw_cap, ctl_cap;
 
     /* order: slots in pre-order (parents first), for serial controllers;
      * by_level: the same nodes by hierarchy level (depth), pre-order within
@@ -146,6 +166,12 @@ struct ob_scene {
     uint32_t level_count, level_start_cap;
     uint32_t *chunk_counts;        /* the update's per-chunk figures */
     uint32_t chunk_counts_cap;
+
+    ob_controller_slot *ctl_pool;  /* see node_controllers */
+    uint32_t ctl_pool_size;
+    uint32_t ctl_loose;            /* controllers outside the pool, and pool slots unused */
+    void **retired;                /* controller blocks replaced during the update, freed after it */
+    uint32_t retired_count, retired_cap;
 
     /* The snapshot. */
     ob_node **renderables;
@@ -167,6 +193,9 @@ struct ob_scene {
 };
 
 static inline node_xf *node_xf_of(const ob_node *n) { return &n->scene->xf[n->by_id_index]; }
+
+/* Marks n for the next update: its evaluation reads what changed. */
+static inline void node_touch(const ob_node *n) { n->scene->state[n->by_id_index] |= NODE_DIRTY; }
 
 typedef enum local_status { LOCAL_OK, LOCAL_NON_FINITE, LOCAL_ZERO_ROTATION } local_status;
 

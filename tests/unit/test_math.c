@@ -297,6 +297,86 @@ static void normalize_refuses_zero_and_non_finite(void **state)
     assert_near(q[3], -1.0, 0.0);
 }
 
+/* The normal matrix as first written (columns c1 x c2, c2 x c0, c0 x c1 of
+ * the float world, rescaled by a power of two outside 2^+-60): the inline
+ * one the scene update uses must give the same bits for every input. */
+static void reference_normal_cofactor(const float w[16], float dest[16])
+{
+    float c[3][3], largest = 0.0f;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            c[i][k] = w[i * 4 + k];
+            float a = c[i][k] < 0.0f ? -c[i][k] : c[i][k];
+            largest = a > largest ? a : largest;
+        }
+    if (largest > 0x1p60f || (largest > 0.0f && largest < 0x1p-60f)) {
+        int exponent;
+        frexpf(largest, &exponent);
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) c[i][k] = ldexpf(c[i][k], -exponent);
+    }
+    for (int i = 0; i < 3; i++) {
+        const float *a = c[(i + 1) % 3], *b = c[(i + 2) % 3];
+        dest[i * 4 + 0] = a[1] * b[2] - a[2] * b[1];
+        dest[i * 4 + 1] = a[2] * b[0] - a[0] * b[2];
+        dest[i * 4 + 2] = a[0] * b[1] - a[1] * b[0];
+        dest[i * 4 + 3] = 0.0f;
+    }
+    dest[12] = dest[13] = dest[14] = 0.0f;
+    dest[15] = 1.0f;
+}
+
+/* The same bits, or both NaN (a NaN's sign and payload depend on which
+ * operand the compiler put first, which C leaves open). */
+static void assert_same_floats(const float *a, const float *b, int count)
+{
+    for (int i = 0; i < count; i++) {
+        if (isnan(a[i]) && isnan(b[i])) continue;
+        assert_memory_equal(&a[i], &b[i], sizeof(float));
+    }
+}
+
+static void fast_affine_math_matches_plain_formulas(void **state)
+{
+    (void)state;
+    static const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, 0x1p61f, -0x1p-61f, 0x1p-140f,
+                                     3e38f, INFINITY, -INFINITY, NAN};
+    uint64_t seed = 99;
+    for (int trial = 0; trial < 20000; trial++) {
+        float w[16] = {0}, m[9], want[16], got4[16], got3[9];
+        bool finite = true;
+        /* A magnitude per matrix (so the rescaled ranges are hit), a special
+         * value now and then. */
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        int exponent = (int)(seed >> 58) * 5 - 80;
+        for (int i = 0; i < 9; i++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            float v = ldexpf((float)((int64_t)(seed >> 40) - (1 << 23)) / (1 << 23), exponent);
+            if ((seed & 63) == 0) v = specials[(seed >> 6) % (sizeof specials / sizeof *specials)];
+            w[(i / 3) * 4 + i % 3] = m[i] = v;
+            finite &= isfinite(v) != 0;
+        }
+        w[15] = 1.0f;
+        reference_normal_cofactor(w, want);
+        ob_mat4_normal_cofactor(w, got4);
+        assert_same_floats(got4, want, 16);
+        assert_int_equal(ob_mat3_normal_cofactor(m, got3), finite);
+        for (int i = 0; i < 9; i++) assert_same_floats(&got3[i], &want[(i / 3) * 4 + i % 3], 1);
+
+        ob_daffine a;
+        for (int i = 0; i < 9; i++) a.m[i] = (double)m[i] * 1e10;
+        for (int i = 0; i < 3; i++) a.t[i] = (double)m[i * 3] * -3.0;
+        bool all = true;
+        double best = 0.0;
+        for (int i = 0; i < 9; i++) all &= isfinite(a.m[i]) != 0;
+        for (int i = 0; i < 3; i++) all &= isfinite(a.t[i]) != 0;
+        for (int c = 0; c < 3; c++) best = fmax(best, ob_dvec3_length(&a.m[c * 3]));
+        assert_int_equal(ob_daffine_is_finite(&a), all);
+        double got_scale = ob_daffine_max_scale(&a);
+        assert_memory_equal(&got_scale, &best, sizeof best);
+    }
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -312,6 +392,7 @@ int main(void)
         cmocka_unit_test(frustum_perspective_culls_spheres),
         cmocka_unit_test(frustum_ortho_has_six_planes),
         cmocka_unit_test(normalize_refuses_zero_and_non_finite),
+        cmocka_unit_test(fast_affine_math_matches_plain_formulas),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -430,6 +430,80 @@ static void destroy_subtree_frees_everything(void **state)
     ob_scene_destroy(s); /* ASan: no leak of nodes, names or controller state */
 }
 
+typedef struct counter_state {
+    uint32_t calls;
+    double sum;
+    int *released;
+} counter_state;
+
+static void counter_step(ob_node *n, double dt, void *user)
+{
+    (void)n;
+    counter_state *st = user;
+    st->calls++;
+    st->sum += dt;
+}
+
+static void counter_release(void *user)
+{
+    counter_state *st = user;
+    *st->released += (int)st->calls;
+}
+
+typedef struct adder {
+    ob_node *target;
+    counter_state added;
+    bool done;
+} adder;
+
+/* Serial: adds a counter to another node once, from inside the update. */
+static void add_once(ob_node *n, double dt, void *user)
+{
+    (void)n;
+    (void)dt;
+    adder *a = user;
+    if (a->done) return;
+    a->done = true;
+    assert_int_equal(ob_node_add_controller_state(a->target, &(ob_controller_desc){
+                         .fn = counter_step, .release = counter_release, .parallel = true},
+                         &a->added, sizeof a->added), OB_OK);
+}
+
+static void controller_state_kept_by_the_node(void **state)
+{
+    (void)state;
+    ob_scene *s = new_scene();
+    ob_node *a = new_node(s, NULL, "a"), *b = new_node(s, NULL, "b");
+    int released = 0;
+    counter_state init = {.released = &released};
+    const ob_controller_desc d = {.fn = counter_step, .release = counter_release, .parallel = true};
+    assert_int_equal(ob_node_add_controller_state(a, &d, &init, sizeof init), OB_OK);
+    /* Many nodes' controllers, so that they are repacked into one pool. */
+    for (int i = 0; i < 200; i++) {
+        ob_node *m = new_node(s, b, "m");
+        assert_int_equal(ob_node_add_controller_state(m, &d, &init, sizeof init), OB_OK);
+        ob_node_add_rotation_controller(m, (float[3]){0, 1, 0}, 1);
+    }
+    adder add = {.target = b, .added = {.released = &released}};
+    assert_int_equal(ob_node_add_script_controller(a, add_once, &add), OB_OK);
+    for (int i = 0; i < 3; i++) assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    assert_int_equal(init.calls, 0); /* the node's copy counted, not the caller's */
+    assert_true(add.done);
+    /* A state over the limit is refused, its release run at once. */
+    char big[OB_CONTROLLER_STATE_SIZE + 8] = {0};
+    ob_test_log_clear();
+    assert_int_equal(ob_node_add_controller_state(a, &(ob_controller_desc){.fn = counter_step},
+                                                  big, sizeof big), OB_ERR_INVALID_ARGUMENT);
+    assert_true(ob_test_log_has("'a'", "state", NULL));
+    ob_node_destroy(s, b);
+    /* b's counter was added by a's script in the first update and ran in the
+     * two after it (parallel ones run before serial ones); each of the 200
+     * children's ran three times. */
+    assert_int_equal(released, 2 + 200 * 3);
+    ob_scene_destroy(s);
+    assert_int_equal(released, 2 + 200 * 3 + 3);
+}
+
 /* ------------------------------------------------ non-finite transforms */
 
 typedef enum fault_kind {
@@ -773,6 +847,7 @@ int main(void)
         cmocka_unit_test(script_controllers_run_in_order_before_world),
         cmocka_unit_test(structure_changes_refused_inside_controllers),
         cmocka_unit_test(destroy_subtree_frees_everything),
+        cmocka_unit_test(controller_state_kept_by_the_node),
         cmocka_unit_test(bad_transform_rejected_once_and_recovers),
         cmocka_unit_test(bad_update_arguments_refused),
         cmocka_unit_test(cameras_and_lights),

@@ -1,0 +1,573 @@
+/* ob_scene_update.c — ob_scene_update: controllers, world transforms, bounds
+ * and the frame's snapshot (see ob_scene.h; the storage is described in
+ * ob_scene_internal.h).
+ *
+ * One loop per hierarchy level, parents first, over the level's nodes by
+ * slot. A node is evaluated (world transform, world rotation, bound, and
+ * its proxy when it stays in the snapshot) when its local transform,
+ * visibility or renderable changed (NODE_DIRTY) or its parent was evaluated
+ * in this update (NODE_CHANGED); any other node costs two bytes read. When
+ * no node has a controller that is not parallel-safe, the same loop first
+ * runs each node's controllers; otherwise the parallel-safe ones run in a
+ * loop of their own, then the others on the caller, before the levels.
+ * Only when a node entered or left the snapshot is the whole snapshot
+ * rebuilt: a count over one byte per node on the caller, then one loop that
+ * fills it in id (= slot) order.
+ *
+ * Every loop writes per node (or per chunk) and the caller combines chunks
+ * in index order, so the result is the same for any thread count.
+ */
+#include "ob_controllers_internal.h"
+
+#include <string.h>
+
+typedef struct update_ctx {
+    ob_scene *s;
+    double dt;
+    const ob_parallel *par;
+    uint32_t grain;             /* nodes per loop index */
+    const level_item *items;    /* the current loop's nodes */
+    uint32_t count;
+    bool controllers;           /* the level loop runs the parallel-safe controllers */
+    uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
+} update_ctx;
+
+static uint32_t chunks_of(uint32_t count, uint32_t grain)
+{
+    return (uint32_t)(((uint64_t)count + grain - 1) / grain);
+}
+
+/* Where chunk k of count items ends, grain per chunk. */
+static uint32_t chunk_end(uint32_t count, uint32_t k, uint32_t grain)
+{
+    return (uint32_t)OB_MIN((uint64_t)count, ((uint64_t)k + 1) * grain);
+}
+
+/* A loop over `items` nodes, grain per index: through par only when each
+ * thread gets two indices' worth (a hand-out costs more than a few nodes'
+ * work), else on the caller; the result is the same either way. */
+static void update_loop(const update_ctx *c, uint32_t items, ob_task_fn fn)
+{
+    const ob_parallel *par = c->par;
+    if (par && (uint64_t)items < 2ull * c->grain * par->threads) par = NULL;
+    ob_parallel_run(par, chunks_of(items, c->grain), fn, (void *)c);
+}
+
+/* ------------------------------------------------------------- transforms */
+
+local_status ob_scene_xf_local(const node_xf *x, ob_daffine *dest, double unit_q[4])
+{
+    /* x - x is 0 for a finite x and NaN otherwise; the rotation is tested
+     * by its normalization, the usual case of which needs it finite. */
+    const double *t = x->position;
+    const float *sc = x->scale;
+    double bad_t = (t[0] - t[0]) + (t[1] - t[1]) + (t[2] - t[2]);
+    float bad_s = (sc[0] - sc[0]) + (sc[1] - sc[1]) + (sc[2] - sc[2]);
+    if (bad_t != 0.0 || bad_s != 0.0f) return LOCAL_NON_FINITE;
+    if (x->flags & XF_ROTATION_UNIT) {
+        memcpy(unit_q, x->rotation, sizeof x->rotation);
+    } else if (!ob_dquat_normalize(x->rotation, unit_q)) {
+        const double *r = x->rotation;
+        bool finite = isfinite(r[0]) && isfinite(r[1]) && isfinite(r[2]) && isfinite(r[3]);
+        return finite ? LOCAL_ZERO_ROTATION : LOCAL_NON_FINITE;
+    }
+    const double scale[3] = {sc[0], sc[1], sc[2]};
+    /* Finite: a unit rotation's entries are at most 1 in magnitude and a
+     * scale at most FLT_MAX, so no product overflows. */
+    ob_daffine_from_trs(t, unit_q, scale, dest);
+    return LOCAL_OK;
+}
+
+static void report_fault(const ob_node *n, local_status st)
+{
+    if (st == LOCAL_ZERO_ROTATION)
+        OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): zero-length rotation quaternion; not rendered",
+                 n->name, n->id);
+    else
+        OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): non-finite transform; not rendered",
+                 n->name, n->id);
+}
+
+static bool is_identity(const node_xf *x)
+{
+    const double *m = x->world.m, *t = x->world.t, *q = x->world_rotation;
+    return m[0] == 1.0 && m[1] == 0.0 && m[2] == 0.0 && m[3] == 0.0 && m[4] == 1.0 &&
+           m[5] == 0.0 && m[6] == 0.0 && m[7] == 0.0 && m[8] == 1.0 && t[0] == 0.0 &&
+           t[1] == 0.0 && t[2] == 0.0 && q[0] == 0.0 && q[1] == 0.0 && q[2] == 0.0 &&
+           q[3] == 1.0;
+}
+
+/* ---------------------------------------------------------------- snapshot */
+
+_Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
+
+static uint8_t zero_scale_flag(const ob_render_bound *b)
+{
+    return b->radius == 0.0f && b->local_radius > 0.0f ? OB_RENDER_ZERO_SCALE : 0u;
+}
+
+/* What of proxy i follows the node's world, in two steps so that a batch's
+ * values are stored well before they are read back (a load that spans
+ * several recent smaller stores waits for them to retire). */
+static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i)
+{
+    ob_render_proxy *p = &s->proxies[i];
+    ob_render_bound *b = &s->bounds[i];
+    for (int k = 0; k < 9; k++) p->linear[k] = (float)x->world.m[k];
+    for (int k = 0; k < 3; k++) {
+        p->world_t[k] = x->world.t[k];
+        b->center[k] = x->world_center[k];
+    }
+    b->radius = x->world_radius;
+    s->soa_x[i] = b->center[0];
+    s->soa_y[i] = b->center[1];
+    s->soa_z[i] = b->center[2];
+    s->soa_radius[i] = b->radius;
+    s->soa_flags[i] = zero_scale_flag(b);
+}
+
+/* The normal matrix, and whether the matrices are finite in float (the
+ * normal one is whenever the linear one is). */
+static void proxy_write_normal(ob_scene *s, uint32_t i)
+{
+    ob_render_proxy *p = &s->proxies[i];
+    p->finite = ob_mat3_normal_cofactor(p->linear, p->normal);
+}
+
+void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
+{
+    const node_draw *d = &s->draw[slot];
+    uint32_t i = s->xf[slot].proxy_index;
+    ob_render_bound *b = &s->bounds[i];
+    s->proxies[i].material = d->material;
+    s->proxies[i].geometry = d->geometry;
+    b->local_radius = s->xf[slot].local_radius;
+    s->soa_material[i] = d->material_index;
+    s->soa_geometry[i] = d->geometry_index;
+    s->soa_flags[i] = zero_scale_flag(b);
+}
+
+/* The whole of proxy i for the node in slot. */
+static void proxy_fill(ob_scene *s, uint32_t slot, uint32_t i)
+{
+    node_xf *x = &s->xf[slot];
+    x->proxy_index = i;
+    s->proxies[i].node = s->soa_node[i] = s->by_id[slot];
+    s->proxies[i].node_id = s->soa_node_id[i] = s->slot_id[slot];
+    ob_scene_proxy_set_renderable(s, slot);
+    proxy_write_world(s, x, i);
+    proxy_write_normal(s, i);
+}
+
+void ob_scene_snapshot_drop_dying(ob_scene *s)
+{
+    uint32_t w = 0;
+    for (uint32_t r = 0; r < s->renderable_count; r++) {
+        ob_node *n = s->renderables[r];
+        if (n->dying) continue;
+        s->renderables[w] = n;
+        s->proxies[w] = s->proxies[r];
+        s->bounds[w] = s->bounds[r];
+        s->soa_x[w] = s->soa_x[r];
+        s->soa_y[w] = s->soa_y[r];
+        s->soa_z[w] = s->soa_z[r];
+        s->soa_radius[w] = s->soa_radius[r];
+        s->soa_flags[w] = s->soa_flags[r];
+        s->soa_material[w] = s->soa_material[r];
+        s->soa_geometry[w] = s->soa_geometry[r];
+        s->soa_node_id[w] = s->soa_node_id[r];
+        s->soa_node[w] = s->soa_node[r];
+        s->xf[n->by_id_index].proxy_index = w++;
+    }
+    s->renderable_count = w;
+    w = 0;
+    for (uint32_t r = 0; r < s->light_count; r++)
+        if (!s->lights[r]->dying) s->lights[w++] = s->lights[r];
+    s->light_count = w;
+}
+
+/* Each chunk of slots fills its part, from the offsets in counts. */
+static void run_snapshot_fill(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    ob_scene *s = c->s;
+    uint32_t end = chunk_end(s->by_id_count, chunk, c->grain);
+    uint32_t rc = c->counts[2 * chunk], lc = c->counts[2 * chunk + 1];
+    for (uint32_t slot = chunk * c->grain; slot < end; slot++) {
+        uint8_t st = s->state[slot];
+        if (st & NODE_IN_RENDERABLES) {
+            proxy_fill(s, slot, rc);
+            s->renderables[rc++] = s->by_id[slot];
+        }
+        if (st & NODE_IN_LIGHTS) s->lights[lc++] = s->by_id[slot];
+    }
+}
+
+static void snapshot_rebuild(ob_scene *s, const update_ctx *c)
+{
+    uint32_t chunks = chunks_of(s->by_id_count, c->grain), rc = 0, lc = 0;
+    for (uint32_t k = 0; k < chunks; k++) {
+        uint32_t end = chunk_end(s->by_id_count, k, c->grain), nr = 0, nl = 0;
+        for (uint32_t slot = k * c->grain; slot < end; slot++) {
+            nr += s->state[slot] & NODE_IN_RENDERABLES;
+            nl += s->state[slot] & NODE_IN_LIGHTS;
+        }
+        c->counts[2 * k] = rc;
+        c->counts[2 * k + 1] = lc;
+        rc += nr / NODE_IN_RENDERABLES;
+        lc += nl / NODE_IN_LIGHTS;
+    }
+    update_loop(c, s->by_id_count, run_snapshot_fill);
+    s->renderable_count = rc;
+    s->light_count = lc;
+    s->snapshot_dirty = false;
+}
+
+/* ------------------------------------------------------------- evaluation */
+
+/* Nodes are evaluated in batches, stage by stage (local transforms, then
+ * worlds, then proxies): a stage's work for one node is independent of the
+ * next node's, so the long latencies (square roots, divisions, cache
+ * misses) of several nodes overlap instead of queueing one behind another. */
+#define EVAL_BATCH 16u
+
+typedef struct eval_batch {
+    uint32_t count;
+    level_item item[EVAL_BATCH];
+    local_status st[EVAL_BATCH];
+    bool in_place[EVAL_BATCH];  /* its world and world rotation are its local ones,
+                                   computed straight into its node_xf */
+    bool proxy[EVAL_BATCH];     /* stays in the snapshot: its proxy follows */
+    uint32_t proxy_index[EVAL_BATCH];
+    double q[EVAL_BATCH][4];    /* unit local rotation */
+    ob_daffine world[EVAL_BATCH];
+} eval_batch;
+
+/* Evaluates node k of the batch, whose parent (if any) is evaluated
+ * already, from its local transform (stage one): validity, visibility,
+ * world transform and rotation, bound. Sets b->proxy[k] when it stays in
+ * the snapshot. True when it entered or left it. */
+static bool node_eval(ob_scene *s, eval_batch *b, uint32_t k)
+{
+    level_item it = b->item[k];
+    local_status st = b->st[k];
+    node_xf *x = &s->xf[it.slot];
+    const node_xf *p = it.parent == NO_SLOT ? NULL : &s->xf[it.parent];
+    uint32_t flags = x->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY);
+    if ((flags & XF_HIDDEN) || (p && (p->flags & XF_EFFECTIVE_HIDDEN))) flags |= XF_EFFECTIVE_HIDDEN;
+    bool parent_valid = !p || (p->flags & XF_WORLD_VALID);
+    /* Under an identity parent (the root, usually) the world is the local
+     * transform and the world rotation the local one. */
+    bool through = p && !(p->flags & XF_IDENTITY);
+    ob_daffine *world = b->in_place[k] ? &x->world : &b->world[k];
+
+    if (st == LOCAL_OK && parent_valid && through) {
+        ob_daffine_mul(&p->world, world, world);
+        if (!ob_daffine_is_finite(world)) st = LOCAL_NON_FINITE; /* overflow through the chain */
+    }
+    if (st != LOCAL_OK) {
+        flags &= ~(uint32_t)XF_WORLD_VALID;
+        if (!(flags & XF_FAULT_REPORTED)) {
+            flags |= XF_FAULT_REPORTED;
+            report_fault(s->by_id[it.slot], st);
+        }
+    } else if (!parent_valid) {
+        /* Its own transform is fine; the ancestor at fault has been named. */
+        flags &= ~(uint32_t)XF_WORLD_VALID;
+    } else {
+        flags |= XF_WORLD_VALID;
+        if (!b->in_place[k]) {
+            x->world = *world;
+            if (through) {
+                ob_dquat_mul(p->world_rotation, b->q[k], x->world_rotation);
+                ob_dquat_normalize(x->world_rotation, x->world_rotation);
+            } else {
+                memcpy(x->world_rotation, b->q[k], sizeof x->world_rotation);
+            }
+        }
+        if (flags & XF_HAS_RENDERABLE) {
+            double c[3] = {x->local_center[0], x->local_center[1], x->local_center[2]};
+            ob_daffine_transform_point(&x->world, c, x->world_center);
+            x->world_radius = (float)(x->local_radius * ob_daffine_max_scale(&x->world));
+        }
+        if ((flags & XF_HAS_CHILDREN) && is_identity(x)) flags |= XF_IDENTITY;
+        if (flags & XF_FAULT_REPORTED) {
+            flags &= ~(uint32_t)XF_FAULT_REPORTED;
+            const ob_node *n = s->by_id[it.slot];
+            OB_LOG_I(SCENE_LOG, "entity '%s' (id %u): transform finite again; rendered", n->name,
+                     n->id);
+        }
+    }
+    x->flags = flags;
+
+    bool shown = (flags & XF_WORLD_VALID) && !(flags & XF_EFFECTIVE_HIDDEN);
+    uint8_t member = (shown && (flags & XF_HAS_RENDERABLE) ? NODE_IN_RENDERABLES : 0u) |
+                     (shown && (flags & XF_HAS_LIGHT) ? NODE_IN_LIGHTS : 0u);
+    uint8_t old = s->state[it.slot];
+    s->state[it.slot] = (uint8_t)((old & ~(NODE_DIRTY | NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) |
+                                  NODE_CHANGED | member);
+    b->proxy[k] = (old & member & NODE_IN_RENDERABLES) != 0;
+    return ((old ^ member) & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) != 0;
+}
+
+/* True when some node of the batch entered or left the snapshot. */
+static bool eval_batch_run(ob_scene *s, eval_batch *b)
+{
+    for (uint32_t k = 0; k < b->count; k++) {
+        level_item it = b->item[k];
+        node_xf *x = &s->xf[it.slot];
+        /* Under a valid identity parent (or none) a node that passes the
+         * local checks is valid, and nothing is written before they pass. */
+        const node_xf *p = it.parent == NO_SLOT ? NULL : &s->xf[it.parent];
+        b->in_place[k] = !p || (p->flags & (XF_IDENTITY | XF_WORLD_VALID)) ==
+                                   (XF_IDENTITY | XF_WORLD_VALID);
+        b->st[k] = b->in_place[k] ? ob_scene_xf_local(x, &x->world, x->world_rotation)
+                                  : ob_scene_xf_local(x, &b->world[k], b->q[k]);
+    }
+    bool changed = false;
+    for (uint32_t k = 0; k < b->count; k++)
+        changed |= node_eval(s, b, k);
+    uint32_t proxies = 0;
+    for (uint32_t k = 0; k < b->count; k++) {
+        if (!b->proxy[k]) continue;
+        const node_xf *x = &s->xf[b->item[k].slot];
+        proxy_write_world(s, x, x->proxy_index);
+        b->proxy_index[proxies++] = x->proxy_index;
+    }
+    for (uint32_t k = 0; k < proxies; k++) proxy_write_normal(s, b->proxy_index[k]);
+    b->count = 0;
+    return changed;
+}
+
+/* ------------------------------------------------------------------ loops */
+
+static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, double dt)
+{
+    node_controllers *ctl = &s->ctl[slot];
+    for (uint32_t k = 0; k < ctl->parallel; k++) ob_controller_run(s, slot, &ctl->slots[k], dt);
+}
+
+static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    ob_scene *s = c->s;
+    uint32_t end = chunk_end(c->count, chunk, c->grain);
+    for (uint32_t i = chunk * c->grain; i < end; i++) {
+        uint32_t slot = c->items[i].slot;
+        if (s->state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+    }
+}
+
+/* One level's nodes, a batch at a time: controllers (when fused), then the
+ * evaluation of those that need it. */
+static void run_level(void *user, uint32_t chunk, uint32_t thread)
+{
+    (void)thread;
+    const update_ctx *c = user;
+    ob_scene *s = c->s;
+    uint8_t *state = s->state;
+    uint32_t end = chunk_end(c->count, chunk, c->grain);
+    bool changed = false;
+    eval_batch b;
+    b.count = 0;
+    for (uint32_t i = chunk * c->grain; i < end; i += EVAL_BATCH) {
+        uint32_t batch_end = OB_MIN(end, i + EVAL_BATCH);
+        if (c->controllers) {
+            for (uint32_t j = i; j < batch_end; j++) {
+                uint32_t slot = c->items[j].slot;
+                if (state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+            }
+        }
+        for (uint32_t j = i; j < batch_end; j++) {
+            level_item it = c->items[j];
+            uint8_t st = state[it.slot];
+            if ((st & NODE_DIRTY) || (it.parent != NO_SLOT && (state[it.parent] & NODE_CHANGED)))
+                b.item[b.count++] = it;
+            else if (st & NODE_CHANGED)
+                state[it.slot] = (uint8_t)(st & ~NODE_CHANGED);
+        }
+        if (b.count) changed |= eval_batch_run(s, &b);
+    }
+    c->counts[chunk] = changed;
+}
+
+/* ------------------------------------------------------------------ update */
+
+/* order in pre-order, and by_level: a counting sort of it by depth. */
+static void order_rebuild(ob_scene *s)
+{
+    uint32_t count = 0, levels = 0;
+    for (ob_node *n = s->root; n; n = ob_scene_preorder_next(n, s->root)) {
+        n->depth = n->parent ? n->parent->depth + 1 : 0;
+        if (n->depth + 1 > levels) levels = n->depth + 1;
+        s->order[count++] = n->by_id_index;
+        node_xf *x = &s->xf[n->by_id_index];
+        if (!n->first_child) {
+            x->flags &= ~(uint32_t)(XF_HAS_CHILDREN | XF_IDENTITY);
+        } else if (!(x->flags & XF_HAS_CHILDREN)) {
+            /* Evaluated again to learn whether it is the identity. */
+            x->flags |= XF_HAS_CHILDREN;
+            s->state[n->by_id_index] |= NODE_DIRTY;
+        }
+    }
+    s->order_count = count;
+    s->level_count = levels;
+    uint32_t *start = s->level_start;
+    memset(start, 0, sizeof *start * (levels + 1));
+    for (uint32_t i = 0; i < count; i++) start[s->by_id[s->order[i]]->depth + 1]++;
+    for (uint32_t d = 0; d < levels; d++) start[d + 1] += start[d];
+    /* start[d] is now where level d begins; fill, then shift back. */
+    for (uint32_t i = 0; i < count; i++) {
+        const ob_node *n = s->by_id[s->order[i]];
+        s->by_level[start[n->depth]++] = (level_item){
+            .slot = n->by_id_index, .parent = n->parent ? n->parent->by_id_index : NO_SLOT};
+    }
+    for (uint32_t d = levels; d > 0; d--) start[d] = start[d - 1];
+    start[0] = 0;
+    s->order_dirty = false;
+}
+
+static ob_result update_reserve(ob_scene *s, uint32_t grain)
+{
+    uint32_t need = s->node_count;
+    ob_result r = ob_array_reserve((void **)&s->order, &s->order_cap, need, sizeof *s->order);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->by_level, &s->by_level_cap, need, sizeof *s->by_level);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->level_start, &s->level_start_cap, need + 1,
+                             sizeof *s->level_start);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->chunk_counts, &s->chunk_counts_cap,
+                             2 * (chunks_of(s->by_id_count, grain) + 1), sizeof *s->chunk_counts);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->renderables, &s->renderable_cap, need,
+                             sizeof *s->renderables);
+    if (r == OB_OK)
+        r = ob_array_reserve_aligned((void **)&s->proxies, &s->proxy_cap, need,
+                                     sizeof *s->proxies, OB_CACHE_LINE);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->bounds, &s->bound_cap, need, sizeof *s->bounds);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
+    if (r == OB_OK && s->soa_cap < need) {
+        /* All the arrays grow together to the same capacity. */
+        uint32_t cap = OB_MAX(need, 2 * s->soa_cap);
+        void *x = ob_realloc(s->soa_x, sizeof(double) * cap);
+        if (x) s->soa_x = x;
+        void *y = x ? ob_realloc(s->soa_y, sizeof(double) * cap) : NULL;
+        if (y) s->soa_y = y;
+        void *z = y ? ob_realloc(s->soa_z, sizeof(double) * cap) : NULL;
+        if (z) s->soa_z = z;
+        void *rad = z ? ob_realloc(s->soa_radius, sizeof(float) * cap) : NULL;
+        if (rad) s->soa_radius = rad;
+        void *fl = rad ? ob_realloc(s->soa_flags, cap) : NULL;
+        if (fl) s->soa_flags = fl;
+        void *m = fl ? ob_realloc(s->soa_material, sizeof(uint32_t) * cap) : NULL;
+        if (m) s->soa_material = m;
+        void *g = m ? ob_realloc(s->soa_geometry, sizeof(uint32_t) * cap) : NULL;
+        if (g) s->soa_geometry = g;
+        void *id = g ? ob_realloc(s->soa_node_id, sizeof(uint32_t) * cap) : NULL;
+        if (id) s->soa_node_id = id;
+        void *nodes = id ? ob_realloc(s->soa_node, sizeof(ob_node *) * cap) : NULL;
+        if (nodes) {
+            s->soa_node = nodes;
+            s->soa_cap = cap;
+        } else {
+            r = OB_ERR_OUT_OF_HOST_MEMORY;
+        }
+    }
+    if (r != OB_OK)
+        OB_LOG_E(SCENE_LOG, "scene update of %u nodes: %s; scene left as it was", need,
+                 ob_result_text(r));
+    return r;
+}
+
+/* Every node's controllers into one new pool, in level order, so that the
+ * update reads them as one stream: once as many lie elsewhere (added since,
+ * or left unused by destroyed nodes) as an eighth of the pool. */
+static ob_result controllers_repack(ob_scene *s)
+{
+    if (s->ctl_loose <= s->ctl_pool_size / 8 + 64) return OB_OK;
+    uint32_t total = 0;
+    for (uint32_t i = 0; i < s->order_count; i++) total += s->ctl[s->by_level[i].slot].count;
+    ob_controller_slot *pool = total ? ob_malloc(sizeof *pool * total) : NULL;
+    if (total && !pool) {
+        OB_LOG_E(SCENE_LOG, "scene update of %u nodes: %s; scene left as it was", s->node_count,
+                 ob_result_text(OB_ERR_OUT_OF_HOST_MEMORY));
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < s->order_count; i++) {
+        node_controllers *ctl = &s->ctl[s->by_level[i].slot];
+        if (!ctl->count) continue;
+        memcpy(pool + w, ctl->slots, sizeof *pool * ctl->count);
+        if (!ctl->pooled) ob_free(ctl->slots);
+        ctl->slots = pool + w;
+        ctl->cap = ctl->count;
+        ctl->pooled = true;
+        w += ctl->count;
+    }
+    ob_free(s->ctl_pool);
+    s->ctl_pool = pool;
+    s->ctl_pool_size = total;
+    s->ctl_loose = 0;
+    return OB_OK;
+}
+
+ob_result ob_scene_update(ob_scene *s, double dt) { return ob_scene_update_parallel(s, dt, NULL); }
+
+ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *par)
+{
+    if (!isfinite(dt) || dt < 0.0) {
+        OB_LOG_E(SCENE_LOG, "scene update: dt must be finite and >= 0 (got %g)", dt);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    if (s->in_update) {
+        OB_LOG_E(SCENE_LOG, "ob_scene_update called from a controller; refused");
+        return OB_ERR_WRONG_STATE;
+    }
+    uint32_t grain = par && par->grain ? par->grain : UPDATE_GRAIN;
+    ob_result r = update_reserve(s, grain);
+    if (r != OB_OK) return r;
+    ob_scene_intern_trim(s);
+    ob_scene_compact(s);
+    if (s->order_dirty) order_rebuild(s);
+    r = controllers_repack(s);
+    if (r != OB_OK) return r;
+
+    s->in_update = true;
+    update_ctx c = {.s = s, .dt = dt, .par = par, .grain = grain, .counts = s->chunk_counts};
+    /* Serial controllers may read any node's local transform, so every
+     * parallel-safe one must have run before them, and every transform
+     * after them. Without any, a node's controllers run right before its
+     * evaluation, in the same loop. */
+    c.controllers = s->serial_nodes == 0;
+    if (!c.controllers) {
+        c.items = s->by_level;
+        c.count = s->order_count;
+        update_loop(&c, c.count, run_parallel_controller_loop);
+        for (uint32_t i = 0; i < s->order_count; i++) {
+            uint32_t slot = s->order[i];
+            if (!(s->state[slot] & NODE_SERIAL)) continue;
+            /* Re-read the array each time: a controller may add controllers. */
+            uint32_t count = s->ctl[slot].count;
+            for (uint32_t k = s->ctl[slot].parallel; k < count; k++)
+                ob_controller_run(s, slot, &s->ctl[slot].slots[k], dt);
+        }
+    }
+    bool membership_changed = s->snapshot_dirty;
+    for (uint32_t d = 0; d < s->level_count; d++) {
+        c.items = s->by_level + s->level_start[d];
+        c.count = s->level_start[d + 1] - s->level_start[d];
+        uint32_t chunks = chunks_of(c.count, grain);
+        update_loop(&c, c.count, run_level);
+        for (uint32_t k = 0; k < chunks; k++) membership_changed |= c.counts[k] != 0;
+    }
+    s->in_update = false;
+    for (uint32_t i = 0; i < s->retired_count; i++) ob_free(s->retired[i]);
+    s->retired_count = 0;
+    if (membership_changed) snapshot_rebuild(s, &c);
+    return OB_OK;
+}
