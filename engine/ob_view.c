@@ -544,6 +544,11 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
     const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     if (count == 0) return OB_OK;
+    if (!scene) {
+        /* A frame begun without a scene: nothing to draw. */
+        for (uint32_t k = 0; k < count; k++) views[k]->item_count = 0;
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     cull_wave w = {.n = count};
     w.views = ob_calloc(count, sizeof *w.views);
     if (!w.views) {

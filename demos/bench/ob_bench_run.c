@@ -206,11 +206,14 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
             uint32_t order[OB_BENCH_MAX_MODES];
             order_of((uint64_t)round * passes + pass, desc->mode_count, order);
             if (pass == 0) {
-                /* The updates step through all orders by round (the passes'
-                 * orders repeat with the pass count), so that no mode
-                 * always updates first, on caches the frames left cold. */
+                /* The updates rotate by round, so that every mode updates
+                 * first (on caches the frames left cold) equally often
+                 * within mode_count rounds: the passes' orders repeat with
+                 * the pass count, and the first (modes - 1)! orders all
+                 * start with the same mode. */
                 uint32_t update_order[OB_BENCH_MAX_MODES];
-                order_of(round, desc->mode_count, update_order);
+                for (uint32_t i = 0; i < desc->mode_count; i++)
+                    update_order[i] = (i + round) % desc->mode_count;
                 ob_result res = round_updates(s, desc, c, round, update_order);
                 if (res != OB_OK) return res;
             }
