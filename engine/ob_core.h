@@ -226,6 +226,14 @@ typedef struct ob_parallel {
     uint32_t grain;
 } ob_parallel;
 
+/* Whether a loop over `items` (grain per index) is worth handing to par:
+ * each thread gets two indices' worth, since waking a pool thread costs
+ * some 30-50 us on a 2-core VM. [any thread] */
+static inline bool ob_parallel_worth(const ob_parallel *par, uint64_t items, uint32_t grain)
+{
+    return par && par->threads > 1 && items >= 2ull * grain * par->threads;
+}
+
 /* Runs the loop through par, or on the caller when par is NULL or has one
  * thread (or count < 2). [any thread] */
 static inline void ob_parallel_run(const ob_parallel *par, uint32_t count, ob_task_fn fn,

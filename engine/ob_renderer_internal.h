@@ -45,8 +45,7 @@ typedef struct ob_worker {
     VkCommandBuffer *cmds[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
-    uint64_t cpu_ns;            /* thread CPU time of its last batch */
-    uint64_t task_cpu_ns;       /* thread CPU time of its share of the last parallel loop */
+    uint64_t cpu_ns;            /* thread CPU time of its last batch (jobs or loop indices) */
     ob_arena_allocator alloc[OB_MAX_FRAMES_IN_FLIGHT];  /* one per pool */
     int cpu;                    /* the CPU it is pinned to; -1 = none yet */
     ob_result error;

@@ -195,7 +195,7 @@ static void *worker_main(void *arg)
         if (r->task_fn) {
             uint64_t c0 = ob_thread_cpu_ns();
             run_tasks(r, w->index);
-            w->task_cpu_ns = ob_thread_cpu_ns() - c0;
+            w->cpu_ns = ob_thread_cpu_ns() - c0;
         } else {
             record_batch(r, w);
         }
@@ -214,6 +214,32 @@ uint32_t ob_renderer_parallel_threads(const ob_renderer *r)
 
 static void place_workers(ob_renderer *r, uint32_t helpers);
 
+/* The hand-out both kinds of batch share (the frame's jobs, a parallel
+ * loop's indices), set up in r beforehand: pool threads 1..helpers are
+ * woken, the render thread runs own(r, arg) meanwhile, and the call returns
+ * when all are done. The pool threads' CPU (their cpu_ns) and the render
+ * thread's count as parallel in the frame's (or the update's) figures. */
+static void hand_out(ob_renderer *r, uint32_t helpers, void (*own)(ob_renderer *r, void *arg),
+                     void *arg)
+{
+    uint64_t c0 = ob_thread_cpu_ns();
+    place_workers(r, helpers);
+    for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
+    own(r, arg);
+    for (uint32_t i = 0; i < helpers; i++)
+        while (sem_wait(&r->done) != 0) {} /* EINTR */
+    uint64_t pool = 0;
+    for (uint32_t i = 0; i < helpers; i++) pool += r->workers[i].cpu_ns;
+    if (r->acc_pool) *r->acc_pool += pool;
+    if (r->acc_render_parallel) *r->acc_render_parallel += ob_thread_cpu_ns() - c0;
+}
+
+static void own_tasks(ob_renderer *r, void *arg)
+{
+    (void)arg;
+    run_tasks(r, 0);
+}
+
 /* ob_parallel's run for the pool: pool threads 1..threads-1 (only as many as
  * there are indices) are woken, the render thread takes indices too, and
  * the call returns when every index is done. A loop started from inside a
@@ -226,27 +252,17 @@ static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
         for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
         return;
     }
-    uint64_t c0 = ob_thread_cpu_ns();
     uint32_t helpers = OB_MIN(threads - 1, count - 1);
     r->in_parallel = true;
     r->task_fn = fn;
     r->task_user = user;
     r->task_count = count;
     atomic_store_explicit(&r->next_task, 0, memory_order_relaxed);
-    place_workers(r, helpers);
-    for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
-    run_tasks(r, 0);
-    for (uint32_t i = 0; i < helpers; i++)
-        while (sem_wait(&r->done) != 0) {} /* EINTR */
+    hand_out(r, helpers, own_tasks, NULL);
     r->task_fn = NULL;
     r->in_parallel = false;
-    uint64_t pool = 0;
-    for (uint32_t i = 0; i < helpers; i++) {
-        pool += r->workers[i].task_cpu_ns;
-        r->workers[i].task_cpu_ns = 0;
-    }
-    if (r->acc_pool) *r->acc_pool += pool;
-    if (r->acc_render_parallel) *r->acc_render_parallel += ob_thread_cpu_ns() - c0;
+    /* Recording reads the workers' cpu_ns as its own: none left from here. */
+    for (uint32_t i = 0; i < helpers; i++) r->workers[i].cpu_ns = 0;
 }
 
 ob_parallel ob_renderer_parallel(ob_renderer *r)
@@ -322,18 +338,12 @@ static void place_workers(ob_renderer *r, uint32_t helpers)
 /* Hand the frame's jobs to the active workers and wait for all. Only the
  * pool threads that have a job to take are woken; the render thread records
  * the last active worker's share instead of sleeping. */
+static void own_jobs(ob_renderer *r, void *worker) { record_batch(r, worker); }
+
 static void run_jobs(ob_renderer *r, uint32_t active)
 {
-    uint64_t c0 = ob_thread_cpu_ns();
     atomic_store_explicit(&r->next_job, 0, memory_order_relaxed);
-    uint32_t helpers = OB_MIN(active - 1, r->job_count - 1);
-    place_workers(r, helpers);
-    for (uint32_t i = 0; i < helpers; i++) sem_post(&r->workers[i].go);
-    record_batch(r, &r->workers[active - 1]);
-    for (uint32_t i = 0; i < helpers; i++)
-        while (sem_wait(&r->done) != 0) {} /* EINTR */
-    for (uint32_t i = 0; i < helpers; i++) r->cur.cpu_pool_ns += r->workers[i].cpu_ns;
-    r->cur.cpu_render_parallel_ns += ob_thread_cpu_ns() - c0;
+    hand_out(r, OB_MIN(active - 1, r->job_count - 1), own_jobs, &r->workers[active - 1]);
 }
 
 /* ------------------------------------------------------------ jobs */

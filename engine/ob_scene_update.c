@@ -48,8 +48,7 @@ static uint32_t chunk_end(uint32_t count, uint32_t k, uint32_t grain)
  * work), else on the caller; the result is the same either way. */
 static void update_loop(const update_ctx *c, uint32_t items, ob_task_fn fn)
 {
-    const ob_parallel *par = c->par;
-    if (par && (uint64_t)items < 2ull * c->grain * par->threads) par = NULL;
+    const ob_parallel *par = ob_parallel_worth(c->par, items, c->grain) ? c->par : NULL;
     ob_parallel_run(par, chunks_of(items, c->grain), fn, (void *)c);
 }
 
@@ -452,31 +451,26 @@ static ob_result update_reserve(ob_scene *s, uint32_t grain)
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
     if (r == OB_OK && s->soa_cap < need) {
-        /* All the arrays grow together to the same capacity. */
+        /* All the arrays grow together to the same capacity; one that
+         * cannot keeps the others' growth, harmless, and the old cap. */
         uint32_t cap = OB_MAX(need, 2 * s->soa_cap);
-        void *x = ob_realloc(s->soa_x, sizeof(double) * cap);
-        if (x) s->soa_x = x;
-        void *y = x ? ob_realloc(s->soa_y, sizeof(double) * cap) : NULL;
-        if (y) s->soa_y = y;
-        void *z = y ? ob_realloc(s->soa_z, sizeof(double) * cap) : NULL;
-        if (z) s->soa_z = z;
-        void *rad = z ? ob_realloc(s->soa_radius, sizeof(float) * cap) : NULL;
-        if (rad) s->soa_radius = rad;
-        void *fl = rad ? ob_realloc(s->soa_flags, cap) : NULL;
-        if (fl) s->soa_flags = fl;
-        void *m = fl ? ob_realloc(s->soa_material, sizeof(uint32_t) * cap) : NULL;
-        if (m) s->soa_material = m;
-        void *g = m ? ob_realloc(s->soa_geometry, sizeof(uint32_t) * cap) : NULL;
-        if (g) s->soa_geometry = g;
-        void *id = g ? ob_realloc(s->soa_node_id, sizeof(uint32_t) * cap) : NULL;
-        if (id) s->soa_node_id = id;
-        void *nodes = id ? ob_realloc(s->soa_node, sizeof(ob_node *) * cap) : NULL;
-        if (nodes) {
-            s->soa_node = nodes;
-            s->soa_cap = cap;
-        } else {
-            r = OB_ERR_OUT_OF_HOST_MEMORY;
+        struct { void **array; size_t size; } soa[] = {
+            {(void **)&s->soa_x, sizeof *s->soa_x},
+            {(void **)&s->soa_y, sizeof *s->soa_y},
+            {(void **)&s->soa_z, sizeof *s->soa_z},
+            {(void **)&s->soa_radius, sizeof *s->soa_radius},
+            {(void **)&s->soa_flags, sizeof *s->soa_flags},
+            {(void **)&s->soa_material, sizeof *s->soa_material},
+            {(void **)&s->soa_geometry, sizeof *s->soa_geometry},
+            {(void **)&s->soa_node_id, sizeof *s->soa_node_id},
+            {(void **)&s->soa_node, sizeof *s->soa_node},
+        };
+        for (size_t k = 0; k < OB_ARRAY_COUNT(soa) && r == OB_OK; k++) {
+            void *grown = ob_realloc(*soa[k].array, soa[k].size * cap);
+            if (grown) *soa[k].array = grown;
+            else r = OB_ERR_OUT_OF_HOST_MEMORY;
         }
+        if (r == OB_OK) s->soa_cap = cap;
     }
     if (r != OB_OK)
         OB_LOG_E(SCENE_LOG, "scene update of %u nodes: %s; scene left as it was", need,

@@ -342,12 +342,11 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     }
 }
 
-/* The view's table of the snapshot's materials and the meshes' ids: one
- * interface call per material and geometry, not per entity. */
-static ob_result cull_tables(ob_view *v, const ob_scene *scene, const ob_material_iface *mi,
-                             const ob_geometry_iface *gi, uint32_t **out_mesh)
+/* The view's table of the snapshot's materials: one interface call per
+ * material, not per entity. */
+static ob_result cull_materials(ob_view *v, const ob_scene *scene, const ob_material_iface *mi)
 {
-    uint32_t mc = ob_scene_material_count(scene), gc = ob_scene_geometry_count(scene);
+    uint32_t mc = ob_scene_material_count(scene);
     ob_result res = ob_array_reserve((void **)&v->materials, &v->material_cap, mc,
                                      sizeof *v->materials);
     if (res != OB_OK) return res;
@@ -365,22 +364,15 @@ static ob_result cull_tables(ob_view *v, const ob_scene *scene, const ob_materia
         e->state = state;
         e->per_entity = !mi->pre_render_per_entity || mi->pre_render_per_entity(m, v->type);
     }
-    /* The mesh ids live in the working memory, after the pairs. */
-    uint32_t *mesh = (uint32_t *)((char *)v->cull_mem + v->cull_mem_size) - gc;
-    for (uint32_t k = 0; k < gc; k++) {
-        struct ob_geometry *g = ob_scene_geometry(scene, k);
-        mesh[k] = gi && g ? gi->id(g) : 0;
-    }
-    *out_mesh = mesh;
     return OB_OK;
 }
 
 /* Working memory: two pair arrays of `count` (the chunks' output and the
- * sort's other buffer), the chunk records, the mesh ids. */
-static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks, uint32_t meshes)
+ * sort's other buffer) and the chunk records. */
+static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks)
 {
     size_t need = 2 * sizeof(cull_pair) * (size_t)OB_MAX(count, 1u) +
-                  sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u) + sizeof(uint32_t) * meshes;
+                  sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u);
     need = (need + 63) & ~(size_t)63;
     if (need <= v->cull_mem_size) return OB_OK;
     size_t size = OB_MAX(need, v->cull_mem_size + v->cull_mem_size / 2);
@@ -396,23 +388,22 @@ static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks, uint3
 typedef struct cull_view {
     ob_view *v;
     cull_ctx c;
-    uint32_t count, chunks;
+    uint32_t count;
     uint64_t ns;                /* its tasks' time, summed */
     ob_result res;
 } cull_view;
 
+/* Every view of a wave culls the same snapshot, so each has the same
+ * number of chunks: chunk task t is chunk t % chunks of view t / chunks. */
 typedef struct cull_wave {
     cull_view *views;
-    uint32_t n;
-    uint32_t *task_view;        /* chunk task -> view of the wave */
-    uint32_t *task_first;       /* chunk task -> its view's first task */
+    uint32_t chunks;
 } cull_wave;
 
-/* Sets up view k of a wave on the render thread: its snapshot, working
- * memory, material and mesh tables and planes. */
+/* Sets up a view of a wave on the render thread: its snapshot, working
+ * memory, material table and planes. mesh: the wave's mesh ids. */
 static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene,
-                            const ob_material_iface *mi, const ob_geometry_iface *gi,
-                            uint32_t grain)
+                            const ob_material_iface *mi, const uint32_t *mesh, uint32_t grain)
 {
     ob_view *v = cv->v;
     uint32_t count = 0;
@@ -424,13 +415,11 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     v->material_items_valid = false;
     v->cull_ns = 0;
     cv->count = count;
-    cv->chunks = 0;
     if (!mi) return OB_ERR_WRONG_STATE;
     uint32_t chunks = (count + grain - 1) / grain;
-    uint32_t *mesh = NULL;
     ob_result res = ob_array_reserve((void **)&v->items, &v->item_cap, count, sizeof *v->items);
-    if (res == OB_OK) res = cull_reserve(v, count, chunks, ob_scene_geometry_count(scene));
-    if (res == OB_OK) res = cull_tables(v, scene, mi, gi, &mesh);
+    if (res == OB_OK) res = cull_reserve(v, count, chunks);
+    if (res == OB_OK) res = cull_materials(v, scene, mi);
     if (res != OB_OK) {
         /* The view goes on empty this frame; the next frame tries again. */
         OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",
@@ -455,17 +444,18 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
         ob_frustum_from_matrix(v->view_proj, &frustum);
         memcpy(cv->c.planes, frustum.planes, sizeof(float) * 4 * frustum.plane_count);
     }
-    cv->chunks = chunks;
     return OB_OK;
 }
 
 static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
 {
     const cull_wave *w = user;
-    cull_view *cv = &w->views[w->task_view[task]];
+    cull_view *cv = &w->views[task / w->chunks];
+    if (cv->res != OB_OK) return;
+    uint32_t chunk = task % w->chunks;
     uint64_t t0 = ob_time_ns();
-    cull_chunk_run(&cv->c, task - w->task_first[task], thread);
-    cv->c.chunks[task - w->task_first[task]].ns = ob_time_ns() - t0;
+    cull_chunk_run(&cv->c, chunk, thread);
+    cv->c.chunks[chunk].ns = ob_time_ns() - t0;
 }
 
 /* A view's chunks side by side (in chunk order, so ascending id), the log
@@ -482,7 +472,7 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     uint32_t n = 0;
     bool far = false;
     uint64_t chunk_ns = 0;
-    for (uint32_t k2 = 0; k2 < cv->chunks; k2++) {
+    for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
         chunk_ns += ch->ns;
         if (n != k2 * cv->c.grain)
@@ -549,8 +539,11 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         for (uint32_t k = 0; k < count; k++) views[k]->item_count = 0;
         return OB_ERR_INVALID_ARGUMENT;
     }
-    cull_wave w = {.n = count};
-    w.views = ob_calloc(count, sizeof *w.views);
+    /* The views, then the mesh ids of the snapshot's geometries: one
+     * interface call per geometry for the whole wave. */
+    uint32_t gc = ob_scene_geometry_count(scene);
+    cull_wave w = {0};
+    w.views = ob_calloc(1, sizeof *w.views * count + sizeof(uint32_t) * gc);
     if (!w.views) {
         OB_LOG_E("view", "%u views not culled: out of host memory; they draw nothing this frame",
                  count);
@@ -560,44 +553,27 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         }
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
+    uint32_t *mesh = (uint32_t *)(w.views + count);
+    for (uint32_t k = 0; k < gc; k++) {
+        struct ob_geometry *g = ob_scene_geometry(scene, k);
+        mesh[k] = gi && g ? gi->id(g) : 0;
+    }
     ob_parallel par = ob_renderer_parallel(r);
     uint32_t grain = par.grain ? par.grain : CULL_GRAIN;
+    uint32_t entities = 0;
+    ob_scene_render_proxies(scene, &entities);
+    w.chunks = (entities + grain - 1) / grain;
     ob_result first_error = OB_OK;
-    uint32_t tasks = 0, entities = 0;
     for (uint32_t k = 0; k < count; k++) {
         cull_view *cv = &w.views[k];
         cv->v = views[k];
-        cv->res = cull_setup(cv, r, scene, mi, gi, grain);
+        cv->res = cull_setup(cv, r, scene, mi, mesh, grain);
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
-        tasks += cv->chunks;
-        entities += cv->count;
     }
-    w.task_view = ob_malloc(sizeof *w.task_view * 2 * OB_MAX(tasks, 1u));
-    /* A hand-out costs some 30-50 us on a 2-core VM (the wake-up): a wave
-     * goes to the pool only with two chunks' worth of entities a thread. */
-    if (entities < 2 * grain * par.threads) par.threads = 1;
-    if (!w.task_view) {
-        /* No task table: cull view by view on this thread instead. */
-        OB_LOG_W("view", "%u views culled on the render thread alone this frame: no memory "
-                 "for the task table", count);
-        for (uint32_t k = 0; k < count; k++) {
-            cull_view *cv = &w.views[k];
-            for (uint32_t c = 0; c < cv->chunks; c++) cull_chunk_run(&cv->c, c, 0);
-            wave_finish_task(&w, k, 0);
-        }
-    } else {
-        w.task_first = w.task_view + OB_MAX(tasks, 1u);
-        for (uint32_t k = 0, t = 0; k < count; k++) {
-            for (uint32_t c = 0; c < w.views[k].chunks; c++, t++) {
-                w.task_view[t] = k;
-                w.task_first[t] = t - c;
-            }
-        }
-        ob_parallel_run(&par, tasks, wave_chunk_task, &w);
-        ob_parallel_run(&par, count, wave_finish_task, &w);
-    }
+    if (!ob_parallel_worth(&par, (uint64_t)entities * count, grain)) par.threads = 1;
+    ob_parallel_run(&par, w.chunks * count, wave_chunk_task, &w);
+    ob_parallel_run(&par, count, wave_finish_task, &w);
     for (uint32_t k = 0; k < count; k++) w.views[k].v->cull_ns = w.views[k].ns;
-    ob_free(w.task_view);
     ob_free(w.views);
     return first_error;
 }
