@@ -41,7 +41,11 @@ struct ob_bench_raw {
     float *push;               /* 32 floats per draw, 32-byte aligned */
     uint32_t count;
     uint32_t width, height;    /* the view's, for viewport and scissor */
-    ob_counting_allocator pool_alloc;  /* the pool's only: driver allocations per draw */
+    /* The pool's allocator: the engine's own (a recording pool's), so that
+     * the two loops record into memory managed the same way and the raw
+     * figure prices Vulkan, not glibc malloc's state; it counts the
+     * driver's allocations per draw. */
+    ob_arena_allocator pool_alloc;
 };
 
 typedef struct ob_bench_raw raw_state;
@@ -126,7 +130,7 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
     VkCommandPoolCreateInfo pci = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                    .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
                                    .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->r))};
-    ob_counting_allocator_init(&s->pool_alloc);
+    ob_arena_allocator_init(&s->pool_alloc);
     VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, &s->pool_alloc.callbacks, &s->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkCommandBufferAllocateInfo ai = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
@@ -177,7 +181,7 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
                  VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT,
         .pInheritanceInfo = &inherit};
     if (OB_VK_CHECK(vkResetCommandPool(s->vk, s->pool, 0)) != VK_SUCCESS) return OB_ERR_VULKAN;
-    uint64_t allocs0 = ob_counting_allocator_count(&s->pool_alloc);
+    uint64_t allocs0 = ob_arena_allocator_count(&s->pool_alloc);
     uint64_t t0 = ob_time_ns();
     if (OB_VK_CHECK(vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return OB_ERR_VULKAN;
     vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s->pipeline);
@@ -209,7 +213,7 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
     /* Pipeline, viewport, scissor, then per draw push + draw, plus binds. */
     *out = (ob_bench_raw_sample){.ns = ns, .draws = s->count, .buffer_binds = binds,
                                  .commands = 3 + 2 * s->count + binds,
-                                 .host_allocs = ob_counting_allocator_count(&s->pool_alloc) - allocs0};
+                                 .host_allocs = ob_arena_allocator_count(&s->pool_alloc) - allocs0};
     return OB_OK;
 }
 
@@ -217,6 +221,7 @@ void ob_bench_raw_destroy(ob_bench_raw *s)
 {
     if (!s) return;
     if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc.callbacks);
+    ob_arena_allocator_release(&s->pool_alloc);
     if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
     if (s->layout) vkDestroyPipelineLayout(s->vk, s->layout, NULL);
     if (s->vert) vkDestroyShaderModule(s->vk, s->vert, NULL);
