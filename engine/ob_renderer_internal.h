@@ -31,12 +31,19 @@ typedef struct ob_job {
  * recorded by pool thread i, or, for the last active worker, by the render
  * thread itself (it would otherwise sleep while the others record). Only the
  * thread recording a batch touches this state; batches are handed over
- * through semaphores, so one thread at a time. */
+ * by hand_out (a ticket the thread polls for, a semaphore once it sleeps),
+ * so one thread at a time. */
 typedef struct ob_worker {
     ob_renderer *renderer;
     pthread_t thread;
     bool started;
-    sem_t go;                   /* posted once per batch, and to quit */
+    /* Handing it a batch (see hand_out): the render thread bumps ticket;
+     * the thread spins on it a while after each batch, then sleeps on go,
+     * which is posted only when it says it sleeps. */
+    atomic_uint ticket;         /* batches handed to it, and the quit */
+    atomic_int sleeping;        /* 1: about to wait, or waiting, on go */
+    uint32_t seen;              /* tickets it took (its own thread only) */
+    sem_t go;
     bool go_ready;
     uint32_t index;             /* 1-based: parameter slot and pair index */
     ob_pipeline_manager *pm;
@@ -164,7 +171,12 @@ struct ob_renderer {
         uint64_t ns, cpu_render, cpu_render_parallel, cpu_pool;
     } update;
 
-    sem_t done;                 /* each pool thread posts it when its batch is recorded */
+    /* A batch's end: each pool thread adds one to finished; the render
+     * thread spins on it a while, then sleeps on done, posted only when
+     * it says it waits. */
+    atomic_uint finished;
+    atomic_int waiting;
+    sem_t done;
     bool done_ready;
     atomic_uint next_job;
     bool quit;
