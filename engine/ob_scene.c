@@ -322,7 +322,6 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->chunk_counts);
     ob_free(s->renderables);
     ob_aligned_free(s->proxies);
-    ob_free(s->bounds);
     ob_free(s->lights);
     ob_free(s->soa_x);
     ob_free(s->soa_y);
@@ -395,13 +394,6 @@ struct ob_geometry *ob_scene_geometry(const ob_scene *s, uint32_t index)
 uint32_t ob_scene_material_count(const ob_scene *s) { return OB_MAX(s->materials.count, 1u); }
 uint32_t ob_scene_geometry_count(const ob_scene *s) { return OB_MAX(s->geometries.count, 1u); }
 
-const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count)
-{
-    static const ob_render_bound none[1];
-    *out_count = s->renderable_count;
-    return s->bounds ? s->bounds : none;
-}
-
 ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count)
 {
     *out_count = s->light_count;
@@ -444,35 +436,30 @@ ob_node *ob_node_create(ob_scene *s, ob_node *parent, const char *name, ob_resul
     return n;
 }
 
-void ob_node_destroy(ob_scene *s, ob_node *n)
+/* Whether n may be destroyed through s (logged when not). */
+static bool destroy_allowed(ob_scene *s, const ob_node *n)
 {
-    if (!n) return;
     if (n->scene != s) {
         OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): destroy through another scene; ignored",
                  n->name, n->id);
-        return;
+        return false;
     }
     if (n == s->root) {
         OB_LOG_E(SCENE_LOG, "the root of a scene cannot be destroyed (destroy the scene); ignored");
-        return;
+        return false;
     }
-    if (refuse_in_update(s, "destroy", n)) return;
+    return true;
+}
 
-    /* Mark first so the snapshot can be filtered while the nodes still exist. */
-    bool in_snapshot = false;
-    for (ob_node *m = n; m; m = ob_scene_preorder_next(m, n)) {
-        m->dying = true;
-        in_snapshot |= (s->state[m->by_id_index] & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) != 0;
-    }
-    if (in_snapshot) ob_scene_snapshot_drop_dying(s);
-
-    unlink_child(n);
-    /* Free leaves first, climbing back up: no stack, each edge walked twice. */
-    ob_node *cur = n;
+/* Frees the subtree of top, already unlinked from its parent: leaves first,
+ * climbing back up, so no stack and each edge walked twice. */
+static void free_subtree(ob_scene *s, ob_node *top)
+{
+    ob_node *cur = top;
     for (;;) {
         while (cur->first_child) cur = cur->first_child;
         ob_node *up = cur->parent;
-        bool last = cur == n;
+        bool last = cur == top;
         if (!last) unlink_child(cur);
         uint32_t slot = cur->by_id_index;
         intern_release(&s->materials, s->draw[slot].material_index);
@@ -484,6 +471,56 @@ void ob_node_destroy(ob_scene *s, ob_node *n)
         node_free(cur);
         if (last) break;
         cur = up;
+    }
+}
+
+void ob_node_destroy(ob_scene *s, ob_node *n) { ob_nodes_destroy(s, &n, 1); }
+
+void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count)
+{
+    if (count == 0) return;
+    if (s->in_update) {
+        const ob_node *n = nodes[0];
+        refuse_in_update(s, "destroy", n);
+        return;
+    }
+    /* Mark every subtree first, so that the snapshot loses them all in one
+     * pass while the nodes still exist, from the first of them in it on:
+     * the work is the subtrees' size plus the snapshot's tail past them,
+     * whatever the count (unloading a scene, newest entities first, pays
+     * for the entities only). */
+    uint32_t first_proxy = UINT32_MAX;
+    bool lights = false;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_node *n = nodes[i];
+        if (!n || n->dying || !destroy_allowed(s, n)) continue;
+        for (ob_node *m = n; m; m = ob_scene_preorder_next(m, n)) {
+            m->dying = true;
+            uint8_t st = s->state[m->by_id_index];
+            if ((st & NODE_IN_RENDERABLES) && s->xf[m->by_id_index].proxy_index < first_proxy)
+                first_proxy = s->xf[m->by_id_index].proxy_index;
+            lights |= (st & NODE_IN_LIGHTS) != 0;
+        }
+    }
+    if (first_proxy != UINT32_MAX || lights)
+        ob_scene_snapshot_drop_dying(s, first_proxy == UINT32_MAX ? s->renderable_count
+                                                                  : first_proxy, lights);
+    /* The tops (listed nodes under no other dying node) leave the tree,
+     * chained through their now unused sibling links; a node listed twice
+     * is out of the tree (no parent) the second time. */
+    ob_node *tops = NULL;
+    for (uint32_t i = 0; i < count; i++) {
+        ob_node *n = nodes[i];
+        if (!n || !n->dying || !n->parent || n->parent->dying) continue;
+        unlink_child(n);
+        n->next_sibling = tops;
+        tops = n;
+    }
+    while (tops) {
+        ob_node *next = tops->next_sibling;
+        tops->next_sibling = NULL;
+        free_subtree(s, tops);
+        tops = next;
     }
     s->order_dirty = true;
 }

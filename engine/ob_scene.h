@@ -103,9 +103,9 @@ ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count);
 /* A renderable's draw data for the frame, kept in arrays parallel to the
  * renderables snapshot (same order, same count), so that the views' loops
  * read contiguous memory instead of chasing nodes: the proxy is what
- * recording reads (two cache lines; the array is 64-byte aligned), the bound
- * what culling adds to it. World data is as of the last ob_scene_update (as
- * the node's queries); material, geometry and local radius follow
+ * recording reads (two cache lines; the array is 64-byte aligned); culling
+ * reads the bounds from ob_render_soa. World data is as of the last
+ * ob_scene_update (as the node's queries); material and geometry follow
  * ob_node_set_renderable at once. */
 typedef struct ob_render_proxy {
     float linear[9];             /* world upper 3x3 in float, column-major */
@@ -118,17 +118,10 @@ typedef struct ob_render_proxy {
     bool finite;                 /* linear and normal are finite in float */
 } ob_render_proxy;
 
-typedef struct ob_render_bound {
-    double center[3];            /* world bounding-sphere centre */
-    float radius;                /* world bounding-sphere radius */
-    float local_radius;
-} ob_render_bound;
-
-/* The proxies and bounds of the snapshot, *out_count of each (= the
- * renderables'). Never NULL. Valid until the next update or node
- * destruction. [any thread, while no mutation runs] */
+/* The proxies of the snapshot, *out_count of them (= the renderables').
+ * Never NULL. Valid until the next update or node destruction. [any
+ * thread, while no mutation runs] */
 const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_count);
-const ob_render_bound *ob_scene_render_bounds(const ob_scene *s, uint32_t *out_count);
 
 /* The snapshot's culling data as a structure of arrays, parallel to the
  * proxies (index i is proxy i, ascending node id), for loops that touch
@@ -186,6 +179,12 @@ ob_node *ob_node_create(ob_scene *s, ob_node *parent, const char *name, ob_resul
 /* Destroys n and its whole subtree (iteratively). The root cannot be
  * destroyed (logged, ignored); NULL is a no-op. */
 void ob_node_destroy(ob_scene *s, ob_node *n);
+/* Destroys each of nodes[0..count) with its subtree, as many calls of
+ * ob_node_destroy would, in time linear in the nodes destroyed (plus the
+ * snapshot's entries of newer nodes), where one call per node costs the
+ * whole snapshot each. A node may lie in another's subtree, be listed
+ * twice, or be NULL. */
+void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count);
 /* Moves n (with its subtree) under parent (NULL → root), keeping its local
  * transform. Refuses cycles, the root and nodes of another scene
  * (OB_ERR_INVALID_ARGUMENT, logged). */

@@ -177,8 +177,7 @@ struct ob_scene {
     ob_node **renderables;
     uint32_t renderable_count, renderable_cap;
     ob_render_proxy *proxies;   /* parallel to renderables */
-    ob_render_bound *bounds;    /* parallel to renderables */
-    uint32_t proxy_cap, bound_cap;
+    uint32_t proxy_cap;
     /* The snapshot's culling data in structure-of-arrays form, parallel
      * to renderables (ob_render_soa). */
     double *soa_x, *soa_y, *soa_z;
@@ -213,7 +212,8 @@ local_status ob_scene_xf_local(const node_xf *x, ob_daffine *dest, double unit_q
 /* The proxy of a node in the snapshot follows its renderable (material,
  * geometry, local radius). */
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot);
-/* Drops the marked (dying) nodes from the snapshot. */
-void ob_scene_snapshot_drop_dying(ob_scene *s);
+/* Drops the marked (dying) nodes from the snapshot: the renderables from
+ * index `from` on (none lies before it), and the lights when `lights`. */
+void ob_scene_snapshot_drop_dying(ob_scene *s, uint32_t from, bool lights);
 
 #endif /* OB_SCENE_INTERNAL_H */

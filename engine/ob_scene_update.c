@@ -100,9 +100,9 @@ static bool is_identity(const node_xf *x)
 
 _Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
 
-static uint8_t zero_scale_flag(const ob_render_bound *b)
+static uint8_t zero_scale_flag(const node_xf *x)
 {
-    return b->radius == 0.0f && b->local_radius > 0.0f ? OB_RENDER_ZERO_SCALE : 0u;
+    return x->world_radius == 0.0f && x->local_radius > 0.0f ? OB_RENDER_ZERO_SCALE : 0u;
 }
 
 /* What of proxy i follows the node's world, in two steps so that a batch's
@@ -111,18 +111,13 @@ static uint8_t zero_scale_flag(const ob_render_bound *b)
 static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i)
 {
     ob_render_proxy *p = &s->proxies[i];
-    ob_render_bound *b = &s->bounds[i];
     for (int k = 0; k < 9; k++) p->linear[k] = (float)x->world.m[k];
-    for (int k = 0; k < 3; k++) {
-        p->world_t[k] = x->world.t[k];
-        b->center[k] = x->world_center[k];
-    }
-    b->radius = x->world_radius;
-    s->soa_x[i] = b->center[0];
-    s->soa_y[i] = b->center[1];
-    s->soa_z[i] = b->center[2];
-    s->soa_radius[i] = b->radius;
-    s->soa_flags[i] = zero_scale_flag(b);
+    for (int k = 0; k < 3; k++) p->world_t[k] = x->world.t[k];
+    s->soa_x[i] = x->world_center[0];
+    s->soa_y[i] = x->world_center[1];
+    s->soa_z[i] = x->world_center[2];
+    s->soa_radius[i] = x->world_radius;
+    s->soa_flags[i] = zero_scale_flag(x);
 }
 
 /* The normal matrix, and whether the matrices are finite in float (the
@@ -136,14 +131,13 @@ static void proxy_write_normal(ob_scene *s, uint32_t i)
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
 {
     const node_draw *d = &s->draw[slot];
-    uint32_t i = s->xf[slot].proxy_index;
-    ob_render_bound *b = &s->bounds[i];
+    const node_xf *x = &s->xf[slot];
+    uint32_t i = x->proxy_index;
     s->proxies[i].material = d->material;
     s->proxies[i].geometry = d->geometry;
-    b->local_radius = s->xf[slot].local_radius;
     s->soa_material[i] = d->material_index;
     s->soa_geometry[i] = d->geometry_index;
-    s->soa_flags[i] = zero_scale_flag(b);
+    s->soa_flags[i] = zero_scale_flag(x);
 }
 
 /* The whole of proxy i for the node in slot. */
@@ -158,15 +152,14 @@ static void proxy_fill(ob_scene *s, uint32_t slot, uint32_t i)
     proxy_write_normal(s, i);
 }
 
-void ob_scene_snapshot_drop_dying(ob_scene *s)
+void ob_scene_snapshot_drop_dying(ob_scene *s, uint32_t from, bool lights)
 {
-    uint32_t w = 0;
-    for (uint32_t r = 0; r < s->renderable_count; r++) {
+    uint32_t w = from;
+    for (uint32_t r = from; r < s->renderable_count; r++) {
         ob_node *n = s->renderables[r];
         if (n->dying) continue;
         s->renderables[w] = n;
         s->proxies[w] = s->proxies[r];
-        s->bounds[w] = s->bounds[r];
         s->soa_x[w] = s->soa_x[r];
         s->soa_y[w] = s->soa_y[r];
         s->soa_z[w] = s->soa_z[r];
@@ -179,6 +172,7 @@ void ob_scene_snapshot_drop_dying(ob_scene *s)
         s->xf[n->by_id_index].proxy_index = w++;
     }
     s->renderable_count = w;
+    if (!lights) return;
     w = 0;
     for (uint32_t r = 0; r < s->light_count; r++)
         if (!s->lights[r]->dying) s->lights[w++] = s->lights[r];
@@ -446,8 +440,6 @@ static ob_result update_reserve(ob_scene *s, uint32_t grain)
     if (r == OB_OK)
         r = ob_array_reserve_aligned((void **)&s->proxies, &s->proxy_cap, need,
                                      sizeof *s->proxies, OB_CACHE_LINE);
-    if (r == OB_OK)
-        r = ob_array_reserve((void **)&s->bounds, &s->bound_cap, need, sizeof *s->bounds);
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->lights, &s->light_cap, need, sizeof *s->lights);
     if (r == OB_OK && s->soa_cap < need) {

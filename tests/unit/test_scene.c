@@ -430,6 +430,67 @@ static void destroy_subtree_frees_everything(void **state)
     ob_scene_destroy(s); /* ASan: no leak of nodes, names or controller state */
 }
 
+/* Destroying many nodes in one call: a node listed under another listed
+ * one, twice, or NULL; what is left (snapshot, lights, tree) is what one
+ * call per node would leave, in id order. */
+static void destroy_many_matches_one_at_a_time(void **state)
+{
+    (void)state;
+    ob_scene *batch = new_scene(), *single = new_scene();
+    ob_scene *scenes[2] = {batch, single};
+    ob_node *nodes[2][40];
+    for (int k = 0; k < 2; k++) {
+        for (int i = 0; i < 40; i++) {
+            /* Every fifth node a root-level one; the rest hang under the
+             * previous node, so subtrees nest. */
+            nodes[k][i] = new_node(scenes[k], i % 5 ? nodes[k][i - 1] : NULL, "n");
+            make_renderable(nodes[k][i]);
+            if (i % 3 == 0) ob_node_set_light(nodes[k][i], &(ob_light_desc){.type = OB_LIGHT_POINT});
+        }
+        assert_int_equal(ob_scene_update(scenes[k], 0.1), OB_OK);
+    }
+    /* 7 lies under 6 (both listed, the child first), 6 twice, 20 with its
+     * subtree, 33 alone at the end of its chain, 0's chain from its root. */
+    ob_node *list[] = {nodes[0][7], nodes[0][6], NULL, nodes[0][20], nodes[0][6], nodes[0][34],
+                       nodes[0][0]};
+    ob_nodes_destroy(batch, list, OB_ARRAY_COUNT(list));
+    int order[] = {34, 20, 6, 0};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(order); i++) ob_node_destroy(single, nodes[1][order[i]]);
+    for (int pass = 0; pass < 2; pass++) {
+        uint32_t nb, ns, lb, ls;
+        ob_node *const *rb = ob_scene_renderables(batch, &nb);
+        ob_node *const *rs = ob_scene_renderables(single, &ns);
+        assert_int_equal(nb, ns);
+        /* 40 less 0-4, 6-9, 20-24, 34 */
+        assert_int_equal(nb, 40 - 5 - 4 - 5 - 1);
+        for (uint32_t i = 0; i < nb; i++) {
+            assert_int_equal(ob_node_id(rb[i]), ob_node_id(rs[i]));
+            if (i) assert_true(ob_node_id(rb[i]) > ob_node_id(rb[i - 1]));
+        }
+        ob_render_soa sb, ss;
+        ob_scene_render_soa(batch, &sb);
+        ob_scene_render_soa(single, &ss);
+        assert_int_equal(sb.count, nb);
+        for (uint32_t i = 0; i < nb; i++) {
+            assert_ptr_equal(sb.node[i], rb[i]);
+            assert_int_equal(sb.node_id[i], ob_node_id(rb[i]));
+            assert_memory_equal(&sb.x[i], &ss.x[i], sizeof(double));
+        }
+        ob_node *const *la = ob_scene_lights(batch, &lb);
+        ob_node *const *lsn = ob_scene_lights(single, &ls);
+        assert_int_equal(lb, ls);
+        for (uint32_t i = 0; i < lb; i++) assert_int_equal(ob_node_id(la[i]), ob_node_id(lsn[i]));
+        assert_int_equal(ob_scene_node_count(batch), ob_scene_node_count(single));
+        assert_int_equal(ob_scene_node_count(batch), 1 + 25);
+        /* And the same after an update. */
+        assert_int_equal(ob_scene_update(batch, 0.1), OB_OK);
+        assert_int_equal(ob_scene_update(single, 0.1), OB_OK);
+    }
+    ob_nodes_destroy(batch, NULL, 0);
+    ob_scene_destroy(batch); /* ASan: nothing leaked, nothing freed twice */
+    ob_scene_destroy(single);
+}
+
 typedef struct counter_state {
     uint32_t calls;
     double sum;
@@ -847,6 +908,7 @@ int main(void)
         cmocka_unit_test(script_controllers_run_in_order_before_world),
         cmocka_unit_test(structure_changes_refused_inside_controllers),
         cmocka_unit_test(destroy_subtree_frees_everything),
+        cmocka_unit_test(destroy_many_matches_one_at_a_time),
         cmocka_unit_test(controller_state_kept_by_the_node),
         cmocka_unit_test(bad_transform_rejected_once_and_recovers),
         cmocka_unit_test(bad_update_arguments_refused),
