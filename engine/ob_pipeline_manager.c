@@ -768,8 +768,9 @@ static void fold(ob_pipeline_manager *pm, uint64_t h)
     pm->hash = ob_cmd_hash_concat(pm->hash, (ob_cmd_hash){h, OB_CMD_HASH_BASE, 1});
 }
 
-ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
-                     uint32_t first_vertex, uint32_t first_instance)
+static inline ob_result draw_plain(ob_pipeline_manager *pm, uint32_t vertex_count,
+                                   uint32_t instance_count, uint32_t first_vertex,
+                                   uint32_t first_instance)
 {
     uint64_t h;
     ob_result r = apply(pm, false, &h);
@@ -781,9 +782,9 @@ ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_coun
     return OB_OK;
 }
 
-ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
-                             uint32_t instance_count, uint32_t first_index,
-                             int32_t vertex_offset, uint32_t first_instance)
+static inline ob_result draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+                                     uint32_t instance_count, uint32_t first_index,
+                                     int32_t vertex_offset, uint32_t first_instance)
 {
     uint64_t h;
     ob_result r = apply(pm, true, &h);
@@ -798,8 +799,49 @@ ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t ind
     return OB_OK;
 }
 
-ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
-                              uint32_t draw_count)
+ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_count, uint32_t instance_count,
+                     uint32_t first_vertex, uint32_t first_instance)
+{
+    return draw_plain(pm, vertex_count, instance_count, first_vertex, first_instance);
+}
+
+ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
+                             uint32_t instance_count, uint32_t first_index,
+                             int32_t vertex_offset, uint32_t first_instance)
+{
+    return draw_indexed(pm, index_count, instance_count, first_index, vertex_offset,
+                        first_instance);
+}
+
+ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                        const float world_normal[32])
+{
+    if (world_normal) {
+        pm->world = world_normal;
+        pm->world_pending = true;
+    }
+    pm->vb = d->vertex_buffer;
+    pm->vb_offset = d->vertex_buffer_offset;
+    ob_result r;
+    if (d->index_buffer.id) {
+        pm->ib = d->index_buffer;
+        pm->ib_offset = d->index_buffer_offset;
+        pm->index_type = d->index_type;
+        r = draw_indexed(pm, d->count, d->instance_count, d->first, d->vertex_offset, 0);
+    } else {
+        r = draw_plain(pm, d->count, d->instance_count, d->first, 0);
+    }
+    /* The caller's array is not read after the call. */
+    pm->world = NULL;
+    pm->world_pending = false;
+    return r;
+}
+
+/* The indirect draws: args checked, state applied, the command and its
+ * hash (the arguments are read by the device, so their buffer, offset and
+ * count are what the hash can know). */
+static ob_result draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+                               uint32_t draw_count, bool indexed)
 {
     VkBuffer vk = ob_buffer_vk(pm->dev, args);
     if (!vk) {
@@ -808,13 +850,29 @@ ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer a
         return OB_ERR_INVALID_HANDLE;
     }
     uint64_t h;
-    ob_result r = apply(pm, false, &h);
+    ob_result r = apply(pm, indexed, &h);
     if (r != OB_OK) return r;
-    vkCmdDrawIndirect(pm->cmd, vk, offset, draw_count, sizeof(VkDrawIndirectCommand));
+    if (indexed)
+        vkCmdDrawIndexedIndirect(pm->cmd, vk, offset, draw_count,
+                                 sizeof(VkDrawIndexedIndirectCommand));
+    else
+        vkCmdDrawIndirect(pm->cmd, vk, offset, draw_count, sizeof(VkDrawIndirectCommand));
     h = ob_hash_u64(h, ((uint64_t)args.id << 32) | draw_count);
-    fold(pm, ob_hash_u64(h, offset));
+    fold(pm, ob_hash_u64(h, offset ^ (indexed ? 0x8000000000000000ull : 0u)));
     pm->stats.draws++;
     return OB_OK;
+}
+
+ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
+                              uint32_t draw_count)
+{
+    return draw_indirect(pm, args, offset, draw_count, false);
+}
+
+ob_result ob_pipeline_manager_draw_indexed_indirect(ob_pipeline_manager *pm, ob_buffer args,
+                                                    uint64_t offset, uint32_t draw_count)
+{
+    return draw_indirect(pm, args, offset, draw_count, true);
 }
 
 ob_result ob_pipeline_manager_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z)

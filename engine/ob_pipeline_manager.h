@@ -104,6 +104,22 @@ void ob_pipeline_manager_set_index_buffer(ob_pipeline_manager *pm, ob_buffer buf
 void ob_pipeline_manager_set_viewport(ob_pipeline_manager *pm, float x, float y, float w, float h);
 void ob_pipeline_manager_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t y, uint32_t w, uint32_t h);
 
+/* What one draw of a geometry needs, by value: the geometry interface
+ * fills it (ob_geometry_iface.draw_data) and the recorder draws from it.
+ * Indexed when index_buffer.id != 0: count indices from first, each plus
+ * vertex_offset; else count vertices from first. */
+typedef struct ob_draw_data {
+    ob_buffer vertex_buffer;
+    uint64_t vertex_buffer_offset;
+    ob_buffer index_buffer;
+    uint64_t index_buffer_offset;
+    VkIndexType index_type;
+    uint32_t count;
+    uint32_t instance_count;    /* 1 for a mesh; procedural geometry draws several */
+    uint32_t first;
+    int32_t vertex_offset;
+} ob_draw_data;
+
 /* Draws apply the desired state, then record. Uniform blocks and resources
  * are applied again only when the program or some parameter of the slot
  * changed since the last draw. They return OB_ERR_WRONG_STATE (no pipeline),
@@ -117,8 +133,18 @@ ob_result ob_pipeline_manager_draw(ob_pipeline_manager *pm, uint32_t vertex_coun
 ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t index_count,
                              uint32_t instance_count, uint32_t first_index,
                              int32_t vertex_offset, uint32_t first_instance);
+/* d's buffers set, then d's draw; world_normal (may be NULL: the world of
+ * an earlier set_world, or none) is what set_world takes, read during the
+ * call only. The whole per-draw step of a view's draw list in one call. */
+ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                        const float world_normal[32]);
+/* draw_count draws of VkDrawIndirectCommand (VkDrawIndexedIndirectCommand
+ * for the indexed one, which needs an index buffer set) read from args at
+ * offset, tightly packed. */
 ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
                               uint32_t draw_count);
+ob_result ob_pipeline_manager_draw_indexed_indirect(ob_pipeline_manager *pm, ob_buffer args,
+                                                    uint64_t offset, uint32_t draw_count);
 ob_result ob_pipeline_manager_dispatch(ob_pipeline_manager *pm, uint32_t x, uint32_t y, uint32_t z);
 
 /* Stats since the last ob_pipeline_manager_stats_take (which resets them). */

@@ -61,8 +61,10 @@ struct ob_material_iface {
 };
 
 struct ob_geometry_iface {
-    /* Bind buffers and draw. [recording thread] */
-    ob_result (*draw)(const struct ob_geometry *g, ob_pipeline_manager *pm);
+    /* What drawing g takes (buffers, counts, ranges), by value: the view's
+     * loop asks once per run of items of one geometry and draws from it
+     * itself (ob_pipeline_manager_draw_data). [any thread] */
+    void (*draw_data)(const struct ob_geometry *g, ob_draw_data *out);
     /* Stable id for sorting and hashing. [any thread] */
     uint32_t (*id)(const struct ob_geometry *g);
 };

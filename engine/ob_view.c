@@ -640,8 +640,11 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
 {
     const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
-    /* Items are sorted by state: a run of one material is applied once. */
+    /* Items are sorted by state: a run of one material is applied once, a
+     * run of one geometry asks for its draw data once. */
     const struct ob_material *applied = NULL;
+    const struct ob_geometry *described = NULL;
+    ob_draw_data dd = {0};
     _Alignas(16) float m[32];
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     for (uint32_t i = first; i < end; i++) {
@@ -661,9 +664,12 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
         }
         /* A refused matrix is not drawn (a stale one would put this entity
          * where the previous one was). */
+        if (p->geometry != described) {
+            gi->draw_data(p->geometry, &dd);
+            described = p->geometry;
+        }
         bool finite = ob_render_proxy_per_draw(p, v->origin, m);
-        if (finite) ob_pipeline_manager_set_world(pm, m);
-        if (!finite || gi->draw(p->geometry, pm) == OB_ERR_NON_FINITE)
+        if (!finite || ob_pipeline_manager_draw_data(pm, &dd, m) == OB_ERR_NON_FINITE)
             OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
                      "(or its derived matrices); not drawn", v->name, ob_node_name(p->node),
                      p->node_id);

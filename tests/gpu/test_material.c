@@ -514,6 +514,139 @@ static void test_hundred_entities_one_pipeline(void **state)
     ob_test_assert_no_validation(f->dev);
 }
 
+/* One grid of 100 triangles recorded in `way`: 0 by draw data (indexed),
+ * 1 by indexed indirect draws, 2 by non-indexed indirect draws, each
+ * triangle's world matrix set as the parameter. Returns the image. */
+static void draw_grid(fixture *f, ob_material *green, ob_view *persp, int way, uint8_t *pixels,
+                      ob_cmd_hash *out_hash)
+{
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_result r;
+    ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
+        .device = f->dev, .registry = f->reg, .slot = 0, .name = "immediate"}, &r);
+    assert_non_null(pm);
+    const float tri[3][8] = {{-0.05f, -0.05f, 0.5f, 0, 0, 1, 0, 0},
+                             {0.0f, 0.05f, 0.5f, 0, 0, 1, 0.5f, 1},
+                             {0.05f, -0.05f, 0.5f, 0, 0, 1, 1, 0}};
+    const uint32_t indices[3] = {0, 1, 2};
+    const VkDrawIndexedIndirectCommand indexed_args = {3, 1, 0, 0, 0};
+    const VkDrawIndirectCommand plain_args = {3, 1, 0, 0};
+    ob_buffer vb = ob_buffer_create(f->dev, &(ob_buffer_desc){
+        .size = sizeof tri, .usage = OB_BUFFER_VERTEX, .data = tri, .name = "triangle"}, &r);
+    ob_buffer ib = ob_buffer_create(f->dev, &(ob_buffer_desc){
+        .size = sizeof indices, .usage = OB_BUFFER_INDEX, .data = indices, .name = "indices"}, &r);
+    ob_buffer args = way == 1
+        ? ob_buffer_create(f->dev, &(ob_buffer_desc){.size = sizeof indexed_args,
+              .usage = OB_BUFFER_INDIRECT, .data = &indexed_args, .name = "indexed args"}, &r)
+        : ob_buffer_create(f->dev, &(ob_buffer_desc){.size = sizeof plain_args,
+              .usage = OB_BUFFER_INDIRECT, .data = &plain_args, .name = "args"}, &r);
+    assert_int_not_equal(vb.id, 0);
+    assert_int_not_equal(ib.id, 0);
+    assert_int_not_equal(args.id, 0);
+
+    VkCommandBuffer cmd;
+    assert_int_equal(ob_device_oneshot_begin(f->dev, &cmd), OB_OK);
+    barrier_to(f, cmd, f->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    barrier_to(f, cmd, f->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo color_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->color),
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue.color.float32 = {0, 0, 0, 1},
+    };
+    VkRenderingAttachmentInfo depth_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->depth),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue.depthStencil = {0.0f, 0},
+    };
+    VkRenderingInfo ri = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                          .renderArea = {{0, 0}, {SIZE, SIZE}}, .layerCount = 1,
+                          .colorAttachmentCount = 1, .pColorAttachments = &color_att,
+                          .pDepthAttachment = &depth_att};
+    vkCmdBeginRendering(cmd, &ri);
+    ob_pipeline_manager_begin_frame(pm, 0, 1);
+    ob_pipeline_manager_begin(pm, cmd);
+    ob_pipeline_manager_set_viewport(pm, 0, 0, SIZE, SIZE);
+    ob_pipeline_manager_set_scissor(pm, 0, 0, SIZE, SIZE);
+    ob_params *params = ob_pipeline_manager_params(pm);
+    ob_param world = ob_param_registry_builtins(f->reg)->world;
+    const ob_draw_data dd = {.vertex_buffer = vb, .index_buffer = ib,
+                             .index_type = VK_INDEX_TYPE_UINT32, .count = 3, .instance_count = 1};
+    for (int i = 0; i < 100; i++) {
+        float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,
+                       -0.9f + 0.2f * (float)(i % 10), -0.9f + 0.2f * (float)(i / 10), 0, 1};
+        assert_int_equal(ob_params_set_mat4(params, world, m), OB_OK);
+        assert_true(mi->apply(green, NULL, NULL, pm, persp));
+        if (way == 0) {
+            assert_int_equal(ob_pipeline_manager_draw_data(pm, &dd, NULL), OB_OK);
+            continue;
+        }
+        ob_pipeline_manager_set_vertex_buffer(pm, vb, 0);
+        if (way == 1) {
+            ob_pipeline_manager_set_index_buffer(pm, ib, 0, VK_INDEX_TYPE_UINT32);
+            assert_int_equal(ob_pipeline_manager_draw_indexed_indirect(pm, args, 0, 1), OB_OK);
+        } else {
+            assert_int_equal(ob_pipeline_manager_draw_indirect(pm, args, 0, 1), OB_OK);
+        }
+    }
+    /* A stale argument buffer is refused, and nothing is recorded. */
+    ob_buffer stale = args;
+    stale.id ^= 0x5a5a0000u;
+    assert_int_equal(ob_pipeline_manager_draw_indexed_indirect(pm, stale, 0, 1),
+                     OB_ERR_INVALID_HANDLE);
+    *out_hash = ob_pipeline_manager_end(pm);
+    vkCmdEndRendering(cmd);
+    assert_int_equal(ob_device_oneshot_submit(f->dev, cmd), OB_OK);
+    ob_pipeline_manager_stats st = ob_pipeline_manager_stats_take(pm);
+    assert_int_equal(st.draws, 100);
+    assert_int_equal(st.skipped_draws, 1);
+    assert_int_equal(ob_image_read_rgba8(f->dev, f->color, pixels), OB_OK);
+    ob_buffer_destroy(f->dev, args);
+    ob_buffer_destroy(f->dev, ib);
+    ob_buffer_destroy(f->dev, vb);
+    ob_pipeline_manager_destroy(pm);
+}
+
+/* The draw-data path and both indirect draws (the arguments read by the
+ * device from a buffer) draw the same image; their command hashes tell the
+ * three apart. */
+static void test_indirect_draws_match_direct_ones(void **state)
+{
+    fixture *f = *state;
+    ob_material_library *lib = make_library(f);
+    const ob_material_iface *mi = ob_material_iface_get();
+    ob_result r;
+    ob_view persp;
+    make_view(f, &persp, OB_VIEW_PERSPECTIVE, "camera");
+    ob_material *green = ob_material_create(lib, &(ob_material_desc){
+        .name = "green", .diffuse = {0, 0, 0, 1}, .specular = {0, 0, 0, 1},
+        .emissive = {0, 1, 0, 0}}, &r);
+    assert_non_null(green);
+    mi->pre_render(green, NULL, NULL, &persp);
+    static uint8_t pixels[3][SIZE * SIZE * 4];
+    ob_cmd_hash hash[3];
+    for (int way = 0; way < 3; way++) draw_grid(f, green, &persp, way, pixels[way], &hash[way]);
+    /* Triangle 0 around clip (-0.9, -0.9): pixel (3, 3) at 64 x 64. */
+    const uint8_t *p = &pixels[0][(3 * SIZE + 3) * 4];
+    assert_int_equal(p[1], 255);
+    assert_memory_equal(pixels[0], pixels[1], sizeof pixels[0]);
+    assert_memory_equal(pixels[0], pixels[2], sizeof pixels[0]);
+    assert_int_equal(hash[0].draws, 100);
+    assert_int_equal(hash[1].draws, 100);
+    assert_true(hash[0].hash != hash[1].hash && hash[1].hash != hash[2].hash);
+    destroy_library(f, lib);
+    ob_test_assert_no_validation(f->dev);
+}
+
 typedef struct usage_log {
     ob_view base;                 /* first: the renderer sees an ob_view */
     uint32_t calls;
@@ -642,6 +775,7 @@ int main(void)
         cmocka_unit_test(test_reflective_queues_env_map),
         cmocka_unit_test(test_apply_and_prepare_view),
         cmocka_unit_test(test_hundred_entities_one_pipeline),
+        cmocka_unit_test(test_indirect_draws_match_direct_ones),
         cmocka_unit_test(test_reflective_uses_attached_env_map),
         cmocka_unit_test(test_library_registers_standard_interface),
     };
