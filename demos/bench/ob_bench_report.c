@@ -187,6 +187,9 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fputs(" (ST, 10k x 8)\n", f);
     print_spread(f, "update_ns_per_object", s->update_ns_per_object);
     fputs(" (ST, 50k objects, 1 view)", f);
+    fprintf(f, "\n  %-30s %.0f (ob_nodes_destroy of all), %.0f (one at a time, newest first); "
+               "100k entities", "teardown_ns_per_entity", s->teardown_ns_per_entity_batch,
+            s->teardown_ns_per_entity_single);
     fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
                "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
             "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
@@ -396,6 +399,8 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "amdahl_speedup_16_cores", s->amdahl_speedup_16_cores);
     json_spread(f, "prerender_ns_per_object_view", s->prerender_ns_per_object_view);
     json_spread(f, "update_ns_per_object", s->update_ns_per_object);
+    json_field(f, "teardown_ns_per_entity_batch", s->teardown_ns_per_entity_batch);
+    json_field(f, "teardown_ns_per_entity_single", s->teardown_ns_per_entity_single);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
     json_field(f, "commands_per_object_raw", s->commands_per_object_raw);
     json_field(f, "host_allocs_per_object_engine", s->host_allocs_per_object_engine);

@@ -62,6 +62,10 @@ typedef struct ob_bench_summary {
      * views; update ns / objects at 50k objects, 1 view. */
     ob_bench_spread prerender_ns_per_object_view;
     ob_bench_spread update_ns_per_object;
+    /* Destroying a scene graph of 100k renderable entities (no device), ns
+     * per entity, median of 3: all in one ob_nodes_destroy, and one
+     * ob_node_destroy each, newest first (ob_scene_unload's order). */
+    double teardown_ns_per_entity_batch, teardown_ns_per_entity_single;
     /* vkCmd calls per visible object: the engine's estimated from the
      * pipeline manager's issued counters, the raw loop's counted; in the raw
      * configuration, ST */

@@ -15,6 +15,8 @@
  *              highest-quality single-threaded image next to frame time; the
  *              threading modes must give that image byte for byte; MSAA
  *              sample counts against a supersampled antialiasing reference
+ *   teardown   destroying a scene graph of 100k entities, in one call and
+ *              one entity at a time (no device)
  *   stability  numerical precision and extreme cases (ob_stability.h):
  *              each case's error against the bound its test asserts, and its
  *              run time
@@ -28,6 +30,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -473,6 +476,47 @@ static double st_ns_per_draw(const ob_bench_sweep_entry *e)
     return e->results[0].record_total_ms * 1e6 / e->results[0].draws;
 }
 
+/* Teardown of a scene graph of `count` renderable entities, ns per entity:
+ * batch in one ob_nodes_destroy, else one ob_node_destroy each, newest
+ * first. The renderables' material and geometry are placeholders: the scene
+ * only interns the pointers. NAN when the scene cannot be built. */
+#define TEARDOWN_ENTITIES 100000u
+
+static double teardown_once(uint32_t count, bool batch)
+{
+    static const int material, geometry;
+    ob_scene *s = ob_scene_create(NULL);
+    ob_node **nodes = ob_calloc(count, sizeof *nodes);
+    double ns = NAN;
+    uint32_t made = 0;
+    for (; s && nodes && made < count; made++) {
+        nodes[made] = ob_node_create(s, NULL, "entity", NULL);
+        if (!nodes[made]) break;
+        ob_renderable rd = {.material = (struct ob_material *)(uintptr_t)&material,
+                            .geometry = (struct ob_geometry *)(uintptr_t)&geometry,
+                            .local_radius = 1.0f};
+        if (ob_node_set_renderable(nodes[made], &rd) != OB_OK) break;
+        ob_node_set_position(nodes[made], (double[3]){made % 300, 0.0, made / 300});
+    }
+    if (made == count && ob_scene_update(s, 0.0) == OB_OK) {
+        uint64_t t0 = ob_time_ns();
+        if (batch) ob_nodes_destroy(s, nodes, count);
+        else
+            for (uint32_t i = count; i-- > 0;) ob_node_destroy(s, nodes[i]);
+        ns = (double)(ob_time_ns() - t0) / count;
+    }
+    ob_free(nodes);
+    ob_scene_destroy(s);
+    return ns;
+}
+
+static double teardown_ns(bool batch)
+{
+    double v[3];
+    for (int i = 0; i < 3; i++) v[i] = teardown_once(TEARDOWN_ENTITIES, batch);
+    return ob_median(v, 3);
+}
+
 static void summarize(ob_bench_report *rep)
 {
     ob_bench_summary *s = &rep->summary;
@@ -701,7 +745,11 @@ static int run(const bench_options *o)
         fprintf(stderr, "obelisk-bench: failed: %s (%s)\n", ob_result_name(r), ob_result_text(r));
         code = 1;
     } else {
-        if (o->perf) summarize(&rep);
+        if (o->perf) {
+            summarize(&rep);
+            rep.summary.teardown_ns_per_entity_batch = teardown_ns(true);
+            rep.summary.teardown_ns_per_entity_single = teardown_ns(false);
+        }
         ob_bench_report_print(&rep, stdout);
         if (o->json && ob_bench_report_json(&rep, o->json) != OB_OK) code = 1;
         if (o->csv && o->perf && ob_bench_report_csv(&rep, o->csv) != OB_OK) code = 1;

@@ -52,7 +52,8 @@ foreach(setting warmup:1 rounds:3 passes:2)
 endforeach()
 # Ratios come with their spread over rounds (_p25, _p75).
 set(positive engine_vs_raw_per_draw auto_vs_best_200_frame per_object_growth_50k_vs_1k
-    commands_per_object_engine commands_per_object_raw)
+    commands_per_object_engine commands_per_object_raw teardown_ns_per_entity_batch
+    teardown_ns_per_entity_single)
 foreach(field mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_best_200
         auto_vs_best_10k_8views)
   list(APPEND positive ${field} ${field}_p25 ${field}_p75)
