@@ -8,18 +8,22 @@
 #include <string.h>
 
 #include "ob_stack.h"
+#include "ob_test_adopt.h"
 
 #define W 64u
 #define H 48u
 
-static ob_stack *make_stack(ob_result *out_result)
+static ob_stack *make_stack_on(const ob_vulkan_handles *adopt, ob_result *out_result)
 {
-    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1},
+    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1,
+                                               .adopt = adopt},
                                     .worker_count = 2},
                        .width = W, .height = H, .shadow_map_size = 64,
                        .clear_color = {0.0f, 0.0f, 1.0f, 1.0f}};
     return ob_stack_create(&d, out_result);
 }
+
+static ob_stack *make_stack(ob_result *out_result) { return make_stack_on(NULL, out_result); }
 
 static void test_stack_renders_and_frees(void **state)
 {
@@ -96,12 +100,16 @@ static void test_stack_overlay_is_final(void **state)
 
 /* Every point of one fault kind during create in turn (about 170 in all,
  * a few seconds): NULL and an error whenever the point fired, nothing left
- * behind on Obelisk's heap (the address-sanitizer build checks the rest). */
+ * behind on Obelisk's heap (the address-sanitizer build checks the rest).
+ * All on one adopted instance (ob_test_adopt.h): test_device walks the
+ * points of instance and device creation. */
 static void walk_create_faults(ob_fault_kind kind)
 {
+    ob_test_vulkan tv;
+    ob_test_vulkan_create(&tv);
     ob_result r;
     ob_fault_arm(kind, 0);   /* unarmed: counts the points */
-    ob_stack *s = make_stack(&r);
+    ob_stack *s = make_stack_on(&tv.handles, &r);
     uint64_t points = ob_fault_count(kind);
     assert_non_null(s);
     ob_stack_destroy(s);
@@ -110,7 +118,7 @@ static void walk_create_faults(ob_fault_kind kind)
     for (uint64_t n = 1; n <= points; n++) {
         ob_heap_stats before = ob_heap_stats_now();
         ob_fault_arm(kind, n);
-        s = make_stack(&r);
+        s = make_stack_on(&tv.handles, &r);
         bool hit = ob_fault_hit(kind);
         ob_fault_arm(kind, 0);
         if (hit) {
@@ -125,6 +133,7 @@ static void walk_create_faults(ob_fault_kind kind)
                      (long long)(after.live_blocks - before.live_blocks));
     }
     ob_test_log_set_echo(true);
+    ob_test_vulkan_destroy(&tv);
 }
 
 static void test_stack_create_host_faults(void **state)
