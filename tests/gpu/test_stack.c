@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L
 /* test_stack.c — ob_stack, the usual set-up in one call: it renders what a
  * program adds to it, frees everything it made, refuses bad entities, and a
  * failure at any allocation or Vulkan creation of ob_stack_create returns
@@ -5,6 +6,7 @@
 #include "ob_test.h"
 
 #include <stdlib.h>
+#include <unistd.h>
 #include <string.h>
 
 #include "ob_stack.h"
@@ -81,6 +83,29 @@ static void test_stack_renders_and_frees(void **state)
     assert_int_equal(after.live_bytes, before.live_bytes);
 }
 
+/* Issue 25.8: with its shader folder empty, the stack rendered black and
+ * every call returned OB_OK. Creation fails now, naming the file. */
+static void test_stack_without_shaders_fails_naming_one(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/obelisk-no-shaders-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    ob_test_log_clear();
+    ob_test_log_set_echo(false);
+    ob_result r = OB_OK;
+    ob_stack_desc d = {.renderer = {.device = {.validation = 1, .shader_dir = dir}, .worker_count = 1},
+                       .width = W, .height = H};
+    ob_stack *s = ob_stack_create(&d, &r);
+    ob_test_log_set_echo(true);
+    rmdir(dir);
+    assert_null(s);
+    assert_int_equal(r, OB_ERR_IO);
+    if (!ob_test_log_has("lit.vert", "cannot be read", dir, NULL)) {
+        ob_test_log_dump(OB_LOG_WARN, 20);
+        fail_msg("no log line names the missing shader and its folder");
+    }
+}
+
 static void test_stack_overlay_is_final(void **state)
 {
     (void)state;
@@ -154,6 +179,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stack_renders_and_frees),
         cmocka_unit_test(test_stack_overlay_is_final),
+        cmocka_unit_test(test_stack_without_shaders_fails_naming_one),
         cmocka_unit_test(test_stack_create_host_faults),
         cmocka_unit_test(test_stack_create_vk_faults),
     };
