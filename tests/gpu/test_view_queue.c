@@ -296,6 +296,39 @@ static void second_camera_leaves_the_main_cameras_shadow(void **state)
     for (int run = 0; run < 4; run++) free(main_images[run]);
 }
 
+/* Issue 25.6: the lit shader shades the first directional light with the
+ * one ShadowMap. With a second shadow-casting sun, its map was bound last
+ * and shaded the first sun's light. Now only the shaded light gets a shadow
+ * view (the other is reported not needed), and the image is the one where
+ * the second sun casts no shadow. */
+static void second_shadow_casting_sun_leaves_the_first_ones_shadow(void **state)
+{
+    (void)state;
+    uint8_t *images[2];
+    for (int run = 0; run < 2; run++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_test_world_look(&w, 0, 3, 5, 0, 0, 0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 6, 1);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, run == 0, 1.0f, -6, 2, -1);
+        ob_material *grey = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
+        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+        ob_test_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
+        ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_view *root = ob_composite_view_base(w.composite);
+        const ob_frame_stats *st = frame_from_roots(&w, &root, 1, OB_THREADING_SINGLE);
+        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
+        if (run == 0) assert_int_equal(ob_test_count_skipped(st, OB_SKIP_NOT_NEEDED), 1);
+        ob_test_world_read(&w);
+        images[run] = ob_test_world_copy(&w);
+        ob_test_world_destroy(&w);
+    }
+    uint32_t n = ob_test_image_diff_count(images[0], images[1], 160, 120, 0);
+    if (n) fail_msg("%u pixels differ from the frame where only the first sun casts a shadow", n);
+    free(images[0]);
+    free(images[1]);
+}
+
 /* ------------------------------------------------------------ recursion */
 
 /* A chain of views each needing the next: the bound cuts it, the cut view is
@@ -650,6 +683,7 @@ int main(void)
         cmocka_unit_test(shared_dependency_runs_before_every_consumer),
         cmocka_unit_test(second_camera_sees_this_frames_env_map),
         cmocka_unit_test(second_camera_leaves_the_main_cameras_shadow),
+        cmocka_unit_test(second_shadow_casting_sun_leaves_the_first_ones_shadow),
         cmocka_unit_test(view_chain_stops_at_recursion_bound),
         cmocka_unit_test(view_cycle_is_queued_once),
         cmocka_unit_test(mirror_spheres_stop_at_recursion_bound),
