@@ -67,6 +67,8 @@ typedef struct bound_state {
     VkViewport viewport;
     VkRect2D scissor;
     bool viewport_valid, scissor_valid;
+    bool front_face_valid;
+    VkFrontFace front_face;
 } bound_state;
 
 struct ob_pipeline_manager {
@@ -99,6 +101,7 @@ struct ob_pipeline_manager {
 
     const float *world;         /* ob_pipeline_manager_set_world's world and normal, for the next draw */
     bool world_pending;
+    bool world_mirrors;         /* the world's 3x3 has a negative determinant */
 
     /* What the last full apply of uniforms and resources was made from: while
      * the program and the slot's parameter serial are unchanged, the bound
@@ -248,10 +251,22 @@ void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeli
     pm->program = program;
 }
 
+/* Whether the world's 3x3 mirrors: the sign of its determinant, in double
+ * (a product of three float columns neither underflows nor overflows). */
+static bool world_mirrors(const float world_normal[32])
+{
+    const float *w = world_normal;
+    double a[3] = {w[0], w[1], w[2]}, b[3] = {w[4], w[5], w[6]}, c[3] = {w[8], w[9], w[10]};
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    return det < 0.0;
+}
+
 void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
     pm->world = world_normal;
     pm->world_pending = true;
+    pm->world_mirrors = world_mirrors(world_normal);
 }
 
 void ob_pipeline_manager_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
@@ -642,6 +657,7 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         return OB_ERR_WRONG_STATE;
     }
     bool world = pm->world_pending;
+    bool mirrors = world && pm->world_mirrors;
     pm->world_pending = false;
     if (world && !prog->push_world_normal) {
         /* Another push layout, or a uniform block reads the world: the
@@ -748,6 +764,17 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->stats.index_binds_requested++;
         *h = ob_hash_u64(*h, ((uint64_t)pm->ib.id << 32) ^ pm->ib_offset);
     }
+    /* Counter-clockwise is front, as every pipeline had it; a mirroring
+     * world transform turns the triangles, so its draws take clockwise
+     * (their normals are turned by the normal matrix). Hashed only when
+     * clockwise: the hashes of scenes without mirrors stay as they were. */
+    VkFrontFace face = mirrors ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    if (!pm->cur.front_face_valid || pm->cur.front_face != face) {
+        vkCmdSetFrontFace(pm->cmd, face);
+        pm->cur.front_face = face;
+        pm->cur.front_face_valid = true;
+    }
+    if (mirrors) *h = ob_hash_u64(*h, VK_FRONT_FACE_CLOCKWISE);
     if (pm->viewport_set &&
         (!pm->cur.viewport_valid || memcmp(&pm->cur.viewport, &pm->viewport, sizeof pm->viewport))) {
         vkCmdSetViewport(pm->cmd, 0, 1, &pm->viewport);

@@ -535,10 +535,14 @@ static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, ui
         .attachmentCount = has_color ? 1u : 0u,
         .pAttachments = &blend,
     };
-    VkDynamicState dyn_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    /* The front face is the pipeline manager's per draw: an entity whose
+     * world transform mirrors (negative determinant) turns its triangles
+     * clockwise (core dynamic state in Vulkan 1.3). */
+    VkDynamicState dyn_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
+                                   VK_DYNAMIC_STATE_FRONT_FACE};
     VkPipelineDynamicStateCreateInfo dyn = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-        .dynamicStateCount = 2,
+        .dynamicStateCount = 3,
         .pDynamicStates = dyn_states,
     };
     VkPipelineRenderingCreateInfo rendering = {

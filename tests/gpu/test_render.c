@@ -151,11 +151,43 @@ static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
     free(unit);
 }
 
+/* Issue 25.7: a scene transform that mirrors (negative determinant) kept
+ * counter-clockwise front faces and turned the normal matrix's normals
+ * inward: the mirrored box showed its inside, dark. A box mirrored in x, in
+ * y and z, and in all three is now the same picture as the box itself (the
+ * box is symmetric, and the sun lights it from a general direction). */
+static void mirrored_entity_looks_like_the_original(void **state)
+{
+    (void)state;
+    static const float scales[4][3] = {{1, 1, 1}, {-1, 1, 1}, {1, -1, -1}, {-1, -1, -1}};
+    uint8_t *images[4];
+    for (int i = 0; i < 4; i++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_test_world_look(&w, 1.5, 2.0, 4.0, 0.0, 0.0, 0.0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 3, 1);
+        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.3f, 0.1f, false);
+        ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_node_set_scale(box, scales[i]);
+        ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        ob_test_world_read(&w);
+        images[i] = ob_test_world_copy(&w);
+        ob_test_world_destroy(&w);
+    }
+    for (int i = 1; i < 4; i++) {
+        uint32_t n = ob_test_image_diff_count(images[0], images[i], 160, 120, 2);
+        if (n) fail_msg("scale (%g, %g, %g): %u pixels differ from the unmirrored box", (double)scales[i][0],
+                        (double)scales[i][1], (double)scales[i][2], n);
+    }
+    for (int i = 0; i < 4; i++) free(images[i]);
+}
+
 int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(empty_scene_is_the_clear_colour),
+        cmocka_unit_test(mirrored_entity_looks_like_the_original),
         cmocka_unit_test(tiny_and_huge_scenes_keep_clip_coordinates_normal),
         cmocka_unit_test(lit_cube_centre_has_the_expected_shade),
         cmocka_unit_test(rotating_cube_same_in_every_mode),
