@@ -104,7 +104,8 @@ static void rotating_cube_same_in_every_mode(void **state)
  * levels). The view's projection now keeps clip coordinates of the order
  * of 1 at every scale: the near plane's w lies in [0.5, 1), so every
  * product of two clip coordinates of what is drawn is a normal float, on
- * any device. The picture is the unit scene's, bit for bit. */
+ * any device. The picture, specular highlight included, is the unit
+ * scene's, bit for bit. */
 static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
 {
     (void)state;
@@ -118,7 +119,12 @@ static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
                          OB_OK);
         ob_test_world_look(&w, 0.0, 2.0 * sc, 5.0 * sc, 0.0, 0.0, 0.0);
         ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2 * sc, 6 * sc, 1 * sc);
-        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, false);
+        /* Specular: the view vector, camera-relative and as small as the scene. */
+        ob_result mr;
+        ob_material *red = ob_material_create(w.lib, &(ob_material_desc){
+            .name = "shiny", .kind = OB_MATERIAL_LIT, .diffuse = {0.9f, 0.1f, 0.1f, 1.0f},
+            .specular = {0.8f, 0.8f, 0.8f, 16.0f}}, &mr);
+        assert_non_null(red);
         ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         ob_node_set_scale(box, (const float[3]){(float)sc, (float)sc, (float)sc});
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
