@@ -12,22 +12,19 @@ static void engine_choice(VkPhysicalDeviceProperties *out)
     ob_device_destroy(dev);
 }
 
-void ob_test_vulkan_create(ob_test_vulkan *tv)
+VkInstance ob_test_vulkan_instance(const char *app_name, const void *next, const char *exts[2])
 {
-    memset(tv, 0, sizeof *tv);
-    VkPhysicalDeviceProperties want;
-    engine_choice(&want);
-
-    tv->instance_exts[0] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
-    tv->instance_exts[1] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
+    exts[0] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    exts[1] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
     const char *layers[] = {"VK_LAYER_KHRONOS_validation"};
     const VkValidationFeatureEnableEXT enables[] = {
         VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
     VkValidationFeaturesEXT vf = {.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                  .pNext = next,
                                   .enabledValidationFeatureCount = 1,
                                   .pEnabledValidationFeatures = enables};
     VkApplicationInfo ai = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-                            .pApplicationName = "obelisk-test-adopt",
+                            .pApplicationName = app_name,
                             .apiVersion = VK_API_VERSION_1_3};
     VkInstanceCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
                                .pNext = &vf,
@@ -35,8 +32,19 @@ void ob_test_vulkan_create(ob_test_vulkan *tv)
                                .enabledLayerCount = 1,
                                .ppEnabledLayerNames = layers,
                                .enabledExtensionCount = 2,
-                               .ppEnabledExtensionNames = tv->instance_exts};
-    assert_int_equal(vkCreateInstance(&ci, NULL, &tv->instance), VK_SUCCESS);
+                               .ppEnabledExtensionNames = exts};
+    VkInstance instance = VK_NULL_HANDLE;
+    assert_int_equal(vkCreateInstance(&ci, NULL, &instance), VK_SUCCESS);
+    return instance;
+}
+
+void ob_test_vulkan_create(ob_test_vulkan *tv)
+{
+    memset(tv, 0, sizeof *tv);
+    VkPhysicalDeviceProperties want;
+    engine_choice(&want);
+
+    tv->instance = ob_test_vulkan_instance("obelisk-test-adopt", NULL, tv->instance_exts);
 
     VkPhysicalDevice pds[16];
     uint32_t n = 16;

@@ -32,6 +32,12 @@ typedef struct ob_test_vulkan {
     ob_vulkan_handles handles;   /* for ob_device_desc.adopt */
 } ob_test_vulkan;
 
+/* The instance alone: Vulkan 1.3, the validation layer with synchronization
+ * validation, VK_EXT_debug_utils and VK_EXT_validation_features (their names
+ * in `exts`, which must outlive the instance's use as adopted handles);
+ * `next` (a messenger's create info, or NULL) is chained after the
+ * validation features. Fails the test when it cannot. */
+VkInstance ob_test_vulkan_instance(const char *app_name, const void *next, const char *exts[2]);
 /* Creates the instance and device; fails the test when it cannot. */
 void ob_test_vulkan_create(ob_test_vulkan *out);
 /* Waits idle and destroys the device and instance. */

@@ -188,6 +188,23 @@ static void shared_dependency_runs_before_every_consumer(void **state)
     graph_release(g, 4);
 }
 
+/* A second camera at `eye` looking at `target`, and its perspective view
+ * "side" of the world's size (the caller destroys the view). */
+static ob_perspective_view *side_view(ob_test_world *w, const double eye[3], const double target[3])
+{
+    ob_result r;
+    ob_node *cam = ob_node_create(w->scene, NULL, "side-camera", &r);
+    assert_non_null(cam);
+    assert_int_equal(ob_node_set_camera(cam, &(ob_camera_desc){.fovy = 0.6f}), OB_OK);
+    ob_node_set_position(cam, eye);
+    assert_int_equal(ob_node_look_at(cam, target, (const double[3]){0, 1, 0}), OB_OK);
+    ob_perspective_view *side = ob_perspective_view_create(w->views,
+        &(ob_perspective_desc){.name = "side", .camera = cam, .width = w->width,
+                               .height = w->height, .clear_color = {0.3f, 0.3f, 0.3f, 1}}, &r);
+    assert_non_null(side);
+    return side;
+}
+
 /* Two cameras see one mirror: its environment map is rendered once, before
  * both, so the second camera's image is what it would be on its own. */
 static void second_camera_sees_this_frames_env_map(void **state)
@@ -204,17 +221,7 @@ static void second_camera_sees_this_frames_env_map(void **state)
         ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 0);
         ob_test_world_entity(&w, NULL, "red", w.box, red, -1.5, 0, 0);
         ob_test_world_entity(&w, NULL, "green", w.box, green, 1.5, 0, 0);
-        ob_result r;
-        ob_node *side_cam = ob_node_create(w.scene, NULL, "side-camera", &r);
-        assert_non_null(side_cam);
-        assert_int_equal(ob_node_set_camera(side_cam, &(ob_camera_desc){.fovy = 0.6f}), OB_OK);
-        ob_node_set_position(side_cam, (const double[3]){0.5, 0.5, -3.0});
-        assert_int_equal(ob_node_look_at(side_cam, (const double[3]){0, 0, 0},
-                                         (const double[3]){0, 1, 0}), OB_OK);
-        ob_perspective_view *side = ob_perspective_view_create(w.views,
-            &(ob_perspective_desc){.name = "side", .camera = side_cam, .width = w.width,
-                                   .height = w.height, .clear_color = {0.3f, 0.3f, 0.3f, 1}}, &r);
-        assert_non_null(side);
+        ob_perspective_view *side = side_view(&w, (const double[3]){0.5, 0.5, -3.0}, (const double[3]){0, 0, 0});
         /* Run 0: the side view alone. Run 1: the main camera first, which
          * queues the mirror's map before the side view asks for it. */
         ob_view *roots[2] = {ob_composite_view_base(w.composite), ob_perspective_view_base(side)};
@@ -256,17 +263,7 @@ static void second_camera_leaves_the_main_cameras_shadow(void **state)
         /* What only the side camera sees: casters 40 units away. */
         ob_test_world_entity(&w, NULL, "far ground", w.plane, grey, 40, -0.5, 0);
         ob_test_world_entity(&w, NULL, "far box", w.box, red, 40, 0, 0);
-        ob_result r;
-        ob_node *side_cam = ob_node_create(w.scene, NULL, "side-camera", &r);
-        assert_non_null(side_cam);
-        assert_int_equal(ob_node_set_camera(side_cam, &(ob_camera_desc){.fovy = 0.6f}), OB_OK);
-        ob_node_set_position(side_cam, (const double[3]){40, 3, 5});
-        assert_int_equal(ob_node_look_at(side_cam, (const double[3]){40, 0, 0},
-                                         (const double[3]){0, 1, 0}), OB_OK);
-        ob_perspective_view *side = ob_perspective_view_create(w.views,
-            &(ob_perspective_desc){.name = "side", .camera = side_cam, .width = w.width,
-                                   .height = w.height, .clear_color = {0.3f, 0.3f, 0.3f, 1}}, &r);
-        assert_non_null(side);
+        ob_perspective_view *side = side_view(&w, (const double[3]){40, 3, 5}, (const double[3]){40, 0, 0});
         /* Run 0: the main camera alone; 1: then the side camera, one
          * PreRender each; 2: both in one PreRender; 3: the main camera
          * alone, the sun casting no shadow. */
