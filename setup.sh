@@ -42,7 +42,7 @@ packages=(
   cmake make gcc clang libclang-rt-14-dev pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev spirv-tools libspirv-cross-c-shared-dev
-  libcglm-dev libstb-dev libassimp-dev assimp-testmodels libcjson-dev
+  libcglm-dev libstb-dev zlib1g-dev libassimp-dev assimp-testmodels libcjson-dev
   libcmocka-dev gnuplot-nox libglfw3-dev xvfb xauth
 )
 

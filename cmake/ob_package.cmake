@@ -60,7 +60,7 @@ endforeach()
 # What the engine's code links besides Vulkan (the headers' only third-party
 # include) and libc: private to the shared library, link-only for the static one.
 set(OB_LIBRARY_PRIVATE_LINK PkgConfig::GLSLANG glslang-default-resource-limits stdc++
-    ${SPIRV_CROSS_C} PkgConfig::ASSIMP PkgConfig::CJSON Threads::Threads m ${CMAKE_DL_LIBS})
+    ${SPIRV_CROSS_C} PkgConfig::ASSIMP PkgConfig::CJSON PkgConfig::ZLIB Threads::Threads m ${CMAKE_DL_LIBS})
 
 add_library(obelisk SHARED ${OB_LIBRARY_OBJECTS})
 add_library(obelisk_static STATIC ${OB_LIBRARY_OBJECTS})

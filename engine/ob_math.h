@@ -254,7 +254,8 @@ void ob_mat4_identity(float dest[16]);
 /* dest = a * b. dest may alias a or b. */
 void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
 /* The normal matrix of world w (column-major): the cofactor matrix of its
- * upper 3x3 (columns c1×c2, c2×c0, c0×c1), i.e. det · inverse-transpose:
+ * upper 3x3 (columns c1×c2, c2×c0, c0×c1), i.e. det · inverse-transpose,
+ * times the sign of det so that a mirroring w keeps normals outward:
  * correct for non-uniform scale, finite for zero scale, and the shader
  * normalizes anyway. It grows as scale²; outside 2^±60 the columns are first
  * scaled by a power of two (exact; only the direction matters), so it neither
@@ -309,6 +310,13 @@ inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
     dest[6] = c1 * c5 - c2 * c4;
     dest[7] = c2 * c3 - c0 * c5;
     dest[8] = c0 * c4 - c1 * c3;
+    /* The cofactor is det * inverse-transpose: a mirroring matrix (negative
+     * determinant) would turn normals inward. The sign of det (column 0
+     * dotted with column 0 of the cofactor, in double so that it cannot
+     * underflow) turns them back: the inverse-transpose's direction at any
+     * scale. */
+    if ((double)c0 * dest[0] + (double)c1 * dest[1] + (double)c2 * dest[2] < 0.0)
+        for (int i = 0; i < 9; i++) dest[i] = -dest[i];
     return !nan && largest <= 0x1.fffffep127f;
 }
 

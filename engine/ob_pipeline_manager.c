@@ -3,6 +3,7 @@
 #include "ob_resources_internal.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define MAX_FRAME_SLOTS 4
@@ -11,6 +12,11 @@
 #define SET_CACHE_MIN 64        /* power of two; the set cache doubles when half full */
 #define SETS_PER_POOL 128
 #define MAX_POOLS 32
+/* Set-0 sets a frame slot's cache may keep from frame to frame: past this,
+ * the slot's pools are reset and the cache emptied when the slot begins its
+ * next frame (the sets of programs no longer drawn would otherwise be kept
+ * forever, issue 25.9). A frame may still use up to MAX_POOLS pools. */
+#define SET_CACHE_LIMIT 1024
 
 /* Ring chunks are raw Vulkan objects, not ob_buffer handles: a worker may
  * grow its ring while recording, and the handle pool belongs to the render
@@ -46,7 +52,8 @@ typedef struct frame_ring {
     ring_chunk chunks[MAX_CHUNKS];
     uint32_t chunk_count, current;
     VkDescriptorPool pools[MAX_POOLS];
-    uint32_t pool_count, sets_in_last_pool;
+    uint32_t pool_count;
+    uint32_t pool_in_use, sets_in_pool;   /* pools after pool_in_use are empty */
     set_entry *sets;            /* open addressing, set_cap entries (power of two) */
     uint32_t set_cap, set_count;
 } frame_ring;
@@ -67,6 +74,8 @@ typedef struct bound_state {
     VkViewport viewport;
     VkRect2D scissor;
     bool viewport_valid, scissor_valid;
+    bool front_face_valid;
+    VkFrontFace front_face;
 } bound_state;
 
 struct ob_pipeline_manager {
@@ -75,6 +84,7 @@ struct ob_pipeline_manager {
     ob_params params;
     char name[32];
     uint32_t frames_in_flight;
+    uint32_t set_cache_limit;   /* SET_CACHE_LIMIT unless a test lowers it */
     uint64_t chunk_size;
     uint32_t ubo_align;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor;
@@ -99,6 +109,7 @@ struct ob_pipeline_manager {
 
     const float *world;         /* ob_pipeline_manager_set_world's world and normal, for the next draw */
     bool world_pending;
+    bool world_mirrors;         /* the world's 3x3 has a negative determinant */
 
     /* What the last full apply of uniforms and resources was made from: while
      * the program and the slot's parameter serial are unchanged, the bound
@@ -148,6 +159,10 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     pm->frames_in_flight = desc->frames_in_flight ? desc->frames_in_flight : 2;
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
     pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
+    /* $OB_SET_CACHE_LIMIT lowers the bound for tests (tests/gpu/test_pipeline_manager.c)
+     * that cannot afford a thousand programs. */
+    const char *limit = getenv("OB_SET_CACHE_LIMIT");
+    pm->set_cache_limit = limit && atoi(limit) > 0 ? (uint32_t)atoi(limit) : SET_CACHE_LIMIT;
     const VkPhysicalDeviceLimits *lim = &ob_device_properties(pm->dev)->limits;
     pm->ubo_align = (uint32_t)OB_MAX(lim->minUniformBufferOffsetAlignment, 16u);
     pm->push_descriptor = ob_device_push_descriptor_fn(pm->dev);
@@ -205,9 +220,21 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)
     ob_free(pm);
 }
 
+/* Empties a frame slot's set cache: its previous frame has completed, so
+ * none of its sets is in use. */
+static void set_cache_reset(ob_pipeline_manager *pm, frame_ring *fr)
+{
+    for (uint32_t i = 0; i < fr->pool_count; i++) vkResetDescriptorPool(pm->vk, fr->pools[i], 0);
+    fr->pool_in_use = fr->sets_in_pool = 0;
+    if (fr->sets) memset(fr->sets, 0, (size_t)fr->set_cap * sizeof *fr->sets);
+    fr->set_count = 0;
+    pm->stats.descriptor_set_cache_resets++;
+}
+
 void ob_pipeline_manager_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial)
 {
     pm->ring = &pm->rings[slot % MAX_FRAME_SLOTS];
+    if (pm->ring->set_count > pm->set_cache_limit) set_cache_reset(pm, pm->ring);
     for (uint32_t i = 0; i < pm->ring->chunk_count; i++) pm->ring->chunks[i].used = 0;
     pm->ring->current = 0;
     pm->frame_serial = frame_serial;
@@ -248,10 +275,22 @@ void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeli
     pm->program = program;
 }
 
+/* Whether the world's 3x3 mirrors: the sign of its determinant, in double
+ * (a product of three float columns neither underflows nor overflows). */
+static bool world_mirrors(const float world_normal[32])
+{
+    const float *w = world_normal;
+    double a[3] = {w[0], w[1], w[2]}, b[3] = {w[4], w[5], w[6]}, c[3] = {w[8], w[9], w[10]};
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    return det < 0.0;
+}
+
 void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
     pm->world = world_normal;
     pm->world_pending = true;
+    pm->world_mirrors = world_mirrors(world_normal);
 }
 
 void ob_pipeline_manager_set_vertex_buffer(ob_pipeline_manager *pm, ob_buffer buf, uint64_t offset)
@@ -346,8 +385,8 @@ static ob_result new_pool(ob_pipeline_manager *pm, frame_ring *fr)
     };
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateDescriptorPool(pm->vk, &ci, NULL, &fr->pools[fr->pool_count]));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    fr->pool_count++;
-    fr->sets_in_last_pool = 0;
+    fr->pool_in_use = fr->pool_count++;
+    fr->sets_in_pool = 0;
     return OB_OK;
 }
 
@@ -390,20 +429,26 @@ static ob_result uniform_set(ob_pipeline_manager *pm, const ob_program *prog, ui
         *out_set = slot->set;
         return OB_OK;
     }
-    if (fr->pool_count == 0 || fr->sets_in_last_pool >= SETS_PER_POOL) {
-        ob_result r = new_pool(pm, fr);
-        if (r != OB_OK) return r;
+    if (fr->pool_count == 0 || fr->sets_in_pool >= SETS_PER_POOL) {
+        if (fr->pool_count > 0 && fr->pool_in_use + 1 < fr->pool_count) {
+            fr->pool_in_use++;   /* emptied by the last reset */
+            fr->sets_in_pool = 0;
+        } else {
+            ob_result r = new_pool(pm, fr);
+            if (r != OB_OK) return r;
+        }
     }
     VkDescriptorSetAllocateInfo ai = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = fr->pools[fr->pool_count - 1],
+        .descriptorPool = fr->pools[fr->pool_in_use],
         .descriptorSetCount = 1,
         .pSetLayouts = &prog->set_layouts[0],
     };
     VkDescriptorSet set;
     VkResult vr = OB_VK_CHECK_CREATE(vkAllocateDescriptorSets(pm->vk, &ai, &set));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    fr->sets_in_last_pool++;
+    fr->sets_in_pool++;
+    pm->stats.descriptor_sets_allocated++;
     VkDescriptorBufferInfo infos[OB_PROGRAM_MAX_UBOS];
     VkWriteDescriptorSet writes[OB_PROGRAM_MAX_UBOS];
     for (uint32_t i = 0; i < prog->ubo_count; i++) {
@@ -642,6 +687,7 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         return OB_ERR_WRONG_STATE;
     }
     bool world = pm->world_pending;
+    bool mirrors = world && pm->world_mirrors;
     pm->world_pending = false;
     if (world && !prog->push_world_normal) {
         /* Another push layout, or a uniform block reads the world: the
@@ -748,6 +794,17 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         pm->stats.index_binds_requested++;
         *h = ob_hash_u64(*h, ((uint64_t)pm->ib.id << 32) ^ pm->ib_offset);
     }
+    /* Counter-clockwise is front, as every pipeline had it; a mirroring
+     * world transform turns the triangles, so its draws take clockwise
+     * (their normals are turned by the normal matrix). Hashed only when
+     * clockwise: the hashes of scenes without mirrors stay as they were. */
+    VkFrontFace face = mirrors ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    if (!pm->cur.front_face_valid || pm->cur.front_face != face) {
+        vkCmdSetFrontFace(pm->cmd, face);
+        pm->cur.front_face = face;
+        pm->cur.front_face_valid = true;
+    }
+    if (mirrors) *h = ob_hash_u64(*h, VK_FRONT_FACE_CLOCKWISE);
     if (pm->viewport_set &&
         (!pm->cur.viewport_valid || memcmp(&pm->cur.viewport, &pm->viewport, sizeof pm->viewport))) {
         vkCmdSetViewport(pm->cmd, 0, 1, &pm->viewport);
@@ -891,6 +948,7 @@ ob_pipeline_manager_stats ob_pipeline_manager_stats_take(ob_pipeline_manager *pm
 {
     ob_pipeline_manager_stats s = pm->stats;
     memset(&pm->stats, 0, sizeof pm->stats);
+    s.descriptor_sets_held = pm->ring ? pm->ring->set_count : 0;
     return s;
 }
 
@@ -903,4 +961,6 @@ void ob_pipeline_manager_stats_add(ob_pipeline_manager_stats *into, const ob_pip
     for (size_t i = 0; i < n32; i++) a[i] += b[i];
     into->uniform_bytes += s->uniform_bytes;
     into->skipped_draws += s->skipped_draws;
+    /* A level, not a counter: the largest of any manager. */
+    if (s->descriptor_sets_held > into->descriptor_sets_held) into->descriptor_sets_held = s->descriptor_sets_held;
 }

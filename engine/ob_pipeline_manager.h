@@ -65,8 +65,14 @@ typedef struct ob_pipeline_manager_stats {
     uint32_t vertex_binds_requested, vertex_binds_issued;
     uint32_t index_binds_requested, index_binds_issued;
     uint32_t blocks_packed, blocks_reused;
+    uint32_t descriptor_sets_allocated;     /* set-0 sets written for the cache */
+    uint32_t descriptor_set_cache_resets;   /* frame slots whose cache was emptied (past its bound) */
     uint64_t uniform_bytes;
     uint32_t skipped_draws;     /* draws refused: invalid handles, no pipeline */
+    /* Set-0 sets the manager's frame slot keeps cached after the frame (the
+     * largest of any manager in ob_frame_stats); at most 1024 carried into
+     * the next frame of that slot, whatever programs came and went. */
+    uint32_t descriptor_sets_held;
 } ob_pipeline_manager_stats;
 
 ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,

@@ -7,9 +7,10 @@
  */
 #include "ob_resources_internal.h"
 
-#include <stb_image_write.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 static const VkMemoryBarrier2 to_host = {
     .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
@@ -229,25 +230,88 @@ ob_result ob_image_read_rgba8(ob_device *dev, ob_image img, uint8_t *out)
 
 /* ---------------------------------------------------------------------- PNG */
 
-typedef struct png_sink {
-    unsigned char *data;
-    size_t size;
-    bool failed;
-} png_sink;
-
-/* stb calls this once with the whole encoded file. */
-static void png_collect(void *context, void *data, int size)
+/* PNG: 8-bit RGBA, each row filtered as stb_image_write does (the filter
+ * with the smallest sum of absolute residuals), deflated by zlib, chunks
+ * checked with zlib's CRC-32. Every failure frees what it made and returns
+ * NULL (stbi_write_png_to_mem crashed on a failed realloc, then leaked on a
+ * failed malloc: issue 25.10). */
+static uint8_t paeth(int a, int b, int c)
 {
-    png_sink *sink = context;
-    if (sink->failed || size <= 0) return;
-    unsigned char *grown = ob_realloc(sink->data, sink->size + (size_t)size);
-    if (!grown) {
-        sink->failed = true;
-        return;
+    int p = a + b - c, pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+    return (uint8_t)(pa <= pb && pa <= pc ? a : pb <= pc ? b : c);
+}
+
+static void png_filter_row(const uint8_t *row, const uint8_t *above, uint32_t bytes, int type, uint8_t *out)
+{
+    for (uint32_t i = 0; i < bytes; i++) {
+        int a = i >= 4 ? row[i - 4] : 0, b = above ? above[i] : 0, c = above && i >= 4 ? above[i - 4] : 0;
+        int pred = type == 1 ? a : type == 2 ? b : type == 3 ? (a + b) / 2 : type == 4 ? paeth(a, b, c) : 0;
+        out[i] = (uint8_t)(row[i] - pred);
     }
-    memcpy(grown + sink->size, data, (size_t)size);
-    sink->data = grown;
-    sink->size += (size_t)size;
+}
+
+static uint8_t *png_put32(uint8_t *o, uint32_t v)
+{
+    o[0] = (uint8_t)(v >> 24);
+    o[1] = (uint8_t)(v >> 16);
+    o[2] = (uint8_t)(v >> 8);
+    o[3] = (uint8_t)v;
+    return o + 4;
+}
+
+static uint8_t *png_chunk(uint8_t *o, const char tag[4], const uint8_t *data, uint32_t len)
+{
+    o = png_put32(o, len);
+    uint8_t *start = o;
+    memcpy(o, tag, 4);
+    if (len) memcpy(o + 4, data, len);
+    o += 4 + len;
+    return png_put32(o, (uint32_t)crc32(crc32(0L, Z_NULL, 0), start, 4 + len));
+}
+
+static uint8_t *png_encode(const uint8_t *rgba, uint32_t w, uint32_t h, size_t *out_size)
+{
+    const uint32_t row_bytes = w * 4;
+    uint8_t *filtered = ob_malloc((size_t)(row_bytes + 1) * h);
+    uint8_t *trial = ob_malloc(row_bytes);
+    uint8_t *z = NULL, *png = NULL;
+    size_t zlen = 0;
+    if (!filtered || !trial) goto done;
+    for (uint32_t y = 0; y < h; y++) {
+        const uint8_t *row = rgba + (size_t)y * row_bytes, *above = y ? row - row_bytes : NULL;
+        uint8_t *dst = filtered + (size_t)y * (row_bytes + 1);
+        uint64_t best = UINT64_MAX;
+        for (int type = 0; type < 5; type++) {
+            png_filter_row(row, above, row_bytes, type, trial);
+            uint64_t cost = 0;
+            for (uint32_t i = 0; i < row_bytes; i++) cost += (uint64_t)abs((int8_t)trial[i]);
+            if (cost < best) {
+                best = cost;
+                dst[0] = (uint8_t)type;
+                memcpy(dst + 1, trial, row_bytes);
+            }
+        }
+    }
+    z = ob_res_deflate(filtered, (size_t)(row_bytes + 1) * h, 8, &zlen);
+    if (!z || zlen > UINT32_MAX - 64) goto done;
+    static const uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    uint8_t ihdr[13];
+    png_put32(png_put32(ihdr, w), h);
+    ihdr[8] = 8;    /* bits per channel */
+    ihdr[9] = 6;    /* RGBA */
+    ihdr[10] = ihdr[11] = ihdr[12] = 0;
+    *out_size = 8 + (12 + 13) + (12 + zlen) + 12;
+    png = ob_malloc(*out_size);
+    if (!png) goto done;
+    memcpy(png, signature, 8);
+    uint8_t *o = png_chunk(png + 8, "IHDR", ihdr, 13);
+    o = png_chunk(o, "IDAT", z, (uint32_t)zlen);
+    png_chunk(o, "IEND", NULL, 0);
+done:
+    ob_free(z);
+    ob_free(trial);
+    ob_free(filtered);
+    return png;
 }
 
 ob_result ob_image_write_png(ob_device *dev, ob_image img, const char *path)
@@ -270,14 +334,15 @@ ob_result ob_image_write_png(ob_device *dev, ob_image img, const char *path)
     }
     ob_result r = ob_image_read_rgba8(dev, img, pixels);
     if (r != OB_OK) goto done;
-    png_sink sink = {0};
-    if (!stbi_write_png_to_func(png_collect, &sink, (int)w, (int)h, 4, pixels, (int)(w * 4)) || sink.failed) {
+    size_t size = 0;
+    uint8_t *png = png_encode(pixels, w, h, &size);
+    if (!png) {
         OB_LOG_E("resources", "image '%s': PNG encoding for '%s' failed (out of host memory)", rec->name, path);
         r = OB_ERR_OUT_OF_HOST_MEMORY;
     } else {
-        r = ob_file_write(path, sink.data, sink.size);
+        r = ob_file_write(path, png, size);
     }
-    ob_free(sink.data);
+    ob_free(png);
 done:
     ob_free(pixels);
     return r;

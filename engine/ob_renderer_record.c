@@ -773,6 +773,22 @@ static uint64_t cmd_allocations(ob_renderer *r)
 }
 
 /* The measured cost of recording this frame's way (engine/ob_auto.c). */
+
+/* The stage of the frame's end stamp. On a real GPU a stamp at top of pipe
+ * is written when the command is read, before the work: it must wait for
+ * all commands. lavapipe flushes llvmpipe's scene for any stamp not at top
+ * of pipe (lvp_execute.c, handle_write_timestamp2), which with the default
+ * sampled timing cost up to twice the frame period (issue 25.11); its
+ * timestamp queries are binned into the scene (lp_setup_end_query), so at
+ * top of pipe the end stamp still follows the frame's rasterisation, and
+ * costs no flush. Frames stamping every view keep ALL_COMMANDS, as the views'
+ * own end stamps flush anyway. */
+static VkPipelineStageFlags2 frame_end_stage(const ob_renderer *r, bool view_stamps)
+{
+    return ob_device_is_cpu(r->dev) && !view_stamps ? VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT
+                                                    : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+}
+
 static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns, uint32_t draws)
 {
     uint32_t way = multi ? workers : 0;
@@ -912,7 +928,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     }
     ob_free(by_view);
     ob_renderer_present_record(r, cmd);
-    if (timestamps) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, fs->queries, 1);
+    if (timestamps) vkCmdWriteTimestamp2(cmd, frame_end_stage(r, view_stamps), fs->queries, 1);
     ob_param_registry_end_recording(r->reg);
     if (!multi) st->record_ns = ob_time_ns() - t_assemble;
     st->assemble_ns = ob_time_ns() - t_assemble - (multi ? 0 : st->record_ns);

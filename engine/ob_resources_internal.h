@@ -115,4 +115,9 @@ void ob_res_image_copy_levels(VkCommandBuffer cmd, VkBuffer staging, const ob_im
 /* Freed here so that the registry can release leaked images at destroy. */
 void ob_res_image_free(ob_device *dev, ob_image_rec *rec);
 
+/* zlib's deflate of data at `level` (1-9), every allocation through
+ * ob_malloc: an ob_malloc'ed stream and its length, NULL on any failure
+ * (logged by the caller). [any thread] (engine/ob_stb_impl.c) */
+uint8_t *ob_res_deflate(const uint8_t *data, size_t len, int level, size_t *out_len);
+
 #endif /* OB_RESOURCES_INTERNAL_H */

@@ -4,8 +4,50 @@
  *
  * Their allocations go through ob_malloc & co., so fault injection reaches
  * them too; memory they return (stbi_load*) is freed with stbi_image_free.
+ * PNGs are deflated by zlib (below), whose failures are reported.
  */
-#include "ob_core.h"
+#include "ob_resources_internal.h"
+
+#include <limits.h>
+#include <stdint.h>
+#include <zlib.h>
+
+static voidpf ob_zlib_alloc(voidpf opaque, uInt items, uInt size)
+{
+    (void)opaque;
+    if (size && items > SIZE_MAX / size) return Z_NULL;
+    return ob_malloc((size_t)items * size);
+}
+
+static void ob_zlib_free(voidpf opaque, voidpf p)
+{
+    (void)opaque;
+    ob_free(p);
+}
+
+uint8_t *ob_res_deflate(const uint8_t *data, size_t len, int level, size_t *out_len)
+{
+    z_stream zs = {.zalloc = ob_zlib_alloc, .zfree = ob_zlib_free};
+    if (len > UINT_MAX || deflateInit(&zs, level < 1 ? 1 : level > 9 ? 9 : level) != Z_OK) return NULL;
+    uLong bound = deflateBound(&zs, (uLong)len);
+    uint8_t *out = bound <= UINT_MAX ? ob_malloc(bound) : NULL;
+    if (!out) {
+        deflateEnd(&zs);
+        return NULL;
+    }
+    zs.next_in = (Bytef *)data;   /* zlib does not write through it */
+    zs.avail_in = (uInt)len;
+    zs.next_out = out;
+    zs.avail_out = (uInt)bound;
+    int z = deflate(&zs, Z_FINISH);
+    *out_len = zs.total_out;
+    deflateEnd(&zs);
+    if (z != Z_STREAM_END) {
+        ob_free(out);
+        return NULL;
+    }
+    return out;
+}
 
 #define STBI_MALLOC(sz) ob_malloc(sz)
 #define STBI_REALLOC(p, newsz) ob_realloc(p, newsz)
@@ -13,6 +55,26 @@
 #define STBIW_MALLOC(sz) ob_malloc(sz)
 #define STBIW_REALLOC(p, newsz) ob_realloc(p, newsz)
 #define STBIW_FREE(p) ob_free(p)
+
+/* stb_image_write's own deflate grows its buffers with an unchecked realloc:
+ * a failed allocation there writes past the old buffer (issue 25.10). Its
+ * PNG writer uses zlib instead (ob_res_deflate), which reports every
+ * failure; stb frees the result with STBIW_FREE. The engine's own PNGs go
+ * through ob_readback.c's encoder, which frees everything on every failure
+ * (stbi_write_png_to_mem leaks the deflated data when its last allocation
+ * fails). */
+static unsigned char *ob_stbiw_zlib_compress(unsigned char *data, int data_len, int *out_len, int quality)
+{
+    size_t len = 0;
+    uint8_t *out = data_len >= 0 ? ob_res_deflate(data, (size_t)data_len, quality, &len) : NULL;
+    if (out && len > INT_MAX) {
+        ob_free(out);
+        out = NULL;
+    }
+    if (out) *out_len = (int)len;
+    return out;
+}
+#define STBIW_ZLIB_COMPRESS ob_stbiw_zlib_compress
 #define STBIR_MALLOC(sz, ctx) ((void)(ctx), ob_malloc(sz))
 #define STBIR_FREE(p, ctx) ((void)(ctx), ob_free(p))
 

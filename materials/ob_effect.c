@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ob_effect.h"
+#include "ob_shader_source.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -236,6 +237,23 @@ ob_param_registry *ob_effect_context_registry(const ob_effect_context *ctx) { re
 const char *ob_effect_context_cache_path(const ob_effect_context *ctx)
 {
     return ctx->cache_path ? ctx->cache_path : "";
+}
+
+ob_result ob_effect_context_check_shaders(ob_effect_context *ctx, const char *what,
+                                          const char *const *paths, uint32_t count)
+{
+    const char *dir = ob_shader_compiler_shader_dir(ctx->compiler);
+    for (uint32_t i = 0; i < count; i++) {
+        ob_shader_source src;
+        ob_result r = ob_shader_source_load(dir, paths[i], NULL, &src);
+        if (r != OB_OK) {
+            OB_LOG_E("effect", "%s: shader '%s' (folder '%s') cannot be read: %s", what, paths[i],
+                     dir ? dir : "", ob_result_name(r));
+            return r;
+        }
+        ob_shader_source_release(&src);
+    }
+    return OB_OK;
 }
 
 /* ----------------------------------------------------------------- effect */
@@ -517,10 +535,14 @@ static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, ui
         .attachmentCount = has_color ? 1u : 0u,
         .pAttachments = &blend,
     };
-    VkDynamicState dyn_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    /* The front face is the pipeline manager's per draw: an entity whose
+     * world transform mirrors (negative determinant) turns its triangles
+     * clockwise (core dynamic state in Vulkan 1.3). */
+    VkDynamicState dyn_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
+                                   VK_DYNAMIC_STATE_FRONT_FACE};
     VkPipelineDynamicStateCreateInfo dyn = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-        .dynamicStateCount = 2,
+        .dynamicStateCount = 3,
         .pDynamicStates = dyn_states,
     };
     VkPipelineRenderingCreateInfo rendering = {

@@ -116,6 +116,15 @@ ob_device *ob_effect_context_device(const ob_effect_context *ctx);
 ob_param_registry *ob_effect_context_registry(const ob_effect_context *ctx);
 /* Path of pipelines.bin (owned by the context). */
 const char *ob_effect_context_cache_path(const ob_effect_context *ctx);
+/* Reads each of `paths` (relative to the compiler's shader folder unless
+ * absolute) with its includes, as compiling would, and keeps nothing: what
+ * creates effects lazily calls it at its own creation, so that a shader that
+ * cannot be read fails there, where the caller sees it, instead of every
+ * frame later. `what` names the caller in the log line. Failure: the first
+ * error (OB_ERR_IO for a missing or unreadable file,
+ * OB_ERR_OUT_OF_HOST_MEMORY), logged with the path. [render thread] */
+ob_result ob_effect_context_check_shaders(ob_effect_context *ctx, const char *what,
+                                          const char *const *paths, uint32_t count);
 
 /* ----------------------------------------------------------------- effect */
 

@@ -278,6 +278,16 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     lib->bias_constant = d.shadow_bias_constant != 0.0f ? d.shadow_bias_constant : -1.0f;
     lib->bias_slope = d.shadow_bias_slope != 0.0f ? d.shadow_bias_slope : -1.75f;
 
+    /* Every shader of the standard effects, read now: their effects are
+     * made on first use, in a frame, where a missing file could only be
+     * logged (issue 25.8). */
+    static const char *const standard_shaders[] = {
+        "lit.vert", "lit.frag", "depth.vert", "paraboloid.vert", "unlit.vert", "unlit.frag",
+        "fullscreen.vert", "fullscreen.frag", "particles.comp", "particles.vert", "particles.frag",
+        "pbr.vert", "pbr.frag"};
+    r = ob_effect_context_check_shaders(ctx, "material library", standard_shaders,
+                                        OB_ARRAY_COUNT(standard_shaders));
+    if (r != OB_OK) goto fail_destroy_library;
     r = register_standard_params(lib);
     if (r == OB_OK) r = ob_pbr_register_params(lib);
     if (r == OB_OK) r = create_samplers(lib);

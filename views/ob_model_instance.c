@@ -8,9 +8,12 @@
 
 #define LOG_MODULE "model"
 
-/* Geometry variants of one primitive: extended layout × mirrored winding. */
+/* Geometry variants of one primitive: the extended layout or not. (A
+ * mirroring node needs no variant of its own: the pipeline manager turns
+ * the front face and the normal matrix keeps normals outward for any world
+ * transform with a negative determinant.) The id range keeps room for
+ * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE variants. */
 #define VARIANT_EXTENDED 1u
-#define VARIANT_FLIPPED 2u
 #define VARIANT_COUNT OB_MODEL_ASSETS_IDS_PER_PRIMITIVE
 
 struct ob_model_assets {
@@ -218,50 +221,11 @@ static ob_geometry *variant(ob_model_assets *a, uint32_t p, uint32_t v, ob_resul
     const ob_model_primitive *prim = &a->model->primitives[p];
     ob_mesh mesh = prim->mesh;   /* shallow: the arrays stay the model's */
     if (!(v & VARIANT_EXTENDED)) mesh.tangents = NULL, mesh.colors = NULL;
-    uint32_t *flipped = NULL;
-    ob_vertex *vertices = NULL;
-    float(*tangents)[4] = NULL;
-    if (v & VARIANT_FLIPPED) {
-        /* The engine's normal matrix is the cofactor of the world matrix,
-         * which under a mirror turns normals inwards (and the bitangent
-         * cross(N, T)·w with them): the mirrored copy stores them negated,
-         * so the cofactor turns them back out. */
-        flipped = ob_malloc((size_t)mesh.index_count * sizeof *flipped);
-        vertices = ob_malloc((size_t)mesh.vertex_count * sizeof *vertices);
-        if (mesh.tangents) tangents = ob_malloc((size_t)mesh.vertex_count * sizeof *tangents);
-        if (!flipped || !vertices || (mesh.tangents && !tangents)) {
-            ob_free(flipped);
-            ob_free(vertices);
-            ob_free(tangents);
-            OB_LOG_E(LOG_MODULE, "%s: out of memory mirroring primitive '%s'", a->model->path, prim->name);
-            *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
-            return NULL;
-        }
-        for (uint32_t i = 0; i + 2 < mesh.index_count; i += 3) {
-            flipped[i] = mesh.indices[i];
-            flipped[i + 1] = mesh.indices[i + 2];
-            flipped[i + 2] = mesh.indices[i + 1];
-        }
-        for (uint32_t i = 0; i < mesh.vertex_count; i++) {
-            vertices[i] = mesh.vertices[i];
-            for (int k = 0; k < 3; k++) vertices[i].normal[k] = -vertices[i].normal[k];
-            if (tangents) {
-                memcpy(tangents[i], mesh.tangents[i], sizeof tangents[i]);
-                tangents[i][3] = -tangents[i][3];
-            }
-        }
-        mesh.indices = flipped;
-        mesh.vertices = vertices;
-        if (tangents) mesh.tangents = tangents;
-    }
     char name[160];
-    snprintf(name, sizeof name, "%s/%s%s", a->name, prim->name, v & VARIANT_FLIPPED ? " (mirrored)" : "");
+    snprintf(name, sizeof name, "%s/%s", a->name, prim->name);
     ob_geometry_desc gd = {.mesh = &mesh, .name = name, .extended = (v & VARIANT_EXTENDED) != 0,
                            .id = a->first_geometry_id ? a->first_geometry_id + p * VARIANT_COUNT + v : 0};
     ob_geometry *g = ob_geometry_create(ob_renderer_device(a->renderer), &gd, out_result);
-    ob_free(flipped);
-    ob_free(vertices);
-    ob_free(tangents);
     if (!g) {
         OB_LOG_E(LOG_MODULE, "%s: primitive %u '%s' could not be uploaded: %s", a->model->path, p,
                  prim->name, ob_result_name(*out_result));
@@ -337,13 +301,6 @@ static void decompose(const float *m, double pos[3], double quat[4], float scale
     }
 }
 
-static bool mirrors(const float *m)
-{
-    double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) +
-                 m[8] * (m[1] * m[6] - m[2] * m[5]);
-    return det < 0.0;
-}
-
 ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_node *root,
                                       ob_material *override, uint32_t *out_entities)
 {
@@ -354,10 +311,9 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
     }
     const ob_model *model = a->model;
     ob_node **nodes = ob_calloc(model->node_count, sizeof *nodes);
-    bool *flip = ob_calloc(model->node_count, sizeof *flip);
     ob_result r = OB_OK;
     uint32_t made = 0;
-    if (!nodes || !flip) {
+    if (!nodes) {
         OB_LOG_E(LOG_MODULE, "%s: out of memory instantiating %u nodes", model->path, model->node_count);
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto done;
@@ -375,12 +331,10 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
         ob_node_set_position(n, pos);
         ob_node_set_rotation_d(n, quat);
         ob_node_set_scale(n, scale);
-        flip[i] = (mn->parent >= 0 && flip[mn->parent]) != mirrors(mn->local);
         for (uint32_t k = 0; k < mn->primitive_count && r == OB_OK; k++) {
             uint32_t p = mn->primitives[k];
             uint32_t mat = model->primitives[p].material;
-            uint32_t v = (flip[i] ? VARIANT_FLIPPED : 0u) |
-                         (!override && a->material_extended[mat] ? VARIANT_EXTENDED : 0u);
+            uint32_t v = !override && a->material_extended[mat] ? VARIANT_EXTENDED : 0u;
             ob_geometry *g = variant(a, p, v, &r);
             if (!g) break;
             ob_node *e = ob_node_create(scene, n, model->primitives[p].name, &r);
@@ -403,7 +357,6 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
     }
 done:
     ob_free(nodes);
-    ob_free(flip);
     if (out_entities) *out_entities = made;
     return r;
 }

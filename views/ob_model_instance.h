@@ -26,12 +26,10 @@
  * material reads (the standard layout for an override of a standard kind,
  * its tangents and colours left out).
  *
- * Mirroring: a primitive whose node transform within the model (the product
- * of the local transforms from the model root) has a negative determinant
- * is drawn with a copy of its geometry whose triangles are wound the other
- * way, so its outside stays the front face (the model's culling is
- * back-face). A scene transform above the model root that mirrors is not
- * compensated.
+ * Mirroring: any world transform with a negative determinant, within the
+ * model or above its root, is drawn with clockwise front faces and outward
+ * normals by the engine itself (the pipeline manager and the normal matrix),
+ * so primitives need no mirrored copy.
  *
  * Thread rule: everything here is [render thread], between frames (it makes
  * device resources, materials and nodes).
@@ -85,7 +83,8 @@ typedef struct ob_model_assets_desc {
      * their own cache, destroyed with them. */
     ob_texture_cache *textures;
     const char *name;                /* for geometry, materials and logs; NULL → the model's file name */
-    /* Geometry ids for command hashes: primitive p's variant v (0..3) gets
+    /* Geometry ids for command hashes: primitive p's variant v (0..3; 0 and
+     * 1 are used, the standard and the extended layout) gets
      * first_geometry_id + 4·p + v, so the model reserves
      * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE × primitive_count ids whatever is
      * uploaded; 0 → each derived from its contents. */

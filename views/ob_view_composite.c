@@ -105,6 +105,11 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
+    /* Its effect is made in its first frame: a shader that cannot be read
+     * fails here instead, where the caller sees it. */
+    static const char *const shaders[] = {"fullscreen.vert", "composite.frag"};
+    r = ob_effect_context_check_shaders(ctx->effects, "composite view", shaders, OB_ARRAY_COUNT(shaders));
+    if (r != OB_OK) goto done;
     cv = ob_calloc(1, sizeof *cv);
     if (!cv) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;

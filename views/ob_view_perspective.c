@@ -11,6 +11,22 @@ struct ob_perspective_view {
     bool warned_degenerate;
 };
 
+/* Clip coordinates are homogeneous: the projection times any k draws the
+ * same picture. With k a power of two near 1 / znear (frexp: w on the near
+ * plane in [0.5, 1)), clip coordinates are of the order of 1 at any scene
+ * scale, and the scaling is exact in float, so the pixels are the same as
+ * with k = 1 wherever that worked. Without it a 1e-30 scene has clip
+ * coordinates of 1e-30, and a GPU that rasterizes homogeneously (products
+ * of two clip coordinates: 1e-60) and flushes denormals to zero loses its
+ * triangles (issue 25.2: 194 levels on NVIDIA, none on lavapipe, which
+ * divides by w first). */
+static void scale_clip_to_near(float proj[16], float znear)
+{
+    int e = 0;
+    (void)frexpf(znear, &e);
+    for (int i = 0; i < 16; i++) proj[i] = ldexpf(proj[i], -e);
+}
+
 static bool perspective_pre_cull(ob_view *v, ob_renderer *r)
 {
     ob_perspective_view *pv = (ob_perspective_view *)v;
@@ -35,6 +51,7 @@ static bool perspective_pre_cull(ob_view *v, ob_renderer *r)
     float fovy = cam->fovy > 0.0f && cam->fovy < 3.1f ? cam->fovy : 1.0471976f;
     float znear = cam->znear > 0.0f ? cam->znear : 0.1f;
     ob_math_perspective_reverse_z(fovy, aspect, znear, pv->proj);
+    scale_clip_to_near(pv->proj, znear);
     ob_mat4_mul(pv->proj, pv->view, v->view_proj);
     v->cull_exclude = NULL;
     return true;

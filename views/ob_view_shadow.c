@@ -72,6 +72,14 @@ static bool fit_to_casters(ob_shadow_view *sv, ob_renderer *r)
 static bool shadow_pre_cull(ob_view *v, ob_renderer *r)
 {
     ob_shadow_view *sv = (ob_shadow_view *)v;
+    if (v->queued_frame == ob_renderer_frame_serial(r)) {
+        /* Queued by an earlier consumer this frame: fitted and culled for
+         * it. Refitting now would record its culled list through another
+         * frustum (issue 25.5); the queue call makes this consumer depend
+         * on it. */
+        ob_renderer_queue_view(r, v);
+        return false;
+    }
     if (!sv->consumer || !fit_to_casters(sv, r)) {
         ob_renderer_note_skipped(r, v->name, OB_SKIP_NO_CASTERS);
         return false;

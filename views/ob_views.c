@@ -326,12 +326,19 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
 {
     uint32_t count = 0;
     ob_node *const *lights = ob_scene_lights(ob_renderer_scene(r), &count);
+    bool shaded_found = false;
     for (uint32_t i = 0; i < count; i++) {
         const ob_light_desc *l = ob_node_get_light(lights[i]);
-        if (l->type != OB_LIGHT_DIRECTIONAL || !l->casts_shadows) continue;
+        if (l->type != OB_LIGHT_DIRECTIONAL) continue;
+        /* Only the first directional light is shaded (ob_views_set_common_params,
+         * the one ShadowMap of lit.frag): a map of another would be sampled
+         * as the first one's shadow (issue 25.6). */
+        bool shaded = !shaded_found;
+        shaded_found = true;
+        if (!l->casts_shadows) continue;
         char name[64];
         snprintf(name, sizeof name, "shadow:%s", ob_node_name(lights[i]));
-        if (!(l->intensity > 0.0f)) {
+        if (!shaded || !(l->intensity > 0.0f)) {
             ob_renderer_note_skipped(r, name, OB_SKIP_NOT_NEEDED);
             continue;
         }

@@ -621,9 +621,12 @@ static ob_result check_effects(const bench_options *o, uint32_t pool)
     ob_demo_options dopt = demo_options(o, pool, 64, 64, 0);
     ob_demo d;
     ob_result r = ob_demo_init(&d, &dopt);
+    /* A shader that cannot be read fails the material library's creation
+     * (the log names the file); the hint says where shaders are looked for. */
     if (r != OB_OK)
-        fprintf(stderr, "obelisk-bench: cannot set up the renderer: %s (%s)\n", ob_result_name(r),
-                ob_result_text(r));
+        fprintf(stderr, "obelisk-bench: cannot set up the renderer: %s (%s)%s\n", ob_result_name(r),
+                ob_result_text(r), r == OB_ERR_IO ? "; nothing measured. Are the shaders where the library "
+                "looks ($OB_SHADER_DIR, else share/obelisk/shaders beside the library)?" : "");
     for (uint32_t k = 0; r == OB_OK && k < OB_STD_EFFECT_COUNT; k++) {
         if (ob_material_library_effect(d.lib, (ob_std_effect)k, 0, &r)) continue;
         fprintf(stderr, "obelisk-bench: the standard effect '%s' does not compile: %s (%s); "

@@ -71,4 +71,15 @@ vec3 ob_unit_normal(vec3 n)
     return m > 0.0 ? normalize(n / m) : vec3(0.0);
 }
 
+// -1 where the world transform mirrors (negative determinant), else 1: the
+// bitangent's sign turns with it (the normal matrix keeps normals outward).
+// Divided by the largest entry first, so the determinant neither underflows
+// nor overflows at any scale.
+float ob_mirror_sign(mat3 w)
+{
+    vec3 a = max(abs(w[0]), max(abs(w[1]), abs(w[2])));
+    float m = max(a.x, max(a.y, a.z));
+    return m > 0.0 && determinant(w * (1.0 / m)) < 0.0 ? -1.0 : 1.0;
+}
+
 #endif

@@ -43,7 +43,7 @@ void main()
     if (vHemisphere < 0.0) discard;
 #endif
     vec3 n = ob_safe_normalize(vNormal);
-    vec3 v = ob_safe_normalize(CameraPosition.xyz - vPosition);
+    vec3 v = ob_unit_normal(CameraPosition.xyz - vPosition);   // any scale (issue 25.2)
 #if !defined(PARABOLOID)
     // Two-sided lighting for open meshes seen from behind. (The paraboloid
     // projection mirrors the back hemisphere, so facing means nothing there.)

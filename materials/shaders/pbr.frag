@@ -157,7 +157,7 @@ void main()
 
     ob_surface s;
     s.n = n;
-    s.v = ob_safe_normalize(CameraPosition.xyz - vPosition);
+    s.v = ob_unit_normal(CameraPosition.xyz - vPosition);   // any scale (issue 25.2)
     s.base = base.rgb;
     s.metallic = metallic;
     s.a = roughness * roughness;

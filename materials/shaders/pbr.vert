@@ -53,7 +53,8 @@ void main()
     vColor = inColor;
 #endif
 #if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
-    vTangent = vec4(ob_unit_normal(mat3(WorldMatrix) * inTangent.xyz), inTangent.w < 0.0 ? -1.0 : 1.0);
+    vTangent = vec4(ob_unit_normal(mat3(WorldMatrix) * inTangent.xyz),
+                    (inTangent.w < 0.0 ? -1.0 : 1.0) * ob_mirror_sign(mat3(WorldMatrix)));
 #endif
 #if defined(PARABOLOID)
     gl_Position = ob_paraboloid_position(world.xyz, vHemisphere);

@@ -24,7 +24,7 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
     }
 
     ob_stack_desc sd = {
-        .renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1},
+        .renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1, .adopt = d.adopt},
                      .worker_count = s->workers},
         .cache_dir = s->cache_dir,
         .width = s->width, .height = s->height,

@@ -32,6 +32,9 @@ typedef struct ob_test_stack_desc {
     uint32_t env_map_size;     /* 0 → 16 */
     uint32_t shadow_map_size;  /* 0 → 32 */
     const char *cache_dir;     /* NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack */
+    /* The application's instance and device (ob_test_adopt.h) for walks
+     * that start many stacks; NULL → the engine's own. */
+    const ob_vulkan_handles *adopt;
 } ob_test_stack_desc;
 
 typedef struct ob_test_stack {

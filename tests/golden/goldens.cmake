@@ -22,6 +22,20 @@ ob_golden(boxtextured ${OB_GOLDEN_MODELS}/glTF2/BoxTextured-glTF-Binary/BoxTextu
 ob_golden(2cylinderengine ${OB_GOLDEN_MODELS}/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb --frames 2)
 ob_golden(clearcoat ${OB_GOLDEN_MODELS}/glTF2/ClearCoat-glTF/ClearCoatTest.gltf --frames 2)
 ob_golden(texturetransform ${OB_GOLDEN_MODELS}/glTF2/textureTransform/TextureTransformTest.gltf --frames 2)
+# Measured on an NVIDIA H200 (issue 25.1): 605, 116 and 43 pixels beyond 2,
+# all on colour edges inside textures, where the Vulkan spec leaves the
+# result to the implementation (docs/testing.md, "Goldens on other devices"):
+# - BoxTextured samples NEAREST_MIPMAP_LINEAR at a level of detail near 0 to
+#   2: which texel NEAREST takes, where magnification (LINEAR) turns into
+#   minification, and the mip blend weight follow the device's texel
+#   precision and level-of-detail approximation;
+# - ClearCoat's textures are trilinear: the same level-of-detail weights, and
+#   mip levels of non-power-of-two images made by the device's linear blit;
+# - TextureTransform is bilinear without mips: the weights' sub-texel
+#   precision (subTexelPrecisionBits) differs.
+ob_golden_device_tolerance(boxtextured 900 "NEAREST texel choice and level of detail at texture edges are implementation-defined")
+ob_golden_device_tolerance(clearcoat 180 "trilinear weights and blitted non-power-of-two mips are implementation-defined")
+ob_golden_device_tolerance(texturetransform 70 "bilinear sub-texel precision is implementation-defined")
 # The repo's small files (tests/data/models/make_models.py): OBJ + .mtl
 # textures, glTF alpha MASK and BLEND with hierarchy and instancing, and PLY
 # vertex colours (tests/golden/models/colour_cube.ply).

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "ob_stack.h"
+#include "ob_test_adopt.h"
 
 #define W 64u
 #define H 48u
@@ -57,9 +58,6 @@ static void app_instance(app_vulkan *app)
 {
     memset(app, 0, sizeof *app);
     atomic_init(&app->complaints, 0);
-    app->instance_exts[0] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
-    app->instance_exts[1] = VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME;
-    const char *layers[] = {"VK_LAYER_KHRONOS_validation"};
     VkDebugUtilsMessengerCreateInfoEXT mi = {
         .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
         .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
@@ -69,23 +67,7 @@ static void app_instance(app_vulkan *app)
         .pfnUserCallback = app_message,
         .pUserData = app,
     };
-    const VkValidationFeatureEnableEXT enables[] = {
-        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
-    VkValidationFeaturesEXT vf = {.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
-                                  .pNext = &mi,
-                                  .enabledValidationFeatureCount = 1,
-                                  .pEnabledValidationFeatures = enables};
-    VkApplicationInfo ai = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-                            .pApplicationName = "test_adopt",
-                            .apiVersion = VK_API_VERSION_1_3};
-    VkInstanceCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-                               .pNext = &vf,
-                               .pApplicationInfo = &ai,
-                               .enabledLayerCount = 1,
-                               .ppEnabledLayerNames = layers,
-                               .enabledExtensionCount = 2,
-                               .ppEnabledExtensionNames = app->instance_exts};
-    assert_int_equal(vkCreateInstance(&ci, NULL, &app->instance), VK_SUCCESS);
+    app->instance = ob_test_vulkan_instance("test_adopt", &mi, app->instance_exts);
     PFN_vkCreateDebugUtilsMessengerEXT create = (PFN_vkCreateDebugUtilsMessengerEXT)
         vkGetInstanceProcAddr(app->instance, "vkCreateDebugUtilsMessengerEXT");
     assert_non_null(create);

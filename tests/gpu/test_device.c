@@ -4,6 +4,8 @@
 #include "ob_test.h"
 #include "ob_resources.h"
 
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,10 +36,36 @@ static void device_reports_name_driver_and_timestamps(void **state)
     ob_device_destroy(dev);
 }
 
+/* Whether the loader lists a CPU device (lavapipe), asked of Vulkan directly
+ * so that the answer does not depend on the selection under test. */
+static bool loader_lists_a_cpu_device(void)
+{
+    VkApplicationInfo app = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO, .apiVersion = VK_API_VERSION_1_3};
+    VkInstanceCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO, .pApplicationInfo = &app};
+    VkInstance inst = VK_NULL_HANDLE;
+    if (vkCreateInstance(&ci, NULL, &inst) != VK_SUCCESS) return false;
+    VkPhysicalDevice devices[16];
+    uint32_t n = 16;
+    bool found = false;
+    VkResult res = vkEnumeratePhysicalDevices(inst, &n, devices);
+    for (uint32_t i = 0; (res == VK_SUCCESS || res == VK_INCOMPLETE) && i < n; i++) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(devices[i], &p);
+        if (p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) found = true;
+    }
+    vkDestroyInstance(inst, NULL);
+    return found;
+}
+
 static void env_lavapipe_selects_the_cpu_device(void **state)
 {
     (void)state;
     ob_test_setup_log();
+    if (!loader_lists_a_cpu_device()) {
+        /* A GPU machine without mesa-vulkan-drivers: nothing to select. */
+        fprintf(stderr, "[  SKIPPED ] no CPU Vulkan device (lavapipe) is installed\n");
+        skip();
+    }
     setenv("OB_DEVICE", "lavapipe", 1);
     ob_result r;
     ob_device *dev = create_with(NULL, 1, &r);

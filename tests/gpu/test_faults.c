@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ob_test_adopt.h"
 #include "ob_test_stack.h"
 
 
@@ -54,6 +55,10 @@ typedef struct outcome {
 typedef struct reference {
     uint8_t *first, *steady;   /* images of frames CHECK_FRAME_FIRST and CHECK_FRAME_STEADY */
     uint32_t width, height;
+    /* Every stack of the walks on one instance (ob_test_adopt.h: a real
+     * driver does not survive an instance per point; test_device walks the
+     * points of instance and device creation). */
+    ob_test_vulkan tv;
 } reference;
 
 static ob_threading mode_of(bool multi) { return multi ? OB_THREADING_MULTI : OB_THREADING_SINGLE; }
@@ -113,7 +118,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
     ob_result r = OB_OK;
     if (ph == PHASE_START) {
         ob_fault_arm(kind, nth);
-        r = ob_test_stack_start(&s, NULL);
+        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
         ob_test_stack_stop(&s);
         o->hit = ob_fault_hit(kind);
         o->count = ob_fault_count(kind);
@@ -121,7 +126,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
         o->result = r;
         o->after_ok = true;
     } else {
-        r = ob_test_stack_start(&s, NULL);
+        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
         if (r != OB_OK) fail_msg("%s: unarmed start-up failed: %s", phase_names[ph], ob_result_name(r));
         if (ph != PHASE_SCENE) {
             r = ob_test_stack_build_scene(&s);
@@ -159,7 +164,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
 static void make_reference(reference *ref)
 {
     ob_test_stack s;
-    ob_result r = ob_test_stack_start(&s, NULL);
+    ob_result r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
     if (r == OB_OK) r = ob_test_stack_build_scene(&s);
     if (r != OB_OK) fail_msg("reference run: %s", ob_result_name(r));
     ref->width = s.width;
@@ -253,6 +258,7 @@ static int setup(void **state)
 {
     reference *ref = calloc(1, sizeof *ref);
     if (!ref) return -1;
+    ob_test_vulkan_create(&ref->tv);
     make_reference(ref);
     *state = ref;
     return 0;
@@ -262,6 +268,7 @@ static int teardown(void **state)
 {
     if (!*state) return 0; /* setup failed */
     free_reference(*state);
+    ob_test_vulkan_destroy(&((reference *)*state)->tv);
     free(*state);
     return 0;
 }

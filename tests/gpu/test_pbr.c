@@ -22,6 +22,7 @@
 unsigned char *stbi_write_png_to_mem(const unsigned char *pixels, int stride_bytes, int x, int y, int n,
                                      int *out_len);
 
+#include "ob_test_adopt.h"
 #include "ob_test_stack.h"
 #include "ob_texture.h"
 
@@ -679,12 +680,12 @@ typedef struct pbr_outcome {
 
 /* Builds (armed when `scene`), runs the first frame (armed otherwise), then
  * an unarmed frame compared with ref. */
-static pbr_outcome pbr_fault_run(bool scene, ob_fault_kind kind, uint64_t nth, const uint8_t *ref,
-                                 uint8_t *const png[2], const int png_size[2])
+static pbr_outcome pbr_fault_run(const ob_test_vulkan *tv, bool scene, ob_fault_kind kind, uint64_t nth,
+                                 const uint8_t *ref, uint8_t *const png[2], const int png_size[2])
 {
     pbr_outcome o = {0};
     pbr_stack ps = {.png = {png[0], png[1]}, .png_size = {png_size[0], png_size[1]}};
-    ob_result r = ob_test_stack_start(&ps.t, NULL);
+    ob_result r = ob_test_stack_start(&ps.t, &(ob_test_stack_desc){.adopt = &tv->handles});
     if (r != OB_OK) fail_msg("fault walk: unarmed start failed: %s", ob_result_name(r));
     ob_test_log_clear();
     if (scene) ob_fault_arm(kind, nth);
@@ -741,11 +742,14 @@ static void pbr_scene_survives_every_fault(void **state)
     uint8_t *png[2];
     int png_size[2];
     walk_pngs(png, png_size);
-    pbr_outcome ref_run = pbr_fault_run(false, OB_FAULT_HOST_ALLOC, 0, NULL, png, png_size);
+    /* Every stack of the walk on one instance (ob_test_adopt.h says why). */
+    ob_test_vulkan tv;
+    ob_test_vulkan_create(&tv);
+    pbr_outcome ref_run = pbr_fault_run(&tv, false, OB_FAULT_HOST_ALLOC, 0, NULL, png, png_size);
     assert_true(ref_run.next_ok);
     /* The reference image: an unarmed run, frame 2. */
     pbr_stack ps = {.png = {png[0], png[1]}, .png_size = {png_size[0], png_size[1]}};
-    assert_int_equal(ob_test_stack_start(&ps.t, NULL), OB_OK);
+    assert_int_equal(ob_test_stack_start(&ps.t, &(ob_test_stack_desc){.adopt = &tv.handles}), OB_OK);
     assert_int_equal(pbr_stack_build(&ps), OB_OK);
     assert_int_equal(ob_test_stack_frame(&ps.t, OB_THREADING_SINGLE, 0), OB_OK);
     assert_int_equal(ob_test_stack_frame(&ps.t, OB_THREADING_SINGLE, 0), OB_OK);
@@ -755,11 +759,11 @@ static void pbr_scene_survives_every_fault(void **state)
     pbr_stack_stop(&ps);
     for (int phase = 0; phase < 2; phase++) {
         for (int kind = OB_FAULT_HOST_ALLOC; kind <= OB_FAULT_VK_OBJECT; kind++) {
-            uint64_t count = pbr_fault_run(phase == 0, (ob_fault_kind)kind, 0, ref, png, png_size).count;
+            uint64_t count = pbr_fault_run(&tv, phase == 0, (ob_fault_kind)kind, 0, ref, png, png_size).count;
             uint64_t errors = 0, degraded = 0, walked = 0;
             for (uint64_t n = 1; n <= count; n = n + stride > count && n != count ? count : n + stride) {
                 walked++;
-                pbr_outcome o = pbr_fault_run(phase == 0, (ob_fault_kind)kind, n, ref, png, png_size);
+                pbr_outcome o = pbr_fault_run(&tv, phase == 0, (ob_fault_kind)kind, n, ref, png, png_size);
                 const char *where = phase == 0 ? "PBR scene" : "PBR first frame";
                 if (!o.hit) fail_msg("%s, kind %d point %llu: never reached", where, kind, (unsigned long long)n);
                 if (o.validation)
@@ -781,6 +785,7 @@ static void pbr_scene_survives_every_fault(void **state)
     free(ref);
     ob_free(png[0]);
     ob_free(png[1]);
+    ob_test_vulkan_destroy(&tv);
     ob_test_log_set_echo(true);
 }
 

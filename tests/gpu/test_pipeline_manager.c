@@ -270,6 +270,71 @@ static void many_programs_each_read_their_own_uniforms(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* Issue 25.9: a frame slot's set-0 cache kept a set for every program it
+ * ever drew, so a program that changes its scenes held more every time.
+ * With the bound lowered to 8 ($OB_SET_CACHE_LIMIT), rounds of 12 new
+ * programs each (made, drawn in both modes, destroyed) leave every manager
+ * holding at most the bound plus one frame's programs, the resets are
+ * counted, and every box keeps its colour. Before: 12 more sets a round. */
+static void set_cache_holds_its_bound_across_changing_scenes(void **state)
+{
+    (void)state;
+    enum { ROUNDS = 5, N = 12, LIMIT = 8 };
+    setenv("OB_SET_CACHE_LIMIT", "8", 1);
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    unsetenv("OB_SET_CACHE_LIMIT");
+    ob_test_world_look(&w, 0, 0, 20, 0, 0, 0);
+    ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 0.6f, .znear = 0.1f});
+    uint32_t resets = 0, most_held = 0;
+    for (uint32_t round = 0; round < ROUNDS; round++) {
+        ob_effect *effects[N];
+        ob_material *materials[N];
+        ob_node *nodes[N];
+        for (uint32_t i = 0; i < N; i++) {
+            char name[32], value[16];
+            snprintf(name, sizeof name, "round-%u-%u", round, i);
+            snprintf(value, sizeof value, "%u", round * N + i);
+            ob_shader_define def = {"TEST_VARIANT", value};
+            ob_effect_desc ed = {.name = name, .vertex = "unlit.vert", .fragment = "unlit.frag",
+                                 .define_count = 1, .defines = &def,
+                                 .layout = ob_views_standard_input(), .depth_test = true,
+                                 .depth_write = true, .cull = VK_CULL_MODE_BACK_BIT};
+            ob_result r;
+            effects[i] = ob_effect_create(w.fx, &ed, &r);
+            if (!effects[i]) fail_msg("effect %u: %s", i, ob_result_name(r));
+            ob_material_desc md = {.name = name, .kind = OB_MATERIAL_CUSTOM,
+                                   .diffuse = {0.2f + 0.05f * (float)i, 0.5f, 0.9f - 0.05f * (float)i, 1.0f}};
+            materials[i] = ob_material_create(w.lib, &md, &r);
+            assert_non_null(materials[i]);
+            assert_int_equal(ob_material_set_view_effect(materials[i], OB_VIEW_PERSPECTIVE, effects[i]), OB_OK);
+            nodes[i] = ob_test_world_entity(&w, NULL, name, w.box, materials[i], (double)i * 1.5 - 8.25, 0, 0);
+        }
+        for (int f = 0; f < 4; f++) {
+            const ob_frame_stats *st =
+                ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+            assert_int_equal(ob_test_view_stats(st, "main")->draws, N);
+            resets += st->pm.descriptor_set_cache_resets;
+            if (st->pm.descriptor_sets_held > most_held) most_held = st->pm.descriptor_sets_held;
+            if (st->pm.descriptor_sets_held > LIMIT + N + 4)
+                fail_msg("round %u frame %d: a manager holds %u sets (bound %u)", round, f,
+                         st->pm.descriptor_sets_held, LIMIT);
+            ob_test_world_read(&w);
+            const uint8_t *p = ob_test_world_pixel(&w, w.width / 2, w.height / 2);
+            if (p[2] < 64) fail_msg("round %u frame %d: the middle box is %u,%u,%u", round, f, p[0], p[1], p[2]);
+        }
+        assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+        for (uint32_t i = 0; i < N; i++) {
+            ob_node_destroy(w.scene, nodes[i]);
+            ob_material_destroy(materials[i]);
+            ob_effect_destroy(effects[i]);
+        }
+    }
+    printf("[ set cache ] %u resets, at most %u sets held (bound %u)\n", resets, most_held, LIMIT);
+    assert_true(resets > 0);
+    ob_test_world_destroy(&w);
+}
+
 /* Build the scene used for the ST/MT comparison: shared and distinct
  * materials, two geometries, a shadow-casting light. */
 static void mixed_scene(ob_test_world *w)
@@ -519,6 +584,7 @@ int main(void)
         cmocka_unit_test(shared_state_bound_once_per_secondary),
         cmocka_unit_test(uniforms_packed_only_after_a_change),
         cmocka_unit_test(many_programs_each_read_their_own_uniforms),
+        cmocka_unit_test(set_cache_holds_its_bound_across_changing_scenes),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
         cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),

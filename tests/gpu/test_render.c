@@ -97,11 +97,104 @@ static void rotating_cube_same_in_every_mode(void **state)
     }
 }
 
+/* Issue 25.2: scaled by 1e-30 the scene's clip coordinates were 1e-30.
+ * lavapipe divides by w before rasterizing and drew it exactly; a GPU that
+ * rasterizes in homogeneous coordinates forms products of two of them
+ * (1e-60), which a float flushes to zero, and lost the picture (NVIDIA: 194
+ * levels). The view's projection now keeps clip coordinates of the order
+ * of 1 at every scale: the near plane's w lies in [0.5, 1), so every
+ * product of two clip coordinates of what is drawn is a normal float, on
+ * any device. The picture, specular highlight included, is the unit
+ * scene's, bit for bit. */
+static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
+{
+    (void)state;
+    static const double scales[] = {1.0, 1e-30, 0x1p-100, 1e-12, 1e-3, 1e12, 1e30};
+    uint8_t *unit = NULL;
+    for (size_t i = 0; i < sizeof scales / sizeof scales[0]; i++) {
+        const double sc = scales[i];
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        assert_int_equal(ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 1.0f, .znear = (float)(0.1 * sc)}),
+                         OB_OK);
+        ob_test_world_look(&w, 0.0, 2.0 * sc, 5.0 * sc, 0.0, 0.0, 0.0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2 * sc, 6 * sc, 1 * sc);
+        /* Specular: the view vector, camera-relative and as small as the scene. */
+        ob_result mr;
+        ob_material *red = ob_material_create(w.lib, &(ob_material_desc){
+            .name = "shiny", .kind = OB_MATERIAL_LIT, .diffuse = {0.9f, 0.1f, 0.1f, 1.0f},
+            .specular = {0.8f, 0.8f, 0.8f, 16.0f}}, &mr);
+        assert_non_null(red);
+        ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_node_set_scale(box, (const float[3]){(float)sc, (float)sc, (float)sc});
+        ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        ob_test_world_read(&w);
+
+        /* The box's corners (half-size 0.5) through the view's matrix. */
+        const ob_view *v = ob_perspective_view_base(w.main);
+        float smallest = INFINITY;
+        for (int c = 0; c < 8; c++) {
+            float p[3] = {(float)((c & 1 ? 0.5 : -0.5) * sc - v->origin[0]),
+                          (float)((c & 2 ? 0.5 : -0.5) * sc - v->origin[1]),
+                          (float)((c & 4 ? 0.5 : -0.5) * sc - v->origin[2])};
+            for (int row = 0; row < 4; row++) {
+                float clip = v->view_proj[row] * p[0] + v->view_proj[4 + row] * p[1] +
+                             v->view_proj[8 + row] * p[2] + v->view_proj[12 + row];
+                if (row == 3 || clip != 0.0f) smallest = fminf(smallest, fabsf(clip));
+            }
+        }
+        /* Products of two coordinates this size are normal floats. */
+        if (!(smallest * smallest >= 0x1p-126f))
+            fail_msg("scale %g: a clip coordinate of %g; products of two flush to zero", sc, (double)smallest);
+        if (i == 0) {
+            unit = ob_test_world_copy(&w);
+        } else {
+            uint32_t d = ob_test_image_max_diff(unit, w.pixels, w.width, w.height);
+            if (d) fail_msg("scale %g: %u levels from the unit scene", sc, d);
+        }
+        ob_test_world_destroy(&w);
+    }
+    free(unit);
+}
+
+/* Issue 25.7: a scene transform that mirrors (negative determinant) kept
+ * counter-clockwise front faces and turned the normal matrix's normals
+ * inward: the mirrored box showed its inside, dark. A box mirrored in x, in
+ * y and z, and in all three is now the same picture as the box itself (the
+ * box is symmetric, and the sun lights it from a general direction). */
+static void mirrored_entity_looks_like_the_original(void **state)
+{
+    (void)state;
+    static const float scales[4][3] = {{1, 1, 1}, {-1, 1, 1}, {1, -1, -1}, {-1, -1, -1}};
+    uint8_t *images[4];
+    for (int i = 0; i < 4; i++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_test_world_look(&w, 1.5, 2.0, 4.0, 0.0, 0.0, 0.0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 3, 1);
+        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.3f, 0.1f, false);
+        ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_node_set_scale(box, scales[i]);
+        ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        ob_test_world_read(&w);
+        images[i] = ob_test_world_copy(&w);
+        ob_test_world_destroy(&w);
+    }
+    for (int i = 1; i < 4; i++) {
+        uint32_t n = ob_test_image_diff_count(images[0], images[i], 160, 120, 2);
+        if (n) fail_msg("scale (%g, %g, %g): %u pixels differ from the unmirrored box", (double)scales[i][0],
+                        (double)scales[i][1], (double)scales[i][2], n);
+    }
+    for (int i = 0; i < 4; i++) free(images[i]);
+}
+
 int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(empty_scene_is_the_clear_colour),
+        cmocka_unit_test(mirrored_entity_looks_like_the_original),
+        cmocka_unit_test(tiny_and_huge_scenes_keep_clip_coordinates_normal),
         cmocka_unit_test(lit_cube_centre_has_the_expected_shade),
         cmocka_unit_test(rotating_cube_same_in_every_mode),
     };

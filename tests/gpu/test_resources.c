@@ -389,37 +389,95 @@ static void array_image_has_a_view_per_layer(void **state)
     ob_test_assert_no_validation(dev);
 }
 
-static void png_round_trips_through_stb(void **state)
+/* An opaque RGBA8 image of w x h pattern texels (kept in `texels`) that can
+ * be read back, and a path for its PNG in the test cache folder. */
+static ob_image png_source(ob_device *dev, uint32_t w, uint32_t h, uint8_t *texels, uint32_t seed,
+                           const char *name, char *path, size_t path_size)
 {
-    ob_device *dev = *state;
     ob_result r;
-    enum { W = 13, H = 7 };   /* odd sizes catch stride mistakes */
-    uint8_t texels[W * H * 4];
-    pattern(texels, sizeof texels, 4);
-    for (size_t i = 0; i < W * H; i++) texels[4 * i + 3] = 255;
-    ob_image img = ob_image_create(dev, &(ob_image_desc){.width = W, .height = H, .format = VK_FORMAT_R8G8B8A8_UNORM,
+    pattern(texels, (size_t)w * h * 4, seed);
+    for (size_t i = 0; i < (size_t)w * h; i++) texels[4 * i + 3] = 255;
+    ob_image img = ob_image_create(dev, &(ob_image_desc){.width = w, .height = h, .format = VK_FORMAT_R8G8B8A8_UNORM,
                                                          .usage = OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC,
-                                                         .data = texels, .name = "png-source"}, &r);
+                                                         .data = texels, .name = name}, &r);
     assert_int_equal(r, OB_OK);
     const char *dir = getenv("OB_CACHE_DIR");
     if (!dir) dir = "/tmp";
     assert_int_equal(ob_dir_make(dir), OB_OK);
-    char path[512];
-    snprintf(path, sizeof path, "%s/test_resources_%ld.png", dir, (long)getpid());
-    assert_int_equal(ob_image_write_png(dev, img, path), OB_OK);
+    snprintf(path, path_size, "%s/%s_%ld.png", dir, name, (long)getpid());
+    return img;
+}
 
-    int w = 0, h = 0, comp = 0;
-    unsigned char *loaded = stbi_load(path, &w, &h, &comp, 4);
+/* The PNG at path holds exactly texels (w x h); then it is removed. */
+static void assert_png_holds(const char *path, const uint8_t *texels, uint32_t w, uint32_t h)
+{
+    int lw = 0, lh = 0, comp = 0;
+    unsigned char *loaded = stbi_load(path, &lw, &lh, &comp, 4);
     assert_non_null(loaded);
-    assert_int_equal(w, W);
-    assert_int_equal(h, H);
-    assert_int_equal(ob_test_image_max_diff(loaded, texels, W, H), 0);
+    assert_int_equal(lw, (int)w);
+    assert_int_equal(lh, (int)h);
+    assert_int_equal(ob_test_image_max_diff(loaded, texels, w, h), 0);
     stbi_image_free(loaded);
     remove(path);
+}
+
+static void png_round_trips_through_stb(void **state)
+{
+    ob_device *dev = *state;
+    enum { W = 13, H = 7 };   /* odd sizes catch stride mistakes */
+    uint8_t texels[W * H * 4];
+    char path[512];
+    ob_image img = png_source(dev, W, H, texels, 4, "png-source", path, sizeof path);
+    assert_int_equal(ob_image_write_png(dev, img, path), OB_OK);
+    assert_png_holds(path, texels, W, H);
 
     ob_test_log_clear();
     assert_int_equal(ob_image_write_png(dev, img, "/nonexistent-obelisk-dir/x.png"), OB_ERR_IO);
     assert_true(ob_test_log_has("nonexistent-obelisk-dir", NULL));
+    ob_image_destroy(dev, img);
+    ob_test_assert_no_validation(dev);
+}
+
+/* Issue 25.10: stb_image_write's own deflate grows its buffers with an
+ * unchecked realloc, so a failed allocation while encoding wrote past the
+ * old buffer (a crash). Every host allocation of ob_image_write_png fails in
+ * turn now: an error with a message, no file, nothing left on the heap;
+ * then the same call writes the same picture. */
+static void png_writing_survives_every_allocation_failure(void **state)
+{
+    ob_device *dev = *state;
+    ob_result r;
+    enum { W = 61, H = 37 };   /* big enough for the encoder to grow its buffers */
+    uint8_t texels[W * H * 4];
+    char path[512];
+    ob_image img = png_source(dev, W, H, texels, 6, "png-faults", path, sizeof path);
+    remove(path);
+    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+    assert_int_equal(ob_image_write_png(dev, img, path), OB_OK);
+    uint64_t points = ob_fault_count(OB_FAULT_HOST_ALLOC);
+    remove(path);
+    assert_true(points >= 3);   /* pixels, the encoder's buffers, the file's */
+    ob_test_log_set_echo(false);
+    for (uint64_t n = 1; n <= points; n++) {
+        ob_heap_stats before = ob_heap_stats_now();
+        ob_test_log_clear();
+        ob_fault_arm(OB_FAULT_HOST_ALLOC, n);
+        r = ob_image_write_png(dev, img, path);
+        bool hit = ob_fault_hit(OB_FAULT_HOST_ALLOC);
+        ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
+        ob_heap_stats after = ob_heap_stats_now();
+        assert_true(hit);
+        if (r != OB_ERR_OUT_OF_HOST_MEMORY)
+            fail_msg("point %llu of %llu: %s", (unsigned long long)n, (unsigned long long)points, ob_result_name(r));
+        if (!ob_test_log_has("png-faults", NULL)) fail_msg("point %llu: failed without a message", (unsigned long long)n);
+        if (access(path, F_OK) == 0) fail_msg("point %llu: a file was written", (unsigned long long)n);
+        if (after.live_blocks != before.live_blocks)
+            fail_msg("point %llu: %lld blocks left", (unsigned long long)n,
+                     (long long)(after.live_blocks - before.live_blocks));
+    }
+    ob_test_log_set_echo(true);
+    assert_int_equal(ob_image_write_png(dev, img, path), OB_OK);
+    assert_png_holds(path, texels, W, H);
     ob_image_destroy(dev, img);
     ob_test_assert_no_validation(dev);
 }
@@ -670,6 +728,7 @@ int main(void)
         cmocka_unit_test(cleared_color_reads_back_exactly),
         cmocka_unit_test(array_image_has_a_view_per_layer),
         cmocka_unit_test(png_round_trips_through_stb),
+        cmocka_unit_test(png_writing_survives_every_allocation_failure),
         cmocka_unit_test(depth_image_clears_and_copies_out),
         cmocka_unit_test(compare_sampler_is_created),
         cmocka_unit_test(transitions_follow_the_tracked_state),

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L
 /* test_stack.c — ob_stack, the usual set-up in one call: it renders what a
  * program adds to it, frees everything it made, refuses bad entities, and a
  * failure at any allocation or Vulkan creation of ob_stack_create returns
@@ -5,21 +6,26 @@
 #include "ob_test.h"
 
 #include <stdlib.h>
+#include <unistd.h>
 #include <string.h>
 
 #include "ob_stack.h"
+#include "ob_test_adopt.h"
 
 #define W 64u
 #define H 48u
 
-static ob_stack *make_stack(ob_result *out_result)
+static ob_stack *make_stack_on(const ob_vulkan_handles *adopt, ob_result *out_result)
 {
-    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1},
+    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1,
+                                               .adopt = adopt},
                                     .worker_count = 2},
                        .width = W, .height = H, .shadow_map_size = 64,
                        .clear_color = {0.0f, 0.0f, 1.0f, 1.0f}};
     return ob_stack_create(&d, out_result);
 }
+
+static ob_stack *make_stack(ob_result *out_result) { return make_stack_on(NULL, out_result); }
 
 static void test_stack_renders_and_frees(void **state)
 {
@@ -77,6 +83,29 @@ static void test_stack_renders_and_frees(void **state)
     assert_int_equal(after.live_bytes, before.live_bytes);
 }
 
+/* Issue 25.8: with its shader folder empty, the stack rendered black and
+ * every call returned OB_OK. Creation fails now, naming the file. */
+static void test_stack_without_shaders_fails_naming_one(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/obelisk-no-shaders-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    ob_test_log_clear();
+    ob_test_log_set_echo(false);
+    ob_result r = OB_OK;
+    ob_stack_desc d = {.renderer = {.device = {.validation = 1, .shader_dir = dir}, .worker_count = 1},
+                       .width = W, .height = H};
+    ob_stack *s = ob_stack_create(&d, &r);
+    ob_test_log_set_echo(true);
+    rmdir(dir);
+    assert_null(s);
+    assert_int_equal(r, OB_ERR_IO);
+    if (!ob_test_log_has("lit.vert", "cannot be read", dir, NULL)) {
+        ob_test_log_dump(OB_LOG_WARN, 20);
+        fail_msg("no log line names the missing shader and its folder");
+    }
+}
+
 static void test_stack_overlay_is_final(void **state)
 {
     (void)state;
@@ -96,12 +125,16 @@ static void test_stack_overlay_is_final(void **state)
 
 /* Every point of one fault kind during create in turn (about 170 in all,
  * a few seconds): NULL and an error whenever the point fired, nothing left
- * behind on Obelisk's heap (the address-sanitizer build checks the rest). */
+ * behind on Obelisk's heap (the address-sanitizer build checks the rest).
+ * All on one adopted instance (ob_test_adopt.h): test_device walks the
+ * points of instance and device creation. */
 static void walk_create_faults(ob_fault_kind kind)
 {
+    ob_test_vulkan tv;
+    ob_test_vulkan_create(&tv);
     ob_result r;
     ob_fault_arm(kind, 0);   /* unarmed: counts the points */
-    ob_stack *s = make_stack(&r);
+    ob_stack *s = make_stack_on(&tv.handles, &r);
     uint64_t points = ob_fault_count(kind);
     assert_non_null(s);
     ob_stack_destroy(s);
@@ -110,7 +143,7 @@ static void walk_create_faults(ob_fault_kind kind)
     for (uint64_t n = 1; n <= points; n++) {
         ob_heap_stats before = ob_heap_stats_now();
         ob_fault_arm(kind, n);
-        s = make_stack(&r);
+        s = make_stack_on(&tv.handles, &r);
         bool hit = ob_fault_hit(kind);
         ob_fault_arm(kind, 0);
         if (hit) {
@@ -125,6 +158,7 @@ static void walk_create_faults(ob_fault_kind kind)
                      (long long)(after.live_blocks - before.live_blocks));
     }
     ob_test_log_set_echo(true);
+    ob_test_vulkan_destroy(&tv);
 }
 
 static void test_stack_create_host_faults(void **state)
@@ -145,6 +179,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stack_renders_and_frees),
         cmocka_unit_test(test_stack_overlay_is_final),
+        cmocka_unit_test(test_stack_without_shaders_fails_naming_one),
         cmocka_unit_test(test_stack_create_host_faults),
         cmocka_unit_test(test_stack_create_vk_faults),
     };

@@ -188,6 +188,23 @@ static void shared_dependency_runs_before_every_consumer(void **state)
     graph_release(g, 4);
 }
 
+/* A second camera at `eye` looking at `target`, and its perspective view
+ * "side" of the world's size (the caller destroys the view). */
+static ob_perspective_view *side_view(ob_test_world *w, const double eye[3], const double target[3])
+{
+    ob_result r;
+    ob_node *cam = ob_node_create(w->scene, NULL, "side-camera", &r);
+    assert_non_null(cam);
+    assert_int_equal(ob_node_set_camera(cam, &(ob_camera_desc){.fovy = 0.6f}), OB_OK);
+    ob_node_set_position(cam, eye);
+    assert_int_equal(ob_node_look_at(cam, target, (const double[3]){0, 1, 0}), OB_OK);
+    ob_perspective_view *side = ob_perspective_view_create(w->views,
+        &(ob_perspective_desc){.name = "side", .camera = cam, .width = w->width,
+                               .height = w->height, .clear_color = {0.3f, 0.3f, 0.3f, 1}}, &r);
+    assert_non_null(side);
+    return side;
+}
+
 /* Two cameras see one mirror: its environment map is rendered once, before
  * both, so the second camera's image is what it would be on its own. */
 static void second_camera_sees_this_frames_env_map(void **state)
@@ -204,17 +221,7 @@ static void second_camera_sees_this_frames_env_map(void **state)
         ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 0);
         ob_test_world_entity(&w, NULL, "red", w.box, red, -1.5, 0, 0);
         ob_test_world_entity(&w, NULL, "green", w.box, green, 1.5, 0, 0);
-        ob_result r;
-        ob_node *side_cam = ob_node_create(w.scene, NULL, "side-camera", &r);
-        assert_non_null(side_cam);
-        assert_int_equal(ob_node_set_camera(side_cam, &(ob_camera_desc){.fovy = 0.6f}), OB_OK);
-        ob_node_set_position(side_cam, (const double[3]){0.5, 0.5, -3.0});
-        assert_int_equal(ob_node_look_at(side_cam, (const double[3]){0, 0, 0},
-                                         (const double[3]){0, 1, 0}), OB_OK);
-        ob_perspective_view *side = ob_perspective_view_create(w.views,
-            &(ob_perspective_desc){.name = "side", .camera = side_cam, .width = w.width,
-                                   .height = w.height, .clear_color = {0.3f, 0.3f, 0.3f, 1}}, &r);
-        assert_non_null(side);
+        ob_perspective_view *side = side_view(&w, (const double[3]){0.5, 0.5, -3.0}, (const double[3]){0, 0, 0});
         /* Run 0: the side view alone. Run 1: the main camera first, which
          * queues the mirror's map before the side view asks for it. */
         ob_view *roots[2] = {ob_composite_view_base(w.composite), ob_perspective_view_base(side)};
@@ -232,6 +239,91 @@ static void second_camera_sees_this_frames_env_map(void **state)
     assert_int_equal(ob_test_image_max_diff(side_images[0], side_images[1], 160, 120), 0);
     free(side_images[0]);
     free(side_images[1]);
+}
+
+/* Issue 25.5: a sun's shadow map is fitted and culled for the first camera
+ * that asks for it. A second camera in the same frame (one looking at
+ * casters far away) once refitted it after the first had culled it, and
+ * the main camera's box lost its shadow. Its image is now the same as with
+ * one camera, whether the two PreRenders run one after the other or as one
+ * (ob_views_render_many). */
+static void second_camera_leaves_the_main_cameras_shadow(void **state)
+{
+    (void)state;
+    uint8_t *main_images[4] = {NULL, NULL, NULL, NULL};
+    for (int run = 0; run < 4; run++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_test_world_look(&w, 0, 3, 5, 0, 0, 0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, run != 3, 1.0f, 2, 6, 1);
+        ob_material *grey = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
+        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+        ob_test_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
+        ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        /* What only the side camera sees: casters 40 units away. */
+        ob_test_world_entity(&w, NULL, "far ground", w.plane, grey, 40, -0.5, 0);
+        ob_test_world_entity(&w, NULL, "far box", w.box, red, 40, 0, 0);
+        ob_perspective_view *side = side_view(&w, (const double[3]){40, 3, 5}, (const double[3]){40, 0, 0});
+        /* Run 0: the main camera alone; 1: then the side camera, one
+         * PreRender each; 2: both in one PreRender; 3: the main camera
+         * alone, the sun casting no shadow. */
+        ob_view *roots[2] = {ob_composite_view_base(w.composite), ob_perspective_view_base(side)};
+        if (run != 2) {
+            frame_from_roots(&w, roots, run == 1 ? 2 : 1, OB_THREADING_SINGLE);
+        } else {
+            assert_int_equal(ob_scene_update(w.scene, 1.0 / 60.0), OB_OK);
+            assert_int_equal(ob_renderer_begin_frame(w.r, w.scene), OB_OK);
+            ob_views_render_many(w.views, roots, 2);
+            assert_int_equal(ob_renderer_end_frame(w.r), OB_OK);
+            assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
+        }
+        assert_int_equal(ob_test_count_views(ob_renderer_last_stats(w.r), OB_VIEW_SHADOW), run != 3);
+        ob_test_world_read(&w);
+        main_images[run] = ob_test_world_copy(&w);
+        ob_perspective_view_destroy(w.views, side);
+        ob_test_world_destroy(&w);
+    }
+    /* The shadow is there to lose. */
+    uint32_t shadow_px = ob_test_image_diff_count(main_images[0], main_images[3], 160, 120, 2);
+    assert_true(shadow_px > 40);
+    for (int run = 1; run < 3; run++) {
+        uint32_t n = ob_test_image_diff_count(main_images[0], main_images[run], 160, 120, 0);
+        if (n) fail_msg("run %d: %u pixels of the main camera differ from the one-camera frame", run, n);
+    }
+    for (int run = 0; run < 4; run++) free(main_images[run]);
+}
+
+/* Issue 25.6: the lit shader shades the first directional light with the
+ * one ShadowMap. With a second shadow-casting sun, its map was bound last
+ * and shaded the first sun's light. Now only the shaded light gets a shadow
+ * view (the other is reported not needed), and the image is the one where
+ * the second sun casts no shadow. */
+static void second_shadow_casting_sun_leaves_the_first_ones_shadow(void **state)
+{
+    (void)state;
+    uint8_t *images[2];
+    for (int run = 0; run < 2; run++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_test_world_look(&w, 0, 3, 5, 0, 0, 0);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 6, 1);
+        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, run == 0, 1.0f, -6, 2, -1);
+        ob_material *grey = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
+        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+        ob_test_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
+        ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_view *root = ob_composite_view_base(w.composite);
+        const ob_frame_stats *st = frame_from_roots(&w, &root, 1, OB_THREADING_SINGLE);
+        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
+        if (run == 0) assert_int_equal(ob_test_count_skipped(st, OB_SKIP_NOT_NEEDED), 1);
+        ob_test_world_read(&w);
+        images[run] = ob_test_world_copy(&w);
+        ob_test_world_destroy(&w);
+    }
+    uint32_t n = ob_test_image_diff_count(images[0], images[1], 160, 120, 0);
+    if (n) fail_msg("%u pixels differ from the frame where only the first sun casts a shadow", n);
+    free(images[0]);
+    free(images[1]);
 }
 
 /* ------------------------------------------------------------ recursion */
@@ -587,6 +679,8 @@ int main(void)
         cmocka_unit_test(dependencies_run_before_consumers),
         cmocka_unit_test(shared_dependency_runs_before_every_consumer),
         cmocka_unit_test(second_camera_sees_this_frames_env_map),
+        cmocka_unit_test(second_camera_leaves_the_main_cameras_shadow),
+        cmocka_unit_test(second_shadow_casting_sun_leaves_the_first_ones_shadow),
         cmocka_unit_test(view_chain_stops_at_recursion_bound),
         cmocka_unit_test(view_cycle_is_queued_once),
         cmocka_unit_test(mirror_spheres_stop_at_recursion_bound),

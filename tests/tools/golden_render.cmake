@@ -3,7 +3,8 @@
 # or absolute) headless with ${BIN}/obelisk-view at 160x120 (unless ARGS
 # give --size), --threads THREADS and validation on, into PNG; any failure
 # (exit status, an [error] line, a validation message, no image) stops the
-# script with obelisk-view's output.
+# script with obelisk-view's output. Sets OB_GOLDEN_DEVICE to the device's
+# name as obelisk-view printed it.
 
 function(ob_golden_input input out_var)
   if(IS_ABSOLUTE ${input})
@@ -32,5 +33,10 @@ function(ob_golden_render input png threads)
   endif()
   if(NOT EXISTS ${png})
     message(FATAL_ERROR "${cmd}: ${png} was not written\n${out}\n${err}")
+  endif()
+  # The device obelisk-view ran on ("obelisk-view: INPUT: DEVICE, WxH, mode"),
+  # for per-device tolerances (golden_test.cmake).
+  if("${out}${err}" MATCHES "obelisk-view: [^\n]*: ([^\n]*), [0-9]+x[0-9]+, [a-z-]+")
+    set(OB_GOLDEN_DEVICE "${CMAKE_MATCH_1}" PARENT_SCOPE)
   endif()
 endfunction()

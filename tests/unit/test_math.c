@@ -298,7 +298,8 @@ static void normalize_refuses_zero_and_non_finite(void **state)
 }
 
 /* The normal matrix as first written (columns c1 x c2, c2 x c0, c0 x c1 of
- * the float world, rescaled by a power of two outside 2^+-60): the inline
+ * the float world, rescaled by a power of two outside 2^+-60, negated when
+ * the determinant is negative): the inline
  * one the scene update uses must give the same bits for every input. */
 static void reference_normal_cofactor(const float w[16], float dest[16])
 {
@@ -322,6 +323,12 @@ static void reference_normal_cofactor(const float w[16], float dest[16])
         dest[i * 4 + 2] = a[0] * b[1] - a[1] * b[0];
         dest[i * 4 + 3] = 0.0f;
     }
+    /* Times the sign of the determinant: a mirroring world keeps its
+     * normals outward (issue 25.7). */
+    double det = (double)c[0][0] * dest[0] + (double)c[0][1] * dest[1] + (double)c[0][2] * dest[2];
+    if (det < 0.0)
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) dest[i * 4 + k] = -dest[i * 4 + k];
     dest[12] = dest[13] = dest[14] = 0.0f;
     dest[15] = 1.0f;
 }
