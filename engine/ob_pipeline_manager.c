@@ -873,10 +873,7 @@ ob_result ob_pipeline_manager_draw_indexed(ob_pipeline_manager *pm, uint32_t ind
 ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_data *d,
                                         const float world_normal[32])
 {
-    if (world_normal) {
-        pm->world = world_normal;
-        pm->world_pending = true;
-    }
+    if (world_normal) ob_pipeline_manager_set_world(pm, world_normal);
     pm->vb = d->vertex_buffer;
     pm->vb_offset = d->vertex_buffer_offset;
     ob_result r;
