@@ -68,6 +68,7 @@ typedef struct bound_state {
     uint8_t push[OB_PUSH_CONSTANT_MAX];
     bool push_valid;
     VkBuffer vb, ib;
+    VkBuffer instances;         /* binding 1: the ring chunk of the per-instance blocks */
     uint32_t vb_id, ib_id;      /* handles of vb and ib: an equal id needs no lookup */
     uint64_t vb_offset, ib_offset;
     VkIndexType index_type;
@@ -188,13 +189,15 @@ static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
     memset(c, 0, sizeof *c);
 }
 
-/* A host-visible, coherent, persistently mapped uniform buffer, through the
- * resources' one buffer path. [own thread] */
+/* A host-visible, coherent, persistently mapped buffer of uniform blocks and
+ * per-instance blocks, through the resources' one buffer path. [own thread] */
 static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
 {
     ob_res_vk_buffer b;
     memset(c, 0, sizeof *c);
-    ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+    ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size,
+                                        VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
+                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
                                             VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                                         true, "uniform ring of pipeline manager", pm->name, &b);
@@ -321,14 +324,14 @@ void ob_pipeline_manager_set_scissor(ob_pipeline_manager *pm, int32_t x, int32_t
 
 /* ------------------------------------------------------------ uniform ring */
 
-static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *out_chunk,
-                            uint32_t *out_offset)
+static ob_result ring_alloc_aligned(ob_pipeline_manager *pm, uint32_t size, uint32_t align,
+                                    uint32_t *out_chunk, uint32_t *out_offset)
 {
     frame_ring *fr = pm->ring;
     for (;;) {
         if (fr->current < fr->chunk_count) {
             ring_chunk *c = &fr->chunks[fr->current];
-            uint64_t off = (c->used + pm->ubo_align - 1) & ~(uint64_t)(pm->ubo_align - 1);
+            uint64_t off = (c->used + align - 1) / align * align;
             if (off + size <= c->size) {
                 c->used = off + size;
                 *out_chunk = fr->current;
@@ -343,6 +346,12 @@ static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *ou
         if (r != OB_OK) return r;
         fr->chunk_count++;
     }
+}
+
+static ob_result ring_alloc(ob_pipeline_manager *pm, uint32_t size, uint32_t *out_chunk,
+                            uint32_t *out_offset)
+{
+    return ring_alloc_aligned(pm, size, pm->ubo_align, out_chunk, out_offset);
 }
 
 /* The cache entry of a mapping, claimed for this frame: its own entry, or a
@@ -836,6 +845,7 @@ static inline ob_result draw_plain(ob_pipeline_manager *pm, uint32_t vertex_coun
     h = ob_hash_u64(h, ((uint64_t)vertex_count << 32) | instance_count);
     fold(pm, ob_hash_u64(h, ((uint64_t)first_vertex << 32) | first_instance));
     pm->stats.draws++;
+    pm->stats.draw_calls++;
     return OB_OK;
 }
 
@@ -853,6 +863,7 @@ static inline ob_result draw_indexed(ob_pipeline_manager *pm, uint32_t index_cou
                            ((uint64_t)first_instance * 0x9e3779b97f4a7c15ull));
     fold(pm, h);
     pm->stats.draws++;
+    pm->stats.draw_calls++;
     return OB_OK;
 }
 
@@ -891,6 +902,79 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
     return r;
 }
 
+bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm)
+{
+    return pm->program && pm->program->instanced;
+}
+
+ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                             const float *blocks, uint32_t count)
+{
+    if (count == 0) return OB_OK;
+    if (!pm->program || !pm->program->instanced) {
+        pm->stats.skipped_draws += count;
+        log_once(pm, "instanced draw with a program that reads no per-instance block");
+        return OB_ERR_WRONG_STATE;
+    }
+    /* The blocks go to this frame's ring, at a multiple of the block size
+     * from the chunk's start: the chunk is bound once at offset 0 and the
+     * draw's first instance picks the blocks. */
+    uint32_t chunk, off, size = count * OB_INSTANCE_STRIDE;
+    if (size > pm->chunk_size) {
+        pm->stats.skipped_draws += count;
+        log_once(pm, "an instanced draw's blocks do not fit a ring chunk");
+        return OB_ERR_LIMIT;
+    }
+    ob_result r = ring_alloc_aligned(pm, size, OB_INSTANCE_STRIDE, &chunk, &off);
+    if (r != OB_OK) {
+        pm->stats.skipped_draws += count;
+        log_once(pm, "the ring could not grow for per-instance blocks");
+        return r;
+    }
+    memcpy(pm->ring->chunks[chunk].mapped + off, blocks, size);
+    pm->world_pending = false;
+    pm->vb = d->vertex_buffer;
+    pm->vb_offset = d->vertex_buffer_offset;
+    bool indexed = d->index_buffer.id != 0;
+    if (indexed) {
+        pm->ib = d->index_buffer;
+        pm->ib_offset = d->index_buffer_offset;
+        pm->index_type = d->index_type;
+    }
+    uint64_t h;
+    r = apply(pm, indexed, &h);
+    if (r != OB_OK) {
+        pm->stats.skipped_draws += count - 1;  /* apply counted one */
+        return r;
+    }
+    VkBuffer vk = pm->ring->chunks[chunk].vk;
+    if (pm->cur.instances != vk) {
+        const VkDeviceSize zero = 0;
+        vkCmdBindVertexBuffers(pm->cmd, 1, 1, &vk, &zero);
+        pm->cur.instances = vk;
+        pm->stats.vertex_binds_issued++;
+    }
+    uint32_t first = off / OB_INSTANCE_STRIDE;
+    if (indexed)
+        vkCmdDrawIndexed(pm->cmd, d->count, count, d->first, d->vertex_offset, first);
+    else
+        vkCmdDraw(pm->cmd, d->count, count, d->first, first);
+    /* One fold per instance, as a draw of it alone would give: the hash
+     * does not depend on how a run is cut into draws (recording jobs cut
+     * draw lists anywhere). */
+    uint64_t tail = indexed ? (((uint64_t)d->first << 32) | (uint32_t)d->vertex_offset)
+                            : ((uint64_t)d->first << 32);
+    for (uint32_t k = 0; k < count; k++) {
+        uint64_t hk = ob_hash_block(h, blocks + 32u * k, 64);
+        hk = ob_hash_u64(hk, ((uint64_t)d->count << 32) | 1u);
+        fold(pm, ob_hash_u64(hk, tail));
+    }
+    pm->stats.draws += count;
+    pm->stats.draw_calls++;
+    pm->stats.instances += count;
+    return OB_OK;
+}
+
 /* The indirect draws: args checked, state applied, the command and its
  * hash (the arguments are read by the device, so their buffer, offset and
  * count are what the hash can know). */
@@ -914,6 +998,7 @@ static ob_result draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t
     h = ob_hash_u64(h, ((uint64_t)args.id << 32) | draw_count);
     fold(pm, ob_hash_u64(h, offset ^ (indexed ? 0x8000000000000000ull : 0u)));
     pm->stats.draws++;
+    pm->stats.draw_calls++;
     return OB_OK;
 }
 

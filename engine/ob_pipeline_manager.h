@@ -57,7 +57,9 @@ static inline ob_cmd_hash ob_cmd_hash_concat(ob_cmd_hash a, ob_cmd_hash b)
 }
 
 typedef struct ob_pipeline_manager_stats {
-    uint32_t draws, dispatches;
+    uint32_t draws, dispatches;     /* draws: entities (an instanced draw counts each instance) */
+    uint32_t draw_calls;            /* draw commands recorded */
+    uint32_t instances;             /* instances drawn by instanced draws (of draws) */
     uint32_t pipeline_binds_requested, pipeline_binds_issued;
     uint32_t descriptor_binds_requested, descriptor_binds_issued;  /* set 0 (dynamic UBOs) */
     uint32_t push_descriptor_requested, push_descriptor_issued;     /* set 1 */
@@ -147,6 +149,16 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
 /* draw_count draws of VkDrawIndirectCommand (VkDrawIndexedIndirectCommand
  * for the indexed one, which needs an index buffer set) read from args at
  * offset, tightly packed. */
+/* Whether the program set reads the per-draw block per instance
+ * (ob_program.instanced): then draws go through draw_instances. */
+bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
+/* count instances of d in one draw: blocks holds count per-draw blocks (32
+ * floats each, as ob_render_proxy_per_draw gives them, all finite), copied
+ * into this frame's ring. The command hash folds one value per instance, the
+ * same whatever the count, so a run cut into several draws hashes alike.
+ * OB_ERR_WRONG_STATE when the program is not instanced. */
+ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                             const float *blocks, uint32_t count);
 ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
                               uint32_t draw_count);
 ob_result ob_pipeline_manager_draw_indexed_indirect(ob_pipeline_manager *pm, ob_buffer args,

@@ -635,19 +635,30 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
 /* Items ahead of the one being drawn whose proxy is prefetched. */
 #define PROXY_PREFETCH 16u
 
+/* Instances gathered before a draw: a longer run takes several draws (its
+ * hash is the same either way). 16 KiB of stack. */
+#define RUN_BLOCKS 128u
+
+static void log_not_finite(const ob_view *v, const ob_render_proxy *p)
+{
+    OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
+             "(or its derived matrices); not drawn", v->name, ob_node_name(p->node), p->node_id);
+}
+
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                           uint32_t first, uint32_t count)
 {
     const ob_material_iface *mi = ob_renderer_get_material_iface(r);
     const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     /* Items are sorted by state: a run of one material is applied once, a
-     * run of one geometry asks for its draw data once. */
+     * run of one geometry asks for its draw data once, and with an
+     * instanced program a run of both is one draw. */
     const struct ob_material *applied = NULL;
     const struct ob_geometry *described = NULL;
     ob_draw_data dd = {0};
-    _Alignas(16) float m[32];
+    _Alignas(16) float blocks[RUN_BLOCKS][32];
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
-    for (uint32_t i = first; i < end; i++) {
+    for (uint32_t i = first; i < end;) {
         /* Items are in draw order, proxies in id order: fetch a few ahead so
          * the loop does not wait on memory. */
         if (i + PROXY_PREFETCH < end) {
@@ -656,23 +667,49 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
             __builtin_prefetch((const char *)ahead + 64);
         }
         const ob_render_proxy *p = &v->proxies[v->items[i].proxy];
-        if (!p->material) continue;
+        if (!p->material) {
+            i++;
+            continue;
+        }
         if (p->material != applied) {
             ob_apply_result a = mi->apply(p->material, p->node, r, pm, v);
             applied = a == OB_APPLY_MATERIAL ? p->material : NULL;
-            if (a == OB_APPLY_SKIP) continue;
+            if (a == OB_APPLY_SKIP) {
+                i++;
+                continue;
+            }
         }
-        /* A refused matrix is not drawn (a stale one would put this entity
-         * where the previous one was). */
         if (p->geometry != described) {
             gi->draw_data(p->geometry, &dd);
             described = p->geometry;
         }
-        bool finite = ob_render_proxy_per_draw(p, v->origin, m);
-        if (!finite || ob_pipeline_manager_draw_data(pm, &dd, m) == OB_ERR_NON_FINITE)
-            OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
-                     "(or its derived matrices); not drawn", v->name, ob_node_name(p->node),
-                     p->node_id);
+        if (!ob_pipeline_manager_instanced(pm)) {
+            /* A refused matrix is not drawn (a stale one would put this
+             * entity where the previous one was). */
+            bool finite = ob_render_proxy_per_draw(p, v->origin, blocks[0]);
+            if (!finite || ob_pipeline_manager_draw_data(pm, &dd, blocks[0]) == OB_ERR_NON_FINITE)
+                log_not_finite(v, p);
+            i++;
+            continue;
+        }
+        /* The run: this item and the next ones of the material applied for
+         * all (an entity-dependent one is applied per item) and this mesh. */
+        uint32_t n = 0, j = i;
+        do {
+            const ob_render_proxy *q = &v->proxies[v->items[j].proxy];
+            if (j + PROXY_PREFETCH < end) {
+                const ob_render_proxy *ahead = &v->proxies[v->items[j + PROXY_PREFETCH].proxy];
+                __builtin_prefetch(ahead);
+                __builtin_prefetch((const char *)ahead + 64);
+            }
+            if (ob_render_proxy_per_draw(q, v->origin, blocks[n])) n++;
+            else log_not_finite(v, q);
+            j++;
+        } while (j < end && n < RUN_BLOCKS && applied &&
+                 v->proxies[v->items[j].proxy].material == applied &&
+                 v->proxies[v->items[j].proxy].geometry == p->geometry);
+        if (n) ob_pipeline_manager_draw_instances(pm, &dd, &blocks[0][0], n);
+        i = j;
     }
 }
 

@@ -35,7 +35,8 @@ struct ob_effect {
     float depth_bias_constant, depth_bias_slope;
     uint32_t stride;
     uint32_t attribute_count;                    /* only those the shader reads */
-    VkVertexInputAttributeDescription attributes[OB_EFFECT_MAX_ATTRIBUTES];
+    VkVertexInputAttributeDescription attributes[OB_EFFECT_MAX_INPUTS];
+    bool instanced;                              /* binding 1: the per-instance block */
 
     pthread_mutex_t lock;
     _Atomic uint32_t pipeline_count;
@@ -310,6 +311,17 @@ static ob_result resolve_vertex_input(ob_effect *e, const ob_effect_desc *desc,
     if (layout) e->stride = layout->stride;
     for (uint32_t i = 0; i < vs->vertex_input_count; i++) {
         const ob_vertex_input *in = &vs->vertex_inputs[i];
+        if (in->location >= OB_INSTANCE_LOCATION && in->location < OB_INSTANCE_LOCATION + 7u) {
+            /* The per-instance block: column k at byte 16 k of binding 1. */
+            e->attributes[e->attribute_count++] = (VkVertexInputAttributeDescription){
+                .location = in->location,
+                .binding = 1,
+                .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                .offset = 16u * (in->location - OB_INSTANCE_LOCATION),
+            };
+            e->instanced = true;
+            continue;
+        }
         bool found = false;
         for (uint32_t a = 0; layout && a < layout->attribute_count; a++) {
             if (layout->attributes[a].location != in->location) continue;
@@ -436,6 +448,7 @@ ob_effect *ob_effect_create(ob_effect_context *ctx, const ob_effect_desc *desc,
         e->program = ob_program_create(ctx->dev, ctx->reg, &merged, e->compute, e->name, &r);
         if (!e->program)
             OB_LOG_E("effect", "effect '%s': program not created: %s", e->name, ob_result_text(r));
+        else e->program->instanced = e->instanced;
     }
     ob_reflection_release(&merged);
     if (r != OB_OK) goto fail_destroy_effect;
@@ -479,11 +492,14 @@ static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, ui
 {
     VkPipelineShaderStageCreateInfo stages[2];
     for (uint32_t i = 0; i < e->stage_count; i++) stages[i] = stage_info(e, i);
-    VkVertexInputBindingDescription binding = {0, e->stride, VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputBindingDescription bindings[2] = {
+        {0, e->stride, VK_VERTEX_INPUT_RATE_VERTEX},
+        {1, OB_INSTANCE_STRIDE, VK_VERTEX_INPUT_RATE_INSTANCE},
+    };
     VkPipelineVertexInputStateCreateInfo vi = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = e->attribute_count ? 1u : 0u,
-        .pVertexBindingDescriptions = &binding,
+        .vertexBindingDescriptionCount = e->instanced ? 2u : e->attribute_count ? 1u : 0u,
+        .pVertexBindingDescriptions = bindings,
         .vertexAttributeDescriptionCount = e->attribute_count,
         .pVertexAttributeDescriptions = e->attributes,
     };

@@ -37,6 +37,9 @@ extern "C" {
 #endif
 
 #define OB_EFFECT_MAX_ATTRIBUTES 8
+/* Vertex inputs of the pipeline: the layout's, and the per-instance block's
+ * seven (ob_program.instanced). */
+#define OB_EFFECT_MAX_INPUTS (OB_EFFECT_MAX_ATTRIBUTES + 7u)
 #define OB_EFFECT_MAX_PIPELINES 16
 
 /* Vertex input of an effect: one interleaved vertex buffer (binding 0).

@@ -16,9 +16,11 @@ typedef struct effect_choice {
 /* ------------------------------------------------------- standard effects */
 
 static const uint32_t allowed_variants[OB_STD_EFFECT_COUNT] = {
-    [OB_STD_LIT] = OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP | OB_VARIANT_BLENDED,
-    [OB_STD_PARABOLOID] = OB_VARIANT_BLENDED,
-    [OB_STD_UNLIT] = OB_VARIANT_BLENDED,
+    [OB_STD_LIT] = OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP | OB_VARIANT_BLENDED |
+                   OB_VARIANT_INSTANCED,
+    [OB_STD_DEPTH] = OB_VARIANT_INSTANCED,
+    [OB_STD_PARABOLOID] = OB_VARIANT_BLENDED | OB_VARIANT_INSTANCED,
+    [OB_STD_UNLIT] = OB_VARIANT_BLENDED | OB_VARIANT_INSTANCED,
 };
 
 static const char *const std_names[OB_STD_EFFECT_COUNT] = {
@@ -28,18 +30,20 @@ static const char *const std_names[OB_STD_EFFECT_COUNT] = {
 
 static void variant_name(ob_std_effect kind, uint32_t variant, char *out, size_t cap)
 {
-    snprintf(out, cap, "%s%s%s%s", std_names[kind],
+    snprintf(out, cap, "%s%s%s%s%s", std_names[kind],
              variant & OB_VARIANT_SHADOWS ? "+SHADOWS" : "",
              variant & OB_VARIANT_ENVMAP ? "+ENVMAP" : "",
-             variant & OB_VARIANT_BLENDED ? "+BLENDED" : "");
+             variant & OB_VARIANT_BLENDED ? "+BLENDED" : "",
+             variant & OB_VARIANT_INSTANCED ? "+INSTANCED" : "");
 }
 
 /* Fills desc (and its defines) for a standard variant. */
 static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_t variant,
-                     ob_effect_desc *desc, ob_shader_define defines[3])
+                     ob_effect_desc *desc, ob_shader_define defines[4])
 {
     bool blended = variant & OB_VARIANT_BLENDED;
     uint32_t n = 0;
+    if (variant & OB_VARIANT_INSTANCED) defines[n++] = (ob_shader_define){"INSTANCED", "1"};
     *desc = (ob_effect_desc){
         .layout = &lib->standard_layout,
         .depth_test = true,
@@ -128,7 +132,7 @@ ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect ki
     if (!e && r == OB_OK) {
         char name[64];
         ob_effect_desc desc;
-        ob_shader_define defines[3];
+        ob_shader_define defines[4];
         variant_name(kind, variant, name, sizeof name);
         std_desc(lib, kind, variant, &desc, defines);
         desc.name = name;
@@ -139,6 +143,16 @@ ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect ki
     }
     if (out_result) *out_result = e ? OB_OK : r;
     return e;
+}
+
+void ob_material_library_set_instancing(ob_material_library *lib, bool on)
+{
+    if (lib) lib->instancing = on;
+}
+
+bool ob_material_library_instancing(const ob_material_library *lib)
+{
+    return lib && lib->instancing;
 }
 
 /* ---------------------------------------------------------------- library */
@@ -270,6 +284,7 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
         goto fail_log;
     }
     lib->ctx = ctx;
+    lib->instancing = true;
     lib->dev = ob_effect_context_device(ctx);
     lib->reg = ob_effect_context_registry(ctx);
     lib->standard_layout = d.standard_layout ? *d.standard_layout : builtin_standard_layout;
@@ -516,25 +531,27 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
     }
     uint32_t blended = m->blended ? OB_VARIANT_BLENDED : 0u;
     out->standard = true;
+    uint32_t instanced = m->lib->instancing ? OB_VARIANT_INSTANCED : 0u;
     switch (v->type) {
     case OB_VIEW_PERSPECTIVE:
         if (m->kind == OB_MATERIAL_UNLIT) {
             out->kind = OB_STD_UNLIT;
-            out->variant = blended;
+            out->variant = blended | instanced;
             return true;
         }
         out->kind = OB_STD_LIT;
-        out->variant = blended;
+        out->variant = blended | instanced;
         if (ob_material_view_depends_on(v, OB_VIEW_SHADOW)) out->variant |= OB_VARIANT_SHADOWS;
         if (m->kind == OB_MATERIAL_REFLECTIVE && ob_material_attached_env_map(r, entity))
             out->variant |= OB_VARIANT_ENVMAP;
         return true;
     case OB_VIEW_SHADOW:
         out->kind = OB_STD_DEPTH;
+        out->variant = instanced;
         return true;
     case OB_VIEW_PARABOLOID:
         out->kind = OB_STD_PARABOLOID;
-        out->variant = blended;
+        out->variant = blended | instanced;
         return true;
     case OB_VIEW_OVERLAY:
         out->kind = OB_STD_OVERLAY;

@@ -134,6 +134,8 @@ typedef enum ob_std_variant {
     OB_VARIANT_SHADOWS = 1u << 0,  /* lit: shadowed directional light */
     OB_VARIANT_ENVMAP = 1u << 1,   /* lit: paraboloid environment lookup */
     OB_VARIANT_BLENDED = 1u << 2,  /* lit/paraboloid/unlit: alpha blended, no depth write */
+    OB_VARIANT_INSTANCED = 1u << 3, /* lit/depth/paraboloid/unlit: the per-draw block per
+                                       instance (ob_material_library_set_instancing) */
 } ob_std_variant;
 
 /* A view type of a material: render flag and the base effect (NULL until the
@@ -191,6 +193,12 @@ typedef struct ob_material_library_desc {
 ob_material_library *ob_material_library_create(ob_effect_context *ctx,
                                                 const ob_material_library_desc *desc,
                                                 ob_result *out_result);
+/* Whether the standard effects draw instanced (default true): a run of
+ * entities of one material and mesh is then one draw. false keeps one draw
+ * per entity (the per-draw push block), for comparison and tests. Takes
+ * effect at the next PreRender. [render thread, between frames] */
+void ob_material_library_set_instancing(ob_material_library *lib, bool on);
+bool ob_material_library_instancing(const ob_material_library *lib);
 /* Destroys every material and effect of the library and its samplers. NULL ok. */
 void ob_material_library_destroy(ob_material_library *lib);
 void ob_material_library_set_queue_hook(ob_material_library *lib, ob_material_queue_fn fn,

@@ -14,7 +14,7 @@
 #include "ob_material.h"
 #include "ob_renderer_layer.h"
 
-#define VARIANT_COUNT 8u   /* every combination of the ob_std_variant bits */
+#define VARIANT_COUNT 16u  /* every combination of the ob_std_variant bits */
 
 typedef struct std_slot {
     _Atomic(ob_effect *) effect;   /* published once created; read while recording */
@@ -45,6 +45,7 @@ struct ob_material_library {
     ob_param_registry *reg;
     ob_effect_vertex_input standard_layout, text_layout, extended_layout;
     float bias_constant, bias_slope;
+    bool instancing;               /* standard effects draw the INSTANCED variant */
     std_slot slots[OB_STD_EFFECT_COUNT][VARIANT_COUNT];
     ob_material_queue_fn queue_fn;
     void *queue_user;

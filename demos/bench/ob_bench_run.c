@@ -486,7 +486,7 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->record_cpu_max_worker_ms = MEDIAN(m, SAMPLE_IDLE, cpu_max_worker_ms);
         o->cmd_host_allocs_per_object = MEDIAN(m, SAMPLE_IDLE, host_allocs_per_object);
         const ob_pipeline_manager_stats *p = &o->pm;
-        uint64_t commands = (uint64_t)p->draws + p->dispatches + p->pipeline_binds_issued +
+        uint64_t commands = (uint64_t)p->draw_calls + p->dispatches + p->pipeline_binds_issued +
                             p->descriptor_binds_issued + p->push_descriptor_issued +
                             p->push_constant_issued + p->vertex_binds_issued + p->index_binds_issued;
         o->commands_per_object = p->draws ? (double)commands / p->draws : NAN;

@@ -44,6 +44,7 @@
 typedef struct bench_options {
     bool quick, progress;
     bool perf, stability;      /* which sections run */
+    bool no_instancing;        /* --no-instancing: one draw per entity */
     ob_gpu_timing gpu_timing;  /* --gpu-timing */
     const char *json, *csv, *charts;
     uint32_t seed;
@@ -65,6 +66,7 @@ static const char usage_text[] =
     "                     ST,2,auto, and 50000 objects in 1 view only)\n"
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
+    "  --no-instancing    one draw per entity (the per-draw push block), for comparison\n"
     "  --gpu-timing sampled|views|off   GPU timestamps: the frame's every frame and each\n"
     "                     view's every 16th (default), every view every frame, or none\n"
     "  --json FILE        write every result and the summary as JSON\n"
@@ -171,6 +173,8 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
             o->progress = takes = false;
         } else if (!strcmp(a, "--stability-only")) {
             o->perf = takes = false;
+        } else if (!strcmp(a, "--no-instancing")) {
+            o->no_instancing = true;
         } else if (!strcmp(a, "--no-stability")) {
             o->stability = takes = false;
 
@@ -374,6 +378,7 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     ob_demo d;
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &dopt);
+    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.stack->materials, false);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_SWEEP, .objects = objects, .views = views,
                               .seed = o->seed};
     if (r == OB_OK && !rep->device_name[0]) {
@@ -429,6 +434,7 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
     ob_demo d;
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &dopt);
+    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.stack->materials, false);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_MIRROR, .objects = 200, .seed = o->seed};
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
     ob_bench_mode modes[3] = {{"ST", OB_THREADING_SINGLE, 0},

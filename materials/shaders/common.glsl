@@ -47,11 +47,31 @@ layout(set = 0, binding = 1, std140) uniform PerMaterial {
     vec4 Reflectivity;         // x = mix factor of the environment map
 };
 
+#if defined(INSTANCED)
+// Instanced (the INSTANCED variant): the per-draw block comes per instance
+// from a vertex buffer of instance rate (binding 1, 128 bytes an instance,
+// the same 32 floats as the push block), so one draw covers a run of
+// entities with one material and mesh. Only the vertex stage reads it;
+// a vertex shader says which it is with OB_VERTEX_STAGE before including
+// this file.
+#if defined(OB_VERTEX_STAGE)
+layout(location = 8) in vec4 obInstanceWorld0;
+layout(location = 9) in vec4 obInstanceWorld1;
+layout(location = 10) in vec4 obInstanceWorld2;
+layout(location = 11) in vec4 obInstanceWorld3;
+layout(location = 12) in vec4 obInstanceNormal0;
+layout(location = 13) in vec4 obInstanceNormal1;
+layout(location = 14) in vec4 obInstanceNormal2;
+#define WorldMatrix mat4(obInstanceWorld0, obInstanceWorld1, obInstanceWorld2, obInstanceWorld3)
+#define NormalMatrix mat4(obInstanceNormal0, obInstanceNormal1, obInstanceNormal2, vec4(0.0, 0.0, 0.0, 1.0))
+#endif
+#else
 // 128 bytes: exactly the smallest push-constant limit (lavapipe's).
 layout(push_constant, std430) uniform PerDraw {
     mat4 WorldMatrix;          // model -> camera-relative world
     mat4 NormalMatrix;         // inverse transpose of WorldMatrix's upper 3x3
 };
+#endif
 
 // normalize() of a zero vector is NaN; a zero scale produces zero normals,
 // and a NaN would poison the whole pixel (and blending around it).

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // lit.vert — standard vertex stage for lit and reflective surfaces.
 // Input: the standard vertex layout (position, normal, uv; stride 32).
+#define OB_VERTEX_STAGE
 #include "common.glsl"
 
 layout(location = 0) in vec3 inPosition;

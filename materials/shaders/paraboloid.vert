@@ -9,6 +9,7 @@
 // reversed-Z like every other view, so anything closer than near is clipped.
 // Fragments of the other hemisphere are discarded in lit.frag (PARABOLOID)
 // through vHemisphere, which avoids needing the shaderClipDistance feature.
+#define OB_VERTEX_STAGE
 #include "common.glsl"
 #include "paraboloid.glsl"
 

@@ -9,6 +9,7 @@
 // passed on, in world space: it transforms with WorldMatrix, not the normal
 // matrix), PARABOLOID (dual-paraboloid projection as paraboloid.vert does),
 // DEPTH_ONLY (shadow pass of ALPHA_MASK materials: position and uv only).
+#define OB_VERTEX_STAGE
 #include "common.glsl"
 #if defined(PARABOLOID)
 #include "paraboloid.glsl"

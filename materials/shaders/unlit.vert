@@ -10,6 +10,7 @@
 //                 stb_easy_font's 16-byte vertices: vec3 position + 4 bytes).
 // Without SCREEN_SPACE positions go through WorldMatrix and ViewProjMatrix
 // like every 3D surface (standard layout: only location 0 is read).
+#define OB_VERTEX_STAGE
 #include "common.glsl"
 
 layout(location = 0) in vec3 inPosition;

@@ -69,6 +69,9 @@ static ob_material_library *make_library(fixture *f)
     assert_non_null(f->ctx);
     ob_material_library *lib = ob_material_library_create(f->ctx, NULL, &r);
     assert_non_null(lib);
+    /* These tests draw through the pipeline manager one entity at a time:
+     * the per-draw variants (test_instanced_variants covers the others). */
+    ob_material_library_set_instancing(lib, false);
     return lib;
 }
 
@@ -678,6 +681,7 @@ static void test_reflective_uses_attached_env_map(void **state)
     assert_non_null(ctx);
     ob_material_library *lib = ob_material_library_create(ctx, NULL, &r);
     assert_non_null(lib);
+    ob_material_library_set_instancing(lib, false); /* the variants below are per-draw */
     const ob_material_iface *mi = ob_material_iface_get();
     ob_pipeline_manager *pm = ob_pipeline_manager_create(&(ob_pipeline_manager_desc){
         .device = dev, .registry = ob_renderer_registry(rd), .name = "test"}, &r);

@@ -88,6 +88,7 @@ static void shared_state_bound_once_single_threaded(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
+    ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
     frame_camera(&w);
     ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
     ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
@@ -129,6 +130,7 @@ static void shared_state_bound_once_per_secondary(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 25});
+    ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
     frame_camera(&w);
     ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
     ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
@@ -175,6 +177,7 @@ static void uniforms_packed_only_after_a_change(void **state)
     for (int c = 0; c < CASES; c++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
+        ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
         frame_camera(&w);
         ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
         ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
@@ -394,6 +397,53 @@ static void primary_and_secondaries_record_the_same(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* Instanced runs draw what one draw per entity draws: the same pixels,
+ * byte for byte, in far fewer draw calls, and the same command hashes in
+ * every threading mode however the runs are cut into recording jobs. */
+static void instanced_runs_draw_what_single_draws_draw(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16});
+    mixed_scene(&w);
+    ob_material_library_set_instancing(w.lib, false);
+    ob_frame_stats single = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
+    assert_int_equal(single.pm.instances, 0);
+    assert_int_equal(single.pm.draw_calls, single.pm.draws);
+
+    ob_material_library_set_instancing(w.lib, true);
+    ob_frame_stats inst = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_test_world_read(&w);
+    assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+    assert_int_equal(inst.pm.draws, single.pm.draws);
+    for (uint32_t i = 0; i < inst.view_count; i++)
+        assert_int_equal(inst.views[i].draws, single.views[i].draws);
+    /* 120 boxes of 4 materials, 10 balls of 2, a ground; a shadow view of
+     * the casters: every entity an instance, in a handful of runs. */
+    assert_true(inst.pm.instances >= 131);
+    assert_true(inst.pm.draw_calls * 4 < inst.pm.draws);
+
+    static const uint32_t workers[] = {1, 2, 4};
+    for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, workers[k]);
+        assert_true(ob_test_view_stats(st, "main")->chunks > 1);
+        for (uint32_t i = 0; i < inst.view_count; i++) {
+            assert_string_equal(st->views[i].name, inst.views[i].name);
+            assert_int_equal(st->views[i].hash.draws, inst.views[i].hash.draws);
+            if (st->views[i].hash.hash != inst.views[i].hash.hash)
+                fail_msg("view '%s': hash %016llx with %u workers, %016llx single-threaded",
+                         inst.views[i].name, (unsigned long long)st->views[i].hash.hash,
+                         workers[k], (unsigned long long)inst.views[i].hash.hash);
+        }
+        assert_true(st->frame_hash == inst.frame_hash);
+        ob_test_world_read(&w);
+        assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+    }
+    free(ref_pixels);
+    ob_test_world_destroy(&w);
+}
+
 /* A view cut into more chunks than one vkCmdExecuteCommands batch holds
  * (one draw per chunk, 300 boxes): every chunk is executed, the image and
  * the hashes are those of the single-threaded frame. */
@@ -586,6 +636,7 @@ int main(void)
         cmocka_unit_test(many_programs_each_read_their_own_uniforms),
         cmocka_unit_test(set_cache_holds_its_bound_across_changing_scenes),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
+        cmocka_unit_test(instanced_runs_draw_what_single_draws_draw),
         cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),
