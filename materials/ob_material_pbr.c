@@ -29,6 +29,7 @@ enum {
     OB_PBR_P_ENVMAP = 1u << 10,
     OB_PBR_P_PARABOLOID = 1u << 11,
     OB_PBR_P_DEPTH = 1u << 12,
+    OB_PBR_P_INSTANCED = 1u << 13,  /* the per-draw block per instance */
 };
 
 /* Define, short name token, and what a report calls the feature. */
@@ -49,8 +50,9 @@ static const struct {
     {OB_PBR_P_ENVMAP, "ENVMAP", "env", NULL},
     {OB_PBR_P_PARABOLOID, "PARABOLOID", "para", NULL},
     {OB_PBR_P_DEPTH, "DEPTH_ONLY", "depth", NULL},
+    {OB_PBR_P_INSTANCED, "INSTANCED", "inst", NULL},
 };
-#define PBR_MAX_DEFINES 13
+#define PBR_MAX_DEFINES 14
 
 static const char *const texture_names[OB_PBR_TEX_COUNT] = {
     "BaseColorTexture", "MetallicRoughnessTexture", "NormalTexture", "OcclusionTexture", "EmissiveTexture",
@@ -145,6 +147,11 @@ static void variant_desc(const ob_material_library *lib, uint32_t key, ob_effect
             /* Nothing to cut out: the plain depth stage reads only the position. */
             desc->vertex = "depth.vert";
             desc->fragment = NULL;
+            if (key & OB_PBR_P_INSTANCED) {
+                defines[0] = (ob_shader_define){"INSTANCED", "1"};
+                desc->define_count = 1;
+                desc->defines = defines;
+            }
             return;
         }
     }
@@ -272,9 +279,10 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
                     uint32_t *out_slot, uint32_t *out_key)
 {
     const uint32_t f = m->pbr.features;
+    const uint32_t inst = m->lib->instancing ? OB_PBR_P_INSTANCED : 0u;
     switch (v->type) {
     case OB_VIEW_PERSPECTIVE: {
-        uint32_t slot = OB_PBR_PASS_MAIN, key = f;
+        uint32_t slot = OB_PBR_PASS_MAIN, key = f | inst;
         if (ob_material_view_depends_on(v, OB_VIEW_SHADOW)) {
             slot |= 1u;
             key |= OB_PBR_P_SHADOWS;
@@ -289,12 +297,12 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
     }
     case OB_VIEW_PARABOLOID:
         *out_slot = OB_PBR_PASS_PARABOLOID;
-        *out_key = OB_PBR_P_PARABOLOID | (f & ~OB_PBR_F_DOUBLE_SIDED);
+        *out_key = OB_PBR_P_PARABOLOID | inst | (f & ~OB_PBR_F_DOUBLE_SIDED);
         return true;
     case OB_VIEW_SHADOW:
         *out_slot = OB_PBR_PASS_DEPTH;
         /* Only a cut-out changes what casts a shadow. */
-        *out_key = OB_PBR_P_DEPTH | (f & OB_PBR_F_DOUBLE_SIDED) |
+        *out_key = OB_PBR_P_DEPTH | inst | (f & OB_PBR_F_DOUBLE_SIDED) |
                    ((f & OB_PBR_F_MASK) ? f & (OB_PBR_F_MASK | OB_PBR_F_BASE | OB_PBR_F_VERTEX_COLOR) : 0u);
         return true;
     default:

@@ -480,8 +480,8 @@ static void variants_only_use_what_the_material_uses(void **state)
     /* Two variants: one per feature set (no shadow, env or depth pass here). */
     assert_int_equal(ob_effect_context_counters(w.fx).variants_compiled - before, 2);
     ob_view *main_view = ob_perspective_view_base(w.main);
-    assert_string_equal(ob_effect_name(ob_material_get_view_effect(mp, w.r, a, main_view, false, &r)), "pbr");
-    assert_string_equal(ob_effect_name(ob_material_get_view_effect(mt, w.r, b, main_view, false, &r)), "pbr:base");
+    assert_string_equal(ob_effect_name(ob_material_get_view_effect(mp, w.r, a, main_view, false, &r)), "pbr:inst");
+    assert_string_equal(ob_effect_name(ob_material_get_view_effect(mt, w.r, b, main_view, false, &r)), "pbr:base+inst");
     char left[256];
     assert_int_equal(ob_material_pbr_left_out(mp, left, sizeof left), 9);
     assert_non_null(strstr(left, "normal texture"));
