@@ -111,6 +111,7 @@ struct ob_pipeline_manager {
     const float *world;         /* ob_pipeline_manager_set_world's world and normal, for the next draw */
     bool world_pending;
     bool world_mirrors;         /* the world's 3x3 has a negative determinant */
+    bool instances_mirror;      /* the same, for the instanced draw being applied */
 
     /* What the last full apply of uniforms and resources was made from: while
      * the program and the slot's parameter serial are unchanged, the bound
@@ -696,7 +697,7 @@ static ob_result apply(ob_pipeline_manager *pm, bool indexed, uint64_t *h)
         return OB_ERR_WRONG_STATE;
     }
     bool world = pm->world_pending;
-    bool mirrors = world && pm->world_mirrors;
+    bool mirrors = world ? pm->world_mirrors : pm->instances_mirror;
     pm->world_pending = false;
     if (world && !prog->push_world_normal) {
         /* Another push layout, or a uniform block reads the world: the
@@ -907,15 +908,10 @@ bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm)
     return pm->program && pm->program->instanced;
 }
 
-ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
-                                             const float *blocks, uint32_t count)
+/* One instanced draw of count blocks that mirror alike (mirrors). */
+static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                   const float *blocks, uint32_t count, bool mirrors)
 {
-    if (count == 0) return OB_OK;
-    if (!pm->program || !pm->program->instanced) {
-        pm->stats.skipped_draws += count;
-        log_once(pm, "instanced draw with a program that reads no per-instance block");
-        return OB_ERR_WRONG_STATE;
-    }
     /* The blocks go to this frame's ring, at a multiple of the block size
      * from the chunk's start: the chunk is bound once at offset 0 and the
      * draw's first instance picks the blocks. */
@@ -942,7 +938,9 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
         pm->index_type = d->index_type;
     }
     uint64_t h;
+    pm->instances_mirror = mirrors;
     r = apply(pm, indexed, &h);
+    pm->instances_mirror = false;
     if (r != OB_OK) {
         pm->stats.skipped_draws += count - 1;  /* apply counted one */
         return r;
@@ -972,6 +970,29 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
     pm->stats.draws += count;
     pm->stats.draw_calls++;
     pm->stats.instances += count;
+    if (count > pm->stats.longest_run) pm->stats.longest_run = count;
+    return OB_OK;
+}
+
+ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                             const float *blocks, uint32_t count)
+{
+    if (count == 0) return OB_OK;
+    if (!pm->program || !pm->program->instanced) {
+        pm->stats.skipped_draws += count;
+        log_once(pm, "instanced draw with a program that reads no per-instance block");
+        return OB_ERR_WRONG_STATE;
+    }
+    /* A mirroring instance needs the other front face: the run is cut
+     * where the determinant's sign changes. */
+    for (uint32_t start = 0; start < count;) {
+        bool mirrors = world_mirrors(blocks + 32u * start);
+        uint32_t end = start + 1;
+        while (end < count && world_mirrors(blocks + 32u * end) == mirrors) end++;
+        ob_result r = draw_instance_run(pm, d, blocks + 32u * start, end - start, mirrors);
+        if (r != OB_OK) return r;
+        start = end;
+    }
     return OB_OK;
 }
 
@@ -1045,4 +1066,5 @@ void ob_pipeline_manager_stats_add(ob_pipeline_manager_stats *into, const ob_pip
     into->skipped_draws += s->skipped_draws;
     /* A level, not a counter: the largest of any manager. */
     if (s->descriptor_sets_held > into->descriptor_sets_held) into->descriptor_sets_held = s->descriptor_sets_held;
+    if (s->longest_run > into->longest_run) into->longest_run = s->longest_run;
 }

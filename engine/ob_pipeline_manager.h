@@ -75,6 +75,9 @@ typedef struct ob_pipeline_manager_stats {
      * largest of any manager in ob_frame_stats); at most 1024 carried into
      * the next frame of that slot, whatever programs came and went. */
     uint32_t descriptor_sets_held;
+    /* The most instances one draw drew (a level: the largest of any
+     * manager, or of a view's recording jobs). */
+    uint32_t longest_run;
 } ob_pipeline_manager_stats;
 
 ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,

@@ -105,6 +105,10 @@ typedef struct ob_view_stats {
     char name[48];
     ob_view_type type;
     uint32_t draws, culled, items;
+    /* Draw commands recorded, the draws among `draws` that were instances
+     * of instanced draws, and the most instances of one draw (one recording
+     * job's: a run cut between two jobs counts as two). */
+    uint32_t draw_calls, instances, longest_run;
     uint32_t chunks;
     int32_t worker;              /* worker of the first chunk; -1 = immediate */
     uint64_t cull_ns, record_ns; /* CPU */

@@ -898,6 +898,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
                     vs->hash = ob_cmd_hash_concat(vs->hash, job->hash);
                     ob_pipeline_manager_stats_add(&st->pm, &job->stats);
                     vs->draws += job->stats.draws;
+                    vs->draw_calls += job->stats.draw_calls;
+                    vs->instances += job->stats.instances;
+                    vs->longest_run = OB_MAX(vs->longest_run, job->stats.longest_run);
                     vs->record_ns += job->record_ns;
                     if (vs->chunks++ == 0) vs->worker = job->worker;
                 }
@@ -915,6 +918,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
         if (!multi) {
             ob_pipeline_manager_stats s = ob_pipeline_manager_stats_take(r->immediate);
             vs->draws = s.draws;
+            vs->draw_calls = s.draw_calls;
+            vs->instances = s.instances;
+            vs->longest_run = s.longest_run;
             ob_pipeline_manager_stats_add(&st->pm, &s);
             vs->record_ns = ob_time_ns() - tv;
         }

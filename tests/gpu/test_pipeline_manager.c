@@ -423,6 +423,14 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
      * the casters: every entity an instance, in a handful of runs. */
     assert_true(inst.pm.instances >= 131);
     assert_true(inst.pm.draw_calls * 4 < inst.pm.draws);
+    const ob_view_stats *main = ob_test_view_stats(&inst, "main");
+    assert_int_equal(main->instances, main->draws);
+    assert_true(main->draw_calls * 4 < main->draws);
+    assert_true(main->longest_run >= 10 && main->longest_run <= main->draws);
+    const ob_view_stats *off = ob_test_view_stats(&single, "main");
+    assert_int_equal(off->instances, 0);
+    assert_int_equal(off->draw_calls, off->draws);
+    assert_int_equal(off->longest_run, 0);
 
     static const uint32_t workers[] = {1, 2, 4};
     for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
