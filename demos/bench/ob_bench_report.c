@@ -190,6 +190,9 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fprintf(f, "\n  %-30s %.0f (ob_nodes_destroy of all), %.0f (one at a time, newest first); "
                "100k entities", "teardown_ns_per_entity", s->teardown_ns_per_entity_batch,
             s->teardown_ns_per_entity_single);
+    fprintf(f, "\n  %-30s %.3f (GPU ms, ST, 10k x 8 views: instanced %.1f, one draw per entity "
+               "%.1f)", "gpu_time_instanced_vs_per_draw", s->gpu_time_instanced_vs_per_draw_10k_8views,
+            s->gpu_ms_10k_8views, s->gpu_ms_10k_8views_per_draw);
     fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
                "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
             "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
@@ -399,6 +402,10 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "amdahl_speedup_16_cores", s->amdahl_speedup_16_cores);
     json_spread(f, "prerender_ns_per_object_view", s->prerender_ns_per_object_view);
     json_spread(f, "update_ns_per_object", s->update_ns_per_object);
+    json_field(f, "gpu_ms_10k_8views", s->gpu_ms_10k_8views);
+    json_field(f, "gpu_ms_10k_8views_per_draw", s->gpu_ms_10k_8views_per_draw);
+    json_field(f, "gpu_time_instanced_vs_per_draw_10k_8views",
+               s->gpu_time_instanced_vs_per_draw_10k_8views);
     json_field(f, "teardown_ns_per_entity_batch", s->teardown_ns_per_entity_batch);
     json_field(f, "teardown_ns_per_entity_single", s->teardown_ns_per_entity_single);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);

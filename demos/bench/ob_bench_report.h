@@ -66,6 +66,11 @@ typedef struct ob_bench_summary {
      * per entity, median of 3: all in one ob_nodes_destroy, and one
      * ob_node_destroy each, newest first (ob_scene_unload's order). */
     double teardown_ns_per_entity_batch, teardown_ns_per_entity_single;
+    /* GPU time of the 10k x 8 views frame, ST, instanced (the default) and
+     * with one draw per entity (--no-instancing, a run of its own), medians;
+     * their ratio. */
+    double gpu_ms_10k_8views, gpu_ms_10k_8views_per_draw;
+    double gpu_time_instanced_vs_per_draw_10k_8views;
     /* vkCmd calls per visible object: the engine's estimated from the
      * pipeline manager's issued counters, the raw loop's counted; in the raw
      * configuration, ST */
@@ -105,6 +110,7 @@ typedef struct ob_bench_report {
     ob_bench_quality_row *quality;
     uint32_t quality_count;
     ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */
+    ob_bench_sweep_entry per_draw_10k_8views;      /* ST, --no-instancing (mode_count 0: not run) */
     ob_bench_summary summary;
 } ob_bench_report;
 

@@ -558,6 +558,11 @@ static void summarize(ob_bench_report *rep)
     double object_views = e8 ? (double)e8->objects * e8->views : NAN;
     s->prerender_ns_per_object_view =
         e8 ? spread_scaled(e8->results[0].pre_render_round_ms, 1e6 / object_views) : none;
+    s->gpu_ms_10k_8views = e8 ? e8->results[0].gpu_ms : NAN;
+    s->gpu_ms_10k_8views_per_draw = rep->per_draw_10k_8views.mode_count
+                                        ? rep->per_draw_10k_8views.results[0].gpu_ms : NAN;
+    s->gpu_time_instanced_vs_per_draw_10k_8views =
+        s->gpu_ms_10k_8views / s->gpu_ms_10k_8views_per_draw;
     const ob_bench_sweep_entry *e50 = find_entry(rep, 1, 50000);
     s->update_ns_per_object =
         e50 ? spread_scaled(e50->results[0].update_round_ms, 1e6 / e50->objects) : none;
@@ -696,6 +701,9 @@ static int run(const bench_options *o)
                 uint64_t frames = (uint64_t)o->mode_count *
                                   (rounds * fc.passes * (fc.settle + 1) + fc.flight + 1);
                 total += frames * frame_weight(o->views[v], o->objects[n]);
+                /* The per-draw rerun of 10k x 8 views: ST only. */
+                if (o->views[v] == 8 && o->objects[n] == 10000 && !o->no_instancing)
+                    total += frames / o->mode_count * frame_weight(8, 10000);
             }
         }
     }
@@ -722,6 +730,17 @@ static int run(const bench_options *o)
             r = sweep_config(o, &rep, o->views[v], o->objects[n], &prog, &rep.sweep[rep.sweep_count]);
             if (r == OB_OK) rep.sweep_count++;
         }
+    }
+    /* The GPU time one draw per entity costs, next to instancing's: the
+     * 10k x 8 views frame again, ST only, per-draw. */
+    if (r == OB_OK && o->perf && !o->no_instancing && find_entry(&rep, 8, 10000)) {
+        bench_options po = *o;
+        po.no_instancing = true;
+        po.mode_count = 1;
+        po.modes[0] = (ob_bench_mode){"ST", OB_THREADING_SINGLE, 0};
+        ob_bench_progress_label(&prog, "sweep: 8 views, 10000 objects, one draw per entity");
+        prog.unit = frame_weight(8, 10000);
+        r = sweep_config(&po, &rep, 8, 10000, &prog, &rep.per_draw_10k_8views);
     }
     prog.unit = 1;
     if (r == OB_OK && o->perf) {

@@ -68,7 +68,8 @@ endforeach()
 # The whole frame's CPU phases (update included) and their serial share, the
 # per-object pre-render and update costs: each a number, or null where the
 # run could not compute it.
-set(frame_fields amdahl_speedup_16_cores)
+set(frame_fields amdahl_speedup_16_cores gpu_ms_10k_8views gpu_ms_10k_8views_per_draw
+    gpu_time_instanced_vs_per_draw_10k_8views)
 foreach(field frame_cpu_speedup_10k_8views serial_fraction_10k_8views prerender_ns_per_object_view
         update_ns_per_object)
   list(APPEND frame_fields ${field} ${field}_p25 ${field}_p75)
