@@ -18,6 +18,22 @@ static const char raw_vert[] =
     "    vNormal = mat3(NormalMatrix) * vec3(0.0, 1.0, 0.0);\n"
     "    gl_Position = WorldMatrix * vec4(inPosition, 1.0);\n"
     "}\n";
+/* The instanced loop's: the same matrices per instance, from binding 1. */
+static const char raw_vert_instanced[] =
+    "#version 450\n"
+    "layout(location = 0) in vec3 inPosition;\n"
+    "layout(location = 8) in vec4 w0;\n"
+    "layout(location = 9) in vec4 w1;\n"
+    "layout(location = 10) in vec4 w2;\n"
+    "layout(location = 11) in vec4 w3;\n"
+    "layout(location = 12) in vec4 n0;\n"
+    "layout(location = 13) in vec4 n1;\n"
+    "layout(location = 14) in vec4 n2;\n"
+    "layout(location = 0) out vec3 vNormal;\n"
+    "void main() {\n"
+    "    vNormal = mat3(n0.xyz, n1.xyz, n2.xyz) * vec3(0.0, 1.0, 0.0);\n"
+    "    gl_Position = mat4(w0, w1, w2, w3) * vec4(inPosition, 1.0);\n"
+    "}\n";
 static const char raw_frag[] =
     "#version 450\n"
     "layout(location = 0) in vec3 vNormal;\n"
@@ -32,9 +48,12 @@ typedef struct raw_draw {
 
 struct ob_bench_raw {
     VkDevice vk;
-    VkShaderModule vert, frag;
-    VkPipelineLayout layout;
-    VkPipeline pipeline;
+    ob_device *dev;
+    VkShaderModule vert, frag, vert_instanced;
+    VkPipelineLayout layout, layout_instanced;
+    VkPipeline pipeline, pipeline_instanced;
+    ob_buffer instances;       /* the 32 floats of each draw, as instance data */
+    void *instance_data;       /* its mapping: written at each recording */
     VkCommandPool pool;
     VkCommandBuffer cmd;
     raw_draw *draws;
@@ -63,28 +82,44 @@ static ob_result make_module(ob_demo *d, const char *name, const char *source, o
     return ob_result_from_vk(vr);
 }
 
-static ob_result make_pipeline(ob_demo *d, raw_state *s)
+/* The per-draw pipeline (push constants), or the instanced one (binding 1,
+ * instance rate, no push constants). */
+static ob_result make_pipeline(ob_demo *d, raw_state *s, bool instanced)
 {
-    ob_result r = make_module(d, "bench_raw.vert", raw_vert, OB_SHADER_VERTEX, &s->vert);
-    if (r == OB_OK) r = make_module(d, "bench_raw.frag", raw_frag, OB_SHADER_FRAGMENT, &s->frag);
+    ob_result r = OB_OK;
+    VkShaderModule *vert = instanced ? &s->vert_instanced : &s->vert;
+    if (instanced)
+        r = make_module(d, "bench_raw_instanced.vert", raw_vert_instanced, OB_SHADER_VERTEX, vert);
+    else
+        r = make_module(d, "bench_raw.vert", raw_vert, OB_SHADER_VERTEX, vert);
+    if (r == OB_OK && !s->frag)
+        r = make_module(d, "bench_raw.frag", raw_frag, OB_SHADER_FRAGMENT, &s->frag);
     if (r != OB_OK) return r;
     VkPushConstantRange range = {VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE};
     VkPipelineLayoutCreateInfo lci = {.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-                                      .pushConstantRangeCount = 1, .pPushConstantRanges = &range};
-    VkResult vr = OB_VK_CHECK(vkCreatePipelineLayout(s->vk, &lci, NULL, &s->layout));
+                                      .pushConstantRangeCount = instanced ? 0u : 1u,
+                                      .pPushConstantRanges = &range};
+    VkPipelineLayout *layout = instanced ? &s->layout_instanced : &s->layout;
+    VkResult vr = OB_VK_CHECK(vkCreatePipelineLayout(s->vk, &lci, NULL, layout));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
     VkPipelineShaderStageCreateInfo stages[2] = {
         {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-         .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = s->vert, .pName = "main"},
+         .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = *vert, .pName = "main"},
         {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
          .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = s->frag, .pName = "main"},
     };
-    VkVertexInputBindingDescription binding = {0, sizeof(ob_vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-    VkVertexInputAttributeDescription position = {0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
+    VkVertexInputBindingDescription bindings[2] = {
+        {0, sizeof(ob_vertex), VK_VERTEX_INPUT_RATE_VERTEX},
+        {1, PUSH_SIZE, VK_VERTEX_INPUT_RATE_INSTANCE}};
+    VkVertexInputAttributeDescription attributes[8] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+    for (uint32_t k = 0; k < 7; k++)
+        attributes[1 + k] = (VkVertexInputAttributeDescription){8 + k, 1,
+                                                                VK_FORMAT_R32G32B32A32_SFLOAT, 16 * k};
     VkPipelineVertexInputStateCreateInfo vi = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &binding,
-        .vertexAttributeDescriptionCount = 1, .pVertexAttributeDescriptions = &position};
+        .vertexBindingDescriptionCount = instanced ? 2u : 1u, .pVertexBindingDescriptions = bindings,
+        .vertexAttributeDescriptionCount = instanced ? 8u : 1u,
+        .pVertexAttributeDescriptions = attributes};
     VkPipelineInputAssemblyStateCreateInfo ia = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
         .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
@@ -120,8 +155,9 @@ static ob_result make_pipeline(ob_demo *d, raw_state *s)
         .stageCount = 2, .pStages = stages, .pVertexInputState = &vi,
         .pInputAssemblyState = &ia, .pViewportState = &vp, .pRasterizationState = &rs,
         .pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb,
-        .pDynamicState = &dy, .layout = s->layout};
-    vr = OB_VK_CHECK(vkCreateGraphicsPipelines(s->vk, VK_NULL_HANDLE, 1, &pci, NULL, &s->pipeline));
+        .pDynamicState = &dy, .layout = *layout};
+    vr = OB_VK_CHECK(vkCreateGraphicsPipelines(s->vk, VK_NULL_HANDLE, 1, &pci, NULL,
+                                               instanced ? &s->pipeline_instanced : &s->pipeline));
     return ob_result_from_vk(vr);
 }
 
@@ -165,7 +201,7 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
     return s->count ? OB_OK : OB_ERR_INVALID_ARGUMENT;
 }
 
-ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
+static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instanced)
 {
     memset(out, 0, sizeof *out);
     VkFormat color = COLOR_FORMAT;
@@ -184,14 +220,48 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
     uint64_t allocs0 = ob_arena_allocator_count(&s->pool_alloc);
     uint64_t t0 = ob_time_ns();
     if (OB_VK_CHECK(vkBeginCommandBuffer(s->cmd, &bi)) != VK_SUCCESS) return OB_ERR_VULKAN;
-    vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s->pipeline);
+    vkCmdBindPipeline(s->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                      instanced ? s->pipeline_instanced : s->pipeline);
     VkViewport viewport = {0.0f, 0.0f, (float)s->width, (float)s->height, 0.0f, 1.0f};
     VkRect2D scissor = {{0, 0}, {s->width, s->height}};
     vkCmdSetViewport(s->cmd, 0, 1, &viewport);
     vkCmdSetScissor(s->cmd, 0, 1, &scissor);
     VkBuffer vb = VK_NULL_HANDLE, ib = VK_NULL_HANDLE;
-    uint32_t binds = 0;
-    for (uint32_t i = 0; i < s->count; i++) {
+    uint32_t binds = 0, commands = 3;
+    if (instanced) {
+        /* The frame's instance data written (as a dynamic scene must), bound
+         * once; a run of one mesh is one draw. */
+        memcpy(s->instance_data, s->push, (size_t)PUSH_SIZE * s->count);
+        VkBuffer inst = ob_buffer_vk(s->dev, s->instances);
+        VkDeviceSize zero = 0;
+        vkCmdBindVertexBuffers(s->cmd, 1, 1, &inst, &zero);
+        binds++;
+        commands++;
+        for (uint32_t i = 0; i < s->count;) {
+            const raw_draw *dr = &s->draws[i];
+            if (dr->vb != vb) {
+                VkDeviceSize offset = 0;
+                vkCmdBindVertexBuffers(s->cmd, 0, 1, &dr->vb, &offset);
+                vb = dr->vb;
+                binds++;
+                commands++;
+            }
+            if (dr->ib != ib) {
+                vkCmdBindIndexBuffer(s->cmd, dr->ib, 0, VK_INDEX_TYPE_UINT32);
+                ib = dr->ib;
+                binds++;
+                commands++;
+            }
+            uint32_t j = i + 1;
+            while (j < s->count && s->draws[j].vb == vb && s->draws[j].ib == ib &&
+                   s->draws[j].index_count == dr->index_count)
+                j++;
+            vkCmdDrawIndexed(s->cmd, dr->index_count, j - i, 0, 0, i);
+            commands++;
+            i = j;
+        }
+    }
+    for (uint32_t i = 0; !instanced && i < s->count; i++) {
         const raw_draw *dr = &s->draws[i];
         if (dr->vb != vb) {
             VkDeviceSize offset = 0;
@@ -207,14 +277,25 @@ ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
         vkCmdPushConstants(s->cmd, s->layout, VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE,
                            &s->push[32 * i]);
         vkCmdDrawIndexed(s->cmd, dr->index_count, 1, 0, 0, 0);
+        commands += 2;
     }
     if (OB_VK_CHECK(vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
     uint64_t ns = ob_time_ns() - t0;
     /* Pipeline, viewport, scissor, then per draw push + draw, plus binds. */
     *out = (ob_bench_raw_sample){.ns = ns, .draws = s->count, .buffer_binds = binds,
-                                 .commands = 3 + 2 * s->count + binds,
+                                 .commands = commands + (instanced ? 0u : binds),
                                  .host_allocs = ob_arena_allocator_count(&s->pool_alloc) - allocs0};
     return OB_OK;
+}
+
+ob_result ob_bench_raw_record(ob_bench_raw *s, ob_bench_raw_sample *out)
+{
+    return record(s, out, false);
+}
+
+ob_result ob_bench_raw_record_instanced(ob_bench_raw *s, ob_bench_raw_sample *out)
+{
+    return record(s, out, true);
 }
 
 void ob_bench_raw_destroy(ob_bench_raw *s)
@@ -223,8 +304,12 @@ void ob_bench_raw_destroy(ob_bench_raw *s)
     if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc.callbacks);
     ob_arena_allocator_release(&s->pool_alloc);
     if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
+    if (s->pipeline_instanced) vkDestroyPipeline(s->vk, s->pipeline_instanced, NULL);
     if (s->layout) vkDestroyPipelineLayout(s->vk, s->layout, NULL);
+    if (s->layout_instanced) vkDestroyPipelineLayout(s->vk, s->layout_instanced, NULL);
     if (s->vert) vkDestroyShaderModule(s->vk, s->vert, NULL);
+    if (s->vert_instanced) vkDestroyShaderModule(s->vk, s->vert_instanced, NULL);
+    if (s->instances.id) ob_buffer_destroy(s->dev, s->instances);
     if (s->frag) vkDestroyShaderModule(s->vk, s->frag, NULL);
     ob_free(s->draws);
     ob_aligned_free(s->push);
@@ -244,10 +329,17 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
         *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
         return NULL;
     }
-    *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->r)), .width = v->width,
-                        .height = v->height};
+    *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->r)),
+                        .dev = ob_renderer_device(d->r), .width = v->width, .height = v->height};
     ob_result r = gather(d, v, s);
-    if (r == OB_OK) r = make_pipeline(d, s);
+    if (r == OB_OK) r = make_pipeline(d, s, false);
+    if (r == OB_OK) r = make_pipeline(d, s, true);
+    if (r == OB_OK) {
+        s->instances = ob_buffer_create(s->dev, &(ob_buffer_desc){
+            .size = (uint64_t)PUSH_SIZE * s->count, .usage = OB_BUFFER_VERTEX,
+            .host_visible = true, .name = "raw baseline instances"}, &r);
+        s->instance_data = ob_buffer_mapped(s->dev, s->instances);
+    }
     if (r == OB_OK) r = make_commands(d, s);
     *out_result = r;
     if (r == OB_OK) return s;

@@ -151,6 +151,10 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
             rep->engine_ns_per_draw, rep->summary.engine_vs_raw_per_draw,
             rep->summary.commands_per_object_raw, rep->summary.commands_per_object_engine,
             rep->summary.host_allocs_per_object_raw, rep->summary.host_allocs_per_object_engine);
+    fprintf(f, "raw instanced (a run of one mesh one draw): %.1f ns/draw, engine/raw instanced "
+               "%.2f; vkCmd calls/object %.3f\n",
+            rep->raw_instanced.ns_per_draw, rep->summary.engine_vs_raw_instanced_per_object.median,
+            rep->summary.commands_per_object_raw_instanced);
     fprintf(f, "\nimage error against the reference (ST, highest quality), mirror scene %ux%u, "
                "frame %u:\n  %-10s %5s %6s %-5s %8s %9s %9s %9s %9s %s\n",
             rep->image_width, rep->image_height, rep->image_frames, "kind", "env", "shadow",
@@ -172,6 +176,8 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fprintf(f, " (best MT mode %s)\n", s->mt_speedup_best_mode ? s->mt_speedup_best_mode : "-");
     print_spread(f, "engine_vs_raw_per_object", s->engine_vs_raw_per_object);
     fputs(" (= engine_vs_raw_per_draw)\n", f);
+    print_spread(f, "engine_vs_raw_instanced", s->engine_vs_raw_instanced_per_object);
+    fputs(" (against the raw loop instanced)\n", f);
     print_spread(f, "auto_vs_best_200", s->auto_vs_best_200);
     fprintf(f, " (recording; in-flight frames %.3f)\n", s->auto_vs_best_200_frame);
     print_spread(f, "auto_vs_best_10k_8views", s->auto_vs_best_10k_8views);
@@ -410,6 +416,8 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "teardown_ns_per_entity_single", s->teardown_ns_per_entity_single);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
     json_field(f, "commands_per_object_raw", s->commands_per_object_raw);
+    json_field(f, "commands_per_object_raw_instanced", s->commands_per_object_raw_instanced);
+    json_spread(f, "engine_vs_raw_instanced_per_object", s->engine_vs_raw_instanced_per_object);
     json_field(f, "host_allocs_per_object_engine", s->host_allocs_per_object_engine);
     json_field(f, "host_allocs_per_object_raw", s->host_allocs_per_object_raw);
     fprintf(f, "\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",

@@ -35,6 +35,9 @@ typedef struct ob_bench_summary {
     /* engine ST record_total per visible object / raw ns per object, 1 view,
      * raw_objects; both recorded in every idle round */
     ob_bench_spread engine_vs_raw_per_object;
+    /* The same against the raw loop instanced (a run of one mesh one draw) */
+    ob_bench_spread engine_vs_raw_instanced_per_object;
+    double commands_per_object_raw_instanced;
     double engine_vs_raw_per_draw;         /* the same median, under its older name */
     /* auto record_total / the better fixed mode's (ST or MT, by median over
      * the run) in the same round: 200-object mirror scene, and 10k objects
@@ -107,6 +110,8 @@ typedef struct ob_bench_report {
     uint32_t raw_views, raw_objects;               /* the sweep entry it is compared with */
     double engine_ns_per_draw;                     /* that entry's ST record / draws */
     ob_bench_spread engine_vs_raw;                 /* per-round ratio of the two per draw */
+    ob_bench_raw_result raw_instanced;             /* the raw loop instanced, same rounds */
+    ob_bench_spread engine_vs_raw_instanced;
     ob_bench_quality_row *quality;
     uint32_t quality_count;
     ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */

@@ -314,11 +314,12 @@ typedef struct raw_rounds {
     ob_demo *demo;
     const ob_view *view;
     ob_bench_raw *raw;         /* made at the first round, once the view has a draw list */
-    ob_bench_raw_sample last;
+    ob_bench_raw_sample last, last_instanced;
     uint32_t passes;
-    double round_raw_ns, round_engine_ms;  /* this round's fastest so far */
+    double round_raw_ns, round_raw_instanced_ns, round_engine_ms;  /* this round's fastest so far */
     uint32_t round_engine_draws;
     double *raw_ms, *allocs_per_draw, *engine_vs_raw;  /* one per measured round */
+    double *raw_instanced_ms, *engine_vs_raw_instanced;
     uint32_t n, cap;
 } raw_rounds;
 
@@ -335,8 +336,11 @@ static ob_result raw_round(void *user, uint32_t round, uint32_t pass, bool measu
         if (r != OB_OK) return r;
     }
     r = ob_bench_raw_record(rr->raw, &rr->last);
+    if (r == OB_OK) r = ob_bench_raw_record_instanced(rr->raw, &rr->last_instanced);
     if (r != OB_OK || !measured || rr->n >= rr->cap || rr->last.draws == 0) return r;
     if (pass == 0 || (double)rr->last.ns < rr->round_raw_ns) rr->round_raw_ns = (double)rr->last.ns;
+    if (pass == 0 || (double)rr->last_instanced.ns < rr->round_raw_instanced_ns)
+        rr->round_raw_instanced_ns = (double)rr->last_instanced.ns;
     if (pass == 0 || modes[0].record_total_ms < rr->round_engine_ms) {
         rr->round_engine_ms = modes[0].record_total_ms;
         rr->round_engine_draws = modes[0].draws;
@@ -348,6 +352,8 @@ static ob_result raw_round(void *user, uint32_t round, uint32_t pass, bool measu
     rr->raw_ms[rr->n] = rr->round_raw_ns * 1e-6;
     rr->allocs_per_draw[rr->n] = (double)rr->last.host_allocs / rr->last.draws;
     rr->engine_vs_raw[rr->n] = engine_ns / raw_ns;
+    rr->raw_instanced_ms[rr->n] = rr->round_raw_instanced_ns * 1e-6;
+    rr->engine_vs_raw_instanced[rr->n] = engine_ns / (rr->round_raw_instanced_ns / rr->last.draws);
     rr->n++;
     return OB_OK;
 }
@@ -360,6 +366,18 @@ static void raw_results(raw_rounds *rr, ob_bench_report *rep)
     ob_bench_spread_of(rr->raw_ms, rr->n, &ms);
     ob_bench_spread_of(rr->allocs_per_draw, rr->n, &allocs);
     ob_bench_spread_of(rr->engine_vs_raw, rr->n, &rep->engine_vs_raw);
+    ob_bench_spread_of(rr->engine_vs_raw_instanced, rr->n, &rep->engine_vs_raw_instanced);
+    ob_bench_spread ims;
+    ob_bench_spread_of(rr->raw_instanced_ms, rr->n, &ims);
+    rep->raw_instanced = (ob_bench_raw_result){
+        .draws = rr->last_instanced.draws, .reps = rr->n,
+        .buffer_binds = rr->last_instanced.buffer_binds, .record_ms = ims.median,
+        .ns_per_draw = rr->last_instanced.draws ? ims.median * 1e6 / rr->last_instanced.draws : NAN,
+        .commands_per_object = rr->last_instanced.draws
+                                   ? (double)rr->last_instanced.commands / rr->last_instanced.draws
+                                   : NAN,
+        .host_allocs_per_object = NAN,
+    };
     *o = (ob_bench_raw_result){
         .draws = rr->last.draws, .reps = rr->n, .buffer_binds = rr->last.buffer_binds,
         .record_ms = ms.median,
@@ -402,10 +420,12 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     if (r == OB_OK && raw) {
         rr.view = s.views[0];
         rr.cap = rd.rounds;
-        rr.raw_ms = ob_calloc(3 * (size_t)rr.cap, sizeof *rr.raw_ms);
+        rr.raw_ms = ob_calloc(5 * (size_t)rr.cap, sizeof *rr.raw_ms);
         if (rr.raw_ms) {
             rr.allocs_per_draw = rr.raw_ms + rr.cap;
             rr.engine_vs_raw = rr.raw_ms + 2 * rr.cap;
+            rr.raw_instanced_ms = rr.raw_ms + 3 * rr.cap;
+            rr.engine_vs_raw_instanced = rr.raw_ms + 4 * rr.cap;
             rd.round_hook = raw_round;
             rd.round_user = &rr;
         } else {
@@ -572,6 +592,8 @@ static void summarize(ob_bench_report *rep)
     for (uint32_t m = 0; m < rep->scene200.mode_count; m++)
         s->hash_mismatches += rep->scene200.results[m].hash_mismatches;
     s->engine_vs_raw_per_object = rep->engine_vs_raw;
+    s->engine_vs_raw_instanced_per_object = rep->engine_vs_raw_instanced;
+    s->commands_per_object_raw_instanced = rep->raw_instanced.commands_per_object;
     /* Per visible object is per draw in ST: the old name keeps its meaning. */
     s->engine_vs_raw_per_draw = rep->engine_vs_raw.median;
     const ob_bench_result *r200 = rep->scene200.results;
