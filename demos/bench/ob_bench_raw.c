@@ -230,38 +230,16 @@ static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instance
     uint32_t binds = 0, commands = 3;
     if (instanced) {
         /* The frame's instance data written (as a dynamic scene must), bound
-         * once; a run of one mesh is one draw. */
+         * once. */
         memcpy(s->instance_data, s->push, (size_t)PUSH_SIZE * s->count);
         VkBuffer inst = ob_buffer_vk(s->dev, s->instances);
         VkDeviceSize zero = 0;
         vkCmdBindVertexBuffers(s->cmd, 1, 1, &inst, &zero);
         binds++;
-        commands++;
-        for (uint32_t i = 0; i < s->count;) {
-            const raw_draw *dr = &s->draws[i];
-            if (dr->vb != vb) {
-                VkDeviceSize offset = 0;
-                vkCmdBindVertexBuffers(s->cmd, 0, 1, &dr->vb, &offset);
-                vb = dr->vb;
-                binds++;
-                commands++;
-            }
-            if (dr->ib != ib) {
-                vkCmdBindIndexBuffer(s->cmd, dr->ib, 0, VK_INDEX_TYPE_UINT32);
-                ib = dr->ib;
-                binds++;
-                commands++;
-            }
-            uint32_t j = i + 1;
-            while (j < s->count && s->draws[j].vb == vb && s->draws[j].ib == ib &&
-                   s->draws[j].index_count == dr->index_count)
-                j++;
-            vkCmdDrawIndexed(s->cmd, dr->index_count, j - i, 0, 0, i);
-            commands++;
-            i = j;
-        }
     }
-    for (uint32_t i = 0; !instanced && i < s->count; i++) {
+    /* Buffers bound when the mesh changes; per draw the push block and the
+     * draw, or, instanced, a run of one mesh in one draw. */
+    for (uint32_t i = 0; i < s->count;) {
         const raw_draw *dr = &s->draws[i];
         if (dr->vb != vb) {
             VkDeviceSize offset = 0;
@@ -274,16 +252,25 @@ static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instance
             ib = dr->ib;
             binds++;
         }
-        vkCmdPushConstants(s->cmd, s->layout, VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE,
-                           &s->push[32 * i]);
-        vkCmdDrawIndexed(s->cmd, dr->index_count, 1, 0, 0, 0);
-        commands += 2;
+        uint32_t j = i + 1;
+        if (instanced) {
+            while (j < s->count && s->draws[j].vb == vb && s->draws[j].ib == ib &&
+                   s->draws[j].index_count == dr->index_count)
+                j++;
+        } else {
+            vkCmdPushConstants(s->cmd, s->layout, VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE,
+                               &s->push[32 * i]);
+            commands++;
+        }
+        vkCmdDrawIndexed(s->cmd, dr->index_count, j - i, 0, 0, instanced ? i : 0);
+        commands++;
+        i = j;
     }
     if (OB_VK_CHECK(vkEndCommandBuffer(s->cmd)) != VK_SUCCESS) return OB_ERR_VULKAN;
     uint64_t ns = ob_time_ns() - t0;
     /* Pipeline, viewport, scissor, then per draw push + draw, plus binds. */
     *out = (ob_bench_raw_sample){.ns = ns, .draws = s->count, .buffer_binds = binds,
-                                 .commands = commands + (instanced ? 0u : binds),
+                                 .commands = commands + binds,
                                  .host_allocs = ob_arena_allocator_count(&s->pool_alloc) - allocs0};
     return OB_OK;
 }

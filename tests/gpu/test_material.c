@@ -411,6 +411,44 @@ static void barrier_to(fixture *f, VkCommandBuffer cmd, ob_image img, VkImageLay
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+/* The fixture's colour and depth targets cleared and rendered to by cmd
+ * (dynamic rendering, SIZE x SIZE), through pm, as the draw tests below
+ * need. */
+static void begin_target(fixture *f, VkCommandBuffer cmd, ob_pipeline_manager *pm)
+{
+    barrier_to(f, cmd, f->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    barrier_to(f, cmd, f->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo color_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->color),
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue.color.float32 = {0, 0, 0, 1},
+    };
+    VkRenderingAttachmentInfo depth_att = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(f->dev, f->depth),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue.depthStencil = {0.0f, 0},
+    };
+    VkRenderingInfo ri = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                          .renderArea = {{0, 0}, {SIZE, SIZE}}, .layerCount = 1,
+                          .colorAttachmentCount = 1, .pColorAttachments = &color_att,
+                          .pDepthAttachment = &depth_att};
+    vkCmdBeginRendering(cmd, &ri);
+    ob_pipeline_manager_begin_frame(pm, 0, 1);
+    ob_pipeline_manager_begin(pm, cmd);
+    ob_pipeline_manager_set_viewport(pm, 0, 0, SIZE, SIZE);
+    ob_pipeline_manager_set_scissor(pm, 0, 0, SIZE, SIZE);
+}
+
 /* 100 entities sharing one material draw through one pipeline manager with
  * a single pipeline bind, and the emissive colour reaches the image. */
 static void test_hundred_entities_one_pipeline(void **state)
@@ -441,43 +479,7 @@ static void test_hundred_entities_one_pipeline(void **state)
 
     VkCommandBuffer cmd;
     assert_int_equal(ob_device_oneshot_begin(f->dev, &cmd), OB_OK);
-    barrier_to(f, cmd, f->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    barrier_to(f, cmd, f->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-    VkRenderingAttachmentInfo color_att = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(f->dev, f->color),
-        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .clearValue.color.float32 = {0, 0, 0, 1},
-    };
-    VkRenderingAttachmentInfo depth_att = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(f->dev, f->depth),
-        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .clearValue.depthStencil = {0.0f, 0},
-    };
-    VkRenderingInfo ri = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-        .renderArea = {{0, 0}, {SIZE, SIZE}},
-        .layerCount = 1,
-        .colorAttachmentCount = 1,
-        .pColorAttachments = &color_att,
-        .pDepthAttachment = &depth_att,
-    };
-    vkCmdBeginRendering(cmd, &ri);
-    ob_pipeline_manager_begin_frame(pm, 0, 1);
-    ob_pipeline_manager_begin(pm, cmd);
-    ob_pipeline_manager_set_viewport(pm, 0, 0, SIZE, SIZE);
-    ob_pipeline_manager_set_scissor(pm, 0, 0, SIZE, SIZE);
+    begin_target(f, cmd, pm);
     ob_params *params = ob_pipeline_manager_params(pm);
     ob_param world = ob_param_registry_builtins(f->reg)->world;
     for (int i = 0; i < 100; i++) {
@@ -549,37 +551,7 @@ static void draw_grid(fixture *f, ob_material *green, ob_view *persp, int way, u
 
     VkCommandBuffer cmd;
     assert_int_equal(ob_device_oneshot_begin(f->dev, &cmd), OB_OK);
-    barrier_to(f, cmd, f->color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    barrier_to(f, cmd, f->depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-    VkRenderingAttachmentInfo color_att = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(f->dev, f->color),
-        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .clearValue.color.float32 = {0, 0, 0, 1},
-    };
-    VkRenderingAttachmentInfo depth_att = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = ob_image_view(f->dev, f->depth),
-        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .clearValue.depthStencil = {0.0f, 0},
-    };
-    VkRenderingInfo ri = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-                          .renderArea = {{0, 0}, {SIZE, SIZE}}, .layerCount = 1,
-                          .colorAttachmentCount = 1, .pColorAttachments = &color_att,
-                          .pDepthAttachment = &depth_att};
-    vkCmdBeginRendering(cmd, &ri);
-    ob_pipeline_manager_begin_frame(pm, 0, 1);
-    ob_pipeline_manager_begin(pm, cmd);
-    ob_pipeline_manager_set_viewport(pm, 0, 0, SIZE, SIZE);
-    ob_pipeline_manager_set_scissor(pm, 0, 0, SIZE, SIZE);
+    begin_target(f, cmd, pm);
     ob_params *params = ob_pipeline_manager_params(pm);
     ob_param world = ob_param_registry_builtins(f->reg)->world;
     const ob_draw_data dd = {.vertex_buffer = vb, .index_buffer = ib,
