@@ -202,8 +202,12 @@ static cull_pair *sort_pairs(cull_pair *a, cull_pair *b, uint32_t n)
     return src;
 }
 
-/* Entities per index of the culling loop: ~10-20 us of work each. */
+/* Entities per index of the culling loop: ~10-20 us of work each at most,
+ * and at least a few us; in between, as many as give each thread four
+ * indices of the wave, so that a wave of one view (a shadow map after the
+ * cameras) is shared too. */
 #define CULL_GRAIN 4096u
+#define CULL_GRAIN_MIN 512u
 /* Entities tested per block: the frustum pass writes a byte and a float
  * per entity into the block's stack scratch, the pass after it keys the
  * visible ones. */
@@ -559,9 +563,13 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         mesh[k] = gi && g ? gi->id(g) : 0;
     }
     ob_parallel par = ob_renderer_parallel(r);
-    uint32_t grain = par.grain ? par.grain : CULL_GRAIN;
     uint32_t entities = 0;
     ob_scene_render_proxies(scene, &entities);
+    uint32_t grain = par.grain;
+    if (!grain) {
+        uint64_t share = (uint64_t)entities * count / (4u * OB_MAX(par.threads, 1u));
+        grain = (uint32_t)OB_MIN(CULL_GRAIN, OB_MAX(CULL_GRAIN_MIN, share));
+    }
     w.chunks = (entities + grain - 1) / grain;
     ob_result first_error = OB_OK;
     for (uint32_t k = 0; k < count; k++) {
