@@ -27,6 +27,7 @@
 #include "ob_mesh.h"
 #include "ob_model_internal.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -37,6 +38,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 
 /* assimp's C API stores the text of the last failed import in one
@@ -98,26 +100,14 @@ static const char *mesh_name(const struct aiMesh *m)
 
 ob_result ob_model_check_readable(const char *path)
 {
-    char err[128];
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        int e = errno;
-        if (strerror_r(e, err, sizeof err) != 0) snprintf(err, sizeof err, "errno %d", e);
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: %s", path, err);
-        return OB_ERR_IO;
+    char why[256];
+    ob_result r;
+    int fd = ob_file_open_regular(path, "model file", OB_MODEL_MAX_FILE_BYTES, NULL, why, sizeof why, &r);
+    if (fd < 0) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: %s", path, why);
+        return r;
     }
-    if (!S_ISREG(st.st_mode)) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: not a regular file", path);
-        return OB_ERR_IO;
-    }
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        int e = errno;
-        if (strerror_r(e, err, sizeof err) != 0) snprintf(err, sizeof err, "errno %d", e);
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: %s", path, err);
-        return OB_ERR_IO;
-    }
-    fclose(f);
+    close(fd);
     return OB_OK;
 }
 
@@ -429,10 +419,11 @@ static ob_result merge_scene(model_ctx *c, const struct aiScene *s, ob_mesh *out
 
 /* ---------------------------------------------------------------- load */
 
-const struct aiScene *ob_model_parse(const char *path, char *err, size_t err_size)
+const struct aiScene *ob_model_parse(const char *path, ob_model_io *io, char *err, size_t err_size)
 {
+    struct aiFileIO fio = ob_model_io_assimp(io);
     pthread_mutex_lock(&ob_assimp_parse_lock);
-    const struct aiScene *s = aiImportFile(path, 0);
+    const struct aiScene *s = aiImportFileEx(path, 0, &fio);
     if (!s) {
         const char *text = aiGetErrorString();
         snprintf(err, err_size, "%s", text && *text ? text : "unknown error");
@@ -459,18 +450,27 @@ bool ob_model_mesh_has_area(const ob_mesh *m)
     return false;
 }
 
-ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool refuse_required,
                           const struct aiScene **out_scene)
 {
     *out_scene = NULL;
+    memset(c->io, 0, sizeof *c->io);
     const char *path = c->path;
     ob_result r = ob_model_check_readable(path);
+    if (r == OB_OK) r = ob_model_io_init(c->io, path, desc->allow_any_folder);
     if (r == OB_OK) r = ob_model_ply_precheck(path);
-    if (r == OB_OK && gltf_precheck) r = ob_model_gltf_precheck(path);
+    if (r == OB_OK) r = ob_model_gltf_precheck(path, c->io, refuse_required);
     if (r != OB_OK) return r;
     char err[512];
-    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
+    const struct aiScene *scene = ob_model_parse(path, c->io, err, sizeof err);
+    if (scene && c->io->refused != OB_OK) {
+        /* assimp went on without a file we refused (an OBJ's .mtl): the
+         * refusal, logged already, is the model's. */
+        aiReleaseImport(scene);
+        return c->io->refused;
+    }
     if (!scene) {
+        if (c->io->refused != OB_OK) return c->io->refused;   /* logged, naming the file */
         OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
         return OB_ERR_PARSE;
     }
@@ -481,7 +481,7 @@ ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
         return r;
     }
     unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
-                     aiProcess_JoinIdenticalVertices | (flip_uv ? aiProcess_FlipUVs : 0u);
+                     aiProcess_JoinIdenticalVertices | (desc->flip_uv ? aiProcess_FlipUVs : 0u);
     scene = aiApplyPostProcessing(scene, flags);
     if (!scene) {   /* assimp has released the scene already */
         OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
@@ -500,11 +500,15 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
                  : !out ? "NULL out mesh" : "no path given");
         return OB_ERR_INVALID_ARGUMENT;
     }
-    model_ctx c = {.chk.path = desc->path};
+    ob_model_io io;
+    model_ctx c = {.chk = {.path = desc->path, .io = &io}};
     const char *path = desc->path;
     const struct aiScene *scene;
-    ob_result r = ob_model_import(&c.chk, desc->flip_uv, false, &scene);
-    if (r != OB_OK) return r;
+    ob_result r = ob_model_import(&c.chk, desc, false, &scene);
+    if (r != OB_OK) {
+        ob_model_io_release(&io);
+        return r;
+    }
     r = merge_scene(&c, scene, out);
     if (r != OB_OK) goto fail_release_out;
     if (ob_mesh_validate(out, path) != OB_OK || ob_mesh_compute_bounds(out) != OB_OK) {
@@ -527,11 +531,13 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
     OB_LOG_I(OB_MODEL_LOG, "%s: %u mesh instances, %u vertices, %u triangles", path,
              c.instances, out->vertex_count, out->index_count / 3);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     return OB_OK;
 
 fail_release_out:
     ob_mesh_release(out);
     ob_model_report_more(&c.chk);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     return r;
 }

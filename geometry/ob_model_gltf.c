@@ -19,6 +19,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 /* JSON bigger than this is not scanned (a warning says so); .gltf files
  * carrying base64 buffers reach tens of megabytes. */
@@ -35,8 +36,23 @@
 static const char *const supported_required[] = {NULL};
 
 typedef struct scan {
-    const char *p, *end;
+    const char *p, *begin, *end;
+    /* Offsets (from begin) of the opening quotes of the keys to hide from
+     * assimp: the top-level "skins" and each node's "skin". */
+    uint32_t *hide;
+    uint32_t hide_count, hide_cap;
+    bool out_of_memory;
 } scan;
+
+static bool hide_key(scan *s, const char *quote)
+{
+    if (ob_array_reserve((void **)&s->hide, &s->hide_cap, s->hide_count + 1, sizeof *s->hide) != OB_OK) {
+        s->out_of_memory = true;
+        return false;
+    }
+    s->hide[s->hide_count++] = (uint32_t)(quote - s->begin);
+    return true;
+}
 
 typedef struct name_list {
     char names[GLTF_MAX_NAMES][GLTF_NAME_MAX];
@@ -71,13 +87,19 @@ static bool read_string(scan *s, char *out, size_t out_size)
             switch (e) {
             case '"': case '\\': case '/': ch = e; break;
             case 'b': case 'f': case 'n': case 'r': case 't': ch = '?'; break;
-            case 'u':
+            case 'u': {
                 if (s->end - s->p < 4) return false;
-                for (int k = 0; k < 4; k++)
-                    if (!isxdigit((unsigned char)s->p[k])) return false;
+                unsigned code = 0;
+                for (int k = 0; k < 4; k++) {
+                    unsigned char h = (unsigned char)s->p[k];
+                    if (!isxdigit(h)) return false;
+                    code = code * 16 + (unsigned)(isdigit(h) ? h - '0' : (tolower(h) - 'a' + 10));
+                }
                 s->p += 4;
-                ch = '?';
+                /* Decoded, so "sk\u0069ns" is seen as assimp's JSON reader sees it. */
+                ch = code >= 0x20 && code < 0x7f ? (char)code : '?';
                 break;
+            }
             default: return false;
             }
         } else if ((unsigned char)ch >= 0x7f) {
@@ -166,8 +188,61 @@ static bool read_name_array(scan *s, name_list *l)
     }
 }
 
+/* One node object: its "skin" member is hidden, the rest skipped. */
+static bool scan_node(scan *s)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == '}') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        skip_ws(s);
+        const char *quote = s->p;
+        char key[16];
+        if (!read_string(s, key, sizeof key)) return false;
+        if (strcmp(key, "skin") == 0 && !hide_key(s, quote)) return false;
+        skip_ws(s);
+        if (s->p >= s->end || *s->p++ != ':') return false;
+        if (!skip_value(s)) return false;
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == '}') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
+static bool scan_nodes(scan *s)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '[') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == ']') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        if (!scan_node(s)) return false;
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == ']') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
 /* The top-level object: extensionsRequired and extensionsUsed into the
- * lists, every other member skipped. */
+ * lists, skins and the nodes' skin references to hide, every other member
+ * skipped. */
 static bool scan_top(scan *s, name_list *required, name_list *used)
 {
     skip_ws(s);
@@ -179,6 +254,7 @@ static bool scan_top(scan *s, name_list *required, name_list *used)
     if (s->p < s->end && *s->p == '}') return true;
     for (;;) {
         skip_ws(s);
+        const char *quote = s->p;
         char key[32];
         if (!read_string(s, key, sizeof key)) return false;
         skip_ws(s);
@@ -186,6 +262,8 @@ static bool scan_top(scan *s, name_list *required, name_list *used)
         bool ok;
         if (strcmp(key, "extensionsRequired") == 0) ok = read_name_array(s, required);
         else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
+        else if (strcmp(key, "nodes") == 0) ok = scan_nodes(s);
+        else if (strcmp(key, "skins") == 0) ok = hide_key(s, quote) && skip_value(s);
         else ok = skip_value(s);
         if (!ok) return false;
         skip_ws(s);
@@ -200,68 +278,124 @@ static uint32_t read_u32le(const unsigned char *b)
     return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
 }
 
-/* The JSON text of a glTF file into *out (ob_malloc'd) or *out NULL when
- * the file is not glTF (nor JSON), or its JSON is out of reach (too big,
- * a .glb whose header lies: assimp rejects those). */
-static ob_result read_json(const char *path, char **out, size_t *out_size)
+/* The JSON text of a glTF file into *out (ob_malloc'd; *out_offset: where
+ * it starts in the file) or *out NULL when the file is not glTF (nor
+ * JSON), or its JSON is too big to scan. A .glb whose header or chunk
+ * lengths run past the file is refused here: assimp would allocate what
+ * they claim (4 GB for a 460-byte file) before noticing. */
+static ob_result read_json(const char *path, char **out, size_t *out_size, size_t *out_offset)
 {
     *out = NULL;
     *out_size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: %s", path, strerror(errno));
-        return OB_ERR_IO;
+    *out_offset = 0;
+    char why[256];
+    ob_result r;
+    uint64_t file_size = 0;
+    int fd = ob_file_open_regular(path, "model file", OB_MODEL_MAX_FILE_BYTES, &file_size, why,
+                                  sizeof why, &r);
+    if (fd < 0) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: %s", path, why);
+        return r;
     }
-    unsigned char head[20];
-    size_t got = fread(head, 1, sizeof head, f);
-    size_t offset = 0, length = 0;
-    if (got >= 20 && memcmp(head, "glTF", 4) == 0) {
-        uint32_t version = read_u32le(head + 4);
-        /* glTF 2 .glb: 12-byte header, then the first chunk (JSON, "JSON"
-         * type); glTF 1 binary: 20-byte header whose content is the JSON. */
-        if (version == 2 && read_u32le(head + 16) == 0x4E4F534Au) {
-            offset = 20;
+    unsigned char head[28];
+    ssize_t got = pread(fd, head, sizeof head, 0);
+    if (got < 0) got = 0;
+    uint64_t offset = 0, length = 0;
+    if (got >= 12 && memcmp(head, "glTF", 4) == 0) {
+        uint32_t version = read_u32le(head + 4), total = read_u32le(head + 8);
+        const char *lie = NULL;
+        uint64_t claimed = 0;
+        if (total > file_size) {
+            lie = "its header's total length";
+            claimed = total;
+        } else if (got >= 20) {
             length = read_u32le(head + 12);
-        } else if (version == 1 && read_u32le(head + 16) == 0) {
             offset = 20;
-            length = read_u32le(head + 12);
+            if (version == 2 && read_u32le(head + 16) != 0x4E4F534Au) {
+                lie = "its first chunk (not JSON)";
+                claimed = length;
+                length = 0;
+            } else if (20 + length > file_size) {
+                lie = version == 2 ? "its JSON chunk" : "its content";
+                claimed = length;
+            } else if (version == 2 && 20 + length + 8 <= file_size) {
+                unsigned char bin[4];
+                uint64_t at = 20 + ((length + 3) & ~3ull);
+                if (at + 8 <= file_size && pread(fd, bin, 4, (off_t)at) == 4 &&
+                    at + 8 + read_u32le(bin) > file_size) {
+                    lie = "its second (binary) chunk";
+                    claimed = read_u32le(bin);
+                }
+            }
+        } else {
+            lie = "its header (shorter than 20 bytes)";
+        }
+        if (version != 1 && version != 2) length = 0;   /* assimp's to reject */
+        if (lie) {
+            close(fd);
+            OB_LOG_E(OB_MODEL_LOG, "%s: not a valid binary glTF: %s claims %llu bytes, the file has "
+                     "%llu", path, lie, (unsigned long long)claimed, (unsigned long long)file_size);
+            return OB_ERR_BAD_MODEL;
         }
     } else {
         size_t i = 0;
         if (got >= 3 && memcmp(head, "\xEF\xBB\xBF", 3) == 0) i = 3;
-        while (i < got && isspace(head[i])) i++;
-        if (i < got && head[i] == '{') {
-            if (fseek(f, 0, SEEK_END) == 0) {
-                long end = ftell(f);
-                length = end > 0 ? (size_t)end : 0;
-            }
-        }
+        while (i < (size_t)got && isspace(head[i])) i++;
+        if (i < (size_t)got && head[i] == '{') length = file_size;
     }
     if (length == 0) {
-        fclose(f);
+        close(fd);
         return OB_OK;
     }
     if (length > GLTF_JSON_MAX) {
-        OB_LOG_W(OB_MODEL_LOG, "%s: glTF JSON of %zu bytes not scanned for required extensions "
-                 "(over %u MiB)", path, length, GLTF_JSON_MAX >> 20);
-        fclose(f);
+        OB_LOG_W(OB_MODEL_LOG, "%s: glTF JSON of %llu bytes not scanned for required extensions "
+                 "and skins (over %u MiB)", path, (unsigned long long)length, GLTF_JSON_MAX >> 20);
+        close(fd);
         return OB_OK;
     }
-    char *text = ob_malloc(length);
+    char *text = ob_malloc((size_t)length);
     if (!text) {
-        fclose(f);
-        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory reading %zu bytes of glTF JSON", path, length);
+        close(fd);
+        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory reading %llu bytes of glTF JSON", path,
+                 (unsigned long long)length);
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
     size_t n = 0;
-    if (fseek(f, (long)offset, SEEK_SET) == 0) n = fread(text, 1, length, f);
-    fclose(f);
-    if (n != length) {   /* a .glb whose chunk runs past the file: assimp's to reject */
+    while (n < length) {
+        ssize_t k = pread(fd, text + n, (size_t)length - n, (off_t)(offset + n));
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) break;
+        n += (size_t)k;
+    }
+    close(fd);
+    if (n != length) {
         ob_free(text);
-        return OB_OK;
+        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: it shrank while being read", path);
+        return OB_ERR_IO;
     }
     *out = text;
-    *out_size = length;
+    *out_size = (size_t)length;
+    *out_offset = (size_t)offset;
+    return OB_OK;
+}
+
+/* The file with every hidden key's first character replaced by '_'
+ * ("skins" becomes "_kins", "skin" "_kin"): same length, so a .glb's chunk
+ * lengths stay right, and names assimp ignores. */
+static ob_result hide_skins(const char *path, const scan *s, size_t json_offset, ob_model_io *io)
+{
+    size_t size = 0;
+    ob_result r;
+    char *file = ob_file_read_limited(path, "model file", OB_MODEL_MAX_FILE_BYTES, &size, NULL, 0, &r);
+    if (!file) return r;
+    for (uint32_t i = 0; i < s->hide_count; i++) {
+        size_t at = json_offset + s->hide[i] + 1;
+        if (at < size) file[at] = '_';
+    }
+    io->patched = (uint8_t *)file;
+    io->patched_size = size;
+    OB_LOG_I(OB_MODEL_LOG, "%s: skins ignored (%u references): Obelisk does not animate skins, "
+             "the meshes are drawn in their bind pose", path, s->hide_count);
     return OB_OK;
 }
 
@@ -287,11 +421,11 @@ static void join_names(const name_list *l, const bool *pick, char *out, size_t s
         snprintf(out + at, size - at, " (+%u more)", l->dropped);
 }
 
-ob_result ob_model_gltf_precheck(const char *path)
+ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_required)
 {
     char *text;
-    size_t size;
-    ob_result r = read_json(path, &text, &size);
+    size_t size, json_offset;
+    ob_result r = read_json(path, &text, &size, &json_offset);
     if (r != OB_OK || !text) return r;
     name_list *lists = ob_calloc(2, sizeof *lists);
     if (!lists) {
@@ -300,13 +434,26 @@ ob_result ob_model_gltf_precheck(const char *path)
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
     name_list *required = &lists[0], *used = &lists[1];
-    scan s = {.p = text, .end = text + size};
+    scan s = {.p = text, .begin = text, .end = text + size};
     bool scanned = scan_top(&s, required, used);
     ob_free(text);
+    if (s.out_of_memory) {
+        ob_free(s.hide);
+        ob_free(lists);
+        OB_LOG_E(OB_MODEL_LOG, "%s: out of memory scanning glTF skins", path);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
     if (!scanned) {
-        OB_LOG_D(OB_MODEL_LOG, "%s: JSON not followed by the extension scan; assimp decides", path);
+        OB_LOG_D(OB_MODEL_LOG, "%s: JSON not followed by the glTF scan; assimp decides", path);
+        ob_free(s.hide);
         ob_free(lists);
         return OB_OK;
+    }
+    r = s.hide_count ? hide_skins(path, &s, json_offset, io) : OB_OK;
+    ob_free(s.hide);
+    if (r != OB_OK) {
+        ob_free(lists);
+        return r;
     }
 
     bool unsupported[GLTF_MAX_NAMES] = {false};
@@ -316,13 +463,17 @@ ob_result ob_model_gltf_precheck(const char *path)
         refused += unsupported[i];
     }
     char text_names[512];
-    if (refused || required->dropped) {
+    if (refuse_required && (refused || required->dropped)) {
         join_names(required, unsupported, text_names, sizeof text_names);
         OB_LOG_E(OB_MODEL_LOG, "%s: refused: the model requires the glTF extension%s %s, which "
                  "Obelisk does not support", path, refused + required->dropped > 1 ? "s" : "",
                  text_names);
         ob_free(lists);
         return OB_ERR_UNSUPPORTED;
+    }
+    if (!refuse_required) {
+        ob_free(lists);
+        return OB_OK;
     }
     /* Optional ones: everything used that is not required (and supported). */
     bool optional[GLTF_MAX_NAMES] = {false};

@@ -39,6 +39,11 @@ extern "C" {
 
 #define OB_SCENE_FILE_NONE UINT32_MAX   /* "no index": no parent, default material */
 #define OB_SCENE_FILE_MAX_PARTICLES (1u << 20)
+/* Input bounds (docs/limits.md), checked before memory is committed: a
+ * scene file's bytes (from the file's size, before reading it) and its
+ * entities (from the array's length, before any is parsed). */
+#define OB_SCENE_FILE_MAX_BYTES (64u << 20)
+#define OB_SCENE_FILE_MAX_ENTITIES (1u << 18)
 
 /* The error of a failed parse or load (ob_scene_load.h uses it too). */
 typedef struct ob_scene_file_error {
