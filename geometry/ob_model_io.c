@@ -96,7 +96,10 @@ static void refuse(ob_model_io *io, const char *name, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(why, sizeof why, fmt, ap);
     va_end(ap);
-    if (io->refused == OB_OK) io->refused = OB_ERR_IO;
+    /* assimp asks for a file several times (exists? then open): the first
+     * refusal is the one logged and returned. */
+    if (io->refused != OB_OK) return;
+    io->refused = OB_ERR_IO;
     OB_LOG_E(OB_MODEL_LOG, "%s: refused to read '%s': %s", io->model_path, name, why);
 }
 
@@ -165,8 +168,9 @@ static struct aiFile *io_open(struct aiFileIO *fio, const char *name, const char
         h->fd = ob_file_open_regular(name, "model file", OB_MODEL_MAX_FILE_BYTES, &h->size, why,
                                      sizeof why, &r);
         if (h->fd < 0) {
+            bool first = io->refused == OB_OK;
             refuse(io, name, "%s", why);
-            if (r == OB_ERR_LIMIT) io->refused = OB_ERR_LIMIT;
+            if (first && r == OB_ERR_LIMIT) io->refused = OB_ERR_LIMIT;
             goto fail;
         }
     }
