@@ -11,7 +11,9 @@
  * before the device is created: a malformed one exits with code 2 and one
  * message naming the file and the JSON path. The library's loader
  * (ob_scene_load.h) then builds it: a model of the scene that fails to load
- * is reported (entity and file) and left out; the rest renders.
+ * is reported (entity and file) and left out; the rest renders, and the
+ * exit code is 2 unless --allow-missing. Files a model or a scene refers to
+ * must stay inside its folder unless --allow-any-folder.
  *
  * Output, threading and stats options are those of obelisk-mirror
  * (ob_demo_run); command-line options win over the file's "settings".
@@ -75,6 +77,23 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
 
 /* ------------------------------------------------------------ main */
 
+/* A scene rendered without some of its models is bad input: each is named
+ * (the loader's own lines said why), and the exit is 2 unless
+ * --allow-missing. */
+static int report_left_out(const char *path, const ob_scene_file *sf, const ob_scene_loaded *loaded)
+{
+    fprintf(stderr, "obelisk-view: %s: %u %s left out because %s model did not load:\n", path,
+            loaded->left_out_count, loaded->left_out_count == 1 ? "entity was" : "entities were",
+            loaded->left_out_count == 1 ? "its" : "their");
+    for (uint32_t i = 0; i < loaded->left_out_count; i++) {
+        const ob_scene_file_entity *e = &sf->entities[loaded->left_out[i].entity];
+        fprintf(stderr, "  entities[%u] '%s': model '%s' (%s)\n", e->index, e->name, e->geometry.model,
+                ob_result_name(loaded->left_out[i].result));
+    }
+    fprintf(stderr, "obelisk-view: the rest was rendered; --allow-missing accepts this and exits 0\n");
+    return EXIT_BAD_INPUT;
+}
+
 static bool has_suffix(const char *s, const char *suffix)
 {
     size_t n = strlen(s), m = strlen(suffix);
@@ -99,7 +118,11 @@ int main(int argc, char **argv)
     int code;
     if (!ob_demo_options_parse(argc, argv,
                                "  FILE              a scene (.json, docs/scene-format.md) or a model file\n"
-                               "                    (.gltf .glb .obj .ply ...), framed automatically\n",
+                               "                    (.gltf .glb .obj .ply ...), framed automatically\n"
+                               "  --allow-missing   render a scene whose models did not all load and exit 0\n"
+                               "                    (without it: the rest renders, then exit 2)\n"
+                               "  --allow-any-folder  let models and scene files refer to files outside\n"
+                               "                    their own folder (trusted content only)\n",
                                true, &opt, &code))
         return code;
     bool is_scene = has_suffix(opt.input, ".json");
@@ -113,7 +136,9 @@ int main(int argc, char **argv)
             return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
         }
         apply_settings(&opt, &sf.settings);
-    } else if ((r = ob_model_open(&(ob_model_desc){.path = opt.input, .flip_uv = true}, &model)) != OB_OK) {
+    } else if ((r = ob_model_open(&(ob_model_desc){.path = opt.input, .flip_uv = true,
+                                                   .allow_any_folder = opt.allow_any_folder},
+                                  &model)) != OB_OK) {
         fprintf(stderr, "obelisk-view: %s: the model did not load (%s: %s)\n", opt.input,
                 ob_result_name(r), ob_result_text(r));
         return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
@@ -132,7 +157,8 @@ int main(int argc, char **argv)
         ob_scene_load_target t = {.renderer = d.r, .materials = d.lib, .views = d.views, .scene = d.scene};
         ob_scene_load_desc ld = {.file = &sf, .camera = d.camera,
                                  .frame_aspect = (double)opt.width / opt.height, .seed = opt.seed,
-                                 .first_geometry_id = d.stack->geometry_count + 1};
+                                 .first_geometry_id = d.stack->geometry_count + 1,
+                                 .allow_any_folder = opt.allow_any_folder};
         ob_scene_file_error err;
         if ((r = ob_scene_load(&t, &ld, &loaded, &err)) != OB_OK)
             fprintf(stderr, "obelisk-view: %s\n", err.message);
@@ -160,6 +186,8 @@ int main(int argc, char **argv)
                    sf.description ? "\n  " : "", sf.description ? sf.description : "");
         printf("\n");
         code = ob_demo_run(&d, NULL, NULL);
+        if (code == 0 && is_scene && loaded.left_out_count && !opt.allow_missing)
+            code = report_left_out(opt.input, &sf, &loaded);
     }
     /* The loaded scene's geometry and particle systems are its own: they go
      * once no frame uses them, before the demo takes the scene and views down. */

@@ -74,14 +74,16 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
     if (size) {
         size_t mark = ob_json_push_key(&c->rd, "size");
         double wh[2];
-        if (!ob_json_vector(&c->rd, size, 2, 2, OB_JSON_INT(1, 8192), false, wh, NULL)) return false;
+        if (!ob_json_vector(&c->rd, size, 2, 2, OB_JSON_INT(1, OB_SETTING_SIZE_MAX), false, wh, NULL)) return false;
         s->has_size = true;
         s->width = (uint32_t)wh[0];
         s->height = (uint32_t)wh[1];
         ob_json_pop(&c->rd, mark);
     }
-    if (!ob_json_opt_u32(&c->rd, j, "env_map_size", 8, 4096, &s->env_map_size) ||
-        !ob_json_opt_u32(&c->rd, j, "shadow_map_size", 16, 8192, &s->shadow_map_size))
+    if (!ob_json_opt_u32(&c->rd, j, "env_map_size", OB_SETTING_ENV_MAP_MIN, OB_SETTING_ENV_MAP_MAX,
+                         &s->env_map_size) ||
+        !ob_json_opt_u32(&c->rd, j, "shadow_map_size", OB_SETTING_SHADOW_MAP_MIN, OB_SETTING_SHADOW_MAP_MAX,
+                         &s->shadow_map_size))
         return false;
     const cJSON *threads = ob_json_member(j, "threads");
     if (threads) {
@@ -100,7 +102,9 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
         ob_json_pop(&c->rd, mark);
     }
     if (ob_json_member(j, "exposure")) {
-        if (!ob_json_opt_float(&c->rd, j, "exposure", OB_JSON_POSITIVE, &s->exposure)) return false;
+        if (!ob_json_opt_float(&c->rd, j, "exposure",
+                               OB_JSON_RANGE(OB_SETTING_EXPOSURE_MIN, OB_SETTING_EXPOSURE_MAX), &s->exposure))
+            return false;
     }
     if (ob_json_member(j, "clear_color")) {
         s->has_clear_color = true;
@@ -342,6 +346,7 @@ static bool parse_model(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
     memcpy(g->model, c->dir, dl);
     memcpy(g->model + dl, p, pl + 1);
     g->kind = OB_SCENE_GEOMETRY_MODEL;
+    g->model_relative = p[0] != '/';
     ob_json_pop(&c->rd, mark);
     return true;
 }

@@ -45,6 +45,20 @@ extern "C" {
 #define OB_SCENE_FILE_MAX_BYTES (64u << 20)
 #define OB_SCENE_FILE_MAX_ENTITIES (1u << 18)
 
+/* One range per setting, the same in a scene file's "settings" and on a
+ * program's command line (obelisk-view, obelisk-mirror): a value outside
+ * it is refused, naming it (docs/limits.md). */
+#define OB_SETTING_SIZE_MAX 8192u
+#define OB_SETTING_ENV_MAP_MIN 8u
+#define OB_SETTING_ENV_MAP_MAX 4096u
+#define OB_SETTING_SHADOW_MAP_MIN 16u
+#define OB_SETTING_SHADOW_MAP_MAX 8192u
+/* A linear scale before the tone map: past 1e6 (20 stops) a lit colour
+ * overflows half-float targets and single-precision tone mapping, and the
+ * image turns black or white without saying why. */
+#define OB_SETTING_EXPOSURE_MIN 1e-6
+#define OB_SETTING_EXPOSURE_MAX 1e6
+
 /* The error of a failed parse or load (ob_scene_load.h uses it too). */
 typedef struct ob_scene_file_error {
     char message[1024];      /* "FILE: PATH: what was expected" (or "FILE:LINE:COL: ..." for syntax) */
@@ -57,9 +71,9 @@ typedef struct ob_scene_file_error {
  * ob_scene_load_settings puts them where they belong. */
 typedef struct ob_scene_file_settings {
     bool has_size;
-    uint32_t width, height;       /* 1..8192 */
-    uint32_t env_map_size;        /* 0 = not given; else 8..4096 */
-    uint32_t shadow_map_size;     /* 0 = not given; else 16..8192 */
+    uint32_t width, height;       /* 1..OB_SETTING_SIZE_MAX */
+    uint32_t env_map_size;        /* 0 = not given; else OB_SETTING_ENV_MAP_MIN..MAX */
+    uint32_t shadow_map_size;     /* 0 = not given; else OB_SETTING_SHADOW_MAP_MIN..MAX */
     bool has_threads;
     int threads;                  /* 0 = single-threaded, N workers, -1 = "auto" */
     bool has_clear_color;
@@ -119,6 +133,7 @@ typedef struct ob_scene_file_geometry {
     uint32_t segments[2];         /* sphere: slices, stacks; cone: slices, 0;
                                      plane: subdivisions, 0; torus: major, minor */
     char *model;                  /* MODEL: the path as the loader gets it */
+    bool model_relative;          /* MODEL: the file gave a relative path (joined to its folder) */
 } ob_scene_file_geometry;
 
 typedef enum ob_scene_file_rotation_kind {
