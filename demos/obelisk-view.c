@@ -18,6 +18,7 @@
  * Output, threading and stats options are those of obelisk-mirror
  * (ob_demo_run); command-line options win over the file's "settings".
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -26,6 +27,10 @@
 #include "ob_scene_load.h"
 
 #define EXIT_BAD_INPUT 2
+/* How far from the origin a framed model may reach: the ground plane is 12
+ * radii wide and the camera stands a few radii off, all in single
+ * precision (docs/limits.md). */
+#define OB_VIEW_MAX_EXTENT 1e15
 
 /* ------------------------------------------------------------ one model */
 
@@ -43,8 +48,20 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     if ((r = ob_model_assets_instantiate(assets, d->scene, root, NULL, &entities)) != OB_OK) return r;
     double lo[3], hi[3], center[3], radius;
     if ((r = ob_scene_load_measure(d->scene, lo, hi, center, &radius)) != OB_OK) return r;
-    if (!(hi[0] >= lo[0])) return OB_ERR_BAD_MODEL;   /* nothing renderable */
-    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
+    /* Bounds that overflowed (node scales of 1e38 nested) or are too large to
+     * frame (positions near 3e38) are the model's problem: said so here,
+     * before the automatic ground and sun fail on sizes nobody asked for. */
+    bool finite = isfinite(radius) && isfinite(center[0]) && isfinite(center[1]) && isfinite(center[2]);
+    double reach = finite ? radius + fmax(fabs(center[0]), fmax(fabs(center[1]), fabs(center[2]))) : INFINITY;
+    if (!(hi[0] >= lo[0]) || !(reach <= OB_VIEW_MAX_EXTENT)) {
+        fprintf(stderr, "obelisk-view: %s: the model cannot be framed: its world bounds %s (centre %g %g %g, "
+                "radius %g; at most %g from the origin): check its units and node scales\n", path,
+                !(hi[0] >= lo[0]) ? "are empty" : !finite ? "are not finite (they overflowed)" : "are too large",
+                center[0], center[1],
+                center[2], radius, OB_VIEW_MAX_EXTENT);
+        return OB_ERR_BAD_MODEL;
+    }
+    if (!(radius > 0.0)) radius = 1.0;
     const ob_model *model = ob_model_assets_model(assets);
     printf("obelisk-view: %s: %u nodes, %u primitives, %u materials, %u images: %u entities\n", path,
            model->node_count, model->primitive_count, model->material_count, model->image_count, entities);
@@ -175,7 +192,8 @@ int main(int argc, char **argv)
     }
     ob_model_close(model);   /* only when the device did not come up */
     if (r != OB_OK) {
-        code = 1;
+        /* The model's own bounds are bad input; the rest is the engine's. */
+        code = !is_scene && assets && r == OB_ERR_BAD_MODEL ? EXIT_BAD_INPUT : 1;
     } else {
         printf("obelisk-view: %s: %s, %ux%u, %s", opt.input, ob_device_name(ob_renderer_device(d.r)),
                opt.width, opt.height,

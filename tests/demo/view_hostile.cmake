@@ -91,3 +91,19 @@ if(NOT lean_frames EQUAL 3 OR NOT material MATCHES "mtl_quad" OR NOT no_lean)
 endif()
 view(stats_device 1 "cannot write the stats file '/dev/full': a device, not a regular file"
      ${quad} --frames 1 --size 32x24 --stats-json /dev/full)
+
+# --- Bad bounds are the model's: nested node scales of 1e38 overflow its
+# world bounds; the message says so (not "plane: width must be ..."), exit 2.
+view(overflowing_scales 2 "overflowing_scales.gltf: the model cannot be framed: its world bounds are not finite"
+     ${models}/overflowing_scales.gltf --frames 1 --size 32x24)
+
+# --- A skinned glTF that crashed assimp, in a scene with other entities:
+# everything renders, the skin is drawn in its bind pose.
+file(COPY ${models}/skin_no_ibm.gltf DESTINATION ${OUT}/scenes)
+file(WRITE ${OUT}/scenes/skinned.json
+     "{\"entities\": [{\"name\": \"floor\", \"geometry\": {\"generator\": \"plane\"}},
+                      {\"name\": \"skinned\", \"geometry\": {\"model\": \"skin_no_ibm.gltf\"}}]}")
+view(skinned_scene 0 "" ${OUT}/scenes/skinned.json --frames 1 --size 32x24)
+if(NOT last_out MATCHES "2 entities \\(0 left out\\)")
+  message(FATAL_ERROR "skinned_scene: the skinned model should load beside the floor\n${last_out}")
+endif()
