@@ -41,6 +41,10 @@ typedef struct scan {
      * assimp: the top-level "skins" and each node's "skin". */
     uint32_t *hide;
     uint32_t hide_count, hide_cap;
+    /* byteStride per buffer view (0: none), and per accessor its buffer view
+     * (UINT32_MAX: none) and element size in bytes (0: unknown). */
+    uint32_t *view_stride, *accessor_view, *accessor_size;
+    uint32_t view_count, view_cap, accessor_count, accessor_cap, accessor_cap2;
     bool out_of_memory;
 } scan;
 
@@ -188,6 +192,151 @@ static bool read_name_array(scan *s, name_list *l)
     }
 }
 
+/* A non-negative integer value (anything else: skipped, *ok false). */
+static bool read_uint(scan *s, uint32_t *out, bool *ok)
+{
+    skip_ws(s);
+    const char *start = s->p;
+    uint64_t v = 0;
+    while (s->p < s->end && *s->p >= '0' && *s->p <= '9' && v <= UINT32_MAX)
+        v = v * 10 + (uint64_t)(*s->p++ - '0');
+    bool plain = s->p > start && v <= UINT32_MAX && s->p < s->end && strchr(",}] \t\r\n", *s->p);
+    if (!plain) {
+        s->p = start;
+        *ok = false;
+        return skip_value(s);
+    }
+    *out = (uint32_t)v;
+    *ok = true;
+    return true;
+}
+
+static uint32_t component_bytes(uint32_t type)
+{
+    switch (type) {
+    case 5120: case 5121: return 1;
+    case 5122: case 5123: return 2;
+    case 5125: case 5126: return 4;
+    default: return 0;
+    }
+}
+
+static uint32_t type_components(const char *type)
+{
+    static const struct { const char *name; uint32_t n; } types[] = {
+        {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}, {"MAT2", 4}, {"MAT3", 9}, {"MAT4", 16}};
+    for (size_t i = 0; i < sizeof types / sizeof types[0]; i++)
+        if (strcmp(type, types[i].name) == 0) return types[i].n;
+    return 0;
+}
+
+/* One member of a buffer view or accessor object; the rest skipped. */
+typedef bool (*member_fn)(scan *s, const char *key, uint32_t index);
+
+static bool view_member(scan *s, const char *key, uint32_t index)
+{
+    bool ok;
+    if (strcmp(key, "byteStride") == 0) return read_uint(s, &s->view_stride[index], &ok);
+    return skip_value(s);
+}
+
+static bool accessor_member(scan *s, const char *key, uint32_t index)
+{
+    bool ok;
+    uint32_t v;
+    if (strcmp(key, "bufferView") == 0) {
+        if (!read_uint(s, &v, &ok)) return false;
+        if (ok) s->accessor_view[index] = v;
+        return true;
+    }
+    if (strcmp(key, "componentType") == 0) {
+        if (!read_uint(s, &v, &ok)) return false;
+        /* Kept as components × bytes once both are known: bytes in the
+         * high half until then. */
+        s->accessor_size[index] = (s->accessor_size[index] & 0xFFFFu) | (ok ? component_bytes(v) : 0) << 16;
+        return true;
+    }
+    if (strcmp(key, "type") == 0) {
+        skip_ws(s);
+        char type[8];
+        if (!read_string(s, type, sizeof type)) return false;
+        s->accessor_size[index] = (s->accessor_size[index] & 0xFFFF0000u) | type_components(type);
+        return true;
+    }
+    return skip_value(s);
+}
+
+/* An array of objects, each member handed to fn with the element's index;
+ * grow(index) makes room first. */
+static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '[') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == ']') {
+        s->p++;
+        return true;
+    }
+    for (uint32_t index = 0;; index++) {
+        skip_ws(s);
+        if (s->p >= s->end || *s->p != '{') return false;
+        if (!grow(s, index)) return false;
+        s->p++;
+        skip_ws(s);
+        if (s->p < s->end && *s->p == '}') {
+            s->p++;
+        } else {
+            for (;;) {
+                skip_ws(s);
+                char key[24];
+                if (!read_string(s, key, sizeof key)) return false;
+                skip_ws(s);
+                if (s->p >= s->end || *s->p++ != ':') return false;
+                if (!fn(s, key, index)) return false;
+                skip_ws(s);
+                if (s->p >= s->end) return false;
+                if (*s->p == '}') {
+                    s->p++;
+                    break;
+                }
+                if (*s->p++ != ',') return false;
+            }
+        }
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == ']') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
+static bool grow_views(scan *s, uint32_t index)
+{
+    if (ob_array_reserve((void **)&s->view_stride, &s->view_cap, index + 1, sizeof *s->view_stride) != OB_OK) {
+        s->out_of_memory = true;
+        return false;
+    }
+    s->view_stride[index] = 0;
+    s->view_count = index + 1;
+    return true;
+}
+
+static bool grow_accessors(scan *s, uint32_t index)
+{
+    if (ob_array_reserve((void **)&s->accessor_view, &s->accessor_cap, index + 1, sizeof *s->accessor_view) != OB_OK ||
+        ob_array_reserve((void **)&s->accessor_size, &s->accessor_cap2, index + 1, sizeof *s->accessor_size) != OB_OK) {
+        s->out_of_memory = true;
+        return false;
+    }
+    s->accessor_view[index] = UINT32_MAX;
+    s->accessor_size[index] = 0;
+    s->accessor_count = index + 1;
+    return true;
+}
+
 /* One node object: its "skin" member is hidden, the rest skipped. */
 static bool scan_node(scan *s)
 {
@@ -264,6 +413,8 @@ static bool scan_top(scan *s, name_list *required, name_list *used)
         else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
         else if (strcmp(key, "nodes") == 0) ok = scan_nodes(s);
         else if (strcmp(key, "skins") == 0) ok = hide_key(s, quote) && skip_value(s);
+        else if (strcmp(key, "bufferViews") == 0) ok = scan_objects(s, grow_views, view_member);
+        else if (strcmp(key, "accessors") == 0) ok = scan_objects(s, grow_accessors, accessor_member);
         else ok = skip_value(s);
         if (!ok) return false;
         skip_ws(s);
@@ -379,6 +530,24 @@ static ob_result read_json(const char *path, char **out, size_t *out_size, size_
     return OB_OK;
 }
 
+/* A byteStride shorter than one element makes elements overlap: assimp
+ * reads them silently wrong. Refused, naming the accessor and the view. */
+static ob_result check_strides(const char *path, const scan *s)
+{
+    for (uint32_t a = 0; a < s->accessor_count; a++) {
+        uint32_t v = s->accessor_view[a], bytes = s->accessor_size[a] >> 16,
+                 components = s->accessor_size[a] & 0xFFFFu;
+        if (v >= s->view_count || !s->view_stride[v] || !bytes || !components) continue;
+        if (s->view_stride[v] < bytes * components) {
+            OB_LOG_E(OB_MODEL_LOG, "%s: accessor %u: bufferView %u has byteStride %u, smaller than one "
+                     "element (%u components of %u bytes = %u bytes)", path, a, v, s->view_stride[v],
+                     components, bytes, bytes * components);
+            return OB_ERR_BAD_MODEL;
+        }
+    }
+    return OB_OK;
+}
+
 /* The file with every hidden key's first character replaced by '_'
  * ("skins" becomes "_kins", "skin" "_kin"): same length, so a .glb's chunk
  * lengths stay right, and names assimp ignores. */
@@ -438,6 +607,9 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
     bool scanned = scan_top(&s, required, used);
     ob_free(text);
     if (s.out_of_memory) {
+        ob_free(s.view_stride);
+        ob_free(s.accessor_view);
+        ob_free(s.accessor_size);
         ob_free(s.hide);
         ob_free(lists);
         OB_LOG_E(OB_MODEL_LOG, "%s: out of memory scanning glTF skins", path);
@@ -445,12 +617,19 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
     }
     if (!scanned) {
         OB_LOG_D(OB_MODEL_LOG, "%s: JSON not followed by the glTF scan; assimp decides", path);
+        ob_free(s.view_stride);
+        ob_free(s.accessor_view);
+        ob_free(s.accessor_size);
         ob_free(s.hide);
         ob_free(lists);
         return OB_OK;
     }
-    r = s.hide_count ? hide_skins(path, &s, json_offset, io) : OB_OK;
+    r = check_strides(path, &s);
+    if (r == OB_OK && s.hide_count) r = hide_skins(path, &s, json_offset, io);
     ob_free(s.hide);
+    ob_free(s.view_stride);
+    ob_free(s.accessor_view);
+    ob_free(s.accessor_size);
     if (r != OB_OK) {
         ob_free(lists);
         return r;

@@ -98,6 +98,9 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
  * - a .glb's header and chunk lengths against the file's size
  *   (OB_ERR_BAD_MODEL naming the chunk: assimp would allocate what a
  *   lying header claims);
+ * - a bufferView's byteStride shorter than the element of an accessor
+ *   reading through it (OB_ERR_BAD_MODEL naming both: assimp reads
+ *   overlapping elements silently);
  * - skins: Obelisk does not animate them, and assimp 5.2 crashes or reads
  *   out of bounds on skins the spec allows (no inverseBindMatrices) or that
  *   lie (joint indices, weights, too few matrices). The top-level "skins"

@@ -193,6 +193,26 @@ static void lying_glb_lengths_are_refused(void **state)
     assert_null(mesh.vertices);
 }
 
+/* A byteStride shorter than its element makes vertices overlap; assimp read
+ * them silently. Refused, naming the accessor, the view and the sizes. */
+static void short_byte_stride_is_refused(void **state)
+{
+    (void)state;
+    char path[160];
+    snprintf(path, sizeof path, "%s/stride.gltf", model_dir);
+    write_text(path,
+               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+               "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+               "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+               "\"accessors\":[{\"type\":\"VEC3\",\"bufferView\":0,\"componentType\":5126,\"count\":3}],"
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36,\"byteStride\":4}]}");
+    ob_model *m = NULL;
+    assert_int_equal(open_model(path, false, &m), OB_ERR_BAD_MODEL);
+    assert_true(ob_test_log_has("stride.gltf: accessor 0: bufferView 0 has byteStride 4, smaller than one "
+                                "element (3 components of 4 bytes = 12 bytes)", NULL));
+}
+
 /* A skin without inverseBindMatrices (valid glTF) crashed assimp 5.2 with
  * SIGSEGV; joints past the joint count and NaN weights too. Obelisk does
  * not animate skins: the model opens, drawn in its bind pose, and says so. */
@@ -219,6 +239,7 @@ int main(void)
         cmocka_unit_test(fifos_are_refused_without_blocking),
         cmocka_unit_test(references_stay_inside_the_models_folder),
         cmocka_unit_test(lying_glb_lengths_are_refused),
+        cmocka_unit_test(short_byte_stride_is_refused),
         cmocka_unit_test(skinned_gltf_opens_in_its_bind_pose),
     };
     return cmocka_run_group_tests(tests, make_dirs, remove_dirs);
