@@ -534,80 +534,70 @@ char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result)
     return ob_file_read_limited(path, "file", 0, out_size, NULL, 0, out_result);
 }
 
-/* The file a write to path lands in: path itself, or, when path is a
- * symbolic link, what it points to (resolved, so the temporary file sits in
- * the real target's folder and the rename replaces the target, not the
- * link). Refuses an existing path that is not a regular file: a FIFO, a
- * device (/dev/full), a directory — renaming over those would replace the
- * node. NULL (logged) on refusal; ob_free the result. */
-static char *write_target(const char *path, ob_result *out_result)
+/* The file a write to path lands in, into target (size bytes): path itself,
+ * or, when path is a symbolic link, what it points to (resolved, so the
+ * temporary file sits in the real target's folder and the rename replaces
+ * the target, not the link). Refuses an existing path that is not a regular
+ * file: a FIFO, a device (/dev/full), a directory — renaming over those
+ * would replace the node. No allocation of ours (fault-injection walks
+ * count them). OB_ERR_IO or OB_ERR_INVALID_ARGUMENT (too long), logged. */
+static ob_result write_target(const char *path, char *target, size_t size)
 {
     struct stat st;
-    *out_result = OB_ERR_IO;
     if (stat(path, &st) == 0) {
         if (!S_ISREG(st.st_mode)) {
             OB_LOG_E("io", "cannot write '%s': not a regular file (%s); refusing to replace it", path,
                      special_kind(st.st_mode));
-            return NULL;
+            return OB_ERR_IO;
         }
     } else if (errno != ENOENT) {
         OB_LOG_E("io", "cannot write '%s': %s", path, strerror(errno));
-        return NULL;
+        return OB_ERR_IO;
     }
+    int n;
     struct stat lst;
     if (lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode)) {
-        /* An existing link target (stat succeeded above): write through it. A
-         * dangling link (stat failed with ENOENT) is written as a new file
-         * where it points; realpath needs the target to exist, so resolve
-         * the link's text against the link's folder instead. */
+        /* An existing target (stat succeeded above): write through it. A
+         * dangling link is written as a new file where it points; realpath
+         * needs the target to exist, so the link's text is resolved against
+         * the link's folder instead. */
         char *real = realpath(path, NULL);
         if (real) {
-            char *copy = ob_strdup(real);
+            n = snprintf(target, size, "%s", real);
             free(real);
-            *out_result = copy ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
-            return copy;
+        } else {
+            char link[4096];
+            ssize_t len = readlink(path, link, sizeof link - 1);
+            if (len <= 0) {
+                OB_LOG_E("io", "cannot write '%s': unreadable symbolic link", path);
+                return OB_ERR_IO;
+            }
+            link[len] = '\0';
+            const char *slash = strrchr(path, '/');
+            int dir = link[0] == '/' || !slash ? 0 : (int)(slash - path) + 1;
+            n = snprintf(target, size, "%.*s%s", dir, path, link);
         }
-        char link[4096];
-        ssize_t n = readlink(path, link, sizeof link - 1);
-        if (n <= 0) {
-            OB_LOG_E("io", "cannot write '%s': unreadable symbolic link", path);
-            return NULL;
-        }
-        link[n] = '\0';
-        const char *slash = strrchr(path, '/');
-        size_t dir = link[0] == '/' || !slash ? 0 : (size_t)(slash - path) + 1;
-        char *joined = ob_malloc(dir + (size_t)n + 1);
-        if (!joined) {
-            *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
-            return NULL;
-        }
-        memcpy(joined, path, dir);
-        memcpy(joined + dir, link, (size_t)n + 1);
-        *out_result = OB_OK;
-        return joined;
+    } else {
+        n = snprintf(target, size, "%s", path);
     }
-    char *copy = ob_strdup(path);
-    *out_result = copy ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
-    return copy;
+    if (n < 0 || (size_t)n >= size) {
+        OB_LOG_E("io", "cannot write '%s': the path is too long", path);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    return OB_OK;
 }
 
 ob_result ob_file_write(const char *path, const void *data, size_t size)
 {
-    ob_result r;
-    char *target = write_target(path, &r);
-    if (!target) return r;
-    char tmp[4096];
-    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", target, (long)getpid());
-    if (n < 0 || (size_t)n >= sizeof tmp) {
-        ob_free(target);
-        return OB_ERR_INVALID_ARGUMENT;
-    }
+    char target[4096], tmp[4096 + 32];
+    ob_result r = write_target(path, target, sizeof target);
+    if (r != OB_OK) return r;
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", target, (long)getpid());
     /* Exclusively: whatever is already at the temporary name (a link planted
      * there, a FIFO) makes the write fail instead of being followed. */
     int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOCTTY, 0666);
     if (fd < 0) {
         OB_LOG_E("io", "cannot create '%s': %s", tmp, strerror(errno));
-        ob_free(target);
         return OB_ERR_IO;
     }
     const char *p = data;
@@ -623,16 +613,13 @@ ob_result ob_file_write(const char *path, const void *data, size_t size)
         p += w;
         left -= (size_t)w;
     }
-    if (!err && fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;
     if (close(fd) != 0 && !err) err = errno;
     if (!err && rename(tmp, target) != 0) err = errno;
     if (err) {
         OB_LOG_E("io", "cannot write '%s': %s", path, strerror(err));
         unlink(tmp);
-        ob_free(target);
         return OB_ERR_IO;
     }
-    ob_free(target);
     return OB_OK;
 }
 

@@ -471,7 +471,14 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
     }
     if (!scene) {
         if (c->io->refused != OB_OK) return c->io->refused;   /* logged, naming the file */
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
+        /* assimp's words for two common glTF faults say nothing of the cause. */
+        const char *hint = "";
+        if (c->io->gltf && strstr(err, "No suitable reader found"))
+            hint = " (its glTF JSON does not parse: a NaN or Infinity literal, a file cut short?)";
+        else if (c->io->gltf && strstr(err, "has no faces"))
+            hint = " (assimp drops triangles whose indices are past the vertex count: check the "
+                   "index accessor's values against POSITION's count)";
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s%s", path, err, hint);
         return OB_ERR_PARSE;
     }
     r = ob_model_check_raw_scene(c, scene);

@@ -603,6 +603,7 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
     name_list *required = &lists[0], *used = &lists[1];
+    io->gltf = true;
     scan s = {.p = text, .begin = text, .end = text + size};
     bool scanned = scan_top(&s, required, used);
     ob_free(text);

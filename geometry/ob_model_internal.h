@@ -33,6 +33,7 @@ typedef struct ob_model_io {
     bool any_folder;
     uint8_t *patched;            /* ob_malloc'd, owned */
     size_t patched_size;
+    bool gltf;                   /* the glTF scan saw glTF JSON (for assimp's messages) */
     ob_result refused;
 } ob_model_io;
 

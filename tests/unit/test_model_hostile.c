@@ -213,6 +213,22 @@ static void short_byte_stride_is_refused(void **state)
                                 "element (3 components of 4 bytes = 12 bytes)", NULL));
 }
 
+/* assimp's own words for two glTF faults ("No suitable reader found" for a
+ * NaN literal, "Mesh has no faces" for indices past the vertex count) get
+ * the likely cause added. */
+static void assimp_messages_get_their_cause(void **state)
+{
+    (void)state;
+    char path[160];
+    snprintf(path, sizeof path, "%s/nan.gltf", model_dir);
+    write_text(path, "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"scale\":[NaN,1,1]}]}");
+    ob_model *m = NULL;
+    assert_int_equal(open_model(path, false, &m), OB_ERR_PARSE);
+    assert_true(ob_test_log_has("nan.gltf: assimp could not read the model", "its glTF JSON does not parse", NULL));
+    assert_int_equal(open_model(DATA "index_out_of_range.gltf", false, &m), OB_ERR_PARSE);
+    assert_true(ob_test_log_has("index_out_of_range.gltf", "has no faces", "indices are past the vertex count", NULL));
+}
+
 /* A skin without inverseBindMatrices (valid glTF) crashed assimp 5.2 with
  * SIGSEGV; joints past the joint count and NaN weights too. Obelisk does
  * not animate skins: the model opens, drawn in its bind pose, and says so. */
@@ -240,6 +256,7 @@ int main(void)
         cmocka_unit_test(references_stay_inside_the_models_folder),
         cmocka_unit_test(lying_glb_lengths_are_refused),
         cmocka_unit_test(short_byte_stride_is_refused),
+        cmocka_unit_test(assimp_messages_get_their_cause),
         cmocka_unit_test(skinned_gltf_opens_in_its_bind_pose),
     };
     return cmocka_run_group_tests(tests, make_dirs, remove_dirs);
