@@ -35,16 +35,29 @@
  * only together with the code that honours it. */
 static const char *const supported_required[] = {NULL};
 
+#define GLTF_NONE UINT32_MAX
+
+typedef struct gltf_view {
+    uint32_t stride, length, offset;   /* byteStride (0: none), byteLength, byteOffset */
+} gltf_view;
+
+/* Element sizes: components and bytes per component (0: unknown). */
+typedef struct gltf_accessor {
+    uint32_t view, components, bytes;
+    uint32_t sparse_count;                         /* 0: not sparse */
+    uint32_t index_view, index_offset, index_bytes, value_view, value_offset;
+} gltf_accessor;
+
 typedef struct scan {
     const char *p, *begin, *end;
     /* Offsets (from begin) of the opening quotes of the keys to hide from
      * assimp: the top-level "skins" and each node's "skin". */
     uint32_t *hide;
     uint32_t hide_count, hide_cap;
-    /* byteStride per buffer view (0: none), and per accessor its buffer view
-     * (UINT32_MAX: none) and element size in bytes (0: unknown). */
-    uint32_t *view_stride, *accessor_view, *accessor_size;
-    uint32_t view_count, view_cap, accessor_count, accessor_cap, accessor_cap2;
+    /* What the checks before assimp need of bufferViews and accessors. */
+    struct gltf_view *views;
+    struct gltf_accessor *accessors;
+    uint32_t view_count, view_cap, accessor_count, accessor_cap;
     bool out_of_memory;
 } scan;
 
@@ -236,33 +249,110 @@ typedef bool (*member_fn)(scan *s, const char *key, uint32_t index);
 static bool view_member(scan *s, const char *key, uint32_t index)
 {
     bool ok;
-    if (strcmp(key, "byteStride") == 0) return read_uint(s, &s->view_stride[index], &ok);
+    gltf_view *v = &s->views[index];
+    if (strcmp(key, "byteStride") == 0) return read_uint(s, &v->stride, &ok);
+    if (strcmp(key, "byteLength") == 0) return read_uint(s, &v->length, &ok);
+    if (strcmp(key, "byteOffset") == 0) return read_uint(s, &v->offset, &ok);
     return skip_value(s);
+}
+
+/* A small object's integer members by name (the rest skipped). */
+static bool read_members(scan *s, const char *const *keys, uint32_t **outs, uint32_t n)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == '}') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        skip_ws(s);
+        char key[24];
+        if (!read_string(s, key, sizeof key)) return false;
+        skip_ws(s);
+        if (s->p >= s->end || *s->p++ != ':') return false;
+        uint32_t k = 0;
+        while (k < n && strcmp(key, keys[k]) != 0) k++;
+        bool ok;
+        if (!(k < n ? read_uint(s, outs[k], &ok) : skip_value(s))) return false;
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == '}') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
+static bool sparse_member(scan *s, gltf_accessor *a)
+{
+    /* {"count": N, "indices": {bufferView, byteOffset, componentType}, "values": {bufferView, byteOffset}} */
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == '}') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        skip_ws(s);
+        char key[16];
+        if (!read_string(s, key, sizeof key)) return false;
+        skip_ws(s);
+        if (s->p >= s->end || *s->p++ != ':') return false;
+        bool ok = true;
+        uint32_t type = 0;
+        if (strcmp(key, "count") == 0) {
+            if (!read_uint(s, &a->sparse_count, &ok)) return false;
+        } else if (strcmp(key, "indices") == 0) {
+            static const char *const keys[] = {"bufferView", "byteOffset", "componentType"};
+            uint32_t *outs[] = {&a->index_view, &a->index_offset, &type};
+            if (!read_members(s, keys, outs, 3)) return false;
+            a->index_bytes = component_bytes(type);
+        } else if (strcmp(key, "values") == 0) {
+            static const char *const keys[] = {"bufferView", "byteOffset"};
+            uint32_t *outs[] = {&a->value_view, &a->value_offset};
+            if (!read_members(s, keys, outs, 2)) return false;
+        } else if (!skip_value(s)) {
+            return false;
+        }
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == '}') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
 }
 
 static bool accessor_member(scan *s, const char *key, uint32_t index)
 {
     bool ok;
     uint32_t v;
+    gltf_accessor *a = &s->accessors[index];
     if (strcmp(key, "bufferView") == 0) {
         if (!read_uint(s, &v, &ok)) return false;
-        if (ok) s->accessor_view[index] = v;
+        if (ok) a->view = v;
         return true;
     }
     if (strcmp(key, "componentType") == 0) {
         if (!read_uint(s, &v, &ok)) return false;
-        /* Kept as components × bytes once both are known: bytes in the
-         * high half until then. */
-        s->accessor_size[index] = (s->accessor_size[index] & 0xFFFFu) | (ok ? component_bytes(v) : 0) << 16;
+        a->bytes = ok ? component_bytes(v) : 0;
         return true;
     }
     if (strcmp(key, "type") == 0) {
         skip_ws(s);
         char type[8];
         if (!read_string(s, type, sizeof type)) return false;
-        s->accessor_size[index] = (s->accessor_size[index] & 0xFFFF0000u) | type_components(type);
+        a->components = type_components(type);
         return true;
     }
+    if (strcmp(key, "sparse") == 0) return sparse_member(s, a);
     return skip_value(s);
 }
 
@@ -315,24 +405,22 @@ static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
 
 static bool grow_views(scan *s, uint32_t index)
 {
-    if (ob_array_reserve((void **)&s->view_stride, &s->view_cap, index + 1, sizeof *s->view_stride) != OB_OK) {
+    if (ob_array_reserve((void **)&s->views, &s->view_cap, index + 1, sizeof *s->views) != OB_OK) {
         s->out_of_memory = true;
         return false;
     }
-    s->view_stride[index] = 0;
+    s->views[index] = (gltf_view){0};
     s->view_count = index + 1;
     return true;
 }
 
 static bool grow_accessors(scan *s, uint32_t index)
 {
-    if (ob_array_reserve((void **)&s->accessor_view, &s->accessor_cap, index + 1, sizeof *s->accessor_view) != OB_OK ||
-        ob_array_reserve((void **)&s->accessor_size, &s->accessor_cap2, index + 1, sizeof *s->accessor_size) != OB_OK) {
+    if (ob_array_reserve((void **)&s->accessors, &s->accessor_cap, index + 1, sizeof *s->accessors) != OB_OK) {
         s->out_of_memory = true;
         return false;
     }
-    s->accessor_view[index] = UINT32_MAX;
-    s->accessor_size[index] = 0;
+    s->accessors[index] = (gltf_accessor){.view = GLTF_NONE, .index_view = GLTF_NONE, .value_view = GLTF_NONE};
     s->accessor_count = index + 1;
     return true;
 }
@@ -530,19 +618,39 @@ static ob_result read_json(const char *path, char **out, size_t *out_size, size_
     return OB_OK;
 }
 
-/* A byteStride shorter than one element makes elements overlap: assimp
- * reads them silently wrong. Refused, naming the accessor and the view. */
-static ob_result check_strides(const char *path, const scan *s)
+/* Checks assimp 5.2 does not make, or makes after reading out of bounds:
+ * - a byteStride shorter than one element makes elements overlap, read
+ *   silently wrong;
+ * - a sparse accessor whose count needs more indices or values than their
+ *   buffer views hold makes assimp copy past its buffer (found by
+ *   fuzz_model's structure-aware glTF inputs).
+ * Refused, naming the accessor, the view and the sizes. */
+static ob_result check_accessors(const char *path, const scan *s)
 {
-    for (uint32_t a = 0; a < s->accessor_count; a++) {
-        uint32_t v = s->accessor_view[a], bytes = s->accessor_size[a] >> 16,
-                 components = s->accessor_size[a] & 0xFFFFu;
-        if (v >= s->view_count || !s->view_stride[v] || !bytes || !components) continue;
-        if (s->view_stride[v] < bytes * components) {
+    for (uint32_t i = 0; i < s->accessor_count; i++) {
+        const gltf_accessor *a = &s->accessors[i];
+        const uint32_t element = a->bytes * a->components;
+        if (a->view < s->view_count && s->views[a->view].stride && element &&
+            s->views[a->view].stride < element) {
             OB_LOG_E(OB_MODEL_LOG, "%s: accessor %u: bufferView %u has byteStride %u, smaller than one "
-                     "element (%u components of %u bytes = %u bytes)", path, a, v, s->view_stride[v],
-                     components, bytes, bytes * components);
+                     "element (%u components of %u bytes = %u bytes)", path, i, a->view,
+                     s->views[a->view].stride, a->components, a->bytes, element);
             return OB_ERR_BAD_MODEL;
+        }
+        if (!a->sparse_count) continue;
+        const struct { const char *what; uint32_t view, offset, size; } parts[2] = {
+            {"indices", a->index_view, a->index_offset, a->index_bytes},
+            {"values", a->value_view, a->value_offset, element}};
+        for (int k = 0; k < 2; k++) {
+            if (!parts[k].size) continue;
+            uint64_t need = (uint64_t)parts[k].offset + (uint64_t)a->sparse_count * parts[k].size;
+            uint64_t have = parts[k].view < s->view_count ? s->views[parts[k].view].length : 0;
+            if (need > have) {
+                OB_LOG_E(OB_MODEL_LOG, "%s: accessor %u: sparse count %u needs %llu bytes of %s, its "
+                         "bufferView %u has %llu", path, i, a->sparse_count, (unsigned long long)need,
+                         parts[k].what, parts[k].view, (unsigned long long)have);
+                return OB_ERR_BAD_MODEL;
+            }
         }
     }
     return OB_OK;
@@ -608,9 +716,8 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
     bool scanned = scan_top(&s, required, used);
     ob_free(text);
     if (s.out_of_memory) {
-        ob_free(s.view_stride);
-        ob_free(s.accessor_view);
-        ob_free(s.accessor_size);
+        ob_free(s.views);
+        ob_free(s.accessors);
         ob_free(s.hide);
         ob_free(lists);
         OB_LOG_E(OB_MODEL_LOG, "%s: out of memory scanning glTF skins", path);
@@ -618,19 +725,17 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
     }
     if (!scanned) {
         OB_LOG_D(OB_MODEL_LOG, "%s: JSON not followed by the glTF scan; assimp decides", path);
-        ob_free(s.view_stride);
-        ob_free(s.accessor_view);
-        ob_free(s.accessor_size);
+        ob_free(s.views);
+        ob_free(s.accessors);
         ob_free(s.hide);
         ob_free(lists);
         return OB_OK;
     }
-    r = check_strides(path, &s);
+    r = check_accessors(path, &s);
     if (r == OB_OK && s.hide_count) r = hide_skins(path, &s, json_offset, io);
     ob_free(s.hide);
-    ob_free(s.view_stride);
-    ob_free(s.accessor_view);
-    ob_free(s.accessor_size);
+    ob_free(s.views);
+    ob_free(s.accessors);
     if (r != OB_OK) {
         ob_free(lists);
         return r;

@@ -101,7 +101,9 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
  *   lying header claims);
  * - a bufferView's byteStride shorter than the element of an accessor
  *   reading through it (OB_ERR_BAD_MODEL naming both: assimp reads
- *   overlapping elements silently);
+ *   overlapping elements silently), and a sparse accessor whose count
+ *   needs more indices or values than their views hold (assimp copies past
+ *   its buffer);
  * - skins: Obelisk does not animate them, and assimp 5.2 crashes or reads
  *   out of bounds on skins the spec allows (no inverseBindMatrices) or that
  *   lie (joint indices, weights, too few matrices). The top-level "skins"

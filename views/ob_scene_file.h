@@ -205,8 +205,11 @@ typedef struct ob_scene_file {
 ob_result ob_scene_file_parse(const char *text, size_t size, const char *path,
                               ob_scene_file *out, ob_scene_file_error *out_error);
 
-/* Reads the file at `path` and parses it. Also OB_ERR_IO (message names the
- * file and the OS error). */
+/* Reads the file at `path` and parses it. Only a regular file of at most
+ * OB_SCENE_FILE_MAX_BYTES is read, checked before reading (a FIFO never
+ * blocks, /dev/zero is never read). Also OB_ERR_IO (message names the file
+ * and the OS error, or what the path is: "not a regular file (a FIFO)") and
+ * OB_ERR_LIMIT (the file's size against the bound). */
 ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file_error *out_error);
 
 /* Frees everything the description owns and zeroes it. NULL is a no-op. */

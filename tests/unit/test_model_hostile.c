@@ -213,6 +213,29 @@ static void short_byte_stride_is_refused(void **state)
                                 "element (3 components of 4 bytes = 12 bytes)", NULL));
 }
 
+/* A sparse accessor whose count needs more indices than their view holds
+ * made assimp copy past its buffer (found by fuzz_model's generated glTF). */
+static void lying_sparse_count_is_refused(void **state)
+{
+    (void)state;
+    char path[160];
+    snprintf(path, sizeof path, "%s/sparse.gltf", model_dir);
+    write_text(path,
+               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+               "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+               "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteLength\":4},"
+               "{\"buffer\":0,\"byteLength\":24}],"
+               "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+               "\"sparse\":{\"count\":3,\"indices\":{\"bufferView\":1,\"componentType\":5123},"
+               "\"values\":{\"bufferView\":2}}}]}");
+    ob_model *m = NULL;
+    assert_int_equal(open_model(path, false, &m), OB_ERR_BAD_MODEL);
+    assert_true(ob_test_log_has("sparse.gltf: accessor 0: sparse count 3 needs 6 bytes of indices, its "
+                                "bufferView 1 has 4", NULL));
+}
+
 /* assimp's own words for two glTF faults ("No suitable reader found" for a
  * NaN literal, "Mesh has no faces" for indices past the vertex count) get
  * the likely cause added. */
@@ -256,6 +279,7 @@ int main(void)
         cmocka_unit_test(references_stay_inside_the_models_folder),
         cmocka_unit_test(lying_glb_lengths_are_refused),
         cmocka_unit_test(short_byte_stride_is_refused),
+        cmocka_unit_test(lying_sparse_count_is_refused),
         cmocka_unit_test(assimp_messages_get_their_cause),
         cmocka_unit_test(skinned_gltf_opens_in_its_bind_pose),
     };
