@@ -154,9 +154,13 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
                  o->malloc_threshold_kib <= 32 * 1024;
             i++;
         } else if (!strcmp(a, "--window-resize")) {
-            ok = sscanf(v, "%u:%ux%u", &o->resize_frame, &o->resize_width, &o->resize_height) == 3 &&
-                 o->resize_width > 0 && o->resize_height > 0 && o->resize_width <= 8192 &&
-                 o->resize_height <= 8192;
+            const char *colon = strchr(v, ':');
+            char frame[12] = "";
+            if (colon && colon > v && (size_t)(colon - v) < sizeof frame)
+                memcpy(frame, v, (size_t)(colon - v));
+            ok = colon && parse_u32(frame, &o->resize_frame) &&
+                 parse_size(colon + 1, &o->resize_width, &o->resize_height);
+            range = "F:WxH, each side from 1 to 8192";
             i++;
         } else if (!strcmp(a, "--msaa")) {
             ok = parse_u32(v, &o->msaa) && (o->msaa == 1 || o->msaa == 2 || o->msaa == 4 ||
