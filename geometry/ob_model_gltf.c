@@ -53,7 +53,7 @@ typedef struct scan {
     /* Offsets (from begin) of the opening quotes of the keys to hide from
      * assimp: the top-level "skins" and each node's "skin". */
     uint32_t *hide;
-    uint32_t hide_count, hide_cap;
+    uint32_t hide_count, hide_cap, skin_count;   /* skin_count: hidden keys that are skins */
     /* What the checks before assimp need of bufferViews and accessors. */
     struct gltf_view *views;
     struct gltf_accessor *accessors;
@@ -203,6 +203,12 @@ static bool read_name_array(scan *s, name_list *l)
         }
         if (*s->p++ != ',') return false;
     }
+}
+
+static bool hide_skin(scan *s, const char *quote)
+{
+    s->skin_count++;
+    return hide_key(s, quote);
 }
 
 /* A non-negative integer value (anything else: skipped, *ok false). */
@@ -425,6 +431,84 @@ static bool grow_accessors(scan *s, uint32_t index)
     return true;
 }
 
+/* One primitive object. Points and lines (mode 0-3) are dropped by Obelisk
+ * after the import; their "indices" are hidden from assimp, which then
+ * numbers the vertices in order: assimp 5.2 crashes (SIGSEGV) on a
+ * LINE_LOOP whose index is past the vertex count (found by fuzz_model),
+ * while it drops such triangles itself. */
+static bool scan_primitive(scan *s)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{') return skip_value(s);
+    s->p++;
+    const char *indices = NULL;
+    uint32_t mode = 4;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == '}') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        skip_ws(s);
+        const char *quote = s->p;
+        char key[16];
+        if (!read_string(s, key, sizeof key)) return false;
+        skip_ws(s);
+        if (s->p >= s->end || *s->p++ != ':') return false;
+        bool ok;
+        if (strcmp(key, "mode") == 0) {
+            if (!read_uint(s, &mode, &ok)) return false;
+        } else {
+            if (strcmp(key, "indices") == 0) indices = quote;
+            if (!skip_value(s)) return false;
+        }
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == '}') {
+            s->p++;
+            break;
+        }
+        if (*s->p++ != ',') return false;
+    }
+    if (indices && mode <= 3 && !hide_key(s, indices)) return false;
+    return true;
+}
+
+/* An array of values, each handed to fn (which must consume it). */
+static bool scan_array(scan *s, bool (*fn)(scan *))
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '[') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == ']') {
+        s->p++;
+        return true;
+    }
+    for (;;) {
+        if (!fn(s)) return false;
+        skip_ws(s);
+        if (s->p >= s->end) return false;
+        if (*s->p == ']') {
+            s->p++;
+            return true;
+        }
+        if (*s->p++ != ',') return false;
+    }
+}
+
+static bool mesh_member(scan *s, const char *key, uint32_t index)
+{
+    (void)index;
+    return strcmp(key, "primitives") == 0 ? scan_array(s, scan_primitive) : skip_value(s);
+}
+
+static bool grow_nothing(scan *s, uint32_t index)
+{
+    (void)s, (void)index;
+    return true;
+}
+
 /* One node object: its "skin" member is hidden, the rest skipped. */
 static bool scan_node(scan *s)
 {
@@ -441,7 +525,7 @@ static bool scan_node(scan *s)
         const char *quote = s->p;
         char key[16];
         if (!read_string(s, key, sizeof key)) return false;
-        if (strcmp(key, "skin") == 0 && !hide_key(s, quote)) return false;
+        if (strcmp(key, "skin") == 0 && !hide_skin(s, quote)) return false;
         skip_ws(s);
         if (s->p >= s->end || *s->p++ != ':') return false;
         if (!skip_value(s)) return false;
@@ -500,9 +584,10 @@ static bool scan_top(scan *s, name_list *required, name_list *used)
         if (strcmp(key, "extensionsRequired") == 0) ok = read_name_array(s, required);
         else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
         else if (strcmp(key, "nodes") == 0) ok = scan_nodes(s);
-        else if (strcmp(key, "skins") == 0) ok = hide_key(s, quote) && skip_value(s);
+        else if (strcmp(key, "skins") == 0) ok = hide_skin(s, quote) && skip_value(s);
         else if (strcmp(key, "bufferViews") == 0) ok = scan_objects(s, grow_views, view_member);
         else if (strcmp(key, "accessors") == 0) ok = scan_objects(s, grow_accessors, accessor_member);
+        else if (strcmp(key, "meshes") == 0) ok = scan_objects(s, grow_nothing, mesh_member);
         else ok = skip_value(s);
         if (!ok) return false;
         skip_ws(s);
@@ -657,9 +742,10 @@ static ob_result check_accessors(const char *path, const scan *s)
 }
 
 /* The file with every hidden key's first character replaced by '_'
- * ("skins" becomes "_kins", "skin" "_kin"): same length, so a .glb's chunk
- * lengths stay right, and names assimp ignores. */
-static ob_result hide_skins(const char *path, const scan *s, size_t json_offset, ob_model_io *io)
+ * ("skins" becomes "_kins", "skin" "_kin", a point or line primitive's
+ * "indices" "_ndices"): same length, so a .glb's chunk lengths stay right,
+ * and names assimp ignores. */
+static ob_result hide_keys(const char *path, const scan *s, size_t json_offset, ob_model_io *io)
 {
     size_t size = 0;
     ob_result r;
@@ -671,8 +757,9 @@ static ob_result hide_skins(const char *path, const scan *s, size_t json_offset,
     }
     io->patched = (uint8_t *)file;
     io->patched_size = size;
-    OB_LOG_I(OB_MODEL_LOG, "%s: skins ignored (%u references): Obelisk does not animate skins, "
-             "the meshes are drawn in their bind pose", path, s->hide_count);
+    if (s->skin_count)
+        OB_LOG_I(OB_MODEL_LOG, "%s: skins ignored (%u references): Obelisk does not animate skins, "
+                 "the meshes are drawn in their bind pose", path, s->skin_count);
     return OB_OK;
 }
 
@@ -732,7 +819,7 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
         return OB_OK;
     }
     r = check_accessors(path, &s);
-    if (r == OB_OK && s.hide_count) r = hide_skins(path, &s, json_offset, io);
+    if (r == OB_OK && s.hide_count) r = hide_keys(path, &s, json_offset, io);
     ob_free(s.hide);
     ob_free(s.views);
     ob_free(s.accessors);

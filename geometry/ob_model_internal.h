@@ -109,7 +109,10 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
  *   lie (joint indices, weights, too few matrices). The top-level "skins"
  *   and every node's "skin" are renamed in a copy of the file (io->patched,
  *   served to assimp instead of the file), so assimp never sees a skin;
- *   one info line says so.
+ *   one info line says so;
+ * - point and line primitives (mode 0-3), which Obelisk drops after the
+ *   import: their "indices" are hidden the same way (assimp 5.2 crashes on
+ *   a LINE_LOOP index past the vertex count).
  * With refuse_required false, required extensions are only reported.
  * OK for other files. OB_ERR_IO if the file cannot be read. JSON the scan
  * cannot follow is left to assimp to reject. [any thread] */
