@@ -93,6 +93,28 @@ void ob_model_report_more(const ob_model_check *c)
                  c->problems - OB_MODEL_LOG_MAX, c->problems);
 }
 
+void ob_model_sanitize_text(char *s, size_t length)
+{
+    for (size_t i = 0; i < length && s[i];) {
+        unsigned char c = (unsigned char)s[i];
+        size_t n = c < 0x80 ? 1 : (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c & 0xF8) == 0xF0 ? 4 : 0;
+        uint32_t cp = n == 1 ? c : n == 2 ? c & 0x1Fu : n == 3 ? c & 0x0Fu : c & 0x07u;
+        bool ok = n > 0 && i + n <= length;
+        for (size_t k = 1; ok && k < n; k++) {
+            ok = ((unsigned char)s[i + k] & 0xC0) == 0x80;
+            cp = cp << 6 | ((unsigned char)s[i + k] & 0x3Fu);
+        }
+        static const uint32_t min_cp[5] = {0, 0, 0x80, 0x800, 0x10000};
+        ok = ok && cp >= min_cp[n] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF) && cp >= 0x20 &&
+             !(cp >= 0x7F && cp <= 0x9F);
+        if (!ok) {
+            s[i++] = '?';
+            continue;
+        }
+        i += n;
+    }
+}
+
 static const char *mesh_name(const struct aiMesh *m)
 {
     return m->mName.length ? m->mName.data : "(unnamed)";
@@ -121,6 +143,9 @@ static ob_result check_raw_mesh(ob_model_check *c, uint32_t mi, const struct aiM
                                 uint32_t *out_polygons)
 {
     uint32_t before = c->problems;
+    /* Names are printed (logs, the lean report): terminal escapes and
+     * invalid UTF-8 in them become '?'. */
+    ob_model_sanitize_text(((struct aiMesh *)m)->mName.data, m->mName.length);
     if (m->mNumVertices && !m->mVertices)
         ob_model_bad(c, "mesh %u '%s': %u vertices but no positions", mi, mesh_name(m), m->mNumVertices);
     if (m->mNumFaces && !m->mFaces)
@@ -184,6 +209,7 @@ static ob_result check_raw_nodes(ob_model_check *c, const struct aiScene *s, con
         ob_model_bad(c, "node hierarchy deeper than %u levels", OB_MODEL_MAX_NODE_DEPTH);
         return OB_ERR_BAD_MODEL;
     }
+    ob_model_sanitize_text(((struct aiNode *)n)->mName.data, n->mName.length);
     for (uint32_t k = 0; k < n->mNumMeshes; k++) {
         if (!n->mMeshes || n->mMeshes[k] >= s->mNumMeshes) {
             ob_model_bad(c, "node '%s' refers to mesh %u of %u", n->mName.data,

@@ -62,6 +62,10 @@ void ob_model_report_more(const ob_model_check *c);
  * it rather than hand out a mesh that passes every other check. */
 bool ob_model_mesh_has_area(const ob_mesh *m);
 bool ob_model_v3_finite(const struct aiVector3D *v);
+/* Replaces, in place, each byte of a control character (C0, DEL, C1) or of
+ * invalid UTF-8 in the first length bytes of s with '?': names from a file
+ * are printed, and a terminal would interpret escapes. */
+void ob_model_sanitize_text(char *s, size_t length);
 
 /* OB_ERR_IO (logged) unless path names a readable regular file. */
 ob_result ob_model_check_readable(const char *path);

@@ -186,6 +186,7 @@ static ob_result embedded_image(material_ctx *c, uint32_t index, const char *ref
     const char *name = t->mFilename.length ? t->mFilename.data : ref;
     img->name = ob_strdup(name);
     if (!img->name) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_model_sanitize_text(img->name, strlen(img->name));
     if (t->mHeight == 0) {   /* compressed: mWidth bytes of a PNG, JPEG, … file */
         img->data = ob_malloc(t->mWidth);
         if (!img->data) return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -294,6 +295,7 @@ static ob_result external_image(material_ctx *c, const slot_info *si, const char
     img->path = path;
     img->name = ob_strdup(ref);
     if (!img->name) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_model_sanitize_text(img->name, strlen(img->name));
     *out = (int32_t)(c->model->image_count - 1);
     return OB_OK;
 }
@@ -464,6 +466,7 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
     char fallback[32];
     snprintf(fallback, sizeof fallback, "material %u", index);
     bool named = aiGetMaterialString(m, AI_MATKEY_NAME, &name) == AI_SUCCESS && name.length;
+    if (named) ob_model_sanitize_text(name.data, name.length);
     out->name = ob_strdup(named ? name.data : fallback);
     if (!out->name) return OB_ERR_OUT_OF_HOST_MEMORY;
     const slot_info base = {.material = out->name, .material_index = index};

@@ -249,6 +249,36 @@ static void line_loop_with_a_bad_index_does_not_crash(void **state)
     ob_model_close(m);
 }
 
+/* Names from a file are printed (logs, the lean report): a terminal
+ * escape or invalid UTF-8 in a node, mesh or material name becomes '?'. */
+static void names_with_terminal_escapes_are_made_printable(void **state)
+{
+    (void)state;
+    char path[160];
+    snprintf(path, sizeof path, "%s/names.gltf", model_dir);
+    write_text(path,
+               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+               "\"nodes\":[{\"mesh\":0,\"name\":\"n\\u001b[2J\"}],"
+               "\"meshes\":[{\"name\":\"m\\u009b31m\",\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+               "\"material\":0}]}],\"materials\":[{\"name\":\"x\\u0007y\"}],"
+               "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+               "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+               "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+               "\"min\":[0,0,0],\"max\":[1,1,0]}]}");
+    ob_model *m = NULL;
+    assert_int_equal(open_model(path, false, &m), OB_OK);
+    bool node_seen = false;
+    for (uint32_t i = 0; i < m->node_count; i++) {
+        for (const char *p = m->nodes[i].name; *p; p++) assert_true((unsigned char)*p >= 0x20 && *p != 0x7f);
+        node_seen = node_seen || strcmp(m->nodes[i].name, "n?[2J") == 0;
+    }
+    assert_true(node_seen);
+    assert_string_equal(m->primitives[0].name, "m??31m");   /* U+009B is two bytes in UTF-8 */
+    assert_string_equal(m->materials[0].name, "x?y");
+    ob_model_close(m);
+}
+
 /* assimp's own words for two glTF faults ("No suitable reader found" for a
  * NaN literal, "Mesh has no faces" for indices past the vertex count) get
  * the likely cause added. */
@@ -295,6 +325,7 @@ int main(void)
         cmocka_unit_test(lying_sparse_count_is_refused),
         cmocka_unit_test(line_loop_with_a_bad_index_does_not_crash),
         cmocka_unit_test(assimp_messages_get_their_cause),
+        cmocka_unit_test(names_with_terminal_escapes_are_made_printable),
         cmocka_unit_test(skinned_gltf_opens_in_its_bind_pose),
     };
     return cmocka_run_group_tests(tests, make_dirs, remove_dirs);
