@@ -5,7 +5,8 @@
 #   ./setup.sh test   install missing packages, then build and run the whole test
 #                     suite three times: plain (build/), address+undefined
 #                     sanitizers (build-address/) and thread sanitizer (build-thread/),
-#                     then a minute of libFuzzer on each fuzz target (build-fuzz/).
+#                     then the fuzz targets replay every saved input once (build-fuzz/;
+#                     deterministic: no random search decides whether a commit lands)
 #                     The plain suite also installs the build into
 #                     build/package/prefix and builds and runs examples/ against
 #                     it, out of tree (ctest label package, tests/package/)
@@ -14,6 +15,10 @@
 #                     tests/golden/goldens.cmake), printing per image what changed:
 #                     new, unchanged, or how many pixels differ and by how much
 #                     (docs/testing.md: review, then commit)
+#   ./setup.sh fuzz-explore [SECONDS]  exploratory fuzzing, outside CI: SECONDS (default
+#                     600) of libFuzzer on each target from the saved corpus, then a
+#                     triage; fix what it finds in our code and save the input in
+#                     fuzz/corpus/scene or fuzz/corpus/model-findings (docs/testing.md)
 #   ./setup.sh deps | build
 #
 # Options: --sanitize none|address|thread|undefined|fuzz  one build only (none = plain)
@@ -76,14 +81,34 @@ suite() {
   ctest --test-dir "$dir" --output-on-failure -j"$(nproc)" "${extra[@]}"
 }
 
-# fuzz: the libFuzzer targets (clang) and their bounded runs (ctest label fuzz).
+# fuzz: the libFuzzer targets (clang) and the replay of every saved input
+# (ctest label fuzz): what CI runs.
+fuzz_build() {
+  cmake -S . -B "$1" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+        -DOB_FUZZ=ON >/dev/null
+  cmake --build "$1" -j"$(nproc)" --target fuzz_scene_file fuzz_model
+}
 fuzz() {
   local dir; dir=$([ -n "$build_dir" ] && echo "$build_dir" || echo build-fuzz)
-  echo "== fuzzing: one bounded run per target ($dir)"
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
-        -DOB_FUZZ=ON >/dev/null
-  cmake --build "$dir" -j"$(nproc)" --target fuzz_scene_file fuzz_model
+  echo "== fuzzing: replaying every saved input ($dir)"
+  fuzz_build "$dir"
   ctest --test-dir "$dir" -L fuzz --output-on-failure -j"$(nproc)" "${extra[@]}"
+}
+# fuzz-explore [SECONDS]: random search from the saved corpus, by hand. New
+# inputs go to $dir/fuzz/explore-*, findings to $dir/fuzz/artifacts-*.
+fuzz_explore() {
+  local dir; dir=$([ -n "$build_dir" ] && echo "$build_dir" || echo build-fuzz)
+  local seconds=${extra[0]:-600}
+  fuzz_build "$dir"
+  mkdir -p "$dir/fuzz/explore-scene" "$dir/fuzz/artifacts-scene"
+  echo "== exploring fuzz_scene_file for ${seconds} s"
+  "$dir"/bin/fuzz_scene_file -dict=fuzz/scene_file.dict -max_total_time="$seconds" -timeout=10 \
+      -rss_limit_mb=2048 -artifact_prefix="$dir/fuzz/artifacts-scene/" \
+      "$dir/fuzz/explore-scene" fuzz/corpus/scene
+  echo "== exploring fuzz_model for ${seconds} s"
+  cmake -DMODE=explore -DFUZZER="$dir"/bin/fuzz_model -DWORK="$dir/fuzz/explore-model" \
+        "-DSEEDS=fuzz/corpus/model;fuzz/corpus/model-findings" \
+        -DARTIFACTS="$dir/fuzz/artifacts-model" -DSECONDS="$seconds" -P fuzz/model_run.cmake
 }
 # lavapipe and the loader warn about a missing XDG_RUNTIME_DIR on bare machines.
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
@@ -104,6 +129,7 @@ case "$cmd" in
     else
       suite ""; suite address; suite thread; fuzz
     fi ;;
+  fuzz-explore) deps; fuzz_explore ;;
   golden)
     deps; build "$sanitize"
     dir=$(dir_for "$sanitize")
@@ -111,5 +137,5 @@ case "$cmd" in
     only=$(IFS=';'; echo "${extra[*]:-}")
     cmake -DBIN="$dir"/bin -DTOOL="$dir"/tests/ob_golden -DSRC="$PWD" -DOUT="$dir"/golden-update \
           -DONLY="$only" -P tests/tools/golden_update.cmake ;;
-  *) echo "usage: $0 demo|test|golden|deps|build [--sanitize none|address|thread|undefined|fuzz]" >&2; exit 2 ;;
+  *) echo "usage: $0 demo|test|golden|fuzz-explore|deps|build [--sanitize none|address|thread|undefined|fuzz]" >&2; exit 2 ;;
 esac

@@ -11,11 +11,14 @@
  * before the device is created: a malformed one exits with code 2 and one
  * message naming the file and the JSON path. The library's loader
  * (ob_scene_load.h) then builds it: a model of the scene that fails to load
- * is reported (entity and file) and left out; the rest renders.
+ * is reported (entity and file) and left out; the rest renders, and the
+ * exit code is 2 unless --allow-missing. Files a model or a scene refers to
+ * must stay inside its folder unless --allow-any-folder.
  *
  * Output, threading and stats options are those of obelisk-mirror
  * (ob_demo_run); command-line options win over the file's "settings".
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -24,6 +27,10 @@
 #include "ob_scene_load.h"
 
 #define EXIT_BAD_INPUT 2
+/* How far from the origin a framed model may reach: the ground plane is 12
+ * radii wide and the camera stands a few radii off, all in single
+ * precision (docs/limits.md). */
+#define OB_VIEW_MAX_EXTENT 1e15
 
 /* ------------------------------------------------------------ one model */
 
@@ -41,8 +48,20 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     if ((r = ob_model_assets_instantiate(assets, d->scene, root, NULL, &entities)) != OB_OK) return r;
     double lo[3], hi[3], center[3], radius;
     if ((r = ob_scene_load_measure(d->scene, lo, hi, center, &radius)) != OB_OK) return r;
-    if (!(hi[0] >= lo[0])) return OB_ERR_BAD_MODEL;   /* nothing renderable */
-    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
+    /* Bounds that overflowed (node scales of 1e38 nested) or are too large to
+     * frame (positions near 3e38) are the model's problem: said so here,
+     * before the automatic ground and sun fail on sizes nobody asked for. */
+    bool finite = isfinite(radius) && isfinite(center[0]) && isfinite(center[1]) && isfinite(center[2]);
+    double reach = finite ? radius + fmax(fabs(center[0]), fmax(fabs(center[1]), fabs(center[2]))) : INFINITY;
+    if (!(hi[0] >= lo[0]) || !(reach <= OB_VIEW_MAX_EXTENT)) {
+        fprintf(stderr, "obelisk-view: %s: the model cannot be framed: its world bounds %s (centre %g %g %g, "
+                "radius %g; at most %g from the origin): check its units and node scales\n", path,
+                !(hi[0] >= lo[0]) ? "are empty" : !finite ? "are not finite (they overflowed)" : "are too large",
+                center[0], center[1],
+                center[2], radius, OB_VIEW_MAX_EXTENT);
+        return OB_ERR_BAD_MODEL;
+    }
+    if (!(radius > 0.0)) radius = 1.0;
     const ob_model *model = ob_model_assets_model(assets);
     printf("obelisk-view: %s: %u nodes, %u primitives, %u materials, %u images: %u entities\n", path,
            model->node_count, model->primitive_count, model->material_count, model->image_count, entities);
@@ -75,6 +94,23 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
 
 /* ------------------------------------------------------------ main */
 
+/* A scene rendered without some of its models is bad input: each is named
+ * (the loader's own lines said why), and the exit is 2 unless
+ * --allow-missing. */
+static int report_left_out(const char *path, const ob_scene_file *sf, const ob_scene_loaded *loaded)
+{
+    fprintf(stderr, "obelisk-view: %s: %u %s left out because %s model did not load:\n", path,
+            loaded->left_out_count, loaded->left_out_count == 1 ? "entity was" : "entities were",
+            loaded->left_out_count == 1 ? "its" : "their");
+    for (uint32_t i = 0; i < loaded->left_out_count; i++) {
+        const ob_scene_file_entity *e = &sf->entities[loaded->left_out[i].entity];
+        fprintf(stderr, "  entities[%u] '%s': model '%s' (%s)\n", e->index, e->name, e->geometry.model,
+                ob_result_name(loaded->left_out[i].result));
+    }
+    fprintf(stderr, "obelisk-view: the rest was rendered; --allow-missing accepts this and exits 0\n");
+    return EXIT_BAD_INPUT;
+}
+
 static bool has_suffix(const char *s, const char *suffix)
 {
     size_t n = strlen(s), m = strlen(suffix);
@@ -99,7 +135,11 @@ int main(int argc, char **argv)
     int code;
     if (!ob_demo_options_parse(argc, argv,
                                "  FILE              a scene (.json, docs/scene-format.md) or a model file\n"
-                               "                    (.gltf .glb .obj .ply ...), framed automatically\n",
+                               "                    (.gltf .glb .obj .ply ...), framed automatically\n"
+                               "  --allow-missing   render a scene whose models did not all load and exit 0\n"
+                               "                    (without it: the rest renders, then exit 2)\n"
+                               "  --allow-any-folder  let models and scene files refer to files outside\n"
+                               "                    their own folder (trusted content only)\n",
                                true, &opt, &code))
         return code;
     bool is_scene = has_suffix(opt.input, ".json");
@@ -113,7 +153,9 @@ int main(int argc, char **argv)
             return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
         }
         apply_settings(&opt, &sf.settings);
-    } else if ((r = ob_model_open(&(ob_model_desc){.path = opt.input, .flip_uv = true}, &model)) != OB_OK) {
+    } else if ((r = ob_model_open(&(ob_model_desc){.path = opt.input, .flip_uv = true,
+                                                   .allow_any_folder = opt.allow_any_folder},
+                                  &model)) != OB_OK) {
         fprintf(stderr, "obelisk-view: %s: the model did not load (%s: %s)\n", opt.input,
                 ob_result_name(r), ob_result_text(r));
         return r == OB_ERR_OUT_OF_HOST_MEMORY ? 1 : EXIT_BAD_INPUT;
@@ -132,7 +174,8 @@ int main(int argc, char **argv)
         ob_scene_load_target t = {.renderer = d.r, .materials = d.lib, .views = d.views, .scene = d.scene};
         ob_scene_load_desc ld = {.file = &sf, .camera = d.camera,
                                  .frame_aspect = (double)opt.width / opt.height, .seed = opt.seed,
-                                 .first_geometry_id = d.stack->geometry_count + 1};
+                                 .first_geometry_id = d.stack->geometry_count + 1,
+                                 .allow_any_folder = opt.allow_any_folder};
         ob_scene_file_error err;
         if ((r = ob_scene_load(&t, &ld, &loaded, &err)) != OB_OK)
             fprintf(stderr, "obelisk-view: %s\n", err.message);
@@ -149,7 +192,8 @@ int main(int argc, char **argv)
     }
     ob_model_close(model);   /* only when the device did not come up */
     if (r != OB_OK) {
-        code = 1;
+        /* The model's own bounds are bad input; the rest is the engine's. */
+        code = !is_scene && assets && r == OB_ERR_BAD_MODEL ? EXIT_BAD_INPUT : 1;
     } else {
         printf("obelisk-view: %s: %s, %ux%u, %s", opt.input, ob_device_name(ob_renderer_device(d.r)),
                opt.width, opt.height,
@@ -160,6 +204,8 @@ int main(int argc, char **argv)
                    sf.description ? "\n  " : "", sf.description ? sf.description : "");
         printf("\n");
         code = ob_demo_run(&d, NULL, NULL);
+        if (code == 0 && is_scene && loaded.left_out_count && !opt.allow_missing)
+            code = report_left_out(opt.input, &sf, &loaded);
     }
     /* The loaded scene's geometry and particle systems are its own: they go
      * once no frame uses them, before the demo takes the scene and views down. */

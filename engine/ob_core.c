@@ -1,9 +1,11 @@
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700
 #include "ob_core.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -416,52 +418,206 @@ uint64_t ob_thread_cpu_ns(void)
 
 /* ----------------------------------------------------------------- files */
 
-char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result)
+/* The reason a file could not be read: into why when the caller wants it
+ * for its own message, otherwise logged as "cannot read WHAT 'PATH': ...". */
+static void read_failed(const char *path, const char *what, char *why, size_t why_size,
+                        const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+
+static void read_failed(const char *path, const char *what, char *why, size_t why_size,
+                        const char *fmt, ...)
 {
-    ob_result r = OB_OK;
-    char *buf = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        OB_LOG_E("io", "cannot open '%s': %s", path, strerror(errno));
-        r = OB_ERR_IO;
-        goto done;
+    char text[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    if (why && why_size) snprintf(why, why_size, "%s", text);
+    else OB_LOG_E("io", "cannot read %s '%s': %s", what ? what : "file", path, text);
+}
+
+static const char *special_kind(mode_t mode)
+{
+    return S_ISDIR(mode) ? "a directory" : S_ISFIFO(mode) ? "a FIFO"
+           : S_ISCHR(mode) || S_ISBLK(mode) ? "a device" : S_ISSOCK(mode) ? "a socket"
+           : "a special file";
+}
+
+/* Opens path for reading without ever blocking: O_NONBLOCK keeps open()
+ * from waiting for a FIFO's writer, and fstat on the opened descriptor (not
+ * a stat before the open, which a rename could race) refuses anything that
+ * is not a regular file — a FIFO, a device such as /dev/zero, a directory —
+ * before a byte is read. Then blocking reads are restored. */
+int ob_file_open_regular(const char *path, const char *what, uint64_t max_size, uint64_t *out_size,
+                         char *why, size_t why_size, ob_result *out_result)
+{
+    ob_result r = OB_ERR_IO;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        read_failed(path, what, why, why_size, "%s", strerror(errno));
+        goto fail;
     }
-    if (fseek(f, 0, SEEK_END) != 0) { r = OB_ERR_IO; goto fail_close; }
-    long len = ftell(f);
-    if (len < 0 || fseek(f, 0, SEEK_SET) != 0) { r = OB_ERR_IO; goto fail_close; }
-    buf = ob_malloc((size_t)len + 1);
-    if (!buf) { r = OB_ERR_OUT_OF_HOST_MEMORY; goto fail_close; }
-    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
-        OB_LOG_E("io", "short read of '%s'", path);
-        ob_free(buf);
-        buf = NULL;
-        r = OB_ERR_IO;
+    struct stat st;
+    if (fstat(fd, &st) != 0) {
+        read_failed(path, what, why, why_size, "%s", strerror(errno));
         goto fail_close;
     }
-    buf[len] = '\0';
-    if (out_size) *out_size = (size_t)len;
+    if (!S_ISREG(st.st_mode)) {
+        read_failed(path, what, why, why_size, "not a regular file (%s)", special_kind(st.st_mode));
+        goto fail_close;
+    }
+    if (max_size && (uint64_t)st.st_size > max_size) {
+        read_failed(path, what, why, why_size, "%llu bytes, more than the limit of %llu",
+                    (unsigned long long)st.st_size, (unsigned long long)max_size);
+        r = OB_ERR_LIMIT;
+        goto fail_close;
+    }
+    int flags = fcntl(fd, F_GETFL);
+    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        read_failed(path, what, why, why_size, "%s", strerror(errno));
+        goto fail_close;
+    }
+    if (out_size) *out_size = (uint64_t)st.st_size;
+    if (out_result) *out_result = OB_OK;
+    return fd;
 fail_close:
-    fclose(f);
+    close(fd);
+fail:
+    if (out_result) *out_result = r;
+    return -1;
+}
+
+char *ob_file_read_limited(const char *path, const char *what, uint64_t max_size, size_t *out_size,
+                           char *why, size_t why_size, ob_result *out_result)
+{
+    ob_result r;
+    uint64_t size = 0;
+    char *buf = NULL;
+    int fd = ob_file_open_regular(path, what, max_size, &size, why, why_size, &r);
+    if (fd < 0) goto done;
+    if (size >= SIZE_MAX) {
+        read_failed(path, what, why, why_size, "too large for this address space");
+        r = OB_ERR_LIMIT;
+        goto fail_close;
+    }
+    buf = ob_malloc((size_t)size + 1);
+    if (!buf) {
+        read_failed(path, what, why, why_size, "out of memory for %llu bytes",
+                    (unsigned long long)size);
+        r = OB_ERR_OUT_OF_HOST_MEMORY;
+        goto fail_close;
+    }
+    size_t got = 0;
+    while (got < size) {
+        ssize_t n = read(fd, buf + got, (size_t)size - got);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            read_failed(path, what, why, why_size, "%s",
+                        n < 0 ? strerror(errno) : "the file shrank while being read");
+            ob_free(buf);
+            buf = NULL;
+            r = OB_ERR_IO;
+            goto fail_close;
+        }
+        got += (size_t)n;
+    }
+    buf[got] = '\0';
+    if (out_size) *out_size = got;
+fail_close:
+    close(fd);
 done:
     if (out_result) *out_result = r;
     return buf;
 }
 
+char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result)
+{
+    return ob_file_read_limited(path, "file", 0, out_size, NULL, 0, out_result);
+}
+
+/* The file a write to path lands in, into target (size bytes): path itself,
+ * or, when path is a symbolic link, what it points to (resolved, so the
+ * temporary file sits in the real target's folder and the rename replaces
+ * the target, not the link). Refuses an existing path that is not a regular
+ * file: a FIFO, a device (/dev/full), a directory — renaming over those
+ * would replace the node. No allocation of ours (fault-injection walks
+ * count them). OB_ERR_IO or OB_ERR_INVALID_ARGUMENT (too long), logged. */
+static ob_result write_target(const char *path, char *target, size_t size)
+{
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if (!S_ISREG(st.st_mode)) {
+            OB_LOG_E("io", "cannot write '%s': not a regular file (%s); refusing to replace it", path,
+                     special_kind(st.st_mode));
+            return OB_ERR_IO;
+        }
+    } else if (errno != ENOENT) {
+        OB_LOG_E("io", "cannot write '%s': %s", path, strerror(errno));
+        return OB_ERR_IO;
+    }
+    int n;
+    struct stat lst;
+    if (lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode)) {
+        /* An existing target (stat succeeded above): write through it. A
+         * dangling link is written as a new file where it points; realpath
+         * needs the target to exist, so the link's text is resolved against
+         * the link's folder instead. */
+        char *real = realpath(path, NULL);
+        if (real) {
+            n = snprintf(target, size, "%s", real);
+            free(real);
+        } else {
+            char link[4096];
+            ssize_t len = readlink(path, link, sizeof link - 1);
+            if (len <= 0) {
+                OB_LOG_E("io", "cannot write '%s': unreadable symbolic link", path);
+                return OB_ERR_IO;
+            }
+            link[len] = '\0';
+            const char *slash = strrchr(path, '/');
+            int dir = link[0] == '/' || !slash ? 0 : (int)(slash - path) + 1;
+            n = snprintf(target, size, "%.*s%s", dir, path, link);
+        }
+    } else {
+        n = snprintf(target, size, "%s", path);
+    }
+    if (n < 0 || (size_t)n >= size) {
+        OB_LOG_E("io", "cannot write '%s': the path is too long", path);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    return OB_OK;
+}
+
 ob_result ob_file_write(const char *path, const void *data, size_t size)
 {
-    char tmp[4096];
-    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    if (n < 0 || (size_t)n >= sizeof tmp) return OB_ERR_INVALID_ARGUMENT;
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
+    char target[4096], tmp[4096 + 32];
+    ob_result r = write_target(path, target, sizeof target);
+    if (r != OB_OK) return r;
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", target, (long)getpid());
+    /* Exclusively: whatever is already at the temporary name (a link planted
+     * there, a FIFO) makes the write fail instead of being followed. */
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOCTTY, 0666);
+    if (fd < 0) {
         OB_LOG_E("io", "cannot create '%s': %s", tmp, strerror(errno));
         return OB_ERR_IO;
     }
-    size_t w = fwrite(data, 1, size, f);
-    int closed = fclose(f);
-    if (w != size || closed != 0 || rename(tmp, path) != 0) {
-        OB_LOG_E("io", "cannot write '%s': %s", path, strerror(errno));
-        remove(tmp);
+    const char *p = data;
+    size_t left = size;
+    int err = 0;
+    while (left > 0) {
+        ssize_t w = write(fd, p, left);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            err = w < 0 ? errno : ENOSPC;
+            break;
+        }
+        p += w;
+        left -= (size_t)w;
+    }
+    if (close(fd) != 0 && !err) err = errno;
+    if (!err && rename(tmp, target) != 0) err = errno;
+    if (err) {
+        OB_LOG_E("io", "cannot write '%s': %s", path, strerror(err));
+        unlink(tmp);
         return OB_ERR_IO;
     }
     return OB_OK;

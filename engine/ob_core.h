@@ -246,10 +246,32 @@ static inline void ob_parallel_run(const ob_parallel *par, uint32_t count, ob_ta
     for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
 }
 
-/* Read a whole file into a NUL-terminated buffer (ob_free it). On failure
- * returns NULL, logs the path and the OS error, and sets *out_result. */
+/* Read a whole file into a NUL-terminated buffer (ob_free it). Only a
+ * regular file is read: a FIFO, a device or a directory is refused without
+ * blocking (opened O_NONBLOCK, checked with fstat before any read). On
+ * failure returns NULL, logs the path and the reason, and sets *out_result
+ * (OB_ERR_IO, OB_ERR_OUT_OF_HOST_MEMORY). [any thread] */
 char *ob_file_read(const char *path, size_t *out_size, ob_result *out_result);
-/* Write a file atomically (temp file + rename). */
+/* ob_file_read with a size bound checked before memory is committed: a
+ * file over max_size bytes (0 = no bound) is refused with OB_ERR_LIMIT.
+ * what names the file in the log ("scene file"). With why (why_size
+ * bytes) the reason goes there, for the caller's own message, instead of
+ * the log. [any thread] */
+char *ob_file_read_limited(const char *path, const char *what, uint64_t max_size, size_t *out_size,
+                           char *why, size_t why_size, ob_result *out_result);
+/* The descriptor of a regular file opened for reading (blocking reads),
+ * with its size in *out_size; -1 for anything else, without ever blocking
+ * on a FIFO: the reason logged, or put in why, and *out_result set
+ * (OB_ERR_IO; OB_ERR_LIMIT over max_size when that is not 0). close() it.
+ * [any thread] */
+int ob_file_open_regular(const char *path, const char *what, uint64_t max_size, uint64_t *out_size,
+                         char *why, size_t why_size, ob_result *out_result);
+/* Write a file atomically: a temporary file beside the target, created
+ * exclusively (O_EXCL: nothing already at that name is followed), every
+ * write and the close checked, then renamed over the target. A symbolic
+ * link is written through (the file it names is replaced, the link stays);
+ * an existing FIFO, device or directory is refused (OB_ERR_IO, logged),
+ * never replaced. [any thread] */
 ob_result ob_file_write(const char *path, const void *data, size_t size);
 /* mkdir -p. */
 ob_result ob_dir_make(const char *path);

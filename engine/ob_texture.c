@@ -240,11 +240,26 @@ static ob_result image_create(ob_texture_cache *c, const ob_texture_desc *desc, 
                               const char *context, const char *what, tex_image *out)
 {
     int w = 0, h = 0, comp = 0;
+    /* The header first: a 1 MB PNG may declare 16384x16384 (1 GiB of RGBA)
+     * and the decoder would commit it before finding the data short. */
+    if (!stbi_info_from_memory(bytes, (int)size, &w, &h, &comp)) {
+        const char *why = stbi_failure_reason();
+        OB_LOG_W("texture", "%s: cannot decode %s: not an image stb_image reads (%s)", context, what,
+                 why && *why ? why : "unknown header");
+        return OB_ERR_PARSE;
+    }
+    if ((uint64_t)w * (uint64_t)h > OB_TEXTURE_MAX_PIXELS) {
+        OB_LOG_W("texture", "%s: %s declares %dx%d pixels, more than the limit of %u; not decoded", context,
+                 what, w, h, OB_TEXTURE_MAX_PIXELS);
+        return OB_ERR_LIMIT;
+    }
     uint8_t *pixels = stbi_load_from_memory(bytes, (int)size, &w, &h, &comp, 4);
     if (!pixels) {
         const char *why = stbi_failure_reason();
         bool oom = why && strcmp(why, "outofmem") == 0;
-        OB_LOG_W("texture", "%s: cannot decode %s: %s", context, what, why ? why : "unknown reason");
+        /* stb says little ("", "bad png"); a short file is the common case. */
+        OB_LOG_W("texture", "%s: cannot decode %s: %s (a %dx%d image in %zu bytes: truncated or corrupt "
+                 "data?)", context, what, why && *why ? why : "the decoder gave no reason", w, h, size);
         return oom ? OB_ERR_OUT_OF_HOST_MEMORY : OB_ERR_PARSE;
     }
     ob_result r = OB_OK;

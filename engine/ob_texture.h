@@ -42,6 +42,11 @@
 extern "C" {
 #endif
 
+/* Pixels an image may declare (width x height, read from its header before
+ * decoding): 8192 x 8192, 256 MiB of RGBA8. A larger image is refused
+ * (OB_ERR_LIMIT, logged) without being decoded. */
+#define OB_TEXTURE_MAX_PIXELS (8192u * 8192u)
+
 typedef struct ob_texture_cache ob_texture_cache;
 typedef struct ob_texture ob_texture; /* owned by its cache */
 

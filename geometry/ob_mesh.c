@@ -362,6 +362,17 @@ static bool segments_ok(const char *shape, const char *what, uint32_t n, uint32_
     return false;
 }
 
+/* The product of a generator's two segment counts bounds its vertices
+ * (about one per cell): OB_MESH_MAX_GENERATED_CELLS keeps a 4096 x 4096
+ * request from committing gigabytes. */
+static bool cells_ok(const char *shape, const char *a_name, uint32_t a, const char *b_name, uint32_t b)
+{
+    if ((uint64_t)a * b <= OB_MESH_MAX_GENERATED_CELLS) return true;
+    OB_LOG_E(OB_MESH_LOG, "%s: %s x %s = %u x %u = %llu cells, more than the limit of %u", shape,
+             a_name, b_name, a, b, (unsigned long long)a * b, OB_MESH_MAX_GENERATED_CELLS);
+    return false;
+}
+
 static ob_result mesh_alloc(const char *shape, uint32_t vertex_count, uint32_t index_count,
                             ob_mesh *out)
 {
@@ -474,7 +485,8 @@ ob_result ob_mesh_sphere(float radius, uint32_t slices, uint32_t stacks, ob_mesh
     if (!out) return OB_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     if (!size_ok("sphere", "radius", radius) || !segments_ok("sphere", "slices", slices, 3) ||
-        !segments_ok("sphere", "stacks", stacks, 2))
+        !segments_ok("sphere", "stacks", stacks, 2) ||
+        !cells_ok("sphere", "slices", slices, "stacks", stacks))
         return OB_ERR_INVALID_ARGUMENT;
     /* Rows: the north pole (slices vertices, one per triangle so each gets
      * its own u), stacks-1 rings of slices+1 (the seam column is duplicated
@@ -525,7 +537,8 @@ ob_result ob_mesh_plane(float width, float depth, uint32_t subdivisions, ob_mesh
     if (!out) return OB_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     if (!size_ok("plane", "width", width) || !size_ok("plane", "depth", depth) ||
-        !segments_ok("plane", "subdivisions", subdivisions, 1))
+        !segments_ok("plane", "subdivisions", subdivisions, 1) ||
+        !cells_ok("plane", "subdivisions", subdivisions, "subdivisions", subdivisions))
         return OB_ERR_INVALID_ARGUMENT;
     const uint32_t n = subdivisions, row = n + 1;
     ob_result r = mesh_alloc("plane", row * row, 6 * n * n, out);
@@ -593,7 +606,8 @@ ob_result ob_mesh_torus(float major_radius, float minor_radius, uint32_t major_s
     if (!size_ok("torus", "major radius", major_radius) ||
         !size_ok("torus", "minor radius", minor_radius) ||
         !segments_ok("torus", "major segments", major_segments, 3) ||
-        !segments_ok("torus", "minor segments", minor_segments, 3))
+        !segments_ok("torus", "minor segments", minor_segments, 3) ||
+        !cells_ok("torus", "major segments", major_segments, "minor segments", minor_segments))
         return OB_ERR_INVALID_ARGUMENT;
     if (minor_radius >= major_radius) {
         OB_LOG_E(OB_MESH_LOG, "torus: minor radius %g must be below the major radius %g "

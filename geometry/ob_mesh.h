@@ -113,10 +113,13 @@ ob_result ob_mesh_generate_tangents(ob_mesh *mesh, bool uv_origin_bottom_left);
  * Each fills *out (which it first zeroes; the caller releases it) with unit
  * normals, uv in [0,1] and bounds, and returns OB_OK. Bad parameters
  * (non-finite or non-positive sizes, too few segments, more than
- * OB_MESH_MAX_SEGMENTS) give OB_ERR_INVALID_ARGUMENT with a log line;
+ * OB_MESH_MAX_SEGMENTS, or two segment counts whose product is more than
+ * OB_MESH_MAX_GENERATED_CELLS: sphere slices x stacks, plane
+ * subdivisions², torus major x minor segments) give OB_ERR_INVALID_ARGUMENT with a log line;
  * allocation failure OB_ERR_OUT_OF_HOST_MEMORY. *out stays zeroed on error. */
 
 #define OB_MESH_MAX_SEGMENTS 4096u
+#define OB_MESH_MAX_GENERATED_CELLS (1u << 20)   /* about 50 MB of vertices and indices */
 
 /* Box centred at the origin: 24 vertices (4 per face, flat normals), 36 indices. */
 ob_result ob_mesh_box(const float half_extents[3], ob_mesh *out);
@@ -153,6 +156,11 @@ typedef struct ob_model_desc {
     const char *path;   /* OBJ, PLY, glTF 2 (.gltf/.glb) or any format assimp reads */
     bool flip_uv;       /* v → 1 − v: assimp hands out uv with (0,0) at the bottom-left
                            of the image; set this to sample with Vulkan's top-left origin */
+    /* Files the model refers to (glTF buffers and images, an OBJ's mtllib
+     * and textures) must resolve, after symbolic links, inside the model
+     * file's folder; one that does not is refused, naming it, and the model
+     * with it (OB_ERR_IO). true allows any folder: for trusted content only. */
+    bool allow_any_folder;
 } ob_model_desc;
 
 typedef struct ob_model_info {

@@ -27,6 +27,7 @@
 #include "ob_mesh.h"
 #include "ob_model_internal.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -37,6 +38,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 
 /* assimp's C API stores the text of the last failed import in one
@@ -91,6 +93,28 @@ void ob_model_report_more(const ob_model_check *c)
                  c->problems - OB_MODEL_LOG_MAX, c->problems);
 }
 
+void ob_model_sanitize_text(char *s, size_t length)
+{
+    for (size_t i = 0; i < length && s[i];) {
+        unsigned char c = (unsigned char)s[i];
+        size_t n = c < 0x80 ? 1 : (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c & 0xF8) == 0xF0 ? 4 : 0;
+        uint32_t cp = n == 1 ? c : n == 2 ? c & 0x1Fu : n == 3 ? c & 0x0Fu : c & 0x07u;
+        bool ok = n > 0 && i + n <= length;
+        for (size_t k = 1; ok && k < n; k++) {
+            ok = ((unsigned char)s[i + k] & 0xC0) == 0x80;
+            cp = cp << 6 | ((unsigned char)s[i + k] & 0x3Fu);
+        }
+        static const uint32_t min_cp[5] = {0, 0, 0x80, 0x800, 0x10000};
+        ok = ok && cp >= min_cp[n] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF) && cp >= 0x20 &&
+             !(cp >= 0x7F && cp <= 0x9F);
+        if (!ok) {
+            s[i++] = '?';
+            continue;
+        }
+        i += n;
+    }
+}
+
 static const char *mesh_name(const struct aiMesh *m)
 {
     return m->mName.length ? m->mName.data : "(unnamed)";
@@ -98,26 +122,14 @@ static const char *mesh_name(const struct aiMesh *m)
 
 ob_result ob_model_check_readable(const char *path)
 {
-    char err[128];
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        int e = errno;
-        if (strerror_r(e, err, sizeof err) != 0) snprintf(err, sizeof err, "errno %d", e);
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: %s", path, err);
-        return OB_ERR_IO;
+    char why[256];
+    ob_result r;
+    int fd = ob_file_open_regular(path, "model file", OB_MODEL_MAX_FILE_BYTES, NULL, why, sizeof why, &r);
+    if (fd < 0) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: %s", path, why);
+        return r;
     }
-    if (!S_ISREG(st.st_mode)) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot open model file: not a regular file", path);
-        return OB_ERR_IO;
-    }
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        int e = errno;
-        if (strerror_r(e, err, sizeof err) != 0) snprintf(err, sizeof err, "errno %d", e);
-        OB_LOG_E(OB_MODEL_LOG, "%s: cannot read model file: %s", path, err);
-        return OB_ERR_IO;
-    }
-    fclose(f);
+    close(fd);
     return OB_OK;
 }
 
@@ -131,6 +143,9 @@ static ob_result check_raw_mesh(ob_model_check *c, uint32_t mi, const struct aiM
                                 uint32_t *out_polygons)
 {
     uint32_t before = c->problems;
+    /* Names are printed (logs, the lean report): terminal escapes and
+     * invalid UTF-8 in them become '?'. */
+    ob_model_sanitize_text(((struct aiMesh *)m)->mName.data, m->mName.length);
     if (m->mNumVertices && !m->mVertices)
         ob_model_bad(c, "mesh %u '%s': %u vertices but no positions", mi, mesh_name(m), m->mNumVertices);
     if (m->mNumFaces && !m->mFaces)
@@ -194,6 +209,7 @@ static ob_result check_raw_nodes(ob_model_check *c, const struct aiScene *s, con
         ob_model_bad(c, "node hierarchy deeper than %u levels", OB_MODEL_MAX_NODE_DEPTH);
         return OB_ERR_BAD_MODEL;
     }
+    ob_model_sanitize_text(((struct aiNode *)n)->mName.data, n->mName.length);
     for (uint32_t k = 0; k < n->mNumMeshes; k++) {
         if (!n->mMeshes || n->mMeshes[k] >= s->mNumMeshes) {
             ob_model_bad(c, "node '%s' refers to mesh %u of %u", n->mName.data,
@@ -429,10 +445,11 @@ static ob_result merge_scene(model_ctx *c, const struct aiScene *s, ob_mesh *out
 
 /* ---------------------------------------------------------------- load */
 
-const struct aiScene *ob_model_parse(const char *path, char *err, size_t err_size)
+const struct aiScene *ob_model_parse(const char *path, ob_model_io *io, char *err, size_t err_size)
 {
+    struct aiFileIO fio = ob_model_io_assimp(io);
     pthread_mutex_lock(&ob_assimp_parse_lock);
-    const struct aiScene *s = aiImportFile(path, 0);
+    const struct aiScene *s = aiImportFileEx(path, 0, &fio);
     if (!s) {
         const char *text = aiGetErrorString();
         snprintf(err, err_size, "%s", text && *text ? text : "unknown error");
@@ -459,19 +476,35 @@ bool ob_model_mesh_has_area(const ob_mesh *m)
     return false;
 }
 
-ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
+ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool refuse_required,
                           const struct aiScene **out_scene)
 {
     *out_scene = NULL;
+    memset(c->io, 0, sizeof *c->io);
     const char *path = c->path;
     ob_result r = ob_model_check_readable(path);
+    if (r == OB_OK) r = ob_model_io_init(c->io, path, desc->allow_any_folder);
     if (r == OB_OK) r = ob_model_ply_precheck(path);
-    if (r == OB_OK && gltf_precheck) r = ob_model_gltf_precheck(path);
+    if (r == OB_OK) r = ob_model_gltf_precheck(path, c->io, refuse_required);
     if (r != OB_OK) return r;
     char err[512];
-    const struct aiScene *scene = ob_model_parse(path, err, sizeof err);
+    const struct aiScene *scene = ob_model_parse(path, c->io, err, sizeof err);
+    if (scene && c->io->refused != OB_OK) {
+        /* assimp went on without a file we refused (an OBJ's .mtl): the
+         * refusal, logged already, is the model's. */
+        aiReleaseImport(scene);
+        return c->io->refused;
+    }
     if (!scene) {
-        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s", path, err);
+        if (c->io->refused != OB_OK) return c->io->refused;   /* logged, naming the file */
+        /* assimp's words for two common glTF faults say nothing of the cause. */
+        const char *hint = "";
+        if (c->io->gltf && strstr(err, "No suitable reader found"))
+            hint = " (its glTF JSON does not parse: a NaN or Infinity literal, a file cut short?)";
+        else if (c->io->gltf && strstr(err, "has no faces"))
+            hint = " (assimp drops triangles whose indices are past the vertex count: check the "
+                   "index accessor's values against POSITION's count)";
+        OB_LOG_E(OB_MODEL_LOG, "%s: assimp could not read the model: %s%s", path, err, hint);
         return OB_ERR_PARSE;
     }
     r = ob_model_check_raw_scene(c, scene);
@@ -481,7 +514,7 @@ ob_result ob_model_import(ob_model_check *c, bool flip_uv, bool gltf_precheck,
         return r;
     }
     unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_GenSmoothNormals |
-                     aiProcess_JoinIdenticalVertices | (flip_uv ? aiProcess_FlipUVs : 0u);
+                     aiProcess_JoinIdenticalVertices | (desc->flip_uv ? aiProcess_FlipUVs : 0u);
     scene = aiApplyPostProcessing(scene, flags);
     if (!scene) {   /* assimp has released the scene already */
         OB_LOG_E(OB_MODEL_LOG, "%s: assimp post-processing failed", path);
@@ -500,11 +533,15 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
                  : !out ? "NULL out mesh" : "no path given");
         return OB_ERR_INVALID_ARGUMENT;
     }
-    model_ctx c = {.chk.path = desc->path};
+    ob_model_io io;
+    model_ctx c = {.chk = {.path = desc->path, .io = &io}};
     const char *path = desc->path;
     const struct aiScene *scene;
-    ob_result r = ob_model_import(&c.chk, desc->flip_uv, false, &scene);
-    if (r != OB_OK) return r;
+    ob_result r = ob_model_import(&c.chk, desc, false, &scene);
+    if (r != OB_OK) {
+        ob_model_io_release(&io);
+        return r;
+    }
     r = merge_scene(&c, scene, out);
     if (r != OB_OK) goto fail_release_out;
     if (ob_mesh_validate(out, path) != OB_OK || ob_mesh_compute_bounds(out) != OB_OK) {
@@ -527,11 +564,13 @@ ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *
     OB_LOG_I(OB_MODEL_LOG, "%s: %u mesh instances, %u vertices, %u triangles", path,
              c.instances, out->vertex_count, out->index_count / 3);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     return OB_OK;
 
 fail_release_out:
     ob_mesh_release(out);
     ob_model_report_more(&c.chk);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     return r;
 }

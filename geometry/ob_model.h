@@ -45,8 +45,18 @@
  *   them (PNG, JPEG, …), raw texels (assimp's uncompressed aiTexel arrays)
  *   encoded as PNG here, so a texture loader sees one kind of data. External
  *   images are paths resolved against the model's folder; a file that does
- *   not exist is warned about (model, material, texture, file) and the
- *   texture dropped (image -1), so the material keeps its factors.
+ *   not exist, or is not a regular file (a FIFO, a directory), is warned
+ *   about (model, material, texture, file, what it is) and the texture
+ *   dropped (image -1), so the material keeps its factors. One that
+ *   resolves outside the model's folder refuses the model (see
+ *   ob_model_desc.allow_any_folder).
+ * - Hostile input: every file assimp opens is a regular file inside the
+ *   model's folder (ob_model_desc.allow_any_folder), opened without
+ *   blocking, at most 1 GiB; a glTF file is scanned first (lying .glb
+ *   lengths, short strides and overrunning sparse accessors refused; skins
+ *   and the indices of point/line primitives hidden from assimp, which
+ *   crashes on some); names are made printable. docs/limits.md lists the
+ *   bounds.
  *
  * Thread rule: [any thread], like ob_model_load (assimp's parse step is
  * serialized inside); a model is not synchronized, one thread at a time.

@@ -24,6 +24,7 @@
 #include <assimp/material.h>
 #include <assimp/scene.h>
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -185,6 +186,7 @@ static ob_result embedded_image(material_ctx *c, uint32_t index, const char *ref
     const char *name = t->mFilename.length ? t->mFilename.data : ref;
     img->name = ob_strdup(name);
     if (!img->name) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_model_sanitize_text(img->name, strlen(img->name));
     if (t->mHeight == 0) {   /* compressed: mWidth bytes of a PNG, JPEG, … file */
         img->data = ob_malloc(t->mWidth);
         if (!img->data) return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -202,6 +204,18 @@ static bool is_file(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* Why an image path is not a readable file: "not found", "a FIFO, not a
+ * regular file", ... */
+static const char *why_not_file(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return errno == ENOENT || errno == ENOTDIR ? "not found" : strerror(errno);
+    return S_ISDIR(st.st_mode) ? "a directory, not a regular file"
+           : S_ISFIFO(st.st_mode) ? "a FIFO, not a regular file"
+           : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device, not a regular file"
+           : "not a regular file";
 }
 
 /* "%20" and friends decoded (glTF URIs are URI-encoded); NULL when out of
@@ -250,12 +264,19 @@ static ob_result external_image(material_ctx *c, const slot_info *si, const char
             path = alt;
         } else {
             ob_free(alt);
-            OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s: image file '%s' not found; the "
+            OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s: image file '%s' %s; the "
                      "material uses its factors instead", c->chk->path, si->material_index,
-                     si->material, si->slot, path);
+                     si->material, si->slot, path, why_not_file(path));
             ob_free(path);
             return OB_OK;
         }
+    }
+    char why[512];
+    if (c->chk->io && !ob_model_io_inside(c->chk->io, path, why, sizeof why)) {
+        OB_LOG_E(OB_MODEL_LOG, "%s: material %u '%s' %s: refused to read image '%s': %s",
+                 c->chk->path, si->material_index, si->material, si->slot, ref, why);
+        ob_free(path);
+        return OB_ERR_IO;
     }
     for (uint32_t i = 0; i < c->model->image_count; i++) {
         const ob_model_image *img = &c->model->images[i];
@@ -274,6 +295,7 @@ static ob_result external_image(material_ctx *c, const slot_info *si, const char
     img->path = path;
     img->name = ob_strdup(ref);
     if (!img->name) return OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_model_sanitize_text(img->name, strlen(img->name));
     *out = (int32_t)(c->model->image_count - 1);
     return OB_OK;
 }
@@ -444,6 +466,7 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
     char fallback[32];
     snprintf(fallback, sizeof fallback, "material %u", index);
     bool named = aiGetMaterialString(m, AI_MATKEY_NAME, &name) == AI_SUCCESS && name.length;
+    if (named) ob_model_sanitize_text(name.data, name.length);
     out->name = ob_strdup(named ? name.data : fallback);
     if (!out->name) return OB_ERR_OUT_OF_HOST_MEMORY;
     const slot_info base = {.material = out->name, .material_index = index};

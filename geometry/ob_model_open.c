@@ -332,12 +332,16 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
         return OB_ERR_INVALID_ARGUMENT;
     }
     const char *path = desc->path;
-    open_ctx c = {.chk.path = path, .flip_uv = desc->flip_uv};
+    ob_model_io io;
+    open_ctx c = {.chk = {.path = path, .io = &io}, .flip_uv = desc->flip_uv};
     /* The file's own hierarchy is kept: no PreTransformVertices (the
      * import never asks for it). */
     const struct aiScene *scene;
-    ob_result r = ob_model_import(&c.chk, desc->flip_uv, true, &scene);
-    if (r != OB_OK) return r;
+    ob_result r = ob_model_import(&c.chk, desc, true, &scene);
+    if (r != OB_OK) {
+        ob_model_io_release(&io);
+        return r;
+    }
     c.scene = scene;
     ob_model *model = ob_calloc(1, sizeof *model);
     c.model = model;
@@ -366,6 +370,7 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
              model->image_count);
     ob_free(c.mesh_primitive);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     *out_model = model;
     return OB_OK;
 
@@ -374,6 +379,7 @@ fail_close_model:
     ob_free(c.mesh_primitive);
     ob_model_close(model);
     aiReleaseImport(scene);
+    ob_model_io_release(&io);
     return r;
 }
 

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -136,6 +137,76 @@ static bool syntax_error(ob_json_reader *rd, const char *text, size_t size, size
     return false;
 }
 
+/* What cJSON would report only as "invalid JSON near ...", or not at all,
+ * found first and named: nesting past cJSON's limit (CJSON_NESTING_LIMIT),
+ * and a \u0000 escape, which cJSON decodes into a NUL that silently cuts
+ * the string short (a path "a.obj\u0000.png" would name "a.obj"). */
+static bool scan_structure(ob_json_reader *rd, const char *text, size_t size)
+{
+    size_t depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < size; i++) {
+        char ch = text[i];
+        if (in_string) {
+            if (ch == '"') {
+                in_string = false;
+            } else if (ch == '\\' && i + 1 < size) {
+                if (text[i + 1] == 'u' && i + 5 < size && strncmp(text + i + 2, "0000", 4) == 0)
+                    return syntax_error(rd, text, size, i,
+                                        "a \\u0000 (NUL) escape in a string, which would cut it short");
+                i++;
+            }
+        } else if (ch == '"') {
+            in_string = true;
+        } else if (ch == '[' || ch == '{') {
+            if (++depth > CJSON_NESTING_LIMIT) {
+                char what[96];
+                snprintf(what, sizeof what, "arrays and objects nested deeper than %d levels",
+                         CJSON_NESTING_LIMIT);
+                return syntax_error(rd, text, size, i, what);
+            }
+        } else if ((ch == ']' || ch == '}') && depth) {
+            depth--;
+        }
+    }
+    return true;
+}
+
+/* Text shown to a user (names, descriptions, paths) must be valid UTF-8
+ * without control characters: terminal escapes would be printed raw. The
+ * byte offset of the first bad character, or -1. */
+static long bad_text_at(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    for (size_t i = 0; p[i];) {
+        unsigned c = p[i];
+        uint32_t cp;
+        size_t n;
+        if (c < 0x80) cp = c, n = 1;
+        else if ((c & 0xE0) == 0xC0) cp = c & 0x1F, n = 2;
+        else if ((c & 0xF0) == 0xE0) cp = c & 0x0F, n = 3;
+        else if ((c & 0xF8) == 0xF0) cp = c & 0x07, n = 4;
+        else return (long)i;
+        for (size_t k = 1; k < n; k++) {
+            if ((p[i + k] & 0xC0) != 0x80) return (long)i;
+            cp = cp << 6 | (p[i + k] & 0x3F);
+        }
+        static const uint32_t min_cp[5] = {0, 0, 0x80, 0x800, 0x10000};
+        if (cp < min_cp[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return (long)i;
+        if (cp < 0x20 || (cp >= 0x7F && cp <= 0x9F)) return (long)i;
+        i += n;
+    }
+    return -1;
+}
+
+bool ob_json_check_text(ob_json_reader *rd, const char *s, const char *what)
+{
+    long at = bad_text_at(s);
+    if (at < 0) return true;
+    return ob_json_fail(rd, "expected %s of printable UTF-8 text, got a control character or "
+                        "invalid UTF-8 at byte %ld", what, at);
+}
+
 cJSON *ob_json_parse(ob_json_reader *rd, const char *text, size_t size)
 {
     if (!text) {
@@ -148,6 +219,7 @@ cJSON *ob_json_parse(ob_json_reader *rd, const char *text, size_t size)
         syntax_error(rd, text, size, (size_t)(nul - text), "a NUL byte in the text");
         return NULL;
     }
+    if (!scan_structure(rd, text, size)) return NULL;
     size_t blank = 0;
     while (blank < size && isspace((unsigned char)text[blank])) blank++;
     if (blank == size) {
@@ -303,6 +375,7 @@ const char *ob_json_string(ob_json_reader *rd, const cJSON *j, const char *what)
         ob_json_fail(rd, "expected %s, got an empty string", what);
         return NULL;
     }
+    if (!ob_json_check_text(rd, j->valuestring, what)) return NULL;
     return j->valuestring;
 }
 

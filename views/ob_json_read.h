@@ -97,8 +97,13 @@ const cJSON *ob_json_member(const cJSON *obj, const char *key);
 
 /* Values at the current path. float32 also requires single-precision range. */
 bool ob_json_number(ob_json_reader *rd, const cJSON *j, ob_json_rule rule, bool float32, double *out);
-/* A non-empty string ("expected <what>" otherwise); NULL on error. */
+/* A non-empty string of printable UTF-8 ("expected <what>" otherwise: a
+ * control character such as a terminal escape, or invalid UTF-8, is
+ * refused); NULL on error. */
 const char *ob_json_string(ob_json_reader *rd, const cJSON *j, const char *what);
+/* False (recorded) unless s is printable UTF-8: no C0/C1 control character,
+ * no invalid or overlong sequence. */
+bool ob_json_check_text(ob_json_reader *rd, const char *s, const char *what);
 /* An array of min_n..max_n numbers, each per rule, into out[0..n). */
 bool ob_json_vector(ob_json_reader *rd, const cJSON *j, uint32_t min_n, uint32_t max_n,
                     ob_json_rule rule, bool float32, double *out, uint32_t *out_n);

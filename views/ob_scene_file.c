@@ -74,14 +74,16 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
     if (size) {
         size_t mark = ob_json_push_key(&c->rd, "size");
         double wh[2];
-        if (!ob_json_vector(&c->rd, size, 2, 2, OB_JSON_INT(1, 8192), false, wh, NULL)) return false;
+        if (!ob_json_vector(&c->rd, size, 2, 2, OB_JSON_INT(1, OB_SETTING_SIZE_MAX), false, wh, NULL)) return false;
         s->has_size = true;
         s->width = (uint32_t)wh[0];
         s->height = (uint32_t)wh[1];
         ob_json_pop(&c->rd, mark);
     }
-    if (!ob_json_opt_u32(&c->rd, j, "env_map_size", 8, 4096, &s->env_map_size) ||
-        !ob_json_opt_u32(&c->rd, j, "shadow_map_size", 16, 8192, &s->shadow_map_size))
+    if (!ob_json_opt_u32(&c->rd, j, "env_map_size", OB_SETTING_ENV_MAP_MIN, OB_SETTING_ENV_MAP_MAX,
+                         &s->env_map_size) ||
+        !ob_json_opt_u32(&c->rd, j, "shadow_map_size", OB_SETTING_SHADOW_MAP_MIN, OB_SETTING_SHADOW_MAP_MAX,
+                         &s->shadow_map_size))
         return false;
     const cJSON *threads = ob_json_member(j, "threads");
     if (threads) {
@@ -100,7 +102,9 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
         ob_json_pop(&c->rd, mark);
     }
     if (ob_json_member(j, "exposure")) {
-        if (!ob_json_opt_float(&c->rd, j, "exposure", OB_JSON_POSITIVE, &s->exposure)) return false;
+        if (!ob_json_opt_float(&c->rd, j, "exposure",
+                               OB_JSON_RANGE(OB_SETTING_EXPOSURE_MIN, OB_SETTING_EXPOSURE_MAX), &s->exposure))
+            return false;
     }
     if (ob_json_member(j, "clear_color")) {
         s->has_clear_color = true;
@@ -302,6 +306,7 @@ static bool parse_materials(sf_ctx *c, const cJSON *j)
     for (const cJSON *it = j->child; it; it = it->next) {
         size_t mark = ob_json_push_key(&c->rd, it->string);
         if (!it->string[0]) return ob_json_fail(&c->rd, "a material needs a non-empty name");
+        if (!ob_json_check_text(&c->rd, it->string, "a material name")) return false;
         if (ob_json_names_find(&c->materials, it->string) != OB_SCENE_FILE_NONE) return ob_json_fail(&c->rd, "duplicate material name");
         ob_scene_file_material *m = add_material(c, it->string, false);
         if (!m || !parse_material(c, it, m)) return false;
@@ -341,9 +346,12 @@ static bool parse_model(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
     memcpy(g->model, c->dir, dl);
     memcpy(g->model + dl, p, pl + 1);
     g->kind = OB_SCENE_GEOMETRY_MODEL;
+    g->model_relative = p[0] != '/';
     ob_json_pop(&c->rd, mark);
     return true;
 }
+
+static bool parse_generator(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g, uint32_t max);
 
 static bool parse_geometry(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
 {
@@ -371,6 +379,24 @@ static bool parse_geometry(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
     if (!ob_json_check_object(&c->rd, j, "an object", info->keys, info->key_count)) return false;
     g->kind = info->kind;
     const uint32_t max = OB_MESH_MAX_SEGMENTS;
+    if (!parse_generator(c, j, g, max)) return false;
+    /* The generators' own bound (ob_mesh.h), named here with the file's keys. */
+    static const char *const pairs[][2] = {[OB_SCENE_GEOMETRY_SPHERE] = {"slices", "stacks"},
+                                           [OB_SCENE_GEOMETRY_PLANE] = {"subdivisions", "subdivisions"},
+                                           [OB_SCENE_GEOMETRY_TORUS] = {"major_segments", "minor_segments"}};
+    uint32_t b = g->kind == OB_SCENE_GEOMETRY_PLANE ? g->segments[0] : g->segments[1];
+    if ((size_t)g->kind < OB_ARRAY_COUNT(pairs) && pairs[g->kind][0] &&
+        (uint64_t)g->segments[0] * b > OB_MESH_MAX_GENERATED_CELLS) {
+        ob_json_push_key(&c->rd, ob_json_member(j, pairs[g->kind][1]) ? pairs[g->kind][1] : pairs[g->kind][0]);
+        return ob_json_fail(&c->rd, "%s x %s = %u x %u = %llu cells, more than the limit of %u",
+                            pairs[g->kind][0], pairs[g->kind][1], g->segments[0], b,
+                            (unsigned long long)g->segments[0] * b, OB_MESH_MAX_GENERATED_CELLS);
+    }
+    return true;
+}
+
+static bool parse_generator(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g, uint32_t max)
+{
     switch (g->kind) {
     case OB_SCENE_GEOMETRY_BOX:
         g->size[0] = g->size[1] = g->size[2] = 1.0f;
@@ -572,7 +598,10 @@ static bool parse_entities(sf_ctx *c, const cJSON *j)
 {
     if (!cJSON_IsArray(j)) return ob_json_fail(&c->rd, "expected an array of entities, got %s", ob_json_type_name(j));
     ob_scene_file *sf = c->sf;
-    uint32_t n = (uint32_t)cJSON_GetArraySize(j), i = 0;
+    int count = cJSON_GetArraySize(j);
+    if (count > (int)OB_SCENE_FILE_MAX_ENTITIES)
+        return ob_json_fail(&c->rd, "%d entities, more than the limit of %u", count, OB_SCENE_FILE_MAX_ENTITIES);
+    uint32_t n = (uint32_t)count, i = 0;
     if (!ob_json_names_init(&c->rd, &c->entities, n)) return false;
     if (n && !(sf->entities = ob_calloc(n, sizeof *sf->entities))) return ob_json_out_of_memory(&c->rd);
     for (const cJSON *it = j->child; it; it = it->next, i++) {
@@ -648,6 +677,7 @@ static bool parse_document(sf_ctx *c, const cJSON *root)
     if ((j = ob_json_member(root, "description"))) {
         mark = ob_json_push_key(&c->rd, "description");
         if (!cJSON_IsString(j)) return ob_json_fail(&c->rd, "expected a string, got %s", ob_json_type_name(j));
+        if (!ob_json_check_text(&c->rd, j->valuestring, "a description")) return false;
         if (!(sf->description = dup_or_oom(c, j->valuestring))) return false;
         ob_json_pop(&c->rd, mark);
     }
@@ -724,38 +754,6 @@ ob_result ob_scene_file_parse(const char *text, size_t size, const char *path,
     return c.rd.result;
 }
 
-/* The whole stream, NUL-terminated (ob_free it); NULL with errno on failure. */
-static char *read_stream(FILE *f, size_t *out_size)
-{
-    size_t size = 0, cap = 0;
-    char *buf = NULL;
-    for (;;) {
-        if (cap - size < 4096) {
-            size_t grown = cap ? cap * 2 : 65536;
-            char *p = grown > cap ? ob_realloc(buf, grown) : NULL;
-            if (!p) {
-                ob_free(buf);
-                errno = ENOMEM;
-                return NULL;
-            }
-            buf = p;
-            cap = grown;
-        }
-        size_t got = fread(buf + size, 1, cap - size - 1, f);
-        size += got;
-        if (got == 0) break;
-    }
-    if (ferror(f)) {
-        int e = errno ? errno : EIO;
-        ob_free(buf);
-        errno = e;
-        return NULL;
-    }
-    buf[size] = '\0';
-    *out_size = size;
-    return buf;
-}
-
 ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file_error *out_error)
 {
     ob_scene_file_error local;
@@ -763,21 +761,18 @@ ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file
     memset(e, 0, sizeof *e);
     if (out) memset(out, 0, sizeof *out);
     if (!path || !out) return OB_ERR_INVALID_ARGUMENT;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(e->message, sizeof e->message, "%s: cannot open: %s", path, strerror(errno));
-        return OB_ERR_IO;
-    }
+    /* A regular file no bigger than the bound, checked before anything is
+     * read or allocated: a FIFO would block, /dev/zero would grow forever. */
+    char why[256];
     size_t size = 0;
-    errno = 0;
-    char *text = read_stream(f, &size);
-    int read_errno = errno;
-    fclose(f);
+    ob_result r;
+    char *text = ob_file_read_limited(path, "scene file", OB_SCENE_FILE_MAX_BYTES, &size, why,
+                                      sizeof why, &r);
     if (!text) {
-        snprintf(e->message, sizeof e->message, "%s: cannot read: %s", path, strerror(read_errno));
-        return read_errno == ENOMEM ? OB_ERR_OUT_OF_HOST_MEMORY : OB_ERR_IO;
+        snprintf(e->message, sizeof e->message, "%s: cannot open the scene file: %s", path, why);
+        return r == OB_ERR_OUT_OF_HOST_MEMORY ? r : r == OB_ERR_LIMIT ? OB_ERR_LIMIT : OB_ERR_IO;
     }
-    ob_result r = ob_scene_file_parse(text, size, path, out, e);
+    r = ob_scene_file_parse(text, size, path, out, e);
     ob_free(text);
     return r;
 }

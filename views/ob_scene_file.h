@@ -39,6 +39,25 @@ extern "C" {
 
 #define OB_SCENE_FILE_NONE UINT32_MAX   /* "no index": no parent, default material */
 #define OB_SCENE_FILE_MAX_PARTICLES (1u << 20)
+/* Input bounds (docs/limits.md), checked before memory is committed: a
+ * scene file's bytes (from the file's size, before reading it) and its
+ * entities (from the array's length, before any is parsed). */
+#define OB_SCENE_FILE_MAX_BYTES (64u << 20)
+#define OB_SCENE_FILE_MAX_ENTITIES (1u << 18)
+
+/* One range per setting, the same in a scene file's "settings" and on a
+ * program's command line (obelisk-view, obelisk-mirror): a value outside
+ * it is refused, naming it (docs/limits.md). */
+#define OB_SETTING_SIZE_MAX 8192u
+#define OB_SETTING_ENV_MAP_MIN 8u
+#define OB_SETTING_ENV_MAP_MAX 4096u
+#define OB_SETTING_SHADOW_MAP_MIN 16u
+#define OB_SETTING_SHADOW_MAP_MAX 8192u
+/* A linear scale before the tone map: past 1e6 (20 stops) a lit colour
+ * overflows half-float targets and single-precision tone mapping, and the
+ * image turns black or white without saying why. */
+#define OB_SETTING_EXPOSURE_MIN 1e-6
+#define OB_SETTING_EXPOSURE_MAX 1e6
 
 /* The error of a failed parse or load (ob_scene_load.h uses it too). */
 typedef struct ob_scene_file_error {
@@ -52,9 +71,9 @@ typedef struct ob_scene_file_error {
  * ob_scene_load_settings puts them where they belong. */
 typedef struct ob_scene_file_settings {
     bool has_size;
-    uint32_t width, height;       /* 1..8192 */
-    uint32_t env_map_size;        /* 0 = not given; else 8..4096 */
-    uint32_t shadow_map_size;     /* 0 = not given; else 16..8192 */
+    uint32_t width, height;       /* 1..OB_SETTING_SIZE_MAX */
+    uint32_t env_map_size;        /* 0 = not given; else OB_SETTING_ENV_MAP_MIN..MAX */
+    uint32_t shadow_map_size;     /* 0 = not given; else OB_SETTING_SHADOW_MAP_MIN..MAX */
     bool has_threads;
     int threads;                  /* 0 = single-threaded, N workers, -1 = "auto" */
     bool has_clear_color;
@@ -114,6 +133,7 @@ typedef struct ob_scene_file_geometry {
     uint32_t segments[2];         /* sphere: slices, stacks; cone: slices, 0;
                                      plane: subdivisions, 0; torus: major, minor */
     char *model;                  /* MODEL: the path as the loader gets it */
+    bool model_relative;          /* MODEL: the file gave a relative path (joined to its folder) */
 } ob_scene_file_geometry;
 
 typedef enum ob_scene_file_rotation_kind {
@@ -185,8 +205,11 @@ typedef struct ob_scene_file {
 ob_result ob_scene_file_parse(const char *text, size_t size, const char *path,
                               ob_scene_file *out, ob_scene_file_error *out_error);
 
-/* Reads the file at `path` and parses it. Also OB_ERR_IO (message names the
- * file and the OS error). */
+/* Reads the file at `path` and parses it. Only a regular file of at most
+ * OB_SCENE_FILE_MAX_BYTES is read, checked before reading (a FIFO never
+ * blocks, /dev/zero is never read). Also OB_ERR_IO (message names the file
+ * and the OS error, or what the path is: "not a regular file (a FIFO)") and
+ * OB_ERR_LIMIT (the file's size against the bound). */
 ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file_error *out_error);
 
 /* Frees everything the description owns and zeroes it. NULL is a no-op. */

@@ -1,9 +1,11 @@
+#define _XOPEN_SOURCE 700
 #include "ob_scene_load.h"
 
 #include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ob_mesh.h"
@@ -149,6 +151,30 @@ static ob_result entity_geometry(loader *L, const ob_scene_file_entity *e, ob_ge
     return OB_OK;
 }
 
+/* A relative model path must resolve, after symbolic links, inside the
+ * scene file's folder (ob_scene_load_desc.allow_any_folder). OB_ERR_IO,
+ * logged naming the entity and the path, when it does not. */
+static ob_result model_inside_scene_folder(loader *L, const ob_scene_file_entity *e)
+{
+    if (L->desc->allow_any_folder || !e->geometry.model_relative) return OB_OK;
+    const char *scene = L->sf->path ? L->sf->path : "scene";
+    const char *slash = strrchr(scene, '/');
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - scene) : 1, slash ? scene : ".");
+    if (slash == scene) snprintf(dir, sizeof dir, "/");
+    char *root = realpath(dir, NULL), *real = realpath(e->geometry.model, NULL);
+    size_t n = root ? strlen(root) : 0;
+    bool inside = !real || (root && strncmp(real, root, n) == 0 && (real[n] == '/' || (n == 1 && root[0] == '/')));
+    /* A path that does not resolve (missing) is the model loader's to report. */
+    if (!inside)
+        OB_LOG_E(LOG_MODULE, "%s: entities[%u] '%s': refused model '%s': it resolves to '%s', outside the "
+                 "scene file's folder '%s' (other folders must be allowed explicitly)", scene, e->index,
+                 e->name, e->geometry.model, real, root ? root : dir);
+    free(root);
+    free(real);
+    return inside ? OB_OK : OB_ERR_IO;
+}
+
 /* The entity's model, opened and given its materials once per file into
  * *out_a. *out_a NULL with OB_OK: it did not open (reported, left out). */
 static ob_result entity_model(loader *L, const ob_scene_file_entity *e, ob_model_assets **out_a)
@@ -169,7 +195,11 @@ static ob_result entity_model(loader *L, const ob_scene_file_entity *e, ob_model
     /* flip_uv: the engine samples images with Vulkan's top-left origin. */
     ob_model *model = NULL;
     ob_model_assets *a = NULL;
-    r = ob_model_open(&(ob_model_desc){.path = e->geometry.model, .flip_uv = true}, &model);
+    r = model_inside_scene_folder(L, e);
+    if (r == OB_OK)
+        r = ob_model_open(&(ob_model_desc){.path = e->geometry.model, .flip_uv = true,
+                                           .allow_any_folder = L->desc->allow_any_folder},
+                          &model);
     if (r == OB_OK) {
         uint32_t first = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
         L->ids_used += OB_MODEL_ASSETS_IDS_PER_PRIMITIVE * model->primitive_count;

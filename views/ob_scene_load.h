@@ -86,6 +86,13 @@ typedef struct ob_scene_load_desc {
     /* Geometry ids for command hashes: first_geometry_id, +1, ... in upload
      * order; 0 → each derived from its contents (ob_geometry_desc.id). */
     uint32_t first_geometry_id;
+    /* A model path the file gives relative to itself must resolve, after
+     * symbolic links, inside the scene file's folder, and each model's own
+     * references inside the model's folder (ob_model_desc.allow_any_folder);
+     * otherwise the entity is left out, naming the path. true allows any
+     * folder: trusted content only. Absolute model paths are the file's
+     * explicit choice and are not confined. */
+    bool allow_any_folder;
 } ob_scene_load_desc;
 
 /* An entity left out because its model did not load. */

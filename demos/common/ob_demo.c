@@ -1,10 +1,14 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ob_demo.h"
+#include "ob_scene_file.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -19,16 +23,18 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --frames F        frames to render (default 60; with --window, until it closes)\n"
             "  --threads T       0 = single-threaded, N = N workers, auto = decide per frame\n"
             "  --toggle K        switch single/multi-threaded every K frames\n"
-            "  --size WxH        image size (default 640x480)\n"
-            "  --out FILE.png    write the final image\n"
-            "  --stats-json FILE write one object of stats per frame\n"
+            "  --size WxH        image size (default 640x480; each side 1 to 8192)\n"
+            "  --out FILE.png    write the final image (through a symbolic link; never over a\n"
+            "                    FIFO, device or directory)\n"
+            "  --stats-json FILE write one object of stats per frame (the last also holds the\n"
+            "                    lean report, as \"lean\")\n"
             "  --seed S          scene seed\n"
-            "  --env-size N      environment map size (per paraboloid half)\n"
-            "  --shadow-size N   shadow map size\n"
+            "  --env-size N      environment map size (per paraboloid half; 8 to 4096)\n"
+            "  --shadow-size N   shadow map size (16 to 8192)\n"
             "  --msaa N          samples per pixel of the main view: 1, 2, 4 or 8 (default 1;\n"
             "                    lowered to what the device offers, said in the log)\n"
             "  --exposure F      linear scale of the scene colour before the tone map\n"
-            "                    (default 1; 2 = one stop brighter)\n"
+            "                    (default 1; 2 = one stop brighter; 1e-6 to 1e6)\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
             "  --window          show the scene live (F1 toggles the mode; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
@@ -41,10 +47,37 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
 static bool parse_u32(const char *s, uint32_t *out)
 {
     char *end;
-    unsigned long v = strtoul(s, &end, 10);
-    if (!*s || *end || v > UINT32_MAX) return false;
+    if (!s || *s < '0' || *s > '9') return false;   /* no sign, no blank: strtoul takes "-1" */
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (*end || errno == ERANGE || v > UINT32_MAX) return false;
     *out = (uint32_t)v;
     return true;
+}
+
+/* "WxH", each a decimal from 1 to OB_SETTING_SIZE_MAX and nothing else:
+ * sscanf's "%ux%u" wrapped 4294967297 to 1 and ignored "x56". */
+static bool parse_size(const char *s, uint32_t *w, uint32_t *h)
+{
+    const char *x = s ? strchr(s, 'x') : NULL;
+    if (!x || x == s || (size_t)(x - s) > 10) return false;
+    char first[12];
+    memcpy(first, s, (size_t)(x - s));
+    first[x - s] = '\0';
+    return parse_u32(first, w) && parse_u32(x + 1, h) && *w >= 1 && *h >= 1 &&
+           *w <= OB_SETTING_SIZE_MAX && *h <= OB_SETTING_SIZE_MAX;
+}
+
+/* Options that take a value: a missing value is said as such only for these. */
+static bool takes_value(const char *a)
+{
+    static const char *const with_value[] = {"--frames", "--threads", "--toggle", "--size", "--out",
+                                             "--stats-json", "--seed", "--objects", "--env-size",
+                                             "--malloc-threshold", "--window-resize", "--msaa",
+                                             "--exposure", "--shadow-size"};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(with_value); i++)
+        if (!strcmp(a, with_value[i])) return true;
+    return false;
 }
 
 bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
@@ -58,6 +91,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         bool ok = true;
+        const char *range = NULL;   /* what a bad value should have been */
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout, argv[0], usage_extra, takes_input);
             *out_exit = 0;
@@ -71,25 +105,31 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             o->window = true;
         } else if (!strcmp(a, "--quiet")) {
             o->quiet = true;
-        } else if (a[0] == '-' && a[1] == '-' && !v) {
+        } else if (!strcmp(a, "--allow-missing")) {
+            o->allow_missing = true;
+        } else if (!strcmp(a, "--allow-any-folder")) {
+            o->allow_any_folder = true;
+        } else if (takes_value(a) && !v) {
             fprintf(stderr, "%s: option %s needs a value\n", argv[0], a);
             return false;
         } else if (!strcmp(a, "--frames")) {
             ok = parse_u32(v, &o->frames) && o->frames > 0;
+            range = "a positive integer";
             i++;
             o->frames_given = true;
         } else if (!strcmp(a, "--threads")) {
             uint32_t t;
             if (!strcmp(v, "auto")) o->threads = -1;
             else if ((ok = parse_u32(v, &t) && t <= OB_MAX_WORKERS)) o->threads = (int)t;
+            range = "0 (single-threaded), a worker count or auto";
             i++;
             o->threads_given = true;
         } else if (!strcmp(a, "--toggle")) {
             ok = parse_u32(v, &o->toggle);
             i++;
         } else if (!strcmp(a, "--size")) {
-            ok = sscanf(v, "%ux%u", &o->width, &o->height) == 2 && o->width > 0 && o->height > 0 &&
-                 o->width <= 8192 && o->height <= 8192;
+            ok = parse_size(v, &o->width, &o->height);
+            range = "WxH, each side from 1 to 8192";
             i++;
             o->size_given = true;
         } else if (!strcmp(a, "--out")) {
@@ -105,29 +145,40 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             ok = parse_u32(v, &o->objects) && o->objects <= 100000;
             i++;
         } else if (!strcmp(a, "--env-size")) {
-            ok = parse_u32(v, &o->env_size) && o->env_size >= 8 && o->env_size <= 4096;
+            ok = parse_u32(v, &o->env_size) && o->env_size >= OB_SETTING_ENV_MAP_MIN &&
+                 o->env_size <= OB_SETTING_ENV_MAP_MAX;
+            range = "an integer from 8 to 4096";
             i++;
         } else if (!strcmp(a, "--malloc-threshold")) {
             ok = parse_u32(v, &o->malloc_threshold_kib) && o->malloc_threshold_kib >= 1 &&
                  o->malloc_threshold_kib <= 32 * 1024;
             i++;
         } else if (!strcmp(a, "--window-resize")) {
-            ok = sscanf(v, "%u:%ux%u", &o->resize_frame, &o->resize_width, &o->resize_height) == 3 &&
-                 o->resize_width > 0 && o->resize_height > 0 && o->resize_width <= 8192 &&
-                 o->resize_height <= 8192;
+            const char *colon = strchr(v, ':');
+            char frame[12] = "";
+            if (colon && colon > v && (size_t)(colon - v) < sizeof frame)
+                memcpy(frame, v, (size_t)(colon - v));
+            ok = colon && parse_u32(frame, &o->resize_frame) &&
+                 parse_size(colon + 1, &o->resize_width, &o->resize_height);
+            range = "F:WxH, each side from 1 to 8192";
             i++;
         } else if (!strcmp(a, "--msaa")) {
             ok = parse_u32(v, &o->msaa) && (o->msaa == 1 || o->msaa == 2 || o->msaa == 4 ||
                                             o->msaa == 8);
+            range = "1, 2, 4 or 8";
             i++;
         } else if (!strcmp(a, "--exposure")) {
             char *end;
-            o->exposure = strtof(v, &end);
-            ok = *v && !*end && isfinite(o->exposure) && o->exposure > 0.0f && o->exposure <= 1e6f;
+            double e = strtod(v, &end);
+            ok = *v && !*end && isfinite(e) && e >= OB_SETTING_EXPOSURE_MIN && e <= OB_SETTING_EXPOSURE_MAX;
+            o->exposure = (float)e;
+            range = "a number from 1e-06 to 1e+06";
             o->exposure_given = true;
             i++;
         } else if (!strcmp(a, "--shadow-size")) {
-            ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= 16 && o->shadow_size <= 8192;
+            ok = parse_u32(v, &o->shadow_size) && o->shadow_size >= OB_SETTING_SHADOW_MAP_MIN &&
+                 o->shadow_size <= OB_SETTING_SHADOW_MAP_MAX;
+            range = "an integer from 16 to 8192";
             i++;
         } else if (a[0] != '-' && takes_input && !o->input) {
             o->input = a;
@@ -137,7 +188,8 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             return false;
         }
         if (!ok) {
-            fprintf(stderr, "%s: bad value '%s' for %s\n", argv[0], v, a);
+            fprintf(stderr, "%s: bad value '%s' for %s%s%s\n", argv[0], v, a, range ? ": expected " : "",
+                    range ? range : "");
             return false;
         }
     }
@@ -227,6 +279,40 @@ static void on_stats(void *user, const ob_frame_stats *st)
     }
 }
 
+/* --stats-json's file, opened for writing: through a symbolic link, but
+ * never a FIFO (opening one would block until a reader comes; O_NONBLOCK
+ * fails at once instead), a device (/dev/full) or a directory. Truncated
+ * only once it is known to be a regular file. NULL with a message. */
+static FILE *open_stats_json(const char *path)
+{
+    int fd = open(path, O_WRONLY | O_CREAT | O_NONBLOCK | O_CLOEXEC | O_NOCTTY, 0666);
+    struct stat st;
+    const char *why = NULL;
+    if (fd < 0) why = errno == ENXIO ? "a FIFO, not a regular file" : strerror(errno);
+    else if (fstat(fd, &st) != 0) why = strerror(errno);
+    else if (!S_ISREG(st.st_mode))
+        why = S_ISFIFO(st.st_mode) ? "a FIFO, not a regular file"
+              : S_ISDIR(st.st_mode) ? "a directory, not a regular file" : "a device, not a regular file";
+    FILE *f = NULL;
+    if (!why) {
+        int flags = fcntl(fd, F_GETFL);
+        if (ftruncate(fd, 0) != 0 || flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 ||
+            !(f = fdopen(fd, "w")))
+            why = strerror(errno);
+    }
+    if (why) {
+        if (fd >= 0) close(fd);
+        fprintf(stderr, "cannot write the stats file '%s': %s\n", path, why);
+        return NULL;
+    }
+    if (fputs("[\n", f) == EOF) {
+        fclose(f);
+        fprintf(stderr, "cannot write the stats file '%s': %s\n", path, strerror(errno));
+        return NULL;
+    }
+    return f;
+}
+
 /* Headless runs render --frames frames; windowed runs until the window
  * closes, or for --frames when it was given. */
 static bool frames_bound_run(const ob_demo_options *o) { return !o->window || o->frames_given; }
@@ -311,14 +397,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     if (d->window && (r = ob_window_attach(d->window, d->r)) != OB_OK) return r;
     /* The renderer presents the composite's target; main follows the window's size. */
     if (d->window) ob_composite_view_set_presenting(d->composite, true);
-    if (o->stats_json) {
-        d->json = fopen(o->stats_json, "w");
-        if (!d->json) {
-            fprintf(stderr, "cannot write '%s'\n", o->stats_json);
-            return OB_ERR_IO;
-        }
-        fputs("[\n", d->json);
-    }
+    if (o->stats_json && !(d->json = open_stats_json(o->stats_json))) return OB_ERR_IO;
     /* The summary's 64 bytes per frame, taken once: a headless run's memory
      * then does not grow with its frames (what the soak measures). */
     if (frames_bound_run(o) &&
@@ -335,7 +414,7 @@ void ob_demo_shutdown(ob_demo *d)
     /* The swapchain goes before the device it lives on. */
     ob_window_close(d->window);
     ob_stack_destroy(d->stack);
-    if (d->json) {
+    if (d->json) {   /* a run that stopped early: close the array, best effort */
         fputs("\n]\n", d->json);
         fclose(d->json);
     }
@@ -355,14 +434,18 @@ ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geomet
     return ob_stack_add_entity(d->stack, parent, name, g, m, NULL);
 }
 
-ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc)
+ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc,
+                                      ob_result *out_result)
 {
-    ob_result r;
-    if (ob_array_reserve((void **)&d->systems, &d->system_cap, d->system_count + 1,
-                         sizeof *d->systems) != OB_OK)
-        return NULL;
-    ob_particle_system *ps = ob_particle_system_create(d->views, d->scene, parent, desc, &r);
-    if (ps) d->systems[d->system_count++] = ps;
+    ob_result r = ob_array_reserve((void **)&d->systems, &d->system_cap, d->system_count + 1,
+                                   sizeof *d->systems);
+    ob_particle_system *ps = NULL;
+    if (r != OB_OK)
+        OB_LOG_E("demo", "particle system '%s': out of memory for the demo's list",
+                 desc && desc->name ? desc->name : "(unnamed)");
+    else if ((ps = ob_particle_system_create(d->views, d->scene, parent, desc, &r)))
+        d->systems[d->system_count++] = ps;
+    if (out_result) *out_result = ps ? OB_OK : r;
     return ps;
 }
 
@@ -443,28 +526,12 @@ typedef struct lean_row {
     uint32_t entities;
 } lean_row;
 
-void ob_demo_print_lean_report(ob_demo *d, FILE *f)
+/* One row per (material name, effect) in the order the scene's renderables
+ * first use it: many materials of one kind (the mirror scene's palette)
+ * make one row with their entity count. Rows past LEAN_MATERIALS are
+ * counted in *out_other. */
+static uint32_t lean_rows(ob_demo *d, lean_row rows[LEAN_MATERIALS], uint32_t *out_other)
 {
-    const ob_demo_lean *l = &d->lean;
-    fprintf(f, "lean: %llu shader variants and %llu pipelines created over %u frames\n",
-            (unsigned long long)l->variants_created, (unsigned long long)l->pipelines_created,
-            d->history_count);
-    fputs("lean: views left out:", f);
-    for (uint32_t i = 0; i < l->view_count; i++)
-        fprintf(f, "%s %s (%s, %u frames)", i ? "," : "", l->views[i].name,
-                ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
-    if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
-    fputs(l->view_count ? "\n" : " none\n", f);
-    uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
-    if (samples > 1)
-        fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
-                   "targets, resolved before the composite\n", samples);
-    else
-        fputs("lean: MSAA targets: none (view 'main' is single-sampled)\n", f);
-    /* One line per (material name, effect) in the order the scene's
-     * renderables first use it: many materials of one kind (the mirror
-     * scene's palette) make one line with their entity count. */
-    lean_row rows[LEAN_MATERIALS];
     uint32_t row_count = 0, other_entities = 0, count = 0;
     const ob_render_proxy *proxies = d->scene ? ob_scene_render_proxies(d->scene, &count) : NULL;
     ob_view *main = d->main ? ob_perspective_view_base(d->main) : NULL;
@@ -490,6 +557,31 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
         }
         rows[k].entities++;
     }
+    *out_other = other_entities;
+    return row_count;
+}
+
+void ob_demo_print_lean_report(ob_demo *d, FILE *f)
+{
+    const ob_demo_lean *l = &d->lean;
+    fprintf(f, "lean: %llu shader variants and %llu pipelines created over %u frames\n",
+            (unsigned long long)l->variants_created, (unsigned long long)l->pipelines_created,
+            d->history_count);
+    fputs("lean: views left out:", f);
+    for (uint32_t i = 0; i < l->view_count; i++)
+        fprintf(f, "%s %s (%s, %u frames)", i ? "," : "", l->views[i].name,
+                ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
+    if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
+    fputs(l->view_count ? "\n" : " none\n", f);
+    uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
+    if (samples > 1)
+        fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
+                   "targets, resolved before the composite\n", samples);
+    else
+        fputs("lean: MSAA targets: none (view 'main' is single-sampled)\n", f);
+    lean_row rows[LEAN_MATERIALS];
+    uint32_t other_entities;
+    uint32_t row_count = lean_rows(d, rows, &other_entities);
     for (uint32_t k = 0; k < row_count; k++) {
         char left[256];
         uint32_t n_left = ob_material_pbr_left_out(rows[k].first, left, sizeof left);
@@ -501,6 +593,82 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
     }
     if (other_entities)
         fprintf(f, "lean: and %u more entities with other materials\n", other_entities);
+}
+
+/* A JSON string: quotes, backslashes and control characters escaped (names
+ * come from model files). */
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; p++) {
+        if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+        else if (*p < 0x20 || *p == 0x7f) fprintf(f, "\\u%04x", *p);
+        else fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+/* The lean report as one JSON object: what ob_demo_print_lean_report says. */
+static void write_lean_json(ob_demo *d, FILE *f)
+{
+    const ob_demo_lean *l = &d->lean;
+    fprintf(f, "{\"frames\":%u,\"variants_created\":%llu,\"pipelines_created\":%llu,\"views_left_out\":[",
+            d->history_count, (unsigned long long)l->variants_created,
+            (unsigned long long)l->pipelines_created);
+    for (uint32_t i = 0; i < l->view_count; i++) {
+        fputs(i ? ",{\"name\":" : "{\"name\":", f);
+        json_string(f, l->views[i].name);
+        fprintf(f, ",\"reason\":\"%s\",\"frames\":%u}", ob_skip_reason_name(l->views[i].reason),
+                l->views[i].frames);
+    }
+    fprintf(f, "],\"views_left_out_more\":%u,\"msaa_samples\":%u,\"materials\":[", l->views_more,
+            d->main ? ob_perspective_view_samples(d->main) : 1);
+    lean_row rows[LEAN_MATERIALS];
+    uint32_t other_entities;
+    uint32_t row_count = lean_rows(d, rows, &other_entities);
+    for (uint32_t k = 0; k < row_count; k++) {
+        char left[256];
+        uint32_t n_left = ob_material_pbr_left_out(rows[k].first, left, sizeof left);
+        fputs(k ? ",{\"material\":" : "{\"material\":", f);
+        json_string(f, rows[k].material);
+        fputs(",\"effect\":", f);
+        if (rows[k].effect) json_string(f, rows[k].effect);
+        else fputs("null", f);
+        fputs(",\"left_out\":", f);
+        json_string(f, n_left ? left : "");
+        fprintf(f, ",\"entities\":%u}", rows[k].entities);
+    }
+    fprintf(f, "],\"other_entities\":%u}", other_entities);
+}
+
+/* Ends --stats-json: the lean report goes into the last frame's object as
+ * "lean" (the file stays an array with one entry per frame, so readers that
+ * count entries as frames are unaffected), then the array is closed and
+ * every write and the close are checked: a full disk is an error, not a
+ * short file and exit 0. */
+static bool finish_stats_json(ob_demo *d)
+{
+    FILE *f = d->json;
+    d->json = NULL;
+    bool ok = true;
+    if (d->history_count > 0) {
+        /* Reopen the last object: its closing brace is the file's last byte. */
+        ok = fflush(f) == 0 && fseek(f, -1, SEEK_END) == 0;
+        if (ok) {
+            fputs(",\"lean\":", f);
+            write_lean_json(d, f);
+            fputc('}', f);
+        }
+    }
+    fputs("\n]\n", f);
+    ok = ok && !ferror(f);
+    int err = errno;
+    if (fclose(f) != 0) {
+        ok = false;
+        err = errno;
+    }
+    if (!ok) fprintf(stderr, "cannot write the stats file '%s': %s\n", d->opt.stats_json, strerror(err));
+    return ok;
 }
 
 static void print_summary(const ob_demo *d)
@@ -605,6 +773,7 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
     if (ob_device_validation_enabled(ob_renderer_device(d->r)))
         printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);
+    if (d->json && !finish_stats_json(d)) return 1;
     if (d->opt.out) {
         ob_result r = ob_image_write_png(ob_renderer_device(d->r),
                                          ob_composite_view_target(d->composite), d->opt.out);

@@ -44,6 +44,11 @@ typedef struct ob_demo_options {
      * from a scene file do not override the command line; frames_given makes
      * a windowed run stop after --frames. */
     bool size_given, threads_given, frames_given, exposure_given;
+    /* obelisk-view: --allow-missing renders a scene whose models did not all
+     * load and exits 0 (otherwise it exits 2 after rendering the rest);
+     * --allow-any-folder lets models and scene files refer to files outside
+     * their own folder (ob_model_desc.allow_any_folder): trusted content. */
+    bool allow_missing, allow_any_folder;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
 } ob_demo_options;
@@ -112,8 +117,11 @@ ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name)
 ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
                         ob_material *m);
 /* A particle system under parent that the demo destroys at shutdown.
- * Failure: NULL, logged. */
-ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc);
+ * Failure: NULL, logged, and *out_result (may be NULL) says why — a shader
+ * that cannot be read stays OB_ERR_IO up to the user's message, not
+ * "out of memory". */
+ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc,
+                                      ob_result *out_result);
 
 /* Frame callback: animate before the scene update. */
 typedef void (*ob_demo_update_fn)(ob_demo *d, uint32_t frame, double time, void *user);

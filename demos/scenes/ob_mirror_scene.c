@@ -222,7 +222,8 @@ static ob_result add_fountain(ob_demo *d, uint32_t seed)
     if (!fountain) return r;
     ob_node_set_position(fountain, fountain_position);
     ob_particle_desc pdesc = fountain_particles(seed);
-    return ob_demo_particles(d, fountain, &pdesc) ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
+    ob_demo_particles(d, fountain, &pdesc, &r);   /* r: why it failed, as the views said */
+    return r;
 }
 
 /* Geometry ids follow upload order (the command hashes fold them in): the

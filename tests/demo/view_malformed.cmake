@@ -1,7 +1,7 @@
 # Bad input to obelisk-view: each tests/data/scenes/bad_*.json exits with code
 # 2 and prints the message in its bad_*.expect sidecar (the JSON path and what
-# was expected); a scene whose models do not load renders the rest, exits 0,
-# and names each failed entity and its file.
+# was expected); a scene whose models do not load renders the rest, names
+# each failed entity and its file, and exits 2 -- or 0 with --allow-missing.
 # Run by ctest: cmake -DBIN=<build>/bin -DSRC=<source> -DOUT=<dir> -P view_malformed.cmake
 foreach(var BIN SRC OUT)
   if(NOT DEFINED ${var})
@@ -40,15 +40,18 @@ set(png ${OUT}/missing_model.png)
 file(REMOVE ${png})
 execute_process(COMMAND ${BIN}/obelisk-view ${data}/missing_model.json --frames 3 --quiet --out ${png}
                 RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
-if(NOT code STREQUAL "0")
-  message(FATAL_ERROR "missing_model: exit ${code}, expected 0\n${out}\n${err}")
+if(NOT code STREQUAL "2")
+  message(FATAL_ERROR "missing_model: exit ${code}, expected 2 (models missing, no --allow-missing)\n${out}\n${err}")
 endif()
 foreach(expected
         "entities[2] 'ghost': model '${data}/no-such-model.obj' did not load"
         "entities[4] 'ghost-twin': model '${data}/no-such-model.obj' did not load"
         "entities[5] 'infinite-box': model '/usr/share/assimp/models/glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb' did not load"
         "no-such-model.obj: cannot open model file: No such file or directory"
-        "position is not finite")
+        "position is not finite"
+        "obelisk-view: ${data}/missing_model.json: 3 entities were left out because their model did not load:"
+        "  entities[2] 'ghost': model '${data}/no-such-model.obj' (OB_ERR_IO)"
+        "--allow-missing accepts this and exits 0")
   string(FIND "${err}" "${expected}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "missing_model: stderr lacks '${expected}'\n${err}")
@@ -60,4 +63,10 @@ endif()
 if(NOT EXISTS ${png})
   message(FATAL_ERROR "missing_model: ${png} was not written")
 endif()
-message(STATUS "ok: missing_model renders the rest:\n${err}")
+# --allow-missing: the same render is what the user asked for.
+execute_process(COMMAND ${BIN}/obelisk-view ${data}/missing_model.json --frames 1 --quiet --allow-missing
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
+if(NOT code STREQUAL "0")
+  message(FATAL_ERROR "missing_model --allow-missing: exit ${code}, expected 0\n${out}\n${err}")
+endif()
+message(STATUS "ok: missing_model renders the rest, exits 2, and 0 with --allow-missing:\n${err}")

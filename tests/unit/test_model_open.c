@@ -377,8 +377,10 @@ static void scan_survives_garbage(void **state)
         assert_int_not_equal(r, OB_OK);
         assert_null(m);
         assert_true(ob_test_log_has(path, NULL));
-        if (strcmp(cases[i].name, "escapes.gltf") == 0)   /* "K\u0041" is read, as 'K?' */
-            assert_true(ob_test_log_has("refused", "K?", NULL));
+        /* "K\u0041" is decoded as assimp's JSON reader decodes it: "KA" (so
+         * "sk\u0069ns" is a skin to the scan as it is to assimp). */
+        if (strcmp(cases[i].name, "escapes.gltf") == 0)
+            assert_true(ob_test_log_has("refused", "KA", NULL));
         remove(path);
     }
     rmdir(dir);

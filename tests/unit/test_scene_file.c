@@ -14,6 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define SCENES OB_SOURCE_DIR "/demos/scenes/"
 #define BAD OB_SOURCE_DIR "/tests/data/scenes/"
@@ -374,7 +376,16 @@ static const bad_case bad_cases[] = {
     {"{" E "[{\"controllers\": [{\"rotate\": {}, \"orbit\": {}}]}]}", "entities[0].controllers[0]",
      "expected exactly one of rotate or orbit"},
     {"{" E "[{\"controllers\": [{\"orbit\": {\"radius\": -1}}]}]}", "entities[0].controllers[0].orbit.radius",
-     "expected a number >= 0, got -1"},
+     "expected a number >= 0, got -1"},    /* hostile input (issue 26): bounds checked before memory is committed,
+     * text a terminal would interpret refused */
+    {"{" E "[{\"geometry\": {\"generator\": \"sphere\", \"slices\": 4096, \"stacks\": 4096}}]}",
+     "entities[0].geometry.stacks", "slices x stacks = 4096 x 4096 = 16777216 cells, more than the limit of 1048576"},
+    {"{" E "[{\"geometry\": {\"generator\": \"plane\", \"subdivisions\": 2048}}]}",
+     "entities[0].geometry.subdivisions", "more than the limit of 1048576"},
+    {"{" E "[{\"name\": \"a\\u001b[31mred\"}]}", "entities[0].name",
+     "expected a non-empty name of printable UTF-8 text, got a control character or invalid UTF-8 at byte 1"},
+    {"{" E "[{\"name\": \"bad\xff\"}]}", "entities[0].name", "invalid UTF-8 at byte 3"},
+    {"{\"description\": \"\\u009b2J\", " E "[]}", "description", "a control character"},
 };
 
 static void every_malformed_case_names_its_path(void **state)
@@ -545,10 +556,74 @@ static void unreadable_file_is_an_io_error_naming_it(void **state)
     ob_scene_file sf;
     ob_scene_file_error err;
     assert_int_equal(ob_scene_file_load("/nonexistent/scene.json", &sf, &err), OB_ERR_IO);
-    assert_non_null(strstr(err.message, "/nonexistent/scene.json: cannot open: "));
+    assert_non_null(strstr(err.message, "/nonexistent/scene.json: cannot open the scene file: "));
     assert_int_equal(ob_scene_file_load(BAD, &sf, &err), OB_ERR_IO);   /* a directory */
-    assert_non_null(strstr(err.message, "cannot read: Is a directory"));
+    assert_non_null(strstr(err.message, "cannot open the scene file: not a regular file (a directory)"));
     assert_null(sf.path);
+}
+
+/* Files that would block, grow without bound or cut strings short are
+ * refused before anything is read or allocated, each with a message naming
+ * the file and what was wrong. */
+static void hostile_files_are_refused_with_a_reason(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ob_test_scene_hostile_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[128];
+    ob_scene_file sf;
+    ob_scene_file_error err;
+
+    /* A FIFO nobody writes to: opening it for reading would block forever. */
+    snprintf(path, sizeof path, "%s/fifo.json", dir);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    assert_int_equal(ob_scene_file_load(path, &sf, &err), OB_ERR_IO);
+    assert_non_null(strstr(err.message, "fifo.json: cannot open the scene file: not a regular file (a FIFO)"));
+    remove(path);
+
+    /* A link to /dev/zero would be read until memory runs out. */
+    snprintf(path, sizeof path, "%s/zero.json", dir);
+    assert_int_equal(symlink("/dev/zero", path), 0);
+    assert_int_equal(ob_scene_file_load(path, &sf, &err), OB_ERR_IO);
+    assert_non_null(strstr(err.message, "zero.json: cannot open the scene file: not a regular file (a device)"));
+    remove(path);
+
+    /* A file over the bound is refused from its size (sparse: no disk used). */
+    snprintf(path, sizeof path, "%s/huge.json", dir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(ftruncate(fileno(f), (off_t)OB_SCENE_FILE_MAX_BYTES + 1), 0);
+    fclose(f);
+    assert_int_equal(ob_scene_file_load(path, &sf, &err), OB_ERR_LIMIT);
+    assert_non_null(strstr(err.message, "huge.json: cannot open the scene file: 67108865 bytes, more than "
+                                        "the limit of 67108864"));
+    remove(path);
+    rmdir(dir);
+
+    /* More entities than the bound: refused from the array's length. */
+    size_t n = (size_t)OB_SCENE_FILE_MAX_ENTITIES + 1, size = 16 + 3 * n;
+    char *text = malloc(size);
+    assert_non_null(text);
+    size_t at = (size_t)snprintf(text, size, "{" E "[");
+    for (size_t i = 0; i < n; i++) at += (size_t)snprintf(text + at, size - at, "%s{}", i ? "," : "");
+    at += (size_t)snprintf(text + at, size - at, "]}");
+    assert_int_equal(ob_scene_file_parse(text, at, "many.json", &sf, &err), OB_ERR_PARSE);
+    assert_non_null(strstr(err.message, "many.json: entities: 262145 entities, more than the limit of 262144"));
+    free(text);
+
+    /* Nesting past cJSON's limit says so, instead of "invalid JSON near '[[[['". */
+    char deep[3000];
+    at = (size_t)snprintf(deep, sizeof deep, "{\"description\": ");
+    for (int i = 0; i < 1100; i++) deep[at++] = '[';
+    deep[at] = '\0';
+    assert_int_equal(parse(deep, &sf, &err), OB_ERR_PARSE);
+    assert_non_null(strstr(err.message, "invalid JSON: arrays and objects nested deeper than 1000 levels"));
+
+    /* A \u0000 would silently cut a model path short. */
+    assert_int_equal(parse("{" E "[{\"geometry\": {\"model\": \"a.obj\\u0000.png\"}}]}", &sf, &err),
+                     OB_ERR_PARSE);
+    assert_non_null(strstr(err.message, "test.json:1:"));
+    assert_non_null(strstr(err.message, "(NUL) escape in a string"));
 }
 
 /* ------------------------------------------------------------ allocation failures */
@@ -597,6 +672,7 @@ int main(void)
         cmocka_unit_test(bad_files_fail_as_their_sidecars_say),
         cmocka_unit_test(documented_example_parses),
         cmocka_unit_test(unreadable_file_is_an_io_error_naming_it),
+        cmocka_unit_test(hostile_files_are_refused_with_a_reason),
         cmocka_unit_test(every_allocation_failure_is_clean),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
