@@ -39,6 +39,8 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --window          show the scene live (F1 toggles the mode; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
             "  --quiet           no per-frame lines\n"
+            "  --no-instancing   one draw per entity instead of one per run of a material\n"
+            "                    and mesh (for comparison; the image is the same)\n"
             "  --malloc-threshold KIB  fix glibc's mmap and trim thresholds (steady RSS on\n"
             "                    long runs, slower frames on lavapipe; docs/soak.md)\n%s",
             prog, takes_input ? " FILE" : "", extra ? extra : "");
@@ -105,6 +107,8 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             o->window = true;
         } else if (!strcmp(a, "--quiet")) {
             o->quiet = true;
+        } else if (!strcmp(a, "--no-instancing")) {
+            o->no_instancing = true;
         } else if (!strcmp(a, "--allow-missing")) {
             o->allow_missing = true;
         } else if (!strcmp(a, "--allow-any-folder")) {
@@ -250,6 +254,10 @@ static void lean_note_frame(ob_demo_lean *l, const ob_frame_stats *st)
             lean_note_view(l, st->views[i].name, st->views[i].skipped);
     l->pipelines_created += st->pipelines_created;
     l->variants_created += st->variants_created;
+    l->draws = st->draws;
+    l->draw_calls = st->pm.draw_calls;
+    l->instances = st->pm.instances;
+    l->longest_run = st->pm.longest_run;
 }
 
 static void on_stats(void *user, const ob_frame_stats *st)
@@ -387,6 +395,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     if (!(d->stack = ob_stack_create(&sd, &r))) return r;
     d->r = d->stack->renderer;
     d->lib = d->stack->materials;
+    if (o->no_instancing) ob_material_library_set_instancing(d->lib, false);
     d->views = d->stack->views;
     d->scene = d->stack->scene;
     d->camera = d->stack->camera;
@@ -483,7 +492,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             "\"pipeline_binds\":[%u,%u],\"descriptor_binds\":[%u,%u],\"push_descriptors\":[%u,%u],"
             "\"push_constants\":[%u,%u],\"vertex_binds\":[%u,%u],\"index_binds\":[%u,%u],"
             "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
-            "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\",\"views\":[",
+            "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\","
+            "\"draw_calls\":%u,\"instances\":%u,\"descriptor_sets_allocated\":%u,"
+            "\"descriptor_sets_held\":%u,\"views\":[",
             (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
             st->update_ns * 1e-6, st->pre_render_ns * 1e-6, st->record_ns * 1e-6,
             st->assemble_ns * 1e-6, st->submit_ns * 1e-6, st->wait_ns * 1e-6, st->frame_ns * 1e-6,
@@ -494,16 +505,20 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             st->pm.push_constant_issued, st->pm.vertex_binds_requested, st->pm.vertex_binds_issued,
             st->pm.index_binds_requested, st->pm.index_binds_issued,
             (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
-            st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash);
+            st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash,
+            st->pm.draw_calls, st->pm.instances, st->pm.descriptor_sets_allocated,
+            st->pm.descriptor_sets_held);
     for (uint32_t i = 0; i < st->view_count; i++) {
         const ob_view_stats *v = &st->views[i];
         fprintf(f,
                 "%s{\"name\":\"%s\",\"type\":\"%s\",\"items\":%u,\"draws\":%u,\"culled\":%u,"
                 "\"chunks\":%u,\"worker\":%d,\"cull_ms\":%.4f,\"record_ms\":%.4f,\"gpu_ms\":%.4f,"
-                "\"hash\":\"%016llx\",\"skipped\":\"%s\"}",
+                "\"hash\":\"%016llx\",\"skipped\":\"%s\",\"draw_calls\":%u,\"instances\":%u,"
+                "\"longest_run\":%u}",
                 i ? "," : "", v->name, ob_view_type_name(v->type), v->items, v->draws, v->culled,
                 v->chunks, v->worker, v->cull_ns * 1e-6, v->record_ns * 1e-6, v->gpu_ms,
-                (unsigned long long)v->hash.hash, ob_skip_reason_name(v->skipped));
+                (unsigned long long)v->hash.hash, ob_skip_reason_name(v->skipped), v->draw_calls,
+                v->instances, v->longest_run);
     }
     fputs("],\"skipped\":[", f);
     for (uint32_t i = 0; i < st->skipped_count; i++)
@@ -573,6 +588,8 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
                 ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
     if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
     fputs(l->view_count ? "\n" : " none\n", f);
+    fprintf(f, "lean: draws: %u entities in %u draw calls (%u as instances, longest run %u; "
+               "last frame)\n", l->draws, l->draw_calls, l->instances, l->longest_run);
     uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
     if (samples > 1)
         fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
@@ -621,8 +638,10 @@ static void write_lean_json(ob_demo *d, FILE *f)
         fprintf(f, ",\"reason\":\"%s\",\"frames\":%u}", ob_skip_reason_name(l->views[i].reason),
                 l->views[i].frames);
     }
-    fprintf(f, "],\"views_left_out_more\":%u,\"msaa_samples\":%u,\"materials\":[", l->views_more,
-            d->main ? ob_perspective_view_samples(d->main) : 1);
+    fprintf(f, "],\"views_left_out_more\":%u,\"msaa_samples\":%u,\"draws\":%u,"
+            "\"draw_calls\":%u,\"instances\":%u,\"longest_run\":%u,\"materials\":[",
+            l->views_more, d->main ? ob_perspective_view_samples(d->main) : 1, l->draws,
+            l->draw_calls, l->instances, l->longest_run);
     lean_row rows[LEAN_MATERIALS];
     uint32_t other_entities;
     uint32_t row_count = lean_rows(d, rows, &other_entities);

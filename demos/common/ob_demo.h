@@ -37,6 +37,7 @@ typedef struct ob_demo_options {
     bool window;              /* --window */
     uint32_t resize_frame, resize_width, resize_height; /* --window-resize F:WxH (0 = none) */
     bool quiet;               /* --quiet: no per-frame lines */
+    bool no_instancing;       /* --no-instancing: one draw per entity */
     uint32_t malloc_threshold_kib; /* --malloc-threshold: glibc's thresholds (0 = its own) */
     ob_gpu_timing gpu_timing; /* ob_renderer_desc.gpu_timing (obelisk-bench --gpu-timing) */
     const char *input;        /* positional argument (obelisk-view FILE) */
@@ -75,6 +76,9 @@ typedef struct ob_demo_lean {
     struct { char name[48]; ob_skip_reason reason; uint32_t frames; } views[OB_DEMO_LEAN_VIEWS];
     uint32_t view_count, views_more;  /* views_more: distinct ones past the table */
     uint64_t pipelines_created, variants_created;
+    /* The last frame's draws: entities drawn, draw commands, instances of
+     * instanced draws, the longest run in one draw. */
+    uint32_t draws, draw_calls, instances, longest_run;
 } ob_demo_lean;
 
 typedef struct ob_demo {
