@@ -141,6 +141,16 @@ if ! awk -v g="$pct" 'BEGIN { exit !(g == g + 0 && g < 1.0) }'; then
     echo "FAIL: resident memory grew by ${pct}% after the warm-up" | tee -a "$out/report.txt"
     status=1
 fi
+# The set-0 descriptor sets a pipeline manager keeps cached between frames
+# ("descriptor_sets_held", the largest of any manager): bounded at 1024 per
+# frame slot whatever programs come and go (issue 25.9).
+growth descriptor_sets_held
+echo "  set-0 descriptor sets held after the warm-up: $start -> $end (range $lo..$hi; bound 1024)" \
+    | tee -a "$out/report.txt"
+if [ "${hi:-0}" -gt 1024 ]; then
+    echo "FAIL: a pipeline manager held $hi set-0 descriptor sets" | tee -a "$out/report.txt"
+    status=1
+fi
 
 if [ "$reference" -eq 1 ]; then
     if [ "$parallel" -eq 1 ]; then
