@@ -23,7 +23,7 @@ add_library(ob_fuzz_model_lib STATIC
 target_include_directories(ob_fuzz_model_lib PUBLIC ${OB_FUZZ_ROOT}/engine
                                                     ${OB_FUZZ_ROOT}/geometry ${STB_INCLUDE_DIR})
 target_compile_options(ob_fuzz_model_lib PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer-no-link)
-target_link_libraries(ob_fuzz_model_lib PUBLIC PkgConfig::ASSIMP Threads::Threads m)
+target_link_libraries(ob_fuzz_model_lib PUBLIC PkgConfig::ASSIMP PkgConfig::ZLIB Threads::Threads m)
 
 add_executable(fuzz_model ${CMAKE_CURRENT_LIST_DIR}/fuzz_model.c)
 target_compile_options(fuzz_model PRIVATE ${OB_FUZZ_SANITIZE} -fsanitize=fuzzer)
