@@ -539,28 +539,6 @@ static bool scan_node(scan *s)
     }
 }
 
-static bool scan_nodes(scan *s)
-{
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '[') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == ']') {
-        s->p++;
-        return true;
-    }
-    for (;;) {
-        if (!scan_node(s)) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == ']') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
-    }
-}
-
 /* The top-level object: extensionsRequired and extensionsUsed into the
  * lists, skins and the nodes' skin references to hide, every other member
  * skipped. */
@@ -583,7 +561,7 @@ static bool scan_top(scan *s, name_list *required, name_list *used)
         bool ok;
         if (strcmp(key, "extensionsRequired") == 0) ok = read_name_array(s, required);
         else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
-        else if (strcmp(key, "nodes") == 0) ok = scan_nodes(s);
+        else if (strcmp(key, "nodes") == 0) ok = scan_array(s, scan_node);
         else if (strcmp(key, "skins") == 0) ok = hide_skin(s, quote) && skip_value(s);
         else if (strcmp(key, "bufferViews") == 0) ok = scan_objects(s, grow_views, view_member);
         else if (strcmp(key, "accessors") == 0) ok = scan_objects(s, grow_accessors, accessor_member);
