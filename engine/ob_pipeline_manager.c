@@ -950,6 +950,7 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
         const VkDeviceSize zero = 0;
         vkCmdBindVertexBuffers(pm->cmd, 1, 1, &vk, &zero);
         pm->cur.instances = vk;
+        pm->stats.vertex_binds_requested++;  /* the instance binding's own, so issued <= requested */
         pm->stats.vertex_binds_issued++;
     }
     uint32_t first = off / OB_INSTANCE_STRIDE;
