@@ -504,7 +504,7 @@ static double st_ns_per_draw(const ob_bench_sweep_entry *e)
 
 /* Teardown of a scene graph of `count` renderable entities, ns per entity:
  * batch in one ob_nodes_destroy, else one ob_node_destroy each, newest
- * first. The renderables' material and geometry are placeholders: the scene
+ * first. The renderables' material and geometry pointers are never dereferenced: the scene
  * only interns the pointers. NAN when the scene cannot be built. */
 #define TEARDOWN_ENTITIES 100000u
 
