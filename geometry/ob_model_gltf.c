@@ -262,11 +262,16 @@ static bool view_member(scan *s, const char *key, uint32_t index)
     return skip_value(s);
 }
 
-/* A small object's integer members by name (the rest skipped). */
-static bool read_members(scan *s, const char *const *keys, uint32_t **outs, uint32_t n)
+/* The members of a JSON object: member(s, key, quote, user) for each, with
+ * s->p at its value, which it must consume; quote is where the key's string
+ * starts (hide_key hides it). A value that is not an object is skipped, or,
+ * when strict, refused. Keys are compared cut to 31 characters (read_string). */
+typedef bool (*object_member_fn)(scan *s, const char *key, const char *quote, void *user);
+
+static bool scan_object(scan *s, bool strict, object_member_fn member, void *user)
 {
     skip_ws(s);
-    if (s->p >= s->end || *s->p != '{') return skip_value(s);
+    if (s->p >= s->end || *s->p != '{') return strict ? false : skip_value(s);
     s->p++;
     skip_ws(s);
     if (s->p < s->end && *s->p == '}') {
@@ -275,14 +280,12 @@ static bool read_members(scan *s, const char *const *keys, uint32_t **outs, uint
     }
     for (;;) {
         skip_ws(s);
-        char key[24];
+        const char *quote = s->p;
+        char key[32];
         if (!read_string(s, key, sizeof key)) return false;
         skip_ws(s);
         if (s->p >= s->end || *s->p++ != ':') return false;
-        uint32_t k = 0;
-        while (k < n && strcmp(key, keys[k]) != 0) k++;
-        bool ok;
-        if (!(k < n ? read_uint(s, outs[k], &ok) : skip_value(s))) return false;
+        if (!member(s, key, quote, user)) return false;
         skip_ws(s);
         if (s->p >= s->end) return false;
         if (*s->p == '}') {
@@ -293,47 +296,56 @@ static bool read_members(scan *s, const char *const *keys, uint32_t **outs, uint
     }
 }
 
-static bool sparse_member(scan *s, gltf_accessor *a)
+typedef struct named_uints {
+    const char *const *keys;
+    uint32_t **outs;
+    uint32_t n;
+} named_uints;
+
+static bool named_uint_member(scan *s, const char *key, const char *quote, void *user)
 {
-    /* {"count": N, "indices": {bufferView, byteOffset, componentType}, "values": {bufferView, byteOffset}} */
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '{') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == '}') {
-        s->p++;
+    (void)quote;
+    const named_uints *m = user;
+    uint32_t k = 0;
+    while (k < m->n && strcmp(key, m->keys[k]) != 0) k++;
+    bool ok;
+    return k < m->n ? read_uint(s, m->outs[k], &ok) : skip_value(s);
+}
+
+/* A small object's integer members by name (the rest skipped). */
+static bool read_members(scan *s, const char *const *keys, uint32_t **outs, uint32_t n)
+{
+    named_uints m = {keys, outs, n};
+    return scan_object(s, false, named_uint_member, &m);
+}
+
+/* {"count": N, "indices": {bufferView, byteOffset, componentType},
+ *  "values": {bufferView, byteOffset}} */
+static bool sparse_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)quote;
+    gltf_accessor *a = user;
+    bool ok = true;
+    uint32_t type = 0;
+    if (strcmp(key, "count") == 0) return read_uint(s, &a->sparse_count, &ok);
+    if (strcmp(key, "indices") == 0) {
+        static const char *const keys[] = {"bufferView", "byteOffset", "componentType"};
+        uint32_t *outs[] = {&a->index_view, &a->index_offset, &type};
+        if (!read_members(s, keys, outs, 3)) return false;
+        a->index_bytes = component_bytes(type);
         return true;
     }
-    for (;;) {
-        skip_ws(s);
-        char key[16];
-        if (!read_string(s, key, sizeof key)) return false;
-        skip_ws(s);
-        if (s->p >= s->end || *s->p++ != ':') return false;
-        bool ok = true;
-        uint32_t type = 0;
-        if (strcmp(key, "count") == 0) {
-            if (!read_uint(s, &a->sparse_count, &ok)) return false;
-        } else if (strcmp(key, "indices") == 0) {
-            static const char *const keys[] = {"bufferView", "byteOffset", "componentType"};
-            uint32_t *outs[] = {&a->index_view, &a->index_offset, &type};
-            if (!read_members(s, keys, outs, 3)) return false;
-            a->index_bytes = component_bytes(type);
-        } else if (strcmp(key, "values") == 0) {
-            static const char *const keys[] = {"bufferView", "byteOffset"};
-            uint32_t *outs[] = {&a->value_view, &a->value_offset};
-            if (!read_members(s, keys, outs, 2)) return false;
-        } else if (!skip_value(s)) {
-            return false;
-        }
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == '}') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
+    if (strcmp(key, "values") == 0) {
+        static const char *const keys[] = {"bufferView", "byteOffset"};
+        uint32_t *outs[] = {&a->value_view, &a->value_offset};
+        return read_members(s, keys, outs, 2);
     }
+    return skip_value(s);
+}
+
+static bool sparse_member(scan *s, gltf_accessor *a)
+{
+    return scan_object(s, false, sparse_field, a);
 }
 
 static bool accessor_member(scan *s, const char *key, uint32_t index)
@@ -362,6 +374,18 @@ static bool accessor_member(scan *s, const char *key, uint32_t index)
     return skip_value(s);
 }
 
+typedef struct indexed_member {
+    member_fn fn;
+    uint32_t index;
+} indexed_member;
+
+static bool indexed_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)quote;
+    const indexed_member *im = user;
+    return im->fn(s, key, im->index);
+}
+
 /* An array of objects, each member handed to fn with the element's index;
  * grow(index) makes room first. */
 static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
@@ -378,27 +402,8 @@ static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
         skip_ws(s);
         if (s->p >= s->end || *s->p != '{') return false;
         if (!grow(s, index)) return false;
-        s->p++;
-        skip_ws(s);
-        if (s->p < s->end && *s->p == '}') {
-            s->p++;
-        } else {
-            for (;;) {
-                skip_ws(s);
-                char key[24];
-                if (!read_string(s, key, sizeof key)) return false;
-                skip_ws(s);
-                if (s->p >= s->end || *s->p++ != ':') return false;
-                if (!fn(s, key, index)) return false;
-                skip_ws(s);
-                if (s->p >= s->end) return false;
-                if (*s->p == '}') {
-                    s->p++;
-                    break;
-                }
-                if (*s->p++ != ',') return false;
-            }
-        }
+        indexed_member im = {fn, index};
+        if (!scan_object(s, true, indexed_field, &im)) return false;
         skip_ws(s);
         if (s->p >= s->end) return false;
         if (*s->p == ']') {
@@ -436,41 +441,25 @@ static bool grow_accessors(scan *s, uint32_t index)
  * numbers the vertices in order: assimp 5.2 crashes (SIGSEGV) on a
  * LINE_LOOP whose index is past the vertex count (found by fuzz_model),
  * while it drops such triangles itself. */
+typedef struct primitive_keys {
+    const char *indices;        /* where its "indices" key starts, NULL without one */
+    uint32_t mode;
+} primitive_keys;
+
+static bool primitive_field(scan *s, const char *key, const char *quote, void *user)
+{
+    primitive_keys *pk = user;
+    bool ok;
+    if (strcmp(key, "mode") == 0) return read_uint(s, &pk->mode, &ok);
+    if (strcmp(key, "indices") == 0) pk->indices = quote;
+    return skip_value(s);
+}
+
 static bool scan_primitive(scan *s)
 {
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '{') return skip_value(s);
-    s->p++;
-    const char *indices = NULL;
-    uint32_t mode = 4;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == '}') {
-        s->p++;
-        return true;
-    }
-    for (;;) {
-        skip_ws(s);
-        const char *quote = s->p;
-        char key[16];
-        if (!read_string(s, key, sizeof key)) return false;
-        skip_ws(s);
-        if (s->p >= s->end || *s->p++ != ':') return false;
-        bool ok;
-        if (strcmp(key, "mode") == 0) {
-            if (!read_uint(s, &mode, &ok)) return false;
-        } else {
-            if (strcmp(key, "indices") == 0) indices = quote;
-            if (!skip_value(s)) return false;
-        }
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == '}') {
-            s->p++;
-            break;
-        }
-        if (*s->p++ != ',') return false;
-    }
-    if (indices && mode <= 3 && !hide_key(s, indices)) return false;
+    primitive_keys pk = {NULL, 4};
+    if (!scan_object(s, false, primitive_field, &pk)) return false;
+    if (pk.indices && pk.mode <= 3 && !hide_key(s, pk.indices)) return false;
     return true;
 }
 
@@ -510,69 +499,44 @@ static bool grow_nothing(scan *s, uint32_t index)
 }
 
 /* One node object: its "skin" member is hidden, the rest skipped. */
+static bool node_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)user;
+    if (strcmp(key, "skin") == 0 && !hide_skin(s, quote)) return false;
+    return skip_value(s);
+}
+
 static bool scan_node(scan *s)
 {
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '{') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == '}') {
-        s->p++;
-        return true;
-    }
-    for (;;) {
-        skip_ws(s);
-        const char *quote = s->p;
-        char key[16];
-        if (!read_string(s, key, sizeof key)) return false;
-        if (strcmp(key, "skin") == 0 && !hide_skin(s, quote)) return false;
-        skip_ws(s);
-        if (s->p >= s->end || *s->p++ != ':') return false;
-        if (!skip_value(s)) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == '}') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
-    }
+    return scan_object(s, false, node_field, NULL);
 }
 
 /* The top-level object: extensionsRequired and extensionsUsed into the
  * lists, skins and the nodes' skin references to hide, every other member
  * skipped. */
+typedef struct top_lists {
+    name_list *required, *used;
+} top_lists;
+
+static bool top_field(scan *s, const char *key, const char *quote, void *user)
+{
+    const top_lists *t = user;
+    if (strcmp(key, "extensionsRequired") == 0) return read_name_array(s, t->required);
+    if (strcmp(key, "extensionsUsed") == 0) return read_name_array(s, t->used);
+    if (strcmp(key, "nodes") == 0) return scan_array(s, scan_node);
+    if (strcmp(key, "skins") == 0) return hide_skin(s, quote) && skip_value(s);
+    if (strcmp(key, "bufferViews") == 0) return scan_objects(s, grow_views, view_member);
+    if (strcmp(key, "accessors") == 0) return scan_objects(s, grow_accessors, accessor_member);
+    if (strcmp(key, "meshes") == 0) return scan_objects(s, grow_nothing, mesh_member);
+    return skip_value(s);
+}
+
 static bool scan_top(scan *s, name_list *required, name_list *used)
 {
     skip_ws(s);
     if (s->end - s->p >= 3 && memcmp(s->p, "\xEF\xBB\xBF", 3) == 0) s->p += 3;   /* UTF-8 BOM */
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '{') return false;
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == '}') return true;
-    for (;;) {
-        skip_ws(s);
-        const char *quote = s->p;
-        char key[32];
-        if (!read_string(s, key, sizeof key)) return false;
-        skip_ws(s);
-        if (s->p >= s->end || *s->p++ != ':') return false;
-        bool ok;
-        if (strcmp(key, "extensionsRequired") == 0) ok = read_name_array(s, required);
-        else if (strcmp(key, "extensionsUsed") == 0) ok = read_name_array(s, used);
-        else if (strcmp(key, "nodes") == 0) ok = scan_array(s, scan_node);
-        else if (strcmp(key, "skins") == 0) ok = hide_skin(s, quote) && skip_value(s);
-        else if (strcmp(key, "bufferViews") == 0) ok = scan_objects(s, grow_views, view_member);
-        else if (strcmp(key, "accessors") == 0) ok = scan_objects(s, grow_accessors, accessor_member);
-        else if (strcmp(key, "meshes") == 0) ok = scan_objects(s, grow_nothing, mesh_member);
-        else ok = skip_value(s);
-        if (!ok) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == '}') return true;
-        if (*s->p++ != ',') return false;
-    }
+    top_lists t = {required, used};
+    return scan_object(s, true, top_field, &t);
 }
 
 static uint32_t read_u32le(const unsigned char *b)
