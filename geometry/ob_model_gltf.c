@@ -180,6 +180,20 @@ static void list_add(name_list *l, const char *name)
 
 /* An array of strings into l; a non-string element makes the file
  * unreadable for this scan. */
+/* After a member or element: the closer (then *done) or a comma, blanks
+ * around them skipped. False when neither comes. */
+static bool after_item(scan *s, char close, bool *done)
+{
+    skip_ws(s);
+    if (s->p >= s->end) return false;
+    *done = *s->p == close;
+    if (*done || *s->p == ',') {
+        s->p++;
+        return true;
+    }
+    return false;
+}
+
 static bool read_name_array(scan *s, name_list *l)
 {
     skip_ws(s);
@@ -195,13 +209,9 @@ static bool read_name_array(scan *s, name_list *l)
         char name[GLTF_NAME_MAX];
         if (!read_string(s, name, sizeof name)) return false;
         list_add(l, name);
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == ']') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
+        bool done;
+        if (!after_item(s, ']', &done)) return false;
+        if (done) return true;
     }
 }
 
@@ -286,13 +296,9 @@ static bool scan_object(scan *s, bool strict, object_member_fn member, void *use
         skip_ws(s);
         if (s->p >= s->end || *s->p++ != ':') return false;
         if (!member(s, key, quote, user)) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == '}') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
+        bool done;
+        if (!after_item(s, '}', &done)) return false;
+        if (done) return true;
     }
 }
 
@@ -404,13 +410,9 @@ static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
         if (!grow(s, index)) return false;
         indexed_member im = {fn, index};
         if (!scan_object(s, true, indexed_field, &im)) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == ']') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
+        bool done;
+        if (!after_item(s, ']', &done)) return false;
+        if (done) return true;
     }
 }
 
@@ -476,13 +478,9 @@ static bool scan_array(scan *s, bool (*fn)(scan *))
     }
     for (;;) {
         if (!fn(s)) return false;
-        skip_ws(s);
-        if (s->p >= s->end) return false;
-        if (*s->p == ']') {
-            s->p++;
-            return true;
-        }
-        if (*s->p++ != ',') return false;
+        bool done;
+        if (!after_item(s, ']', &done)) return false;
+        if (done) return true;
     }
 }
 
