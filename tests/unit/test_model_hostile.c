@@ -47,6 +47,15 @@ static void write_file(const char *path, const void *data, size_t size)
 
 static void write_text(const char *path, const char *text) { write_file(path, text, strlen(text)); }
 
+/* A glTF's opening up to its buffers: one node, one mesh whose primitive
+ * reads POSITION from accessor 0, and one 36-byte buffer holding a triangle
+ * (0,0,0), (1,0,0), (0,1,0) as a data URI. The test adds views and accessors. */
+#define TRIANGLE_GLTF_HEAD                                                                         \
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"                      \
+    "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"     \
+    "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"                \
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+
 /* One triangle, its positions in buffer file `uri` (36 bytes). */
 static void write_gltf_with_buffer(const char *path, const char *uri)
 {
@@ -201,10 +210,7 @@ static void short_byte_stride_is_refused(void **state)
     char path[160];
     snprintf(path, sizeof path, "%s/stride.gltf", model_dir);
     write_text(path,
-               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-               "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-               "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
-               "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+               TRIANGLE_GLTF_HEAD
                "\"accessors\":[{\"type\":\"VEC3\",\"bufferView\":0,\"componentType\":5126,\"count\":3}],"
                "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36,\"byteStride\":4}]}");
     ob_model *m = NULL;
@@ -221,10 +227,7 @@ static void lying_sparse_count_is_refused(void **state)
     char path[160];
     snprintf(path, sizeof path, "%s/sparse.gltf", model_dir);
     write_text(path,
-               "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-               "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-               "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
-               "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+               TRIANGLE_GLTF_HEAD
                "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteLength\":4},"
                "{\"buffer\":0,\"byteLength\":24}],"
                "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
