@@ -17,7 +17,7 @@
 # structs) and materials/ob_shader_source.h (the shader compiler's include
 # expander). No installed header may include one of them: the package_headers
 # test compiles every installed header alone against the install tree.
-# views/ob_json_read.h (the scene-file parser's cJSON reader) is internal
+# views/scene/ob_json_read.h (the scene-file parser's cJSON reader) is internal
 # too: cJSON stays a private dependency.
 # The extension headers ob_renderer_layer.h and ob_views_layer.h are
 # installed (custom views and materials need them, docs/extending.md) but
@@ -31,9 +31,9 @@ set(OB_PUBLIC_HEADERS
     engine/ob_texture.h engine/ob_view.h
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h geometry/ob_model.h
-    views/ob_views.h views/ob_views_layer.h views/ob_stack.h views/ob_scene_file.h views/ob_scene_load.h
-    views/ob_model_instance.h
-    views/obelisk.h)
+    views/ob_views.h views/ob_views_layer.h
+    views/scene/ob_stack.h views/scene/ob_scene_file.h views/scene/ob_scene_load.h
+    views/scene/ob_model_instance.h views/scene/obelisk.h)
 
 # ------------------------------------------------------------------ shaders
 # The shaders are looked up relative to the binary that holds the engine

@@ -1,4 +1,4 @@
-/* libFuzzer target for the scene-file parser (views/ob_scene_file.h).
+/* libFuzzer target for the scene-file parser (views/scene/ob_scene_file.h).
  *
  * Any input must either parse into a description that keeps the documented
  * invariants (references in range and pointing backwards, every number

@@ -1,6 +1,6 @@
 /* ob_stab_world.h — what the stability cases share (internal to
  * demos/stability): the run context (rows, expected log lines, frame
- * times), a small world on top of ob_stack (views/ob_stack.h; what the
+ * times), a small world on top of ob_stack (views/scene/ob_stack.h; what the
  * tests' ob_test_world is: camera, main view, composite, box/sphere/plane,
  * helpers to add entities and lights, render a frame in a threading mode
  * and read the image back), and image comparisons.

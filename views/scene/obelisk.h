@@ -10,9 +10,11 @@
  *   materials  run-time shader compiler, render effects, materials
  *   geometry   meshes and generators, model loading, GPU geometry
  *   views      the standard views (perspective, shadow, env map, simulation,
- *              overlay, composite); ob_stack, the usual set-up in one call;
- *              scene files: parsing (ob_scene_file.h) and loading into a
- *              scene (ob_scene_load.h)
+ *              overlay, composite)
+ *   scene      (views/scene) ob_stack, the usual set-up in one call; scene
+ *              files: parsing (ob_scene_file.h) and loading into a scene
+ *              (ob_scene_load.h); models placed with their materials
+ *              (ob_model_instance.h)
  * Only the Vulkan headers come along; cglm, stb and cJSON stay inside the
  * library.
  */

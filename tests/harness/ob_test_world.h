@@ -1,5 +1,5 @@
 /* ob_test_world.h — a whole engine stack for gpu tests, built on ob_stack
- * (views/ob_stack.h): renderer (validation on), effects, materials, views, a
+ * (views/scene/ob_stack.h): renderer (validation on), effects, materials, views, a
  * scene with a camera, the main perspective view and the composite final
  * target; a box, a sphere and a plane; helpers to add entities and lights,
  * run frames in a given threading mode and read the image back.

@@ -1,5 +1,5 @@
 /* ob_demo.h — the demo runner the demo programs share: options, the
- * standard set-up (an ob_stack from views/ob_stack.h, with the window when
+ * standard set-up (an ob_stack from views/scene/ob_stack.h, with the window when
  * --window is given), the frame loop with its ST/MT toggling, per-frame
  * lines, the JSON stats, the summary of medians per mode and the lean-scene
  * report (what the run left out).

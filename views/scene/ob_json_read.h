@@ -29,6 +29,9 @@
 #include "ob_core.h"
 #include "ob_scene_file.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 /* The error report is the scene file's public one (ob_scene_file.h): this
  * reader is internal to the views layer and not installed, so the struct a
  * program reads must live in the installed header. */
@@ -149,5 +152,7 @@ void ob_json_names_release(ob_json_names *m);
 uint32_t ob_json_names_find(const ob_json_names *m, const char *key);
 /* Adds key (not present yet; at most the n given to init). */
 void ob_json_names_put(ob_json_names *m, const char *key, uint32_t value);
+
+#pragma GCC visibility pop
 
 #endif /* OB_JSON_READ_H */

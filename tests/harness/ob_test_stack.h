@@ -1,4 +1,4 @@
-/* ob_test_stack.h — the whole engine stack (an ob_stack, views/ob_stack.h)
+/* ob_test_stack.h — the whole engine stack (an ob_stack, views/scene/ob_stack.h)
  * for tests that expect things to fail: every step returns its ob_result
  * instead of failing the test, and ob_test_stack_stop destroys whatever
  * exists after any failure.
