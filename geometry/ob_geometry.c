@@ -1,6 +1,8 @@
 /* ob_geometry.c — uploading meshes into vertex + index buffers. */
 #include "ob_geometry.h"
 
+#include "ob_renderer_layer.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -272,3 +274,28 @@ VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g)
 const ob_bounds *ob_geometry_bounds(const ob_geometry *g) { return g ? &g->bounds : NULL; }
 uint32_t ob_geometry_id(const ob_geometry *g) { return g ? g->id : 0; }
 const char *ob_geometry_name(const ob_geometry *g) { return g ? g->name : NULL; }
+
+/* ------------------------------------------------------------ engine interface */
+
+static void iface_draw_data(const struct ob_geometry *g, ob_draw_data *out)
+{
+    *out = (ob_draw_data){.vertex_buffer = g->vertex_buffer, .instance_count = 1};
+    if (g->index_count > 0) {
+        out->index_buffer = g->index_buffer;
+        out->index_type = VK_INDEX_TYPE_UINT32;
+        out->count = g->index_count;
+    } else {
+        /* Procedural geometry (no index buffer): vertex pulling, instanced. */
+        out->count = g->vertex_count;
+        out->instance_count = g->instance_count;
+    }
+}
+
+static uint32_t iface_id(const struct ob_geometry *g) { return g->id; }
+
+static const ob_geometry_iface geometry_iface = {
+    .draw_data = iface_draw_data,
+    .id = iface_id,
+};
+
+const ob_geometry_iface *ob_geometry_iface_get(void) { return &geometry_iface; }

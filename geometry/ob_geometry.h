@@ -114,6 +114,11 @@ const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
 uint32_t ob_geometry_id(const ob_geometry *g);              /* never 0 for a live geometry */
 const char *ob_geometry_name(const ob_geometry *g);
 
+/* The engine's interface to geometry (engine/ob_renderer_layer.h): a
+ * geometry's draw data and stable id. ob_views_create installs it. Static
+ * data. [any thread] */
+const struct ob_geometry_iface *ob_geometry_iface_get(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -394,23 +394,7 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
     }
 }
 
-/* ------------------------------------------------------------ geometry glue */
-
-static void geometry_draw_data(const struct ob_geometry *g, ob_draw_data *out)
-{
-    *out = (ob_draw_data){.vertex_buffer = ob_geometry_vertex_buffer(g), .instance_count = 1};
-    if (ob_geometry_index_count(g) > 0) {
-        out->index_buffer = ob_geometry_index_buffer(g);
-        out->index_type = VK_INDEX_TYPE_UINT32;
-        out->count = ob_geometry_index_count(g);
-    } else {
-        /* Procedural geometry (no index buffer): vertex pulling, instanced. */
-        out->count = ob_geometry_vertex_count(g);
-        out->instance_count = ob_geometry_instance_count(g);
-    }
-}
-
-static uint32_t geometry_id(const struct ob_geometry *g) { return ob_geometry_id(g); }
+/* ------------------------------------------------------------ vertex input */
 
 /* The standard layout as an effect's vertex input, made once: constant
  * after that, so any thread may read it (pthread_once orders the write
@@ -465,7 +449,7 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     /* Samplers (ShadowMapSampler, EnvMapSampler, SourceImageSampler) are
      * the material library's defaults. */
     ob_renderer_set_material_iface(ctx->r, ob_material_iface_get());
-    ob_renderer_set_geometry_iface(ctx->r, &(ob_geometry_iface){geometry_draw_data, geometry_id});
+    ob_renderer_set_geometry_iface(ctx->r, ob_geometry_iface_get());
     ob_material_library_set_queue_hook(ctx->materials, queue_hook, ctx);
     goto done;
 
