@@ -1,5 +1,6 @@
-/* ob_device.c — instance, validation capture, logical device, frame slots,
- * deferred deletion and one-shot command buffers.
+/* ob_device.c — instance, validation capture, logical device and one-shot
+ * command buffers. Frame slots and deferred deletion are ob_frame_slots.c,
+ * the Vulkan allocation callbacks ob_vk_allocators.c.
  *
  * Creation runs in stages (slots → instance → physical choice → logical
  * device → one-shot objects → resource registry); each stage undoes itself
@@ -17,16 +18,6 @@
 #include <string.h>
 
 #define OB_VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
-
-typedef struct defer_item {
-    ob_deferred_fn fn;
-    void *payload;
-} defer_item;
-
-typedef struct defer_queue {
-    defer_item *items;
-    uint32_t count, cap;
-} defer_queue;
 
 struct ob_device {
     VkInstance instance;
@@ -60,8 +51,7 @@ struct ob_device {
     atomic_uint val_errors, val_warnings, val_infos;
     atomic_bool lost;
 
-    uint32_t frames_in_flight, current_slot;
-    defer_queue *deferred;   /* one queue per frame slot */
+    ob_frame_slots slots;    /* frame slots and their deferred deletions (ob_frame_slots.c) */
 
     VkCommandPool oneshot_pool;
     VkFence oneshot_fence;
@@ -553,73 +543,6 @@ ob_result ob_device_wait_idle(ob_device *dev)
     return ob_result_from_vk(vr);
 }
 
-/* ------------------------------------------------- frame slots and deferral */
-
-static void slots_destroy(ob_device *dev)
-{
-    for (uint32_t i = 0; dev->deferred && i < dev->frames_in_flight; i++) ob_free(dev->deferred[i].items);
-    ob_free(dev->deferred);
-    dev->deferred = NULL;
-}
-
-static ob_result slots_create(ob_device *dev, uint32_t frames)
-{
-    if (frames > OB_MAX_FRAMES_IN_FLIGHT) {
-        OB_LOG_E("device", "frames_in_flight %u exceeds the limit of %u", frames, OB_MAX_FRAMES_IN_FLIGHT);
-        return OB_ERR_INVALID_ARGUMENT;
-    }
-    dev->frames_in_flight = frames ? frames : 2;
-    dev->deferred = ob_calloc(dev->frames_in_flight, sizeof *dev->deferred);
-    return dev->deferred ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
-}
-
-/* Runs a slot's queue. The queue is detached first so that work deferred by
- * a deferred function lands in a fresh queue and waits a full cycle. */
-static uint32_t run_deferred(ob_device *dev, uint32_t slot)
-{
-    defer_queue *q = &dev->deferred[slot];
-    defer_item *items = q->items;
-    uint32_t count = q->count, cap = q->cap;
-    q->items = NULL;
-    q->count = q->cap = 0;
-    for (uint32_t i = 0; i < count; i++) items[i].fn(dev, items[i].payload);
-    if (!q->items) {
-        q->items = items;   /* keep the capacity for the next cycle */
-        q->cap = cap;
-    } else {
-        ob_free(items);
-    }
-    return count;
-}
-
-uint32_t ob_device_frames_in_flight(const ob_device *dev) { return dev->frames_in_flight; }
-uint32_t ob_device_current_slot(const ob_device *dev) { return dev->current_slot; }
-
-void ob_device_begin_frame_slot(ob_device *dev, uint32_t slot)
-{
-    if (slot >= dev->frames_in_flight) {
-        OB_LOG_E("device", "frame slot %u out of range (frames in flight: %u); ignored", slot,
-                 dev->frames_in_flight);
-        return;
-    }
-    dev->current_slot = slot;
-    run_deferred(dev, slot);
-}
-
-void ob_device_defer(ob_device *dev, ob_deferred_fn fn, void *payload)
-{
-    if (!dev || !fn) return;
-    defer_queue *q = &dev->deferred[dev->current_slot];
-    if (ob_array_reserve((void **)&q->items, &q->cap, q->count + 1, sizeof *q->items) != OB_OK) {
-        OB_LOG_W("device", "deferred-deletion queue of slot %u cannot grow: waiting idle and running "
-                           "the deletion now", dev->current_slot);
-        ob_device_wait_idle(dev);
-        fn(dev, payload);
-        return;
-    }
-    q->items[q->count++] = (defer_item){fn, payload};
-}
-
 /* Instance, physical device choice and logical device of the engine's own.
  * On failure *stage names the step, and nothing of them is left. */
 static ob_result own_create(ob_device *dev, const ob_device_desc *desc, const char **stage)
@@ -675,7 +598,7 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     }
 
     stage = "frame slots";
-    r = slots_create(dev, desc->frames_in_flight);
+    r = ob_frame_slots_init(&dev->slots, desc->frames_in_flight);
     if (r != OB_OK) goto fail_free_dev;
     if (desc->adopt) {
         stage = "adopting the application's device";
@@ -705,7 +628,7 @@ fail_destroy_logical:
     logical_destroy(dev);
     instance_destroy(dev);
 fail_destroy_slots:
-    slots_destroy(dev);
+    ob_frame_slots_release(&dev->slots);
 fail_free_dev:
     ob_free(dev->shader_dir);
     ob_free(dev);
@@ -719,19 +642,13 @@ void ob_device_destroy(ob_device *dev)
 {
     if (!dev) return;
     ob_device_wait_idle(dev);
-    /* Oldest slot first; repeat in case a deferred function deferred more. */
-    for (uint32_t pass = 0; pass < 4; pass++) {
-        uint32_t ran = 0;
-        for (uint32_t k = 1; k <= dev->frames_in_flight; k++)
-            ran += run_deferred(dev, (dev->current_slot + k) % dev->frames_in_flight);
-        if (!ran) break;
-    }
+    ob_frame_slots_drain(&dev->slots, dev);
     ob_resource_registry_destroy(dev, dev->registry);
     dev->registry = NULL;
     oneshot_destroy(dev);
     logical_destroy(dev);
     instance_destroy(dev);
-    slots_destroy(dev);
+    ob_frame_slots_release(&dev->slots);
     ob_free(dev->shader_dir);
     ob_free(dev);
 }
@@ -754,6 +671,7 @@ bool ob_device_validation_enabled(const ob_device *dev) { return dev->validation
 bool ob_device_is_adopted(const ob_device *dev) { return dev->adopted; }
 bool ob_device_has_swapchain(const ob_device *dev) { return dev->swapchain; }
 ob_resource_registry *ob_device_registry(const ob_device *dev) { return dev->registry; }
+ob_frame_slots *ob_device_frame_slots(ob_device *dev) { return &dev->slots; }
 
 double ob_device_timestamp_period_ns(const ob_device *dev)
 {
@@ -805,195 +723,4 @@ void ob_device_note_result(ob_device *dev, VkResult res)
 bool ob_device_is_lost(const ob_device *dev)
 {
     return atomic_load(&((ob_device *)dev)->lost);
-}
-
-/* ------------------------------------------------------ counting allocator */
-
-/* Blocks carry their start in front of the aligned pointer, so frees and
- * reallocations of any alignment go back to malloc. */
-typedef struct alloc_header {
-    void *base;
-    size_t size;
-} alloc_header;
-
-static void *VKAPI_PTR counted_alloc(void *user, size_t size, size_t align,
-                                     VkSystemAllocationScope scope)
-{
-    (void)scope;
-    ob_counting_allocator *a = user;
-    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
-    uint8_t *base = malloc(size + align + sizeof(alloc_header));
-    if (!base) return NULL;
-    uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
-    ((alloc_header *)p)[-1] = (alloc_header){base, size};
-    atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
-    return (void *)p;
-}
-
-static void VKAPI_PTR counted_free(void *user, void *mem)
-{
-    (void)user;
-    if (mem) free(((alloc_header *)mem)[-1].base);
-}
-
-/* Reallocation of either allocator below: a new block, the old contents,
- * the old block freed. Both keep an alloc_header in front of each block. */
-static void *realloc_by_copy(void *user, void *old, size_t size, size_t align,
-                             VkSystemAllocationScope scope, PFN_vkAllocationFunction alloc,
-                             PFN_vkFreeFunction release)
-{
-    if (!old) return alloc(user, size, align, scope);
-    if (size == 0) {
-        release(user, old);
-        return NULL;
-    }
-    void *mem = alloc(user, size, align, scope);
-    if (!mem) return NULL;
-    size_t old_size = ((alloc_header *)old)[-1].size;
-    memcpy(mem, old, old_size < size ? old_size : size);
-    release(user, old);
-    return mem;
-}
-
-static void *VKAPI_PTR counted_realloc(void *user, void *old, size_t size, size_t align,
-                                       VkSystemAllocationScope scope)
-{
-    return realloc_by_copy(user, old, size, align, scope, counted_alloc, counted_free);
-}
-
-void ob_counting_allocator_init(ob_counting_allocator *a)
-{
-    a->callbacks = (VkAllocationCallbacks){
-        .pUserData = a,
-        .pfnAllocation = counted_alloc,
-        .pfnReallocation = counted_realloc,
-        .pfnFree = counted_free,
-    };
-    atomic_init(&a->allocations, 0);
-}
-
-uint64_t ob_counting_allocator_count(ob_counting_allocator *a)
-{
-    return atomic_load_explicit(&a->allocations, memory_order_relaxed);
-}
-
-/* --------------------------------------------------------- arena allocator */
-
-#define ARENA_CHUNK_BYTES (64u * 1024u)
-
-struct ob_arena_chunk {
-    ob_arena_chunk *next;       /* in the spare list */
-    size_t used;
-    uint32_t live;              /* blocks not yet freed */
-    _Alignas(16) uint8_t data[ARENA_CHUNK_BYTES];
-};
-
-/* In front of every block, an alloc_header whose base is its chunk, or (low
- * bit set) the malloc'd start of a block too big for a chunk. */
-
-static ob_arena_chunk *arena_take_chunk(ob_arena_allocator *a)
-{
-    ob_arena_chunk *c = a->spare;
-    if (c) {
-        a->spare = c->next;
-    } else {
-        c = malloc(sizeof *c);
-        if (!c) return NULL;
-    }
-    c->next = NULL;
-    c->used = 0;
-    c->live = 0;
-    return c;
-}
-
-static void *VKAPI_PTR arena_alloc(void *user, size_t size, size_t align,
-                                   VkSystemAllocationScope scope)
-{
-    (void)scope;
-    ob_arena_allocator *a = user;
-    if (align < _Alignof(alloc_header)) align = _Alignof(alloc_header);
-    size_t need = size + align + sizeof(alloc_header);
-    atomic_fetch_add_explicit(&a->allocations, 1, memory_order_relaxed);
-    if (need > ARENA_CHUNK_BYTES / 4) {
-        uint8_t *base = malloc(need);
-        if (!base) return NULL;
-        uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
-        ((alloc_header *)p)[-1] = (alloc_header){(void *)((uintptr_t)base | 1u), size};
-        return (void *)p;
-    }
-    ob_arena_chunk *c = a->current;
-    if (!c || c->used + need > ARENA_CHUNK_BYTES) {
-        /* The old chunk lives on until its last block is freed. */
-        if (c && c->live == 0) {
-            c->next = a->spare;
-            a->spare = c;
-        }
-        c = a->current = arena_take_chunk(a);
-        if (!c) return NULL;
-    }
-    uintptr_t start = (uintptr_t)(c->data + c->used);
-    uintptr_t p = (start + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
-    ((alloc_header *)p)[-1] = (alloc_header){c, size};
-    c->used = p + size - (uintptr_t)c->data;
-    c->live++;
-    return (void *)p;
-}
-
-static void VKAPI_PTR arena_free(void *user, void *mem)
-{
-    ob_arena_allocator *a = user;
-    if (!mem) return;
-    uintptr_t owner = (uintptr_t)((alloc_header *)mem)[-1].base;
-    if (owner & 1u) {
-        free((void *)(owner & ~(uintptr_t)1u));
-        return;
-    }
-    ob_arena_chunk *c = (ob_arena_chunk *)owner;
-    if (--c->live > 0) return;
-    if (c == a->current) {
-        c->used = 0;   /* empty again: refill it from the start (still warm) */
-    } else {
-        c->next = a->spare;
-        a->spare = c;
-    }
-}
-
-static void *VKAPI_PTR arena_realloc(void *user, void *old, size_t size, size_t align,
-                                     VkSystemAllocationScope scope)
-{
-    return realloc_by_copy(user, old, size, align, scope, arena_alloc, arena_free);
-}
-
-void ob_arena_allocator_init(ob_arena_allocator *a)
-{
-    a->callbacks = (VkAllocationCallbacks){
-        .pUserData = a,
-        .pfnAllocation = arena_alloc,
-        .pfnReallocation = arena_realloc,
-        .pfnFree = arena_free,
-    };
-    a->current = a->spare = NULL;
-    atomic_init(&a->allocations, 0);
-}
-
-void ob_arena_allocator_release(ob_arena_allocator *a)
-{
-    if (a->current && a->current->live == 0) {
-        a->current->next = a->spare;
-        a->spare = a->current;
-    } else if (a->current) {
-        OB_LOG_E("device", "arena allocator released with %u blocks in use; they are leaked",
-                 a->current->live);
-    }
-    a->current = NULL;
-    while (a->spare) {
-        ob_arena_chunk *next = a->spare->next;
-        free(a->spare);
-        a->spare = next;
-    }
-}
-
-uint64_t ob_arena_allocator_count(ob_arena_allocator *a)
-{
-    return atomic_load_explicit(&a->allocations, memory_order_relaxed);
 }

@@ -1,6 +1,7 @@
 /* ob_device_internal.h — engine-private glue between the device and the
- * resource modules. Not API: nothing outside engine/ob_device*.c and
- * engine/ob_resources*.c / ob_readback.c includes it.
+ * resource modules. Not API: nothing outside engine/ob_device*.c,
+ * engine/ob_frame_slots.c and engine/ob_resources*.c / ob_readback.c
+ * includes it.
  *
  * The device owns the resource registry so that ob_device_destroy can free
  * whatever the application leaked; the registry code lives with the
@@ -11,6 +12,9 @@
 #define OB_DEVICE_INTERNAL_H
 
 #include "ob_device.h"
+
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
 
 /* ---- physical device selection (ob_device_select.c) ---- */
 
@@ -53,6 +57,30 @@ typedef struct ob_adopted_info {
 ob_result ob_device_check_adopted(const ob_vulkan_handles *a, ob_physical_choice *out_choice,
                                   ob_adopted_info *out_info);
 
+/* ---- frame slots and deferred deletion (ob_frame_slots.c) ---- */
+
+typedef struct ob_defer_queue ob_defer_queue;
+
+/* The device's frame slots: one deferred-deletion queue per slot, run when
+ * the renderer says the slot's previous work is complete
+ * (ob_device_begin_frame_slot). Part of the device; the public functions of
+ * ob_device.h reach it through ob_device_frame_slots. */
+typedef struct ob_frame_slots {
+    ob_defer_queue *queues;   /* one per slot */
+    uint32_t frames_in_flight, current_slot;
+} ob_frame_slots;
+
+/* frames 0 → 2; more than OB_MAX_FRAMES_IN_FLIGHT is refused (logged,
+ * OB_ERR_INVALID_ARGUMENT). On failure nothing is left to release. */
+ob_result ob_frame_slots_init(ob_frame_slots *s, uint32_t frames);
+/* Runs every queue, oldest slot first, until no deferred function defers
+ * more (the device is idle: ob_device_destroy). */
+void ob_frame_slots_drain(ob_frame_slots *s, ob_device *dev);
+/* Frees the queues (drained or not). Safe on a zeroed struct. */
+void ob_frame_slots_release(ob_frame_slots *s);
+/* The device's slots (never NULL for a created device). */
+ob_frame_slots *ob_device_frame_slots(ob_device *dev);
+
 /* ---- resource registry (ob_resources.c) ---- */
 
 typedef struct ob_resource_registry ob_resource_registry;
@@ -64,5 +92,7 @@ ob_resource_registry *ob_resource_registry_create(ob_result *out_result);
 void ob_resource_registry_destroy(ob_device *dev, ob_resource_registry *reg);
 /* The device's registry (never NULL for a created device). */
 ob_resource_registry *ob_device_registry(const ob_device *dev);
+
+#pragma GCC visibility pop
 
 #endif /* OB_DEVICE_INTERNAL_H */
