@@ -8,6 +8,9 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 /* What recording a scene one way (inline or on n workers) cost. */
 typedef struct ob_record_cost {
     uint64_t cost_ns;           /* moving average of a frame's; 0 = never measured */
@@ -48,5 +51,7 @@ uint32_t ob_auto_best_workers(ob_auto_state *s, const ob_record_cost *measured, 
  * never measured, is stale (256 frames old) or was measured at a draw
  * count a quarter away, so the choice follows the scene. [any] */
 uint32_t ob_auto_probe_workers(ob_auto_state *s, const ob_record_cost *measured, uint32_t active);
+
+#pragma GCC visibility pop
 
 #endif

@@ -12,6 +12,9 @@
 
 #include <string.h>
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 typedef struct ob_rotation_state {
     double axis[3];   /* unit */
     double rate;      /* radians per second */
@@ -73,5 +76,7 @@ static inline void ob_controller_run(ob_scene *s, uint32_t slot, ob_controller_s
         c->fn(s->by_id[slot], dt, controller_user(c));
     }
 }
+
+#pragma GCC visibility pop
 
 #endif /* OB_CONTROLLERS_INTERNAL_H */

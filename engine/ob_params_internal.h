@@ -12,6 +12,9 @@
 
 #include "ob_params.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 #define OB_PARAM_VALUE_OFFSET 32u
 
 typedef struct ob_param_info {
@@ -82,5 +85,7 @@ static inline void ob_param_slot_changed(const ob_param_registry *reg, uint32_t 
 /* The parameter for p, or NULL (no log) if p is zero or stale. Lock-free:
  * the tables only change outside recording. */
 ob_param_info *ob_param_info_get(const ob_param_registry *reg, ob_param p);
+
+#pragma GCC visibility pop
 
 #endif /* OB_PARAMS_INTERNAL_H */

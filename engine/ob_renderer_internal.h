@@ -11,6 +11,9 @@
 #include "ob_auto_internal.h"
 #include "ob_renderer_layer.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 #define OB_MAX_VIEW_STACK 32
 
 /* One unit of recording: a chunk of one layer of one view. */
@@ -214,5 +217,7 @@ uint32_t ob_renderer_present_sync(ob_renderer *r, VkSemaphoreSubmitInfo *out_wai
 void ob_renderer_present_submitted(ob_renderer *r, bool submitted);
 /* end_frame: queue the present of a submitted frame. */
 ob_result ob_renderer_present_queue(ob_renderer *r);
+
+#pragma GCC visibility pop
 
 #endif /* OB_RENDERER_INTERNAL_H */

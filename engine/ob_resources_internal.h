@@ -12,6 +12,9 @@
 #include "ob_device_internal.h"
 #include "ob_resources.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 typedef struct ob_buffer_rec {
     VkBuffer buffer;
     VkDeviceMemory memory;
@@ -119,5 +122,7 @@ void ob_res_image_free(ob_device *dev, ob_image_rec *rec);
  * ob_malloc: an ob_malloc'ed stream and its length, NULL on any failure
  * (logged by the caller). [any thread] (engine/ob_stb_impl.c) */
 uint8_t *ob_res_deflate(const uint8_t *data, size_t len, int level, size_t *out_len);
+
+#pragma GCC visibility pop
 
 #endif /* OB_RESOURCES_INTERNAL_H */

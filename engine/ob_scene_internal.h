@@ -17,6 +17,9 @@
 
 #include <stddef.h>
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 #define SCENE_LOG "scene"
 #define NO_SLOT UINT32_MAX
 
@@ -215,5 +218,7 @@ void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot);
 /* Drops the marked (dying) nodes from the snapshot: the renderables from
  * index `from` on (none lies before it), and the lights when `lights`. */
 void ob_scene_snapshot_drop_dying(ob_scene *s, uint32_t from, bool lights);
+
+#pragma GCC visibility pop
 
 #endif /* OB_SCENE_INTERNAL_H */

@@ -7,6 +7,9 @@
 
 #include <stdarg.h>
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 struct aiScene;
 struct aiVector3D;
 
@@ -140,5 +143,7 @@ ob_result ob_model_read_materials(ob_model_check *c, const struct aiScene *s, st
  * Failure: OB_ERR_BAD_MODEL naming the path and the line or element,
  * OB_ERR_IO or OB_ERR_OUT_OF_HOST_MEMORY; logged. [any thread] */
 ob_result ob_model_ply_precheck(const char *path);
+
+#pragma GCC visibility pop
 
 #endif /* OB_MODEL_INTERNAL_H */

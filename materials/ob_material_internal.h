@@ -14,6 +14,9 @@
 #include "ob_material.h"
 #include "ob_renderer_layer.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 #define VARIANT_COUNT 16u  /* every combination of the ob_std_variant bits */
 
 typedef struct std_slot {
@@ -105,5 +108,7 @@ ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
  * factors and textures, and with `env` the entity's environment map. */
 ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,
                                   const ob_view *v, bool env);
+
+#pragma GCC visibility pop
 
 #endif /* OB_MATERIAL_INTERNAL_H */

@@ -17,6 +17,9 @@
 
 #include "ob_shader.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 typedef struct ob_shader_source_note {
     uint32_t file;        /* source-string number */
     uint32_t line;        /* 1-based line in that file */
@@ -71,5 +74,7 @@ char *ob_shader_path_join(const char *dir, const char *name);
  * (materials/ob_shader_dir.c). ob_malloc'ed; NULL when out of memory. A
  * missing folder is logged (warning) and the configured install path returned. */
 char *ob_shader_dir_default(void);
+
+#pragma GCC visibility pop
 
 #endif /* OB_SHADER_SOURCE_H */

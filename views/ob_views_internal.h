@@ -6,6 +6,9 @@
 #include "ob_math.h"
 #include "ob_views_layer.h"
 
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
 typedef struct ob_shadow_view ob_shadow_view;
 typedef struct ob_paraboloid_view ob_paraboloid_view;
 
@@ -68,5 +71,7 @@ uint32_t ob_views_supported_samples(ob_views *ctx, const char *view_name, uint32
 /* Frees a view made by this layer: its targets, its draw list and the
  * object itself (whose first member is the base). NULL ok. */
 void ob_views_free_view(ob_views *ctx, ob_view *base);
+
+#pragma GCC visibility pop
 
 #endif /* OB_VIEWS_INTERNAL_H */
