@@ -30,10 +30,10 @@ static bool is_clear(const ob_composite_view *cv, const uint8_t *p)
 
 static uint32_t not_clear(const ob_stab_world *w, const uint8_t *img)
 {
-    if (!w->s) return N;
+    if (!w->world.stack) return N;
     uint32_t n = 0;
     for (uint32_t i = 0; img && i < N; i++)
-        n += !is_clear(w->s->composite, img + 4 * i) || img[4 * i + 3] != 255;
+        n += !is_clear(w->world.stack->composite, img + 4 * i) || img[4 * i + 3] != 255;
     return n;
 }
 
@@ -46,14 +46,14 @@ typedef struct base_scene {
 static base_scene build_base(ob_stab_world *w)
 {
     base_scene b;
-    b.ground = ob_stab_material(w, "stab-ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    b.red = ob_stab_material(w, "stab-red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
-    b.mirror = ob_stab_material(w, "stab-mirror", OB_MATERIAL_REFLECTIVE, 0.9f, 0.9f, 0.9f, true);
-    ob_stab_entity(w, NULL, "ground", w->plane, b.ground, 0, 0, 0);
-    ob_stab_entity(w, NULL, "left", w->box, b.red, -0.8, 0.5, 0);
-    ob_stab_entity(w, NULL, "right", w->box, b.red, 0.8, 0.5, -0.5);
-    b.sun = ob_stab_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
-    ob_stab_look(w, 0, 2.5, 4.5, 0, 0.4, 0);
+    b.ground = ob_world_material(&w->world, "stab-ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    b.red = ob_world_material(&w->world, "stab-red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
+    b.mirror = ob_world_material(&w->world, "stab-mirror", OB_MATERIAL_REFLECTIVE, 0.9f, 0.9f, 0.9f, true);
+    ob_world_entity(&w->world, NULL, "ground", w->world.plane, b.ground, 0, 0, 0);
+    ob_world_entity(&w->world, NULL, "left", w->world.box, b.red, -0.8, 0.5, 0);
+    ob_world_entity(&w->world, NULL, "right", w->world.box, b.red, 0.8, 0.5, -0.5);
+    b.sun = ob_world_light(&w->world, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
+    ob_world_look(&w->world, 0, 2.5, 4.5, 0, 0.4, 0);
     return b;
 }
 
@@ -63,7 +63,7 @@ static const char *yes(bool b) { return b ? "yes" : "NO"; }
 static ob_result finish(ob_stab_ctx *c, ob_stab_world *w, ob_result row)
 {
     ob_stab_expect(c, NULL);
-    ob_result r = w->err != OB_OK ? w->err : row;
+    ob_result r = w->world.err != OB_OK ? w->world.err : row;
     ob_stab_world_destroy(w);
     return r;
 }
@@ -75,8 +75,8 @@ ob_result ob_stab_zero_scale(ob_stab_ctx *c)
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
     base_scene b = build_base(&w);
-    ob_node *box = ob_stab_entity(&w, NULL, "collapsed-box", w.box, b.red, 2.0, 1.5, -2.5);
-    ob_node *ball = ob_stab_entity(&w, NULL, "collapsed-mirror", w.sphere, b.mirror, -1.5, 0.5, 1.0);
+    ob_node *box = ob_world_entity(&w.world, NULL, "collapsed-box", w.world.box, b.red, 2.0, 1.5, -2.5);
+    ob_node *ball = ob_world_entity(&w.world, NULL, "collapsed-mirror", w.world.sphere, b.mirror, -1.5, 0.5, 1.0);
     ob_stab_hide(box, true);
     ob_stab_hide(ball, true);
     uint8_t *without = ob_stab_render(&w, NULL);
@@ -86,16 +86,16 @@ ob_result ob_stab_zero_scale(ob_stab_ctx *c)
     ob_stab_scale(ball, 0, 0, 0);
     const ob_frame_stats *st;
     uint8_t *with = ob_stab_render(&w, &st);
-    const ob_view_stats *main = ob_stab_view_stats(st, "main");
-    uint32_t black = ob_stab_nan_black(without, with, N);
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
+    uint32_t black = ob_rgba_nan_black(without, with, N);
     ob_result r = OB_OK;
-    if (w.err == OB_OK)
+    if (w.world.err == OB_OK)
         r = ob_stab_add(c, "zero_scale", "pixels differing from the scene without the two "
                                          "zero-scale entities (box, reflective sphere)",
-                        ob_stab_diff_count(without, with, N, 0), "pixels", 0, black == 0,
+                        ob_rgba_diff_count(without, with, N, 0), "pixels", 0, black == 0,
                         ob_stab_take_ms(c), "max abs diff %u; NaN-black pixels %u; main drew %u "
-                        "items, shadow view %s", ob_stab_max_diff(without, with, N), black,
-                        main ? main->draws : 0, ob_stab_view_stats(st, "shadow:sun") ? "ran" : "did not run");
+                        "items, shadow view %s", ob_rgba_max_diff(without, with, N), black,
+                        main ? main->draws : 0, ob_world_view_stats(st, "shadow:sun") ? "ran" : "did not run");
     ob_free(without);
     ob_free(with);
     return finish(c, &w, r);
@@ -107,23 +107,23 @@ ob_result ob_stab_flattened_box(ob_stab_ctx *c)
 {
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
-    ob_material *m = ob_stab_material(&w, "green", OB_MATERIAL_LIT, 0.3f, 0.7f, 0.4f, false);
-    ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 6, 3);
-    ob_stab_look(&w, 0, 3, 2, 0, 0, 0);
-    ob_node *flat = ob_stab_entity(&w, NULL, "flat", w.box, m, 0, 0, 0);
+    ob_material *m = ob_world_material(&w.world, "green", OB_MATERIAL_LIT, 0.3f, 0.7f, 0.4f, false);
+    ob_world_light(&w.world, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 6, 3);
+    ob_world_look(&w.world, 0, 3, 2, 0, 0, 0);
+    ob_node *flat = ob_world_entity(&w.world, NULL, "flat", w.world.box, m, 0, 0, 0);
     ob_stab_scale(flat, 2.0f, 0.0f, 2.0f);
     uint8_t *box_img = ob_stab_render(&w, NULL);
     ob_stab_hide(flat, true);
-    ob_stab_scale(ob_stab_entity(&w, NULL, "plane", w.plane, m, 0, 0, 0), 0.1f, 0.1f, 0.1f);
+    ob_stab_scale(ob_world_entity(&w.world, NULL, "plane", w.world.plane, m, 0, 0, 0), 0.1f, 0.1f, 0.1f);
     uint8_t *plane_img = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK) {
+    if (w.world.err == OB_OK) {
         const uint8_t *p = box_img + ((size_t)(H / 2) * W + W / 2) * 4;
         r = ob_stab_add(c, "flattened_box", "pixels differing by more than 1 level: box scaled "
                                             "(2, 0, 2) vs a plane of that size (edge pixels only)",
-                        ob_stab_diff_count(box_img, plane_img, N, 1), "pixels", 8, p[1] > 100,
+                        ob_rgba_diff_count(box_img, plane_img, N, 1), "pixels", 8, p[1] > 100,
                         ob_stab_take_ms(c), "max abs diff %u; centre pixel %u,%u,%u (lit green "
-                        "> 100, not NaN-black)", ob_stab_max_diff(box_img, plane_img, N), p[0],
+                        "> 100, not NaN-black)", ob_rgba_max_diff(box_img, plane_img, N), p[0],
                         p[1], p[2]);
     }
     ob_free(box_img);
@@ -139,27 +139,27 @@ ob_result ob_stab_up_parallel(ob_stab_ctx *c)
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
     build_base(&w);
-    ob_stab_position(w.s->camera, 0, 6, 0);
+    ob_stab_position(w.world.stack->camera, 0, 6, 0);
     ob_stab_expect(c, expect);
-    ob_result look = w.err == OB_OK ? ob_node_look_at(w.s->camera, (const double[3]){0, 0, 0},
+    ob_result look = w.world.err == OB_OK ? ob_node_look_at(w.world.stack->camera, (const double[3]){0, 0, 0},
                                                       (const double[3]){0, 1, 0})
-                                    : w.err;
+                                    : w.world.err;
     bool named = ob_stab_log_has(c, "'camera'", "parallel", NULL);
     ob_stab_expect(c, NULL);
     uint8_t *fallback = ob_stab_render(&w, NULL);
-    if (w.err == OB_OK && look == OB_OK)
-        look = ob_node_look_at(w.s->camera, (const double[3]){0, 0, 0}, (const double[3]){0, 0, 1});
+    if (w.world.err == OB_OK && look == OB_OK)
+        look = ob_node_look_at(w.world.stack->camera, (const double[3]){0, 0, 0}, (const double[3]){0, 0, 1});
     uint8_t *explicit_up = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK) {
+    if (w.world.err == OB_OK) {
         uint32_t clear_like = N - not_clear(&w, fallback);
         r = ob_stab_add(c, "up_parallel_to_direction", "max abs pixel difference: look_at straight "
                                                        "down with up (0,1,0) vs explicit up (0,0,1)",
-                        ob_stab_max_diff(fallback, explicit_up, N), "levels/255", 0,
+                        ob_rgba_max_diff(fallback, explicit_up, N), "levels/255", 0,
                         look == OB_OK && named && clear_like < N / 2, ob_stab_take_ms(c),
                         "%u pixels differ; look_at accepted: %s; log names the camera: %s; "
                         "clear-colour pixels %u (< half: the boxes are in view)",
-                        ob_stab_diff_count(fallback, explicit_up, N, 0), yes(look == OB_OK),
+                        ob_rgba_diff_count(fallback, explicit_up, N, 0), yes(look == OB_OK),
                         yes(named), clear_like);
     }
     ob_free(fallback);
@@ -182,22 +182,22 @@ ob_result ob_stab_refused_views(ob_stab_ctx *c)
     build_base(&w);
     uint8_t *before = ob_stab_render(&w, NULL);
     uint32_t accepted = 0, wrong_result = 0, unnamed = 0;
-    for (size_t i = 0; i < OB_ARRAY_COUNT(sizes) && w.err == OB_OK; i++) {
+    for (size_t i = 0; i < OB_ARRAY_COUNT(sizes) && w.world.err == OB_OK; i++) {
         ob_stab_expect(c, expect);
         ob_result res = OB_OK;
-        ob_perspective_desc pd = {.name = "degenerate", .camera = w.s->camera,
+        ob_perspective_desc pd = {.name = "degenerate", .camera = w.world.stack->camera,
                                   .width = sizes[i][0], .height = sizes[i][1]};
-        ob_perspective_view *v = ob_perspective_view_create(w.s->views, &pd, &res);
+        ob_perspective_view *v = ob_perspective_view_create(w.world.stack->views, &pd, &res);
         if (v) {
             accepted++;
-            ob_perspective_view_destroy(w.s->views, v);
+            ob_perspective_view_destroy(w.world.stack->views, v);
         }
         wrong_result += !v && res != OB_ERR_INVALID_ARGUMENT;
         unnamed += !ob_stab_log_has(c, "'degenerate'", "width and height", NULL);
     }
     ob_result res = OB_OK;
-    ob_node *bad = w.err == OB_OK ? ob_node_create(w.s->scene, NULL, "bad-camera", &res) : NULL;
-    if (!bad && w.err == OB_OK) w.err = res;
+    ob_node *bad = w.world.err == OB_OK ? ob_node_create(w.world.stack->scene, NULL, "bad-camera", &res) : NULL;
+    if (!bad && w.world.err == OB_OK) w.world.err = res;
     for (size_t i = 0; i < OB_ARRAY_COUNT(bad_cams) && bad; i++) {
         ob_stab_expect(c, expect);
         res = ob_node_set_camera(bad, &bad_cams[i]);
@@ -209,8 +209,8 @@ ob_result ob_stab_refused_views(ob_stab_ctx *c)
     bool no_camera = bad && !ob_node_get_camera(bad);
     uint8_t *after = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK) {
-        uint32_t diff = ob_stab_diff_count(before, after, N, 0);
+    if (w.world.err == OB_OK) {
+        uint32_t diff = ob_rgba_diff_count(before, after, N, 0);
         r = ob_stab_add(c, "refused_views_and_cameras",
                         "bad descs accepted: zero-size views (3) and cameras with fovy 3.5/-1/NaN, "
                         "znear -0.1/Inf, aspect -1 (6)",
@@ -231,24 +231,24 @@ ob_result ob_stab_empty_scene(ob_stab_ctx *c)
 {
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
-    ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
-    ob_stab_light(&w, OB_LIGHT_POINT, false, 2.0f, 0, 2, 0);
+    ob_world_light(&w.world, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
+    ob_world_light(&w.world, OB_LIGHT_POINT, false, 2.0f, 0, 2, 0);
     uint32_t worst = 0;
     bool ok = true;
     ob_skip_reason main_skip = OB_SKIP_NONE, shadow_skip = OB_SKIP_NONE;
-    for (int mode = 0; mode < 4 && w.err == OB_OK; mode++) {
+    for (int mode = 0; mode < 4 && w.world.err == OB_OK; mode++) {
         const ob_frame_stats *st = ob_stab_frame(&w, mode % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE);
         uint8_t *img = ob_stab_snapshot(&w);
-        const ob_view_stats *main = ob_stab_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         main_skip = main ? main->skipped : OB_SKIP_ERROR;
-        shadow_skip = ob_stab_skip_reason(st, "shadow:sun");
+        shadow_skip = ob_world_skip_reason(st, "shadow:sun");
         ok &= main_skip == OB_SKIP_EMPTY && shadow_skip == OB_SKIP_NO_CASTERS &&
-              !ob_stab_view_stats(st, "shadow:sun");
+              !ob_world_view_stats(st, "shadow:sun");
         if (img) worst = OB_MAX(worst, not_clear(&w, img));
         ob_free(img);
     }
     ob_result r = OB_OK;
-    if (w.err == OB_OK)
+    if (w.world.err == OB_OK)
         r = ob_stab_add(c, "empty_scene", "pixels other than the clear colour: lights (one "
                                           "shadowed) but nothing to draw, ST and MT",
                         worst, "pixels", 0, ok, ob_stab_take_ms(c), "main: %s, shadow:sun: %s",
@@ -263,13 +263,13 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
     base_scene b = build_base(&w);
-    ob_node *lamp = ob_stab_light(&w, OB_LIGHT_POINT, false, 1.0f, 1, 2, 1);
+    ob_node *lamp = ob_world_light(&w.world, OB_LIGHT_POINT, false, 1.0f, 1, 2, 1);
     ob_stab_hide(b.sun, true);
     ob_stab_hide(lamp, true);
     const ob_frame_stats *st;
     uint8_t *off = ob_stab_render(&w, &st);
-    bool absent = !ob_stab_view_stats(st, "shadow:sun");
-    if (lamp) ob_node_destroy(w.s->scene, lamp);
+    bool absent = !ob_world_view_stats(st, "shadow:sun");
+    if (lamp) ob_node_destroy(w.world.stack->scene, lamp);
     ob_stab_hide(b.sun, false);
     ob_result set = OB_OK;
     if (b.sun) {
@@ -278,14 +278,14 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
         set = ob_node_set_light(b.sun, &dark);
     }
     uint8_t *zero = ob_stab_render(&w, &st);
-    absent &= !ob_stab_view_stats(st, "shadow:sun");
-    ob_skip_reason skip = ob_stab_skip_reason(st, "shadow:sun");
-    if (b.sun) ob_node_destroy(w.s->scene, b.sun);
+    absent &= !ob_world_view_stats(st, "shadow:sun");
+    ob_skip_reason skip = ob_world_skip_reason(st, "shadow:sun");
+    if (b.sun) ob_node_destroy(w.world.stack->scene, b.sun);
     uint8_t *none = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK) {
-        uint32_t d_zero = ob_stab_diff_count(zero, none, N, 0);
-        uint32_t d_off = ob_stab_diff_count(off, none, N, 0);
+    if (w.world.err == OB_OK) {
+        uint32_t d_zero = ob_rgba_diff_count(zero, none, N, 0);
+        uint32_t d_off = ob_rgba_diff_count(off, none, N, 0);
         r = ob_stab_add(c, "light_intensity_0", "pixels differing from the scene without the "
                                                 "light: sun at intensity 0 (and hidden lights)",
                         OB_MAX(d_zero, d_off), "pixels", 0,
@@ -322,16 +322,16 @@ ob_result ob_stab_non_finite_transform(ob_stab_ctx *c)
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
     base_scene b = build_base(&w);
-    ob_node *bad = ob_stab_entity(&w, NULL, "bad-entity", w.box, b.red, 0, 0.5, 1.2);
-    ob_stab_entity(&w, bad, "bad-child", w.sphere, b.mirror, 0, 1.0, 0);
+    ob_node *bad = ob_world_entity(&w.world, NULL, "bad-entity", w.world.box, b.red, 0, 0.5, 1.2);
+    ob_world_entity(&w.world, bad, "bad-child", w.world.sphere, b.mirror, 0, 1.0, 0);
     uint8_t *good = ob_stab_render(&w, NULL);
     ob_stab_hide(bad, true);
     uint8_t *without = ob_stab_render(&w, NULL);
     ob_stab_hide(bad, false);
-    bool visible = ob_stab_max_diff(good, without, N) > 0;
+    bool visible = ob_rgba_max_diff(good, without, N) > 0;
     ob_stab_take_ms(c);
     ob_result r = OB_OK;
-    for (int i = 0; i < 5 && w.err == OB_OK && r == OB_OK; i++) {
+    for (int i = 0; i < 5 && w.world.err == OB_OK && r == OB_OK; i++) {
         double pos[3], rot[4];
         float scale[3];
         ob_node_get_position(bad, pos);
@@ -341,7 +341,7 @@ ob_result ob_stab_non_finite_transform(ob_stab_ctx *c)
         apply_bad(bad, i);
         const ob_frame_stats *st;
         uint8_t *img = ob_stab_render(&w, &st);
-        const ob_view_stats *main = ob_stab_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         uint32_t draws = main ? main->draws : 0;
         bool named = ob_stab_log_has(c, "'bad-entity'", "not rendered", NULL);
         bool child_named = ob_stab_log_has(c, "'bad-child'", NULL);
@@ -349,16 +349,16 @@ ob_result ob_stab_non_finite_transform(ob_stab_ctx *c)
         ob_node_set_rotation_d(bad, rot);
         ob_node_set_scale(bad, scale);
         uint8_t *fixed = ob_stab_render(&w, NULL);
-        bool back = w.err == OB_OK && ob_stab_max_diff(good, fixed, N) == 0 &&
+        bool back = w.world.err == OB_OK && ob_rgba_max_diff(good, fixed, N) == 0 &&
                     ob_stab_log_has(c, "'bad-entity'", "finite again", NULL);
         ob_stab_expect(c, NULL);
-        if (w.err == OB_OK) {
+        if (w.world.err == OB_OK) {
             char name[48];
             snprintf(name, sizeof name, "non_finite_transform %s", names[i]);
-            uint32_t black = ob_stab_nan_black(without, img, N);
+            uint32_t black = ob_rgba_nan_black(without, img, N);
             r = ob_stab_add(c, name, "pixels differing from the scene without the entity (it has "
                                      "a reflective child)",
-                            ob_stab_diff_count(without, img, N, 0), "pixels", 0,
+                            ob_rgba_diff_count(without, img, N, 0), "pixels", 0,
                             black == 0 && named && !child_named && draws == 3 && back && visible,
                             ob_stab_take_ms(c), "NaN-black %u; main drew %u (3 expected); log "
                             "names it: %s, not its child: %s; back once fixed: %s", black, draws,
@@ -382,40 +382,40 @@ ob_result ob_stab_non_finite_light_camera(ob_stab_ctx *c)
     base_scene b = build_base(&w);
     uint8_t *good = ob_stab_render(&w, NULL);
     ob_stab_expect(c, expect);
-    ob_node *lamp = ob_stab_light(&w, OB_LIGHT_POINT, false, 3.0f, 0, 1, 1);
+    ob_node *lamp = ob_world_light(&w.world, OB_LIGHT_POINT, false, 3.0f, 0, 1, 1);
     ob_stab_position(lamp, NAN, 1, 1);
     uint8_t *img_lamp = ob_stab_render(&w, NULL);
     ob_stab_position(b.sun, 3, INFINITY, 4);
     const ob_frame_stats *st;
     uint8_t *img_sun = ob_stab_render(&w, &st);
-    bool shadow_absent = !ob_stab_view_stats(st, "shadow:sun");
+    bool shadow_absent = !ob_world_view_stats(st, "shadow:sun");
     ob_stab_hide(b.sun, true);
     uint8_t *no_sun = ob_stab_render(&w, NULL);
     ob_stab_hide(b.sun, false);
     ob_stab_position(b.sun, 3, 8, 4);
-    if (lamp) ob_node_destroy(w.s->scene, lamp);
+    if (lamp) ob_node_destroy(w.world.stack->scene, lamp);
     double light_ms = ob_stab_take_ms(c);
 
     ob_stab_expect(c, expect);
     double eye[3] = {0, 2.5, 4.5};
-    if (w.s->camera) ob_node_get_position(w.s->camera, eye);
-    ob_stab_position(w.s->camera, eye[0], NAN, eye[2]);
+    if (w.world.stack->camera) ob_node_get_position(w.world.stack->camera, eye);
+    ob_stab_position(w.world.stack->camera, eye[0], NAN, eye[2]);
     uint8_t *img_cam = ob_stab_render(&w, NULL);
     bool named = ob_stab_log_has(c, "'main'", "'camera'", NULL);
-    ob_stab_position(w.s->camera, eye[0], eye[1], eye[2]);
+    ob_stab_position(w.world.stack->camera, eye[0], eye[1], eye[2]);
     uint8_t *fixed = ob_stab_render(&w, NULL);
     ob_stab_expect(c, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK) {
-        uint32_t d_lamp = ob_stab_diff_count(good, img_lamp, N, 0);
-        uint32_t d_sun = ob_stab_diff_count(no_sun, img_sun, N, 0);
-        uint32_t black = ob_stab_nan_black(good, img_lamp, N) + ob_stab_nan_black(no_sun, img_sun, N);
+    if (w.world.err == OB_OK) {
+        uint32_t d_lamp = ob_rgba_diff_count(good, img_lamp, N, 0);
+        uint32_t d_sun = ob_rgba_diff_count(no_sun, img_sun, N, 0);
+        uint32_t black = ob_rgba_nan_black(good, img_lamp, N) + ob_rgba_nan_black(no_sun, img_sun, N);
         r = ob_stab_add(c, "non_finite_light", "pixels differing from the scene without the "
                                                "light: NaN point light; Inf sun vs hidden sun",
                         OB_MAX(d_lamp, d_sun), "pixels", 0, shadow_absent && black == 0, light_ms,
                         "NaN lamp %u px, Inf sun %u px; NaN-black %u; Inf sun's shadow view left "
                         "out: %s", d_lamp, d_sun, black, yes(shadow_absent));
-        bool back = ob_stab_max_diff(good, fixed, N) == 0;
+        bool back = ob_rgba_max_diff(good, fixed, N) == 0;
         if (r == OB_OK)
             r = ob_stab_add(c, "non_finite_camera", "pixels other than the clear colour with a NaN "
                                                     "camera position",
@@ -445,7 +445,7 @@ ob_result ob_stab_non_finite_material(ob_stab_ctx *c)
     uint32_t refused = 0;
     uint64_t errors = 0;
     bool named = false;
-    if (w.err == OB_OK) {
+    if (w.world.err == OB_OK) {
         ob_stab_expect(c, expect);
         errors = ob_stab_expected_errors(c);
         refused += ob_material_set_diffuse(b.red, (const float[4]){NAN, 0, 0, 1}) == OB_ERR_NON_FINITE;
@@ -457,7 +457,7 @@ ob_result ob_stab_non_finite_material(ob_stab_ctx *c)
         errors = ob_stab_expected_errors(c) - errors;
         ob_result res = OB_OK;
         ob_material *m = ob_material_create(
-            w.s->materials, &(ob_material_desc){.name = "nan-material", .diffuse = {1, NAN, 1, 1}}, &res);
+            w.world.stack->materials, &(ob_material_desc){.name = "nan-material", .diffuse = {1, NAN, 1, 1}}, &res);
         refused += !m && res == OB_ERR_NON_FINITE;
         named = ob_stab_log_has(c, "'stab-red'", "non-finite", NULL) &&
                 ob_stab_log_has(c, "'nan-material'", NULL);
@@ -465,10 +465,10 @@ ob_result ob_stab_non_finite_material(ob_stab_ctx *c)
     }
     uint8_t *after = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK)
+    if (w.world.err == OB_OK)
         r = ob_stab_add(c, "non_finite_material", "pixels differing after NaN/Inf given to 4 "
                                                   "material setters and a create (all refused)",
-                        ob_stab_diff_count(before, after, N, 0), "pixels", 0,
+                        ob_rgba_diff_count(before, after, N, 0), "pixels", 0,
                         refused == 5 && named && errors >= 4, ob_stab_take_ms(c),
                         "%u of 5 refused with OB_ERR_NON_FINITE; named in the log: %s; errors "
                         "logged by the 4 setters %llu", refused, yes(named),
@@ -488,9 +488,9 @@ ob_result ob_stab_non_finite_parameter(ob_stab_ctx *c)
     uint8_t *before = ob_stab_render(&w, NULL);
     uint32_t refused = 0;
     bool kept = false, named = false, found = false;
-    if (w.err == OB_OK) {
-        ob_param_registry *reg = ob_renderer_registry(w.s->renderer);
-        ob_params *params = ob_renderer_params(w.s->renderer);
+    if (w.world.err == OB_OK) {
+        ob_param_registry *reg = ob_renderer_registry(w.world.stack->renderer);
+        ob_params *params = ob_renderer_params(w.world.stack->renderer);
         ob_param ambient = ob_param_find(reg, "AmbientColor");
         ob_param world = ob_param_registry_builtins(reg)->world;
         const float good[4] = {0.5f, 0.25f, 0.125f, 1.0f};
@@ -512,10 +512,10 @@ ob_result ob_stab_non_finite_parameter(ob_stab_ctx *c)
     }
     uint8_t *after = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
-    if (w.err == OB_OK)
+    if (w.world.err == OB_OK)
         r = ob_stab_add(c, "non_finite_parameter", "pixels differing after NaN/Inf written to "
                                                    "AmbientColor (set, init) and WorldMatrix",
-                        ob_stab_diff_count(before, after, N, 0), "pixels", 0,
+                        ob_rgba_diff_count(before, after, N, 0), "pixels", 0,
                         found && refused == 3 && kept && named, ob_stab_take_ms(c),
                         "%u of 3 refused with OB_ERR_NON_FINITE; value kept: %s; named: %s",
                         refused, yes(kept), yes(named));
@@ -534,22 +534,22 @@ ob_result ob_stab_beyond_float(ob_stab_ctx *c)
     static const char *const expect[] = {"'beyond-float'", NULL};
     ob_stab_world w;
     ob_stab_world_create(&w, c, &desc);
-    ob_material *ground = ob_stab_material(&w, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    ob_material *red = ob_stab_material(&w, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
-    ob_stab_entity(&w, NULL, "ground", w.plane, ground, 0, 0, 0);
-    ob_stab_entity(&w, NULL, "cube", w.box, red, 0, 0.5, 0);
-    ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
-    ob_stab_look(&w, 0, 2.5, 4.5, 0, 0.4, 0);
+    ob_material *ground = ob_world_material(&w.world, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_material *red = ob_world_material(&w.world, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
+    ob_world_entity(&w.world, NULL, "ground", w.world.plane, ground, 0, 0, 0);
+    ob_world_entity(&w.world, NULL, "cube", w.world.box, red, 0, 0.5, 0);
+    ob_world_light(&w.world, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
+    ob_world_look(&w.world, 0, 2.5, 4.5, 0, 0.4, 0);
     ob_result res = OB_OK;
-    ob_node *parent = w.err == OB_OK ? ob_node_create(w.s->scene, NULL, "giant-parent", &res) : NULL;
-    if (!parent && w.err == OB_OK) w.err = res;
-    ob_node *far = ob_stab_entity(&w, parent, "beyond-float", w.box, red, 0, 0, 0);
+    ob_node *parent = w.world.err == OB_OK ? ob_node_create(w.world.stack->scene, NULL, "giant-parent", &res) : NULL;
+    if (!parent && w.world.err == OB_OK) w.world.err = res;
+    ob_node *far = ob_world_entity(&w.world, parent, "beyond-float", w.world.box, red, 0, 0, 0);
     ob_stab_hide(far, true);
     uint8_t *without = ob_stab_render(&w, NULL);
     ob_stab_hide(far, false);
     ob_stab_take_ms(c);
     ob_result r = OB_OK;
-    for (int k = 0; k < 2 && w.err == OB_OK && r == OB_OK; k++) {
+    for (int k = 0; k < 2 && w.world.err == OB_OK && r == OB_OK; k++) {
         if (k == 0) {
             ob_stab_position(far, 0, -0.4e39, -1e39);
         } else {
@@ -563,10 +563,10 @@ ob_result ob_stab_beyond_float(ob_stab_ctx *c)
             ob_stab_expect(c, expect);
             const ob_frame_stats *st =
                 ob_stab_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE);
-            const ob_view_stats *main = ob_stab_view_stats(st, "main");
+            const ob_view_stats *main = ob_world_view_stats(st, "main");
             draws[mode] = main ? main->draws : 0;
             uint8_t *img = ob_stab_snapshot(&w);
-            worst = OB_MAX(worst, ob_stab_max_diff(without, img, N));
+            worst = OB_MAX(worst, ob_rgba_max_diff(without, img, N));
             ob_free(img);
             /* Named the first frame, not again while it stays out of range. */
             if (mode == 0) named = ob_stab_log_has(c, "'main'", "'beyond-float'", "float range", NULL);
@@ -579,12 +579,12 @@ ob_result ob_stab_beyond_float(ob_stab_ctx *c)
         ob_stab_scale(far, 0.5f, 0.5f, 0.5f);
         ob_stab_position(far, 0.8, 0.25, 1.0);
         const ob_frame_stats *st = ob_stab_frame(&w, OB_THREADING_SINGLE);
-        const ob_view_stats *main = ob_stab_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         uint8_t *img = ob_stab_snapshot(&w);
-        bool back = main && main->draws == 3 && ob_stab_max_diff(without, img, N) > 0;
+        bool back = main && main->draws == 3 && ob_rgba_max_diff(without, img, N) > 0;
         ob_free(img);
         ob_stab_take_ms(c);
-        if (w.err == OB_OK)
+        if (w.world.err == OB_OK)
             r = ob_stab_add(c, k == 0 ? "beyond_float_range 1e39 ahead"
                                       : "beyond_float_range world scale 1e40",
                             "max abs pixel difference against the scene without the entity, ST "

@@ -35,17 +35,17 @@ static ob_material *unlit(ob_stab_world *w, const char *name, const float rgb[3]
     ob_material_desc md = {.name = name, .kind = OB_MATERIAL_UNLIT,
                            .diffuse = {rgb[0], rgb[1], rgb[2], 1.0f},
                            .specular = {0.0f, 0.0f, 0.0f, 1.0f}, .priority = priority};
-    return ob_stab_material_desc(w, &md);
+    return ob_world_material_desc(&w->world, &md);
 }
 
 static void set_material(ob_stab_world *w, ob_node *n, ob_material *m)
 {
-    if (w->err != OB_OK || !n) return;
+    if (w->world.err != OB_OK || !n) return;
     ob_renderable rd = *ob_node_get_renderable(n);
     rd.material = m;
     ob_result r = ob_node_set_renderable(n, &rd);
     if (r != OB_OK) {
-        w->err = r;
+        w->world.err = r;
         OB_LOG_E("bench", "stability: material of '%s': %s", ob_node_name(n), ob_result_name(r));
     }
 }
@@ -54,7 +54,7 @@ static void set_material(ob_stab_world *w, ob_node *n, ob_material *m)
 static bool is_rgb(const ob_stab_world *w, const uint8_t *p, const float rgb[3])
 {
     for (int i = 0; i < 3; i++)
-        if (abs(p[i] - ob_composite_view_output_level(w->s->composite, rgb[i])) > 1) return false;
+        if (abs(p[i] - ob_composite_view_output_level(w->world.stack->composite, rgb[i])) > 1) return false;
     return true;
 }
 
@@ -69,15 +69,15 @@ static depth_result depth_render(depth_rig *rig, double d, double gap, bool near
     set_material(w, rig->far, near_drawn_first ? rig->far_second : rig->far_first);
     set_material(w, rig->near, near_drawn_first ? rig->near_first : rig->near_second);
     const ob_frame_stats *st = ob_stab_frame(w, OB_THREADING_SINGLE);
-    const ob_view_stats *main = ob_stab_view_stats(st, "main");
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
     uint8_t *img = ob_stab_snapshot(w);
     depth_result res = {.two_draws = main && main->draws == 2};
-    for (uint32_t y = 0; img && y < w->height; y++) {
-        for (uint32_t x = 0; x < w->width; x++) {
-            const uint8_t *p = img + ((size_t)y * w->width + x) * 4;
-            if (x + 2 < w->width / 2) {
+    for (uint32_t y = 0; img && y < w->world.height; y++) {
+        for (uint32_t x = 0; x < w->world.width; x++) {
+            const uint8_t *p = img + ((size_t)y * w->world.width + x) * 4;
+            if (x + 2 < w->world.width / 2) {
                 res.wrong_far += !is_rgb(w, p, far_rgb);
-            } else if (x > w->width / 2 + 1) {
+            } else if (x > w->world.width / 2 + 1) {
                 res.overlap_pixels++;
                 res.wrong_overlap += !is_rgb(w, p, near_rgb);
             }
@@ -103,13 +103,13 @@ ob_result ob_stab_depth_precision(ob_stab_ctx *c)
     depth_rig rig = {0};
     ob_stab_world *w = &rig.w;
     ob_stab_world_create(w, c, &(ob_stab_world_desc){.width = 96, .height = 64, .znear = znear});
-    ob_stab_look(w, 0, 0, 0, 0, 0, -1);
+    ob_world_look(&w->world, 0, 0, 0, 0, 0, -1);
     rig.far_first = unlit(w, "far-first", far_rgb, 0);
     rig.far_second = unlit(w, "far-second", far_rgb, 1);
     rig.near_first = unlit(w, "near-first", near_rgb, 0);
     rig.near_second = unlit(w, "near-second", near_rgb, 1);
-    rig.far = ob_stab_entity(w, NULL, "far", w->plane, rig.far_first, 0, 0, 0);
-    rig.near = ob_stab_entity(w, NULL, "near", w->plane, rig.near_second, 0, 0, 0);
+    rig.far = ob_world_entity(&w->world, NULL, "far", w->world.plane, rig.far_first, 0, 0, 0);
+    rig.near = ob_world_entity(&w->world, NULL, "near", w->world.plane, rig.near_second, 0, 0, 0);
     /* The plane faces +Y; a quarter turn about X makes it face the camera. */
     const double q[4] = {sin(OB_PI / 4), 0, 0, cos(OB_PI / 4)};
     if (rig.far && rig.near) {
@@ -119,7 +119,7 @@ ob_result ob_stab_depth_precision(ob_stab_ctx *c)
     ob_result r = OB_OK;
     struct { depth_result a, b; double ms, smallest, first_bad; uint32_t bad_pixels; bool ok; } res[3];
     memset(res, 0, sizeof res);
-    for (size_t di = 0; di < OB_ARRAY_COUNT(distances) && w->err == OB_OK; di++) {
+    for (size_t di = 0; di < OB_ARRAY_COUNT(distances) && w->world.err == OB_OK; di++) {
         double d = distances[di];
         res[di].smallest = 0.0;
         res[di].first_bad = NAN;
@@ -144,7 +144,7 @@ ob_result ob_stab_depth_precision(ob_stab_ctx *c)
             }
         }
     }
-    if (w->err == OB_OK) {
+    if (w->world.err == OB_OK) {
         for (size_t di = 0; di < OB_ARRAY_COUNT(distances) && r == OB_OK; di++) {
             double d = distances[di];
             const depth_result *a = &res[di].a, *b = &res[di].b;
@@ -171,7 +171,7 @@ ob_result ob_stab_depth_precision(ob_stab_ctx *c)
                             distances[di], res[di].first_bad, res[di].bad_pixels);
         }
     }
-    if (r == OB_OK) r = w->err;
+    if (r == OB_OK) r = w->world.err;
     ob_stab_world_destroy(w);
     return r;
 }
@@ -186,16 +186,16 @@ typedef struct offset_image {
 static ob_node *aimed_light(ob_stab_world *w, const char *name, const ob_light_desc *ld,
                             const double pos[3], const double *target)
 {
-    if (w->err != OB_OK) return NULL;
+    if (w->world.err != OB_OK) return NULL;
     ob_result r;
-    ob_node *n = ob_node_create(w->s->scene, NULL, name, &r);
+    ob_node *n = ob_node_create(w->world.stack->scene, NULL, name, &r);
     if (n) {
         r = ob_node_set_light(n, ld);
         ob_node_set_position(n, pos);
         if (r == OB_OK && target) r = ob_node_look_at(n, target, (const double[3]){0, 1, 0});
     }
     if (r != OB_OK) {
-        w->err = r;
+        w->world.err = r;
         OB_LOG_E("bench", "stability: light '%s': %s", name, ob_result_name(r));
     }
     return n;
@@ -206,27 +206,27 @@ static ob_node *aimed_light(ob_stab_world *w, const char *name, const ob_light_d
  * scene does. */
 static void build_offset_scene(ob_stab_world *w, const double o[3])
 {
-    ob_material *ground = ob_stab_material(w, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.55f, false);
-    ob_material *red = ob_stab_material(w, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
-    ob_material *blue = ob_stab_material(w, "blue", OB_MATERIAL_LIT, 0.2f, 0.3f, 0.9f, true);
-    ob_material *mirror = ob_stab_material_desc(
-        w, &(ob_material_desc){.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE,
+    ob_material *ground = ob_world_material(&w->world, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.55f, false);
+    ob_material *red = ob_world_material(&w->world, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
+    ob_material *blue = ob_world_material(&w->world, "blue", OB_MATERIAL_LIT, 0.2f, 0.3f, 0.9f, true);
+    ob_material *mirror = ob_world_material_desc(
+        &w->world, &(ob_material_desc){.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE,
                                .diffuse = {0.9f, 0.9f, 0.9f, 1.0f}, .reflectivity = 0.7f,
                                .casts_shadows = true});
-    ob_stab_entity(w, NULL, "ground", w->plane, ground, o[0], o[1], o[2]);
-    ob_node *cube = ob_stab_entity(w, NULL, "cube", w->box, red, o[0] - 0.7, o[1] + 0.5, o[2] - 0.3);
+    ob_world_entity(&w->world, NULL, "ground", w->world.plane, ground, o[0], o[1], o[2]);
+    ob_node *cube = ob_world_entity(&w->world, NULL, "cube", w->world.box, red, o[0] - 0.7, o[1] + 0.5, o[2] - 0.3);
     if (cube) ob_node_set_euler(cube, 0.0f, 0.6f, 0.0f);
-    ob_node *tall = ob_stab_entity(w, NULL, "tall", w->box, blue, o[0] + 0.45, o[1] + 0.75,
+    ob_node *tall = ob_world_entity(&w->world, NULL, "tall", w->world.box, blue, o[0] + 0.45, o[1] + 0.75,
                                    o[2] - 1.55);
     ob_stab_scale(tall, 0.5f, 1.5f, 0.5f);
-    ob_stab_entity(w, NULL, "mirror", w->sphere, mirror, o[0] + 1.05, o[1] + 0.5, o[2] + 0.45);
+    ob_world_entity(&w->world, NULL, "mirror", w->world.sphere, mirror, o[0] + 1.05, o[1] + 0.5, o[2] + 0.45);
     aimed_light(w, "sun", &(ob_light_desc){.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 0.95f, 0.9f},
                                            .intensity = 0.9f, .casts_shadows = true},
                 (const double[3]){o[0] + 3.1, o[1] + 8, o[2] + 4.3}, o);
     aimed_light(w, "lamp", &(ob_light_desc){.type = OB_LIGHT_POINT, .color = {0.4f, 0.6f, 1.0f},
                                             .intensity = 3.0f, .range = 8.0f},
                 (const double[3]){o[0] - 2.1, o[1] + 1.5, o[2] + 1.3}, NULL);
-    ob_stab_look(w, o[0] + 0.55, o[1] + 2.5, o[2] + 4.6, o[0] + 0.05, o[1] + 0.5, o[2] - 0.1);
+    ob_world_look(&w->world, o[0] + 0.55, o[1] + 2.5, o[2] + 4.6, o[0] + 0.05, o[1] + 0.5, o[2] - 0.1);
 }
 
 /* Two frames (ST, then MT: the steady state) and the image. */
@@ -238,13 +238,13 @@ static ob_result render_offset(ob_stab_ctx *c, const double o[3], offset_image *
     build_offset_scene(&w, o);
     ob_stab_frame(&w, OB_THREADING_SINGLE);
     const ob_frame_stats *st = ob_stab_frame(&w, OB_THREADING_MULTI);
-    const ob_view_stats *shadow = ob_stab_view_stats(st, "shadow:sun");
-    const ob_view_stats *env = ob_stab_view_stats(st, "envmap:mirror");
+    const ob_view_stats *shadow = ob_world_view_stats(st, "shadow:sun");
+    const ob_view_stats *env = ob_world_view_stats(st, "envmap:mirror");
     out->shadow_draws = shadow ? shadow->draws : 0;
     out->env_draws = env ? env->draws : 0;
     out->env_items = env ? env->items : 0;
     out->pixels = ob_stab_snapshot(&w);
-    ob_result r = w.err;
+    ob_result r = w.world.err;
     ob_stab_world_destroy(&w);
     return r;
 }
@@ -271,8 +271,8 @@ ob_result ob_stab_large_coordinates(ob_stab_ctx *c)
         r = render_offset(c, cases[i].o, &img);
         bool promised = i < 3;
         if (r == OB_OK) {
-            uint32_t max_diff = ob_stab_max_diff(ref.pixels, img.pixels, N);
-            uint32_t count = ob_stab_diff_count(ref.pixels, img.pixels, N, 0);
+            uint32_t max_diff = ob_rgba_max_diff(ref.pixels, img.pixels, N);
+            uint32_t count = ob_rgba_diff_count(ref.pixels, img.pixels, N, 0);
             double spacing = nextafter(fabs(cases[i].o[0]), INFINITY) - fabs(cases[i].o[0]);
             r = ob_stab_add(c, cases[i].name,
                             promised ? "max abs pixel difference against the scene at the origin "
@@ -423,23 +423,23 @@ static ob_result render_scaled(ob_stab_ctx *c, double s, uint8_t **out_img, bool
     ob_stab_world_create(&w, c, &(ob_stab_world_desc){.width = SCALE_W, .height = SCALE_H,
                                                       .clear_color = {0.2f, 0.4f, 0.6f, 1.0f},
                                                       .znear = (float)(0.05 * s)});
-    ob_material *ground = ob_stab_material(&w, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    ob_material *red = ob_stab_material(&w, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
-    ob_material *blue = ob_stab_material(&w, "blue", OB_MATERIAL_LIT, 0.1f, 0.3f, 0.9f, true);
+    ob_material *ground = ob_world_material(&w.world, "ground", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_material *red = ob_world_material(&w.world, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.1f, true);
+    ob_material *blue = ob_world_material(&w.world, "blue", OB_MATERIAL_LIT, 0.1f, 0.3f, 0.9f, true);
     float fs = (float)s;
-    ob_stab_scale(ob_stab_entity(&w, NULL, "ground", w.plane, ground, 0, 0, 0), fs, fs, fs);
-    ob_node *n = ob_stab_entity(&w, NULL, "cube", w.box, red, -0.7 * s, 0.5 * s, 0.3 * s);
+    ob_stab_scale(ob_world_entity(&w.world, NULL, "ground", w.world.plane, ground, 0, 0, 0), fs, fs, fs);
+    ob_node *n = ob_world_entity(&w.world, NULL, "cube", w.world.box, red, -0.7 * s, 0.5 * s, 0.3 * s);
     ob_stab_scale(n, fs, fs, fs);
     if (n) ob_node_set_euler(n, 0.0f, 0.5f, 0.0f);
-    n = ob_stab_entity(&w, NULL, "tall", w.box, blue, 0.6 * s, 0.75 * s, -0.8 * s);
+    n = ob_world_entity(&w.world, NULL, "tall", w.world.box, blue, 0.6 * s, 0.75 * s, -0.8 * s);
     ob_stab_scale(n, 0.5f * fs, 1.5f * fs, 0.5f * fs);
-    ob_stab_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3 * s, 8 * s, 4 * s);
-    ob_stab_look(&w, 0.3 * s, 2.2 * s, 4.1 * s, 0, 0.4 * s, 0);
+    ob_world_light(&w.world, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3 * s, 8 * s, 4 * s);
+    ob_world_look(&w.world, 0.3 * s, 2.2 * s, 4.1 * s, 0, 0.4 * s, 0);
     const ob_frame_stats *st;
     *out_img = ob_stab_render(&w, &st);
-    *out_shadow = ob_stab_view_stats(st, "shadow:sun") != NULL;
+    *out_shadow = ob_world_view_stats(st, "shadow:sun") != NULL;
     ob_stab_frame(&w, OB_THREADING_SINGLE);   /* timed: the first frame makes pipelines */
-    ob_result r = w.err;
+    ob_result r = w.world.err;
     ob_stab_world_destroy(&w);
     return r;
 }
@@ -465,12 +465,12 @@ ob_result ob_stab_scale_invariance(ob_stab_ctx *c)
         for (uint32_t i = 0; i < groups[g].n && r == OB_OK; i++) {
             uint8_t *img = NULL;
             r = render_scaled(c, groups[g].s[i], &img, &shadow);
-            uint32_t d = ob_stab_max_diff(unit, img, N);
+            uint32_t d = ob_rgba_max_diff(unit, img, N);
             all_shadowed &= shadow;
             if (d > worst || i == 0) {
                 worst = d;
                 worst_s = groups[g].s[i];
-                worst_count = ob_stab_diff_count(unit, img, N, 0);
+                worst_count = ob_rgba_diff_count(unit, img, N, 0);
             }
             ob_free(img);
         }
@@ -491,9 +491,9 @@ ob_result ob_stab_scale_invariance(ob_stab_ctx *c)
         if (r == OB_OK)
             r = ob_stab_add(c, "scale_invariance 1e36", "the same at 1e36, where clip coordinates "
                                                         "near FLT_MAX overflow (measured only)",
-                            ob_stab_max_diff(unit, img, N), "levels/255", NAN, true,
+                            ob_rgba_max_diff(unit, img, N), "levels/255", NAN, true,
                             ob_stab_take_ms(c), "%u of %u pixels differ",
-                            ob_stab_diff_count(unit, img, N, 0), N);
+                            ob_rgba_diff_count(unit, img, N, 0), N);
         ob_free(img);
     }
     ob_free(unit);

@@ -1,14 +1,18 @@
 /* ob_stab_world.h — what the stability cases share (internal to
  * demos/stability): the run context (rows, expected log lines, frame
- * times), a small world on top of ob_stack (views/scene/ob_stack.h; what the
- * tests' ob_test_world is: camera, main view, composite, box/sphere/plane,
- * helpers to add entities and lights, render a frame in a threading mode
- * and read the image back), and image comparisons.
+ * times) and the cases' world: the small world of demos/world/ob_world.h
+ * (what the tests render in too) with the run's worker count, frames timed
+ * for the report, the validation layer's counts added to the run, and the
+ * first failure logged.
  *
- * Errors are sticky: the first failing call stores its ob_result in
- * w->err (logged by the engine or here, with the entity's name) and every
- * later helper does nothing and returns NULL / 0; the node setters accept
- * NULL. A case builds its scene, renders, then checks w->err once.
+ * The cases build with the world's helpers (ob_world_entity(&w.world, ...),
+ * ob_world_material, ob_world_light, ob_world_look) and use its stats
+ * lookups and image comparisons (ob_world_view_stats, ob_rgba_*). Errors
+ * are sticky (the world's rule): the first failing call stores its
+ * ob_result in w->world.err (logged by the engine and here, naming what
+ * failed) and every later helper does nothing and returns NULL / 0; a
+ * failed frame is sticky here too. The node setters accept NULL. A case
+ * builds its scene, renders, then checks w->world.err once.
  *
  * Thread rule: [render thread]. The log sink the context installs may be called
  * from any thread (workers, the validation callback); it locks.
@@ -19,7 +23,7 @@
 #include <pthread.h>
 
 #include "ob_stability.h"
-#include "ob_stack.h"
+#include "ob_world.h"
 
 #define OB_STAB_MAX_NEEDLES 8
 #define OB_STAB_LOG_LINES 48
@@ -74,31 +78,15 @@ typedef struct ob_stab_world_desc {
 } ob_stab_world_desc;
 
 typedef struct ob_stab_world {
-    ob_stack *s;                   /* the whole stack; NULL once destroyed */
+    ob_world world;                /* world.stack is NULL once destroyed */
     ob_stab_ctx *ctx;
-    ob_geometry *box, *sphere, *plane;
-    uint32_t width, height;
-    uint8_t *pixels;               /* the last read image */
-    uint32_t frames;
-    ob_result err;
+    uint32_t frames;               /* frames rendered (the first is timed apart) */
 } ob_stab_world;
 
-/* Failure is stored in w->err (and returned); destroy is then still due. */
+/* Failure is stored in w->world.err (and returned); destroy is then still due. */
 ob_result ob_stab_world_create(ob_stab_world *w, ob_stab_ctx *c, const ob_stab_world_desc *desc);
 /* Waits idle, adds the validation layer's counts to the run, frees all. */
 void ob_stab_world_destroy(ob_stab_world *w);
-
-ob_material *ob_stab_material_desc(ob_stab_world *w, const ob_material_desc *md);
-/* No specular highlight, as the tests' materials. */
-ob_material *ob_stab_material(ob_stab_world *w, const char *name, ob_material_kind kind, float r,
-                              float g, float b, bool casts_shadows);
-ob_node *ob_stab_entity(ob_stab_world *w, ob_node *parent, const char *name, ob_geometry *g,
-                        ob_material *m, double x, double y, double z);
-/* White light named "sun" (directional, aimed at the origin) or "lamp". */
-ob_node *ob_stab_light(ob_stab_world *w, ob_light_type type, bool shadows, float intensity,
-                       double x, double y, double z);
-void ob_stab_look(ob_stab_world *w, double ex, double ey, double ez, double tx, double ty,
-                  double tz);
 
 /* NULL-tolerant setters. */
 void ob_stab_position(ob_node *n, double x, double y, double z);
@@ -110,21 +98,11 @@ void ob_stab_hide(ob_node *n, bool hidden);
 const ob_frame_stats *ob_stab_frame(ob_stab_world *w, ob_threading mode);
 const ob_frame_stats *ob_stab_frame_with(ob_stab_world *w, ob_threading mode,
                                          ob_view *const *extra, uint32_t extra_count);
-/* Reads the final image into w->pixels and returns an ob_malloc'ed copy
- * (ob_free it); NULL after a failure. */
+/* Reads the final image into w->world.pixels and returns an ob_malloc'ed
+ * copy (ob_free it); NULL after a failure. */
 uint8_t *ob_stab_snapshot(ob_stab_world *w);
 /* Renders one frame single-threaded and returns its snapshot. */
 uint8_t *ob_stab_render(ob_stab_world *w, const ob_frame_stats **out_stats);
-
-const ob_view_stats *ob_stab_view_stats(const ob_frame_stats *st, const char *name);
-ob_skip_reason ob_stab_skip_reason(const ob_frame_stats *st, const char *name);
-
-/* RGBA8 images of n pixels: largest channel difference (alpha included, as
- * the tests), pixels with a channel differing by more than tol, and pixels
- * black in b where a is not (how a NaN colour shows in UNORM8). */
-uint32_t ob_stab_max_diff(const uint8_t *a, const uint8_t *b, uint32_t n);
-uint32_t ob_stab_diff_count(const uint8_t *a, const uint8_t *b, uint32_t n, uint32_t tol);
-uint32_t ob_stab_nan_black(const uint8_t *a, const uint8_t *b, uint32_t n);
 
 /* The cases, in report order. Each adds its rows; a returned failure ends
  * the run. */

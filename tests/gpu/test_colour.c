@@ -51,7 +51,7 @@ static ob_material *unlit(ob_test_world *w, const char *name, float r, float g, 
  * through the origin: left of the edge the clear colour, right the plane. */
 static ob_node *half_plane(ob_test_world *w, ob_material *m, double angle)
 {
-    ob_node *n = ob_test_world_entity(w, NULL, "half-plane", w->plane, m, 10.0 * cos(angle),
+    ob_node *n = ob_world_entity(w, NULL, "half-plane", w->plane, m, 10.0 * cos(angle),
                                       10.0 * sin(angle), 0.0);
     double s = sin(OB_PI / 4), c = cos(OB_PI / 4);
     double sz = sin(angle / 2), cz = cos(angle / 2);
@@ -72,7 +72,7 @@ static void assert_all_near(const ob_test_world *w, double want, double tol, con
 {
     for (uint32_t y = 0; y < w->height; y++)
         for (uint32_t x = 0; x < w->width; x++) {
-            const uint8_t *p = ob_test_world_pixel(w, x, y);
+            const uint8_t *p = ob_world_pixel(w, x, y);
             for (int i = 0; i < 3; i++)
                 if (fabs(p[i] - want) > tol)
                     fail_msg("%s: pixel (%u,%u) channel %d is %u, expected %.2f +- %.0f", what, x,
@@ -89,15 +89,15 @@ static void linear_half_reads_back_as_188(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.clear_color = {0.5f, 0.5f, 0.5f, 1.0f}});
-    ob_test_world_look(&w, 0, 0, 5, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 5, 0, 0, 0);
     half_plane(&w, unlit(&w, "grey", 0.5f, 0.5f, 0.5f), 0.0);
     ob_composite_view_set_tonemap(w.composite, false);
     assert_true(ob_composite_view_set_exposure(w.composite, 1.0f));
     for (int mode = 0; mode < 2; mode++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        assert_int_equal(ob_test_view_stats(st, "main")->draws, 1);
-        ob_test_world_read(&w);
+        assert_int_equal(ob_world_view_stats(st, "main")->draws, 1);
+        ob_world_read(&w);
         assert_near(level(srgb_encode(0.5)), 187.5, 0.1);
         assert_all_near(&w, 188.0, 1.0, "linear 0.5, tone map off");
     }
@@ -130,7 +130,7 @@ static void tone_map_follows_the_documented_formula(void **state)
         for (size_t i = 0; i < OB_ARRAY_COUNT(values); i++) {
             set_clear(&w, values[i]);
             ob_test_world_frame(&w, (i + e) % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-            ob_test_world_read(&w);
+            ob_world_read(&w);
             double want = level(srgb_encode(aces((double)exposures[e] * values[i])));
             char what[64];
             snprintf(what, sizeof what, "value %g at exposure %g", (double)values[i],
@@ -138,8 +138,8 @@ static void tone_map_follows_the_documented_formula(void **state)
             assert_all_near(&w, want, 1.0, what);
             /* The engine's CPU mirror of the curve agrees too. */
             assert_near(ob_composite_view_output_level(w.composite, values[i]), want, 1.0);
-            if (e == 0 && values[i] == 1.0f) got_at[0] = ob_test_world_pixel(&w, 0, 0)[0];
-            if (e == 0 && values[i] == 4.0f) got_at[1] = ob_test_world_pixel(&w, 0, 0)[0];
+            if (e == 0 && values[i] == 1.0f) got_at[0] = ob_world_pixel(&w, 0, 0)[0];
+            if (e == 0 && values[i] == 4.0f) got_at[1] = ob_world_pixel(&w, 0, 0)[0];
         }
     }
     assert_true(got_at[1] > got_at[0] + 10.0);
@@ -163,16 +163,16 @@ static coverage edge_coverage(uint32_t msaa)
 {
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.clear_color = {0, 0, 0, 1}, .msaa = msaa});
-    ob_test_world_look(&w, 0, 0, 5, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 5, 0, 0, 0);
     half_plane(&w, unlit(&w, "white", 1.0f, 1.0f, 1.0f), 0.15);
     ob_composite_view_set_tonemap(w.composite, false);
     assert_int_equal(ob_perspective_view_samples(w.main), msaa);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     coverage c = {{0}, 0};
     for (uint32_t y = 0; y < w.height; y++)
         for (uint32_t x = 0; x < w.width; x++) {
-            double l = srgb_decode(ob_test_world_pixel(&w, x, y)[1] / 255.0);
+            double l = srgb_decode(ob_world_pixel(&w, x, y)[1] / 255.0);
             double k = round(l * 4.0);
             if (fabs(l - k / 4.0) < 0.01) c.levels[(int)k]++;
             else c.off_level++;
@@ -247,12 +247,12 @@ static void msaa_is_clamped_with_a_message(void **state)
 
 static void lit_scene(ob_test_world *w)
 {
-    ob_test_world_look(w, 0, 2, 5, 0, 0, 0);
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
-    ob_material *red = ob_test_world_material(w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
-    ob_material *grey = ob_test_world_material(w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, true);
-    ob_test_world_entity(w, NULL, "box", w->box, red, 0, 0.5, 0);
-    ob_test_world_entity(w, NULL, "ground", w->plane, grey, 0, 0, 0);
+    ob_world_look(w, 0, 2, 5, 0, 0, 0);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *red = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+    ob_material *grey = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, true);
+    ob_world_entity(w, NULL, "box", w->box, red, 0, 0.5, 0);
+    ob_world_entity(w, NULL, "ground", w->plane, grey, 0, 0, 0);
 }
 
 /* The image a fresh world of that size renders of lit_scene. */
@@ -262,7 +262,7 @@ static uint8_t *fresh_image(uint32_t width, uint32_t height, uint32_t msaa)
     ob_test_world_create(&w, &(ob_test_world_desc){.width = width, .height = height, .msaa = msaa});
     lit_scene(&w);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *img = ob_test_world_snapshot(&w);
+    uint8_t *img = ob_world_snapshot(&w);
     ob_test_world_destroy(&w);
     return img;
 }
@@ -285,7 +285,7 @@ static void resize_mid_run_renders_the_new_size(void **state)
         /* Nothing changes until the next frame. */
         assert_int_equal(ob_perspective_view_base(w.main)->width, 160);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(w.width, 96);
         assert_int_equal(w.height, 64);
         assert_int_equal(ob_perspective_view_base(w.main)->width, 96);
@@ -295,7 +295,7 @@ static void resize_mid_run_renders_the_new_size(void **state)
         assert_true(ob_view_resize(ob_composite_view_base(w.composite), 200, 150));
         ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(w.width, 200);
         assert_int_equal(w.height, 150);
         assert_int_equal(ob_test_image_max_diff(w.pixels, want_big, 200, 150), 0);
@@ -304,7 +304,7 @@ static void resize_mid_run_renders_the_new_size(void **state)
         assert_false(ob_stack_resize(w.stack, 0, 10));
         assert_true(ob_test_log_has("resize", "refused", NULL));
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(w.width, 200);
         ob_test_world_destroy(&w);
         free(want_small);
@@ -330,16 +330,16 @@ static void msaa_4x_same_in_st_and_mt(void **state)
         ob_material *mirror = ob_material_create(
             w.lib, &(ob_material_desc){.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE}, &r);
         assert_non_null(mirror);
-        ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror, 1.2, 0.6, 0.3);
-        ob_test_world_entity(&w, NULL, "box2", w.box, mirror, -1.3, 0.5, -0.5);
+        ob_world_entity(&w, NULL, "mirror", w.sphere, mirror, 1.2, 0.6, 0.3);
+        ob_world_entity(&w, NULL, "box2", w.box, mirror, -1.3, 0.5, -0.5);
         const ob_frame_stats *st = NULL;
         for (int f = 0; f < 3; f++)
             st = ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 2);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 2);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
         assert_int_equal(ob_perspective_view_samples(w.main), 4);
         hash[mode] = st->frame_hash;
-        img[mode] = ob_test_world_snapshot(&w);
+        img[mode] = ob_world_snapshot(&w);
         ob_test_world_destroy(&w);
     }
     assert_int_equal(ob_test_image_max_diff(img[0], img[1], 160, 120), 0);

@@ -45,21 +45,21 @@ static float random01(uint32_t *s) { return (float)next_random(s) / (float)(1u <
 
 static void build_scene(ob_test_world *w, ob_particle_system **out_ps)
 {
-    ob_test_world_look(w, 0, 7, 14, 0, 0.5, 0);
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 6, 12, 4);
-    ob_test_world_light(w, OB_LIGHT_POINT, false, 2.0f, -3, 2, 2);
+    ob_world_look(w, 0, 7, 14, 0, 0.5, 0);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 6, 12, 4);
+    ob_world_light(w, OB_LIGHT_POINT, false, 2.0f, -3, 2, 2);
     ob_result r;
     ob_material *palette[8];
     for (int i = 0; i < 6; i++)
-        palette[i] = ob_test_world_material(w, OB_MATERIAL_LIT, 0.2f + 0.13f * (float)i,
+        palette[i] = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.2f + 0.13f * (float)i,
                                             0.9f - 0.12f * (float)i, 0.3f + 0.1f * (float)(i % 3),
                                             i != 5);
-    palette[6] = ob_test_world_material(w, OB_MATERIAL_UNLIT, 0.95f, 0.85f, 0.2f, true);
+    palette[6] = ob_world_material(w, "test", OB_MATERIAL_UNLIT, 0.95f, 0.85f, 0.2f, true);
     palette[7] = ob_material_create(w->lib, &(ob_material_desc){.name = "glass",
         .kind = OB_MATERIAL_LIT, .diffuse = {0.4f, 0.6f, 0.9f, 0.5f}, .blended = true}, &r);
     assert_non_null(palette[7]);
-    ob_material *ground = ob_test_world_material(w, OB_MATERIAL_LIT, 0.55f, 0.55f, 0.5f, false);
-    ob_test_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.6, 0);
+    ob_material *ground = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.55f, 0.55f, 0.5f, false);
+    ob_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.6, 0);
     ob_material *mirror = ob_material_create(w->lib, &(ob_material_desc){.name = "mirror",
         .kind = OB_MATERIAL_REFLECTIVE, .reflectivity = 0.8f, .casts_shadows = true}, &r);
     assert_non_null(mirror);
@@ -67,7 +67,7 @@ static void build_scene(ob_test_world *w, ob_particle_system **out_ps)
     for (int i = 0; i < 3; i++) {
         char name[16];
         snprintf(name, sizeof name, "mirror%d", i);
-        ob_node *m = ob_test_world_entity(w, NULL, name, w->sphere, mirror, mirrors[i][0],
+        ob_node *m = ob_world_entity(w, NULL, name, w->sphere, mirror, mirrors[i][0],
                                           mirrors[i][1], mirrors[i][2]);
         ob_node_set_scale(m, (const float[3]){1.6f, 1.6f, 1.6f});
     }
@@ -77,7 +77,7 @@ static void build_scene(ob_test_world *w, ob_particle_system **out_ps)
         snprintf(name, sizeof name, "object%u", i);
         ob_geometry *g = i % 3 == 0 ? w->sphere : w->box;
         ob_material *m = palette[next_random(&seed) % 8];
-        ob_node *n = ob_test_world_entity(w, NULL, name, g, m, 0, 0, 0);
+        ob_node *n = ob_world_entity(w, NULL, name, g, m, 0, 0, 0);
         ob_node_set_scale(n, (const float[3]){0.3f, 0.3f, 0.3f});
         double radius = 3.0 + 5.0 * random01(&seed);
         double center[3] = {0.0, 0.2 + 2.0 * random01(&seed), 0.0};
@@ -110,7 +110,7 @@ static void run(const run_plan *plan, run_result *out)
     for (int f = 0; f < FRAMES; f++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, plan->modes[f], plan->workers[f]);
         out->stats[f] = *st;
-        out->images[f] = ob_test_world_snapshot(&w);
+        out->images[f] = ob_world_snapshot(&w);
         /* The mode asked for is the mode used (AUTO decides for itself). */
         if (plan->modes[f] == OB_THREADING_SINGLE) assert_int_equal(st->workers, 0);
         if (plan->modes[f] == OB_THREADING_MULTI)
@@ -132,10 +132,10 @@ static void check_reference(const run_result *ref)
 {
     for (int f = 0; f < FRAMES; f++) {
         const ob_frame_stats *st = &ref->stats[f];
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 3);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_SIMULATION), 1);
-        assert_true(ob_test_view_stats(st, "main")->draws > 200);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 3);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SIMULATION), 1);
+        assert_true(ob_world_view_stats(st, "main")->draws > 200);
         assert_int_equal(st->pm.skipped_draws, 0);
         if (f > 0)
             assert_true(ob_test_image_max_diff(ref->images[f - 1], ref->images[f], WIDTH, HEIGHT) > 0);
@@ -193,7 +193,7 @@ static void same_frames_in_every_threading_mode(void **state)
         run(&plan, &got);
         /* Chunked: the main view was recorded as several secondaries. */
         for (int f = 0; f < FRAMES; f++)
-            assert_true(ob_test_view_stats(&got.stats[f], "main")->chunks > 1);
+            assert_true(ob_world_view_stats(&got.stats[f], "main")->chunks > 1);
         assert_same(&ref, &got, name);
         release(&got);
     }

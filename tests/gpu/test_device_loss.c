@@ -67,17 +67,17 @@ static void assert_same_as_reference(const fixture *fx, ob_test_stack *s)
 /* The device is lost: everything that would use it says so. */
 static void assert_refused(ob_test_stack *s)
 {
-    assert_true(ob_device_is_lost(s->dev));
+    assert_true(ob_device_is_lost(s->world.dev));
     ob_test_log_clear();
     assert_int_equal(ob_test_stack_frame(s, OB_THREADING_SINGLE, 0), OB_ERR_DEVICE_LOST);
     assert_true(ob_test_log_has("[renderer]", "device is lost", NULL));
     assert_int_equal(ob_test_stack_frame(s, OB_THREADING_MULTI, 0), OB_ERR_DEVICE_LOST);
-    assert_int_equal(ob_renderer_wait_idle(s->r), OB_ERR_DEVICE_LOST);
+    assert_int_equal(ob_renderer_wait_idle(s->world.r), OB_ERR_DEVICE_LOST);
 
     ob_mesh m = {0};
     assert_int_equal(ob_mesh_box((const float[3]){1, 1, 1}, &m), OB_OK);
     ob_result r;
-    ob_geometry *g = ob_geometry_create(s->dev, &(ob_geometry_desc){.mesh = &m, .name = "late"}, &r);
+    ob_geometry *g = ob_geometry_create(s->world.dev, &(ob_geometry_desc){.mesh = &m, .name = "late"}, &r);
     ob_mesh_release(&m);
     assert_null(g);
     assert_int_equal(r, OB_ERR_DEVICE_LOST);
@@ -96,7 +96,7 @@ static ob_result frame_failing_at_submit(ob_test_stack *s, ob_threading mode, ob
     if (r != OB_OK) fail_msg("frame %llu did not begin: %s", (unsigned long long)s->frames - 1, ob_result_name(r));
     ob_test_log_clear();
     ob_fault_arm(kind, 1);
-    r = ob_renderer_end_frame(s->r);
+    r = ob_renderer_end_frame(s->world.r);
     bool hit = ob_fault_hit(kind);
     ob_fault_arm(kind, 0);
     assert_true(hit);
@@ -145,10 +145,10 @@ static void lost_at_wait_idle(void **state)
     ob_test_stack s;
     start(&s);
     assert_int_equal(ob_test_stack_frame_begin(&s, OB_THREADING_MULTI, 0), OB_OK);
-    assert_int_equal(ob_renderer_end_frame(s.r), OB_OK);
+    assert_int_equal(ob_renderer_end_frame(s.world.r), OB_OK);
     ob_test_log_clear();
     ob_fault_arm(OB_FAULT_DEVICE_LOST, 1);
-    ob_result r = ob_renderer_wait_idle(s.r);
+    ob_result r = ob_renderer_wait_idle(s.world.r);
     assert_true(ob_fault_hit(OB_FAULT_DEVICE_LOST));
     ob_fault_arm(OB_FAULT_DEVICE_LOST, 0);
     assert_int_equal(r, OB_ERR_DEVICE_LOST);
@@ -169,7 +169,7 @@ static void lost_during_upload(void **state)
     ob_test_log_clear();
     ob_fault_arm(OB_FAULT_DEVICE_LOST, 1);
     ob_result r;
-    ob_geometry *g = ob_geometry_create(s.dev, &(ob_geometry_desc){.mesh = &m, .name = "ball"}, &r);
+    ob_geometry *g = ob_geometry_create(s.world.dev, &(ob_geometry_desc){.mesh = &m, .name = "ball"}, &r);
     assert_true(ob_fault_hit(OB_FAULT_DEVICE_LOST));
     ob_fault_arm(OB_FAULT_DEVICE_LOST, 0);
     ob_mesh_release(&m);
@@ -191,8 +191,8 @@ static void submit_oom(fixture *fx, ob_threading mode)
         ob_result r = frame_failing_at_submit(&s, mode, OB_FAULT_SUBMIT_OOM);
         assert_int_equal(r, OB_ERR_OUT_OF_DEVICE_MEMORY);
         assert_true(ob_test_log_has("[renderer]", "not submitted", NULL));
-        assert_false(ob_device_is_lost(s.dev));
-        assert_int_equal(ob_renderer_wait_idle(s.r), OB_OK);
+        assert_false(ob_device_is_lost(s.world.dev));
+        assert_int_equal(ob_renderer_wait_idle(s.world.r), OB_OK);
         assert_int_equal(ob_test_stack_frame(&s, mode, 0), OB_OK);
         assert_same_as_reference(fx, &s);
         assert_int_equal(ob_test_stack_frame(&s, mode, 0), OB_OK);
@@ -243,7 +243,7 @@ static void device_loss_walk(void **state)
         if (n > 0) {
             if (!hit) fail_msg("point %llu of %llu never reached", (unsigned long long)n, (unsigned long long)count);
             if (!lost) fail_msg("point %llu: the loss was not reported", (unsigned long long)n);
-            assert_true(ob_device_is_lost(s.dev));
+            assert_true(ob_device_is_lost(s.world.dev));
             assert_true(ob_test_log_has("[device]", "lost", NULL));
             lost_in_build += lost_building;
             lost_in_frames += !lost_building;
@@ -296,7 +296,7 @@ static void submit_oom_walk(void **state)
         if (n > 0 && !ob_test_log_has("out of device memory", NULL) &&
             !ob_test_log_has("VK_ERROR_OUT_OF_DEVICE_MEMORY", NULL))
             fail_msg("point %llu: the failure was not logged", (unsigned long long)n);
-        assert_false(ob_device_is_lost(s.dev));
+        assert_false(ob_device_is_lost(s.world.dev));
         stop_clean(&s);
     }
     assert_true(count > 0);

@@ -36,7 +36,7 @@ static ob_geometry *extended(ob_test_world *w, ob_mesh *m, const char *name, con
         static const uint8_t white[4] = {255, 255, 255, 255};
         memcpy(m->colors[i], tint ? tint : white, 4);
     }
-    ob_geometry *g = ob_test_world_geometry(w, m, name);
+    ob_geometry *g = ob_world_geometry(w, m, name);
     ob_mesh_release(m);
     return g;
 }
@@ -70,7 +70,7 @@ static ob_material *pbr(ob_test_world *w, const char *name, const ob_material_pb
 static ob_node *facing_quad(ob_test_world *w, const char *name, ob_geometry *g, ob_material *m, double x, double y,
                             double z, bool away)
 {
-    ob_node *n = ob_test_world_entity(w, NULL, name, g, m, x, y, z);
+    ob_node *n = ob_world_entity(w, NULL, name, g, m, x, y, z);
     const float s = sqrtf(0.5f);
     /* +90 degrees about X takes +Y to +Z; -90 turns it away. */
     ob_node_set_rotation(n, (const float[4]){away ? -s : s, 0, 0, s});
@@ -104,11 +104,11 @@ static void ball_under_sun(ob_test_world *w, const char *name, const ob_material
                            double ly, double lz, const char *dump_name)
 {
     ob_test_world_create(w, &(ob_test_world_desc){.width = 160, .height = 120});
-    ob_test_world_entity(w, NULL, "ball", ext_sphere(w), pbr(w, name, p, false, 0), 0, 0, 0);
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, false, intensity, lx, ly, lz);
-    ob_test_world_look(w, 0, 0, 2.5, 0, 0, 0);
+    ob_world_entity(w, NULL, "ball", ext_sphere(w), pbr(w, name, p, false, 0), 0, 0, 0);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, false, intensity, lx, ly, lz);
+    ob_world_look(w, 0, 0, 2.5, 0, 0, 0);
     ob_test_world_frame(w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(w);
+    ob_world_read(w);
     dump(w, dump_name);
 }
 
@@ -122,8 +122,8 @@ static void lit_side_is_brighter(void **state)
     p.roughness = 0.6f;
     ob_test_world w;
     ball_under_sun(&w, "clay", &p, 2.0f, 5, 0, 0, __func__);
-    float right = luminance(ob_test_world_pixel(&w, 80 + 14, 60));
-    float left = luminance(ob_test_world_pixel(&w, 80 - 14, 60));
+    float right = luminance(ob_world_pixel(&w, 80 + 14, 60));
+    float left = luminance(ob_world_pixel(&w, 80 - 14, 60));
     if (!(right > left + 40.0f)) fail_msg("lit side %.0f, unlit side %.0f", right, left);
     ob_test_world_destroy(&w);
 }
@@ -144,7 +144,7 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     float best = -1.0f;
     for (uint32_t y = 30; y < 90; y++)
         for (uint32_t x = 50; x < 110; x++) {
-            float l = luminance(ob_test_world_pixel(&w, x, y));
+            float l = luminance(ob_world_pixel(&w, x, y));
             if (l > best) best = l, bx = x, by = y;
         }
     /* The half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a sphere of
@@ -155,7 +155,7 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     float ex = 80.0f + radius_px * h[0] / hl, ey = 60.0f - radius_px * h[1] / hl;
     if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
         fail_msg("highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
-    float opposite = luminance(ob_test_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
+    float opposite = luminance(ob_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
     if (!(best > 200.0f && opposite < best - 80.0f))
         fail_msg("highlight %.0f, the opposite side %.0f", best, opposite);
     ob_test_world_destroy(&w);
@@ -208,14 +208,14 @@ static void alpha_mask_cuts_out(void **state)
     ob_material *leaf = leaf_world(&w, &cache, false);
     ob_result r;
     facing_quad(&w, "leaf", ext_quad(&w, 1.0f, "leaf quad"), leaf, 0, 0, 0, false);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     dump(&w, __func__);
     uint8_t bg[4];
-    memcpy(bg, ob_test_world_pixel(&w, 2, 2), 4);
-    const uint8_t *cut = ob_test_world_pixel(&w, 80 - 8, 60);
-    const uint8_t *kept = ob_test_world_pixel(&w, 80 + 8, 60);
+    memcpy(bg, ob_world_pixel(&w, 2, 2), 4);
+    const uint8_t *cut = ob_world_pixel(&w, 80 - 8, 60);
+    const uint8_t *kept = ob_world_pixel(&w, 80 + 8, 60);
     if (!same_rgb(cut, bg, 0)) fail_msg("cut-out half (%u, %u, %u) is not the background", cut[0], cut[1], cut[2]);
     if (!(kept[1] > bg[1] + 60)) fail_msg("kept half (%u, %u, %u) is not the green quad", kept[0], kept[1], kept[2]);
     char effect[96];
@@ -237,17 +237,17 @@ static uint8_t *mask_shadow_scene(bool shadows)
     ob_texture_cache *cache;
     ob_material *leaf = leaf_world(&w, &cache, true);
     /* Horizontal (the plane faces +Y), one unit above the ground. */
-    ob_test_world_entity(&w, NULL, "leaf", ext_quad(&w, 2.0f, "leaf quad"), leaf, 0, 1, 0);
+    ob_world_entity(&w, NULL, "leaf", ext_quad(&w, 2.0f, "leaf quad"), leaf, 0, 1, 0);
     ob_material_pbr g = ob_material_pbr_defaults();
     g.metallic = 0.0f;
     g.base_color[0] = g.base_color[1] = g.base_color[2] = 0.4f;
-    ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 12.0f, "ground quad"), pbr(&w, "ground", &g, true, 0), 0,
+    ob_world_entity(&w, NULL, "ground", ext_quad(&w, 12.0f, "ground quad"), pbr(&w, "ground", &g, true, 0), 0,
                          0, 0);
     /* From behind and above: the shadow falls toward the camera. */
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 1.5f, 0, 10, -8);
-    ob_test_world_look(&w, 0, 5, 5, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 1.5f, 0, 10, -8);
+    ob_world_look(&w, 0, 5, 5, 0, 0, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *img = ob_test_world_snapshot(&w);
+    uint8_t *img = ob_world_snapshot(&w);
     dump(&w, shadows ? "mask_shadow_on" : "mask_shadow_off");
     ob_texture_cache_destroy(cache);   /* before the device goes */
     ob_test_world_destroy(&w);
@@ -290,15 +290,15 @@ static void blend_sorts_back_to_front(void **state)
     ob_geometry *q = ext_quad(&w, 1.0f, "glass quad");
     facing_quad(&w, "front", q, pbr(&w, "green glass", &green, false, 0), 0.25, 0, 0.5, false);
     facing_quad(&w, "back", q, pbr(&w, "red glass", &red, false, 0), -0.25, 0, 0, false);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     dump(&w, __func__);
-    const uint8_t *overlap = ob_test_world_pixel(&w, 80, 60);
+    const uint8_t *overlap = ob_world_pixel(&w, 80, 60);
     if (!(overlap[1] > overlap[0] + 20))
         fail_msg("overlap (%u, %u, %u): the front (green) layer should dominate", overlap[0], overlap[1], overlap[2]);
     /* Each quad alone where they do not overlap: half of its colour over the background. */
-    const uint8_t *only_red = ob_test_world_pixel(&w, 80 - 30, 60);
+    const uint8_t *only_red = ob_world_pixel(&w, 80 - 30, 60);
     assert_true(only_red[0] > only_red[1] + 20);
     ob_test_world_destroy(&w);
 }
@@ -315,12 +315,12 @@ static void double_sided_shows_the_back(void **state)
         p.metallic = 0.0f;
         p.double_sided = ds;
         facing_quad(&w, "card", ext_quad(&w, 1.0f, "card quad"), pbr(&w, "card", &p, false, 0), 0, 0, 0, true);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 0, 0, 5);
-        ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 0, 0, 5);
+        ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
     dump(&w, __func__);
-        const uint8_t *bg = ob_test_world_pixel(&w, 2, 2), *mid = ob_test_world_pixel(&w, 80, 60);
+        const uint8_t *bg = ob_world_pixel(&w, 2, 2), *mid = ob_world_pixel(&w, 80, 60);
         if (ds && !(luminance(mid) > luminance(bg) + 80))
             fail_msg("double-sided back face (%u, %u, %u) is not lit", mid[0], mid[1], mid[2]);
         if (!ds && !same_rgb(mid, bg, 0)) fail_msg("single-sided back face was drawn");
@@ -344,12 +344,12 @@ static void shadow_map_feeds_pbr(void **state)
         ob_material *m = pbr(&w, "stone", &p, true, 0);
         ob_mesh box;
         assert_int_equal(ob_mesh_box((const float[3]){0.5f, 0.5f, 0.5f}, &box), OB_OK);
-        ob_test_world_entity(&w, NULL, "box", extended(&w, &box, "pbr box", NULL), m, 0, 0.5, 0);
-        ob_node *ground = ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 10.0f, "ground quad"), m, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 2.0f, 3, 6, 2);
-        ob_test_world_look(&w, 0, 4, 5, 0, 0, 0);
+        ob_world_entity(&w, NULL, "box", extended(&w, &box, "pbr box", NULL), m, 0, 0.5, 0);
+        ob_node *ground = ob_world_entity(&w, NULL, "ground", ext_quad(&w, 10.0f, "ground quad"), m, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, shadows, 2.0f, 3, 6, 2);
+        ob_world_look(&w, 0, 4, 5, 0, 0, 0);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        img[shadows] = ob_test_world_snapshot(&w);
+        img[shadows] = ob_world_snapshot(&w);
         dump(&w, shadows ? "shadow_on" : "shadow_off");
         ob_result r;
         const char *name = ob_effect_name(
@@ -379,21 +379,21 @@ static void environment_map_feeds_pbr(void **state)
     ob_material_pbr chrome = ob_material_pbr_defaults();
     chrome.roughness = 0.05f;
     ob_material *mirror = pbr(&w, "chrome", &chrome, false, 1.0f);
-    ob_node *ball = ob_test_world_entity(&w, NULL, "ball", ext_sphere(&w), mirror, 0, 0, 0);
+    ob_node *ball = ob_world_entity(&w, NULL, "ball", ext_sphere(&w), mirror, 0, 0, 0);
     ob_material_pbr glow = ob_material_pbr_defaults();
     glow.base_color[0] = glow.base_color[1] = glow.base_color[2] = 0.0f;
     glow.metallic = 0.0f;
     glow.emissive[0] = 1.0f;
     ob_mesh box;
     assert_int_equal(ob_mesh_box((const float[3]){0.5f, 1.0f, 1.0f}, &box), OB_OK);
-    ob_test_world_entity(&w, NULL, "red wall", extended(&w, &box, "wall", NULL), pbr(&w, "glow", &glow, false, 0),
+    ob_world_entity(&w, NULL, "red wall", extended(&w, &box, "wall", NULL), pbr(&w, "glow", &glow, false, 0),
                          1.5, 0, 0);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_true(ob_test_count_views(st, OB_VIEW_PARABOLOID) >= 1);
-    ob_test_world_read(&w);
+    assert_true(ob_world_count_views(st, OB_VIEW_PARABOLOID) >= 1);
+    ob_world_read(&w);
     dump(&w, __func__);
-    const uint8_t *toward = ob_test_world_pixel(&w, 80 + 16, 60), *away = ob_test_world_pixel(&w, 80 - 16, 60);
+    const uint8_t *toward = ob_world_pixel(&w, 80 + 16, 60), *away = ob_world_pixel(&w, 80 - 16, 60);
     /* Redness (red over green), so the check holds through tone mapping too. */
     if (!((int)toward[0] - (int)toward[1] > (int)away[0] - (int)away[1] + 30))
         fail_msg("side facing the red wall (%u, %u, %u), other side (%u, %u, %u)", toward[0], toward[1], toward[2],
@@ -435,19 +435,19 @@ static void st_and_mt_are_byte_identical(void **state)
     for (int i = 0; i < 40; i++) {
         char name[16];
         snprintf(name, sizeof name, "ball %d", i);
-        ob_test_world_entity(&w, NULL, name, ball, mats[i % 4], (i % 8) - 3.5, 0.5 * (i / 8) - 1.0, -(i % 3));
+        ob_world_entity(&w, NULL, name, ball, mats[i % 4], (i % 8) - 3.5, 0.5 * (i / 8) - 1.0, -(i % 3));
     }
-    ob_test_world_entity(&w, NULL, "ground", ext_quad(&w, 20.0f, "ground quad"), mats[0], 0, -1.6, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 2.0f, 2, 6, 3);
-    ob_test_world_look(&w, 0, 1, 7, 0, 0, 0);
+    ob_world_entity(&w, NULL, "ground", ext_quad(&w, 20.0f, "ground quad"), mats[0], 0, -1.6, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 2.0f, 2, 6, 3);
+    ob_world_look(&w, 0, 1, 7, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint64_t st_hash = st->frame_hash;
-    uint8_t *single = ob_test_world_snapshot(&w);
+    uint8_t *single = ob_world_snapshot(&w);
     st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
     uint64_t mt_hash = st->frame_hash;
-    uint8_t *multi = ob_test_world_snapshot(&w);
+    uint8_t *multi = ob_world_snapshot(&w);
     assert_int_equal(st_hash, mt_hash);
-    assert_int_equal(ob_test_image_diff_count(single, multi, 160, 120, 0), 0);
+    assert_int_equal(ob_rgba_diff_count(single, multi, 160 * 120, 0), 0);
     free(single);
     free(multi);
     ob_texture_cache_destroy(cache);   /* before the device goes */
@@ -468,8 +468,8 @@ static void variants_only_use_what_the_material_uses(void **state)
     textured.base_color_texture.texture = half_transparent(cache);
     ob_material *mp = pbr(&w, "plain", &plain, false, 0), *mt = pbr(&w, "textured", &textured, false, 0);
     ob_geometry *ball = ext_sphere(&w);
-    ob_node *a = ob_test_world_entity(&w, NULL, "a", ball, mp, -0.6, 0, 0);
-    ob_node *b = ob_test_world_entity(&w, NULL, "b", ball, mt, 0.6, 0, 0);
+    ob_node *a = ob_world_entity(&w, NULL, "a", ball, mp, -0.6, 0, 0);
+    ob_node *b = ob_world_entity(&w, NULL, "b", ball, mt, 0.6, 0, 0);
     ob_node_set_hidden(a, true);
     ob_node_set_hidden(b, true);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);   /* the composite's own effect, first */
@@ -489,7 +489,7 @@ static void variants_only_use_what_the_material_uses(void **state)
     assert_null(strstr(left, "base colour texture"));
     /* The same feature set in another material shares the variant. */
     ob_material *mp2 = pbr(&w, "plain too", &plain, false, 0);
-    ob_test_world_entity(&w, NULL, "c", ball, mp2, 0, 0.8, 0);
+    ob_world_entity(&w, NULL, "c", ball, mp2, 0, 0.8, 0);
     before = ob_effect_context_counters(w.fx).variants_compiled;
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_int_equal(ob_effect_context_counters(w.fx).variants_compiled - before, 0);
@@ -544,11 +544,11 @@ static float quad_with_map(int map, bool sun)
         break;
     }
     facing_quad(&w, "card", ext_quad(&w, 2.0f, "card quad"), pbr(&w, "card", &p, false, 0), 0, 0, 0, false);
-    if (sun) ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 5, 0, 0.5);
-    ob_test_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    if (sun) ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 2.0f, 5, 0, 0.5);
+    ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
-    const uint8_t *mid = ob_test_world_pixel(&w, 32, 24);
+    ob_world_read(&w);
+    const uint8_t *mid = ob_world_pixel(&w, 32, 24);
     float l = map == MAP_EMISSIVE ? (float)mid[0] - (float)mid[1] : luminance(mid);
     ob_texture_cache_destroy(cache);   /* before the device goes */
     ob_test_world_destroy(&w);
@@ -616,9 +616,9 @@ static ob_geometry *extended_or_error(ob_stack *s, ob_result made, ob_mesh *m, c
 
 static ob_result pbr_stack_build(pbr_stack *ps)
 {
-    ob_stack *s = ps->t.stack;
+    ob_stack *s = ps->t.world.stack;
     ob_result r;
-    ps->cache = ob_texture_cache_create(ps->t.dev, &r);
+    ps->cache = ob_texture_cache_create(ps->t.world.dev, &r);
     if (!ps->cache) return r;
     const ob_texture *tex[2] = {NULL, NULL};
     for (int i = 0; i < 2; i++) {
@@ -665,7 +665,7 @@ static ob_result pbr_stack_build(pbr_stack *ps)
 
 static void pbr_stack_stop(pbr_stack *ps)
 {
-    if (ps->t.r) ob_renderer_wait_idle(ps->t.r);
+    if (ps->t.world.r) ob_renderer_wait_idle(ps->t.world.r);
     ob_texture_cache_destroy(ps->cache);
     ps->cache = NULL;
     ob_test_stack_stop(&ps->t);

@@ -25,11 +25,11 @@ static void add_grid(ob_test_world *w, uint32_t count, ob_material **materials,
         char name[32];
         snprintf(name, sizeof name, "box%u", i);
         double x = ((double)(i % GRID_COLUMNS) - 4.5) * 1.2, z = -(double)(i / GRID_COLUMNS) * 1.2;
-        ob_test_world_entity(w, NULL, name, w->box, materials[i % material_count], x, 0.0, z);
+        ob_world_entity(w, NULL, name, w->box, materials[i % material_count], x, 0.0, z);
     }
 }
 
-static void frame_camera(ob_test_world *w) { ob_test_world_look(w, 0, 12, 8, 0, 0, -5); }
+static void frame_camera(ob_test_world *w) { ob_world_look(w, 0, 12, 8, 0, 0, -5); }
 
 /* a - b, field by field (every field of ob_pipeline_manager_stats is a counter). */
 static ob_pipeline_manager_stats pm_minus(ob_pipeline_manager_stats a, const ob_pipeline_manager_stats *b)
@@ -59,7 +59,7 @@ static ob_pipeline_manager_stats pm_minus(ob_pipeline_manager_stats a, const ob_
 static ob_pipeline_manager_stats composite_only(ob_test_world *w, ob_threading mode, uint32_t workers)
 {
     const ob_frame_stats *st = ob_test_world_frame(w, mode, workers);
-    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
     assert_non_null(main);
     assert_int_equal(main->draws, 0);
     assert_int_equal(st->pm.draws, 1);
@@ -90,16 +90,16 @@ static void shared_state_bound_once_single_threaded(void **state)
     ob_test_world_create(&w, NULL);
     ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
     frame_camera(&w);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
     ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
 
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint32_t per_view, per_material;
     lit_block_sizes(&w, &per_view, &per_material);
     ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
-    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
     assert_int_equal(main->draws, 100);
     assert_int_equal(main->chunks, 1);
     assert_int_equal(main->worker, -1);
@@ -132,16 +132,16 @@ static void shared_state_bound_once_per_secondary(void **state)
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 25});
     ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
     frame_camera(&w);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
     ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
     uint32_t per_view, per_material;
     for (int frame = 0; frame < 3; frame++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 4);
         if (frame == 0) lit_block_sizes(&w, &per_view, &per_material);
         ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
-        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         assert_int_equal(st->workers, 4);
         assert_int_equal(main->draws, 100);
         assert_true(main->worker >= 1 && main->worker <= 4);
@@ -179,18 +179,18 @@ static void uniforms_packed_only_after_a_change(void **state)
         ob_test_world_create(&w, NULL);
         ob_material_library_set_instancing(w.lib, false); /* one draw per entity */
         frame_camera(&w);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
         ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_SINGLE, 0);
         ob_material *mats[100];
         uint32_t nm = c == SHARED_50 || c == SHARED_100 ? 1 : 100;
         for (uint32_t i = 0; i < nm; i++) {
             float red = c == DISTINCT ? (float)i / 100.0f : 0.5f;
-            mats[i] = ob_test_world_material(&w, OB_MATERIAL_LIT, red, 0.5f, 0.5f, false);
+            mats[i] = ob_world_material(&w, "test", OB_MATERIAL_LIT, red, 0.5f, 0.5f, false);
         }
         uint32_t count = c == SHARED_50 ? 50 : 100;
         add_grid(&w, count, mats, nm);
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        assert_int_equal(ob_test_view_stats(st, "main")->draws, count);
+        assert_int_equal(ob_world_view_stats(st, "main")->draws, count);
         got[c] = pm_minus(st->pm, &base);
         if (c == 0) lit_block_sizes(&w, &per_view, &per_material);
         /* The next frame packs again (new ring space) but no more than this one. */
@@ -221,7 +221,7 @@ static void many_programs_each_read_their_own_uniforms(void **state)
     enum { N = 100, SIDE = 10 };
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 0, 20, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 20, 0, 0, 0);
     ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 0.6f, .znear = 0.1f});
     ob_effect *effects[N];
     float colors[N][3];
@@ -246,19 +246,19 @@ static void many_programs_each_read_their_own_uniforms(void **state)
         assert_non_null(m);
         assert_int_equal(ob_material_set_view_effect(m, OB_VIEW_PERSPECTIVE, effects[i]), OB_OK);
         double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
-        ob_test_world_entity(&w, NULL, name, w.box, m, x, y, 0);
+        ob_world_entity(&w, NULL, name, w.box, m, x, y, 0);
     }
     const double half_h = 19.5 * tan(0.3), half_w = half_h * 160.0 / 120.0;
     for (int f = 0; f < 4; f++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        assert_int_equal(ob_test_view_stats(st, "main")->draws, N);
-        ob_test_world_read(&w);
+        assert_int_equal(ob_world_view_stats(st, "main")->draws, N);
+        ob_world_read(&w);
         for (uint32_t i = 0; i < N; i++) {
             double x = (double)(i % SIDE) - 4.5, y = (double)(i / SIDE) - 4.5;
             uint32_t px = (uint32_t)((x / half_w + 1.0) * 0.5 * w.width);
             uint32_t py = (uint32_t)((1.0 - y / half_h) * 0.5 * w.height);
-            const uint8_t *p = ob_test_world_pixel(&w, px, py);
+            const uint8_t *p = ob_world_pixel(&w, px, py);
             uint8_t want[3];
             for (int c = 0; c < 3; c++)
                 want[c] = ob_composite_view_output_level(w.composite, colors[i][c]);
@@ -287,7 +287,7 @@ static void set_cache_holds_its_bound_across_changing_scenes(void **state)
     ob_test_world w;
     ob_test_world_create(&w, NULL);
     unsetenv("OB_SET_CACHE_LIMIT");
-    ob_test_world_look(&w, 0, 0, 20, 0, 0, 0);
+    ob_world_look(&w, 0, 0, 20, 0, 0, 0);
     ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 0.6f, .znear = 0.1f});
     uint32_t resets = 0, most_held = 0;
     for (uint32_t round = 0; round < ROUNDS; round++) {
@@ -311,19 +311,19 @@ static void set_cache_holds_its_bound_across_changing_scenes(void **state)
             materials[i] = ob_material_create(w.lib, &md, &r);
             assert_non_null(materials[i]);
             assert_int_equal(ob_material_set_view_effect(materials[i], OB_VIEW_PERSPECTIVE, effects[i]), OB_OK);
-            nodes[i] = ob_test_world_entity(&w, NULL, name, w.box, materials[i], (double)i * 1.5 - 8.25, 0, 0);
+            nodes[i] = ob_world_entity(&w, NULL, name, w.box, materials[i], (double)i * 1.5 - 8.25, 0, 0);
         }
         for (int f = 0; f < 4; f++) {
             const ob_frame_stats *st =
                 ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-            assert_int_equal(ob_test_view_stats(st, "main")->draws, N);
+            assert_int_equal(ob_world_view_stats(st, "main")->draws, N);
             resets += st->pm.descriptor_set_cache_resets;
             if (st->pm.descriptor_sets_held > most_held) most_held = st->pm.descriptor_sets_held;
             if (st->pm.descriptor_sets_held > LIMIT + N + 4)
                 fail_msg("round %u frame %d: a manager holds %u sets (bound %u)", round, f,
                          st->pm.descriptor_sets_held, LIMIT);
-            ob_test_world_read(&w);
-            const uint8_t *p = ob_test_world_pixel(&w, w.width / 2, w.height / 2);
+            ob_world_read(&w);
+            const uint8_t *p = ob_world_pixel(&w, w.width / 2, w.height / 2);
             if (p[2] < 64) fail_msg("round %u frame %d: the middle box is %u,%u,%u", round, f, p[0], p[1], p[2]);
         }
         assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
@@ -343,20 +343,20 @@ static void set_cache_holds_its_bound_across_changing_scenes(void **state)
 static void mixed_scene(ob_test_world *w)
 {
     frame_camera(w);
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 10, 5);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 10, 5);
     ob_material *mats[4] = {
-        ob_test_world_material(w, OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true),
-        ob_test_world_material(w, OB_MATERIAL_LIT, 0.2f, 0.7f, 0.3f, true),
-        ob_test_world_material(w, OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.2f, false),
-        ob_test_world_material(w, OB_MATERIAL_LIT, 0.3f, 0.3f, 0.9f, false),
+        ob_world_material(w, "test", OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true),
+        ob_world_material(w, "test", OB_MATERIAL_LIT, 0.2f, 0.7f, 0.3f, true),
+        ob_world_material(w, "test", OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.2f, false),
+        ob_world_material(w, "test", OB_MATERIAL_LIT, 0.3f, 0.3f, 0.9f, false),
     };
     add_grid(w, 120, mats, 4);
-    ob_material *ground = ob_test_world_material(w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    ob_test_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.5, -5);
+    ob_material *ground = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.5, -5);
     for (int i = 0; i < 10; i++) {
         char name[16];
         snprintf(name, sizeof name, "ball%d", i);
-        ob_test_world_entity(w, NULL, name, w->sphere, mats[i % 2], -5.0 + i, 1.0, -4.0);
+        ob_world_entity(w, NULL, name, w->sphere, mats[i % 2], -5.0 + i, 1.0, -4.0);
     }
 }
 
@@ -369,17 +369,17 @@ static void primary_and_secondaries_record_the_same(void **state)
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16});
     mixed_scene(&w);
     ob_frame_stats ref = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
+    uint8_t *ref_pixels = ob_world_snapshot(&w);
     assert_int_equal(ref.workers, 0);
-    const ob_view_stats *ref_main = ob_test_view_stats(&ref, "main");
+    const ob_view_stats *ref_main = ob_world_view_stats(&ref, "main");
     assert_true(ref_main->draws >= 120);
-    assert_non_null(ob_test_view_stats(&ref, "shadow:sun"));
+    assert_non_null(ob_world_view_stats(&ref, "shadow:sun"));
     static const uint32_t workers[] = {1, 2, 4};
     for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, workers[k]);
         assert_int_equal(st->workers, workers[k]);
         assert_int_equal(st->view_count, ref.view_count);
-        assert_true(ob_test_view_stats(st, "main")->chunks > 1);
+        assert_true(ob_world_view_stats(st, "main")->chunks > 1);
         for (uint32_t i = 0; i < ref.view_count; i++) {
             assert_string_equal(st->views[i].name, ref.views[i].name);
             assert_int_equal(st->views[i].draws, ref.views[i].draws);
@@ -390,7 +390,7 @@ static void primary_and_secondaries_record_the_same(void **state)
             assert_int_equal(st->views[i].hash.draws, ref.views[i].hash.draws);
         }
         assert_true(st->frame_hash == ref.frame_hash);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
     }
     free(ref_pixels);
@@ -408,13 +408,13 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
     mixed_scene(&w);
     ob_material_library_set_instancing(w.lib, false);
     ob_frame_stats single = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
+    uint8_t *ref_pixels = ob_world_snapshot(&w);
     assert_int_equal(single.pm.instances, 0);
     assert_int_equal(single.pm.draw_calls, single.pm.draws);
 
     ob_material_library_set_instancing(w.lib, true);
     ob_frame_stats inst = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
     assert_int_equal(inst.pm.draws, single.pm.draws);
     for (uint32_t i = 0; i < inst.view_count; i++)
@@ -423,11 +423,11 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
      * the casters: every entity an instance, in a handful of runs. */
     assert_true(inst.pm.instances >= 131);
     assert_true(inst.pm.draw_calls * 4 < inst.pm.draws);
-    const ob_view_stats *main = ob_test_view_stats(&inst, "main");
+    const ob_view_stats *main = ob_world_view_stats(&inst, "main");
     assert_int_equal(main->instances, main->draws);
     assert_true(main->draw_calls * 4 < main->draws);
     assert_true(main->longest_run >= 10 && main->longest_run <= main->draws);
-    const ob_view_stats *off = ob_test_view_stats(&single, "main");
+    const ob_view_stats *off = ob_world_view_stats(&single, "main");
     assert_int_equal(off->instances, 0);
     assert_int_equal(off->draw_calls, off->draws);
     assert_int_equal(off->longest_run, 0);
@@ -435,7 +435,7 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
     static const uint32_t workers[] = {1, 2, 4};
     for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, workers[k]);
-        assert_true(ob_test_view_stats(st, "main")->chunks > 1);
+        assert_true(ob_world_view_stats(st, "main")->chunks > 1);
         for (uint32_t i = 0; i < inst.view_count; i++) {
             assert_string_equal(st->views[i].name, inst.views[i].name);
             assert_int_equal(st->views[i].hash.draws, inst.views[i].hash.draws);
@@ -445,7 +445,7 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
                          workers[k], (unsigned long long)inst.views[i].hash.hash);
         }
         assert_true(st->frame_hash == inst.frame_hash);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
     }
     free(ref_pixels);
@@ -461,20 +461,20 @@ static void a_view_of_many_chunks_draws_everything(void **state)
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 2, .chunk_draws = 1});
     frame_camera(&w);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 10, 6);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 300, &m, 1);
     ob_frame_stats ref = *ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *ref_pixels = ob_test_world_snapshot(&w);
-    const ob_view_stats *ref_main = ob_test_view_stats(&ref, "main");
+    uint8_t *ref_pixels = ob_world_snapshot(&w);
+    const ob_view_stats *ref_main = ob_world_view_stats(&ref, "main");
     assert_true(ref_main->draws > 256);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 2);
-    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
     assert_int_equal(main->chunks, ref_main->draws);
     assert_int_equal(main->draws, ref_main->draws);
     assert_true(main->hash.hash == ref_main->hash.hash);
     assert_true(st->frame_hash == ref.frame_hash);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
     free(ref_pixels);
     ob_test_world_destroy(&w);
@@ -502,8 +502,8 @@ static void stale_texture_skips_the_draw(void **state)
 
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 0, 6, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
+    ob_world_look(&w, 0, 0, 6, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
     ob_result r;
     ob_effect_desc ed = {.name = "textured", .vertex = "unlit.vert", .fragment = path,
                          .layout = ob_views_standard_input(), .depth_test = true,
@@ -528,43 +528,43 @@ static void stale_texture_skips_the_draw(void **state)
     ob_material *textured = ob_material_create(w.lib, &md, &r);
     assert_non_null(textured);
     assert_int_equal(ob_material_set_view_effect(textured, OB_VIEW_PERSPECTIVE, fx), OB_OK);
-    ob_material *red = ob_test_world_material(&w, OB_MATERIAL_UNLIT, 1.0f, 0.0f, 0.0f, false);
+    ob_material *red = ob_world_material(&w, "test", OB_MATERIAL_UNLIT, 1.0f, 0.0f, 0.0f, false);
     ob_node *bad[3];
     for (int i = 0; i < 3; i++) {
         char name[16];
         snprintf(name, sizeof name, "textured%d", i);
-        bad[i] = ob_test_world_entity(&w, NULL, name, w.box, textured, -1.5 + 1.5 * i, 1.2, 0);
+        bad[i] = ob_world_entity(&w, NULL, name, w.box, textured, -1.5 + 1.5 * i, 1.2, 0);
     }
-    ob_test_world_entity(&w, NULL, "red", w.box, red, 0, -1.2, 0);
+    ob_world_entity(&w, NULL, "red", w.box, red, 0, -1.2, 0);
 
     /* Valid texture: the textured boxes are green. */
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_int_equal(st->pm.skipped_draws, 0);
-    assert_int_equal(ob_test_view_stats(st, "main")->draws, 4);
-    ob_test_world_read(&w);
+    assert_int_equal(ob_world_view_stats(st, "main")->draws, 4);
+    ob_world_read(&w);
     uint32_t top = (uint32_t)(w.height * 0.3f), bottom = (uint32_t)(w.height * 0.7f);
-    const uint8_t *p = ob_test_world_pixel(&w, w.width / 2, top);
+    const uint8_t *p = ob_world_pixel(&w, w.width / 2, top);
     uint8_t full = ob_composite_view_output_level(w.composite, 1.0f);
     assert_true(p[0] == 0 && abs(p[1] - full) <= 1 && p[2] == 0);
 
     /* Reference: the frame without the textured boxes. */
     for (int i = 0; i < 3; i++) ob_node_set_hidden(bad[i], true);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint8_t *without = ob_test_world_snapshot(&w);
+    uint8_t *without = ob_world_snapshot(&w);
     for (int i = 0; i < 3; i++) ob_node_set_hidden(bad[i], false);
 
     ob_image_destroy(w.dev, img); /* TestTexture now holds a stale handle */
     for (int mode = 0; mode < 2; mode++) {
         ob_test_log_clear();
         st = ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 1);
-        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         assert_int_equal(st->pm.skipped_draws, 3);
         assert_int_equal(main->draws, 1); /* the red box */
         assert_int_equal(ob_test_log_count(OB_LOG_WARN), 1);
         assert_true(ob_test_log_has("TestTexture", "stale handle", NULL));
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_int_equal(ob_test_image_max_diff(without, w.pixels, w.width, w.height), 0);
-        p = ob_test_world_pixel(&w, w.width / 2, bottom);
+        p = ob_world_pixel(&w, w.width / 2, bottom);
         assert_true(abs(p[0] - full) <= 1 && p[1] == 0 && p[2] == 0);
     }
     free(without);
@@ -586,11 +586,11 @@ static void material_without_effect_is_culled(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 3, 6, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
-    ob_material *caster = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, true);
-    ob_material *no_shadow = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.8f, false);
-    ob_material *unlit = ob_test_world_material(&w, OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.1f, false);
+    ob_world_look(&w, 0, 3, 6, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *caster = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, true);
+    ob_material *no_shadow = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.8f, false);
+    ob_material *unlit = ob_world_material(&w, "test", OB_MATERIAL_UNLIT, 0.9f, 0.9f, 0.1f, false);
     ob_result r;
     ob_material *custom = ob_material_create(w.lib, &(ob_material_desc){.name = "custom-unlit",
                                              .kind = OB_MATERIAL_CUSTOM}, &r);
@@ -603,18 +603,18 @@ static void material_without_effect_is_culled(void **state)
     ob_material *mirror = ob_material_create(w.lib, &mirror_desc, &r);
     assert_non_null(mirror);
 
-    ob_test_world_entity(&w, NULL, "caster", w.box, caster, -1.5, 0, 0);
-    ob_test_world_entity(&w, NULL, "no-shadow", w.box, no_shadow, 0, 0, -1.5);
-    ob_test_world_entity(&w, NULL, "unlit", w.box, unlit, 1.5, 0, 0);
-    ob_test_world_entity(&w, NULL, "custom", w.box, custom, 0, 0, 1.5);
-    ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror, 0, 0, 0);
+    ob_world_entity(&w, NULL, "caster", w.box, caster, -1.5, 0, 0);
+    ob_world_entity(&w, NULL, "no-shadow", w.box, no_shadow, 0, 0, -1.5);
+    ob_world_entity(&w, NULL, "unlit", w.box, unlit, 1.5, 0, 0);
+    ob_world_entity(&w, NULL, "custom", w.box, custom, 0, 0, 1.5);
+    ob_world_entity(&w, NULL, "mirror", w.sphere, mirror, 0, 0, 0);
 
     for (int mode = 0; mode < 2; mode++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        const ob_view_stats *main = ob_test_view_stats(st, "main");
-        const ob_view_stats *shadow = ob_test_view_stats(st, "shadow:sun");
-        const ob_view_stats *env = ob_test_view_stats(st, "envmap:mirror");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
+        const ob_view_stats *shadow = ob_world_view_stats(st, "shadow:sun");
+        const ob_view_stats *env = ob_world_view_stats(st, "envmap:mirror");
         assert_non_null(main);
         assert_non_null(shadow);
         assert_non_null(env);

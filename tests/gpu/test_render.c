@@ -15,14 +15,14 @@ static void empty_scene_is_the_clear_colour(void **state)
     ob_test_world w;
     ob_test_world_create(&w, &small);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    ob_test_world_read(&w);
+    ob_world_read(&w);
     /* The clear colour is linear: what shows is its tone-mapped sRGB level. */
     uint8_t want[3];
     for (int i = 0; i < 3; i++)
         want[i] = ob_composite_view_output_level(w.composite, small.clear_color[i]);
     for (uint32_t y = 0; y < w.height; y++) {
         for (uint32_t x = 0; x < w.width; x++) {
-            const uint8_t *p = ob_test_world_pixel(&w, x, y);
+            const uint8_t *p = ob_world_pixel(&w, x, y);
             if (abs(p[0] - want[0]) > 1 || abs(p[1] - want[1]) > 1 || abs(p[2] - want[2]) > 1 ||
                 p[3] != 255)
                 fail_msg("pixel (%u,%u) = %u,%u,%u,%u, expected the clear colour %u,%u,%u,255", x,
@@ -30,7 +30,7 @@ static void empty_scene_is_the_clear_colour(void **state)
         }
     }
     /* The empty main view records nothing and says so. */
-    const ob_view_stats *main = ob_test_view_stats(st, "main");
+    const ob_view_stats *main = ob_world_view_stats(st, "main");
     assert_non_null(main);
     assert_int_equal(main->draws, 0);
     assert_int_equal(main->skipped, OB_SKIP_EMPTY);
@@ -45,20 +45,20 @@ static void lit_cube_centre_has_the_expected_shade(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, &small);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
-    ob_test_world_entity(&w, NULL, "cube", w.box, m, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
-    ob_test_world_look(&w, 0, 0, 5, 0, 0, 0);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
+    ob_world_entity(&w, NULL, "cube", w.box, m, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 0, 0, 10);
+    ob_world_look(&w, 0, 0, 5, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_int_equal(st->draws, 2); /* the cube and the composite's full-screen triangle */
-    ob_test_world_read(&w);
-    const uint8_t *c = ob_test_world_pixel(&w, w.width / 2, w.height / 2);
+    ob_world_read(&w);
+    const uint8_t *c = ob_world_pixel(&w, w.width / 2, w.height / 2);
     const float expected[3] = {1.15f * 0.8f, 1.15f * 0.4f, 1.15f * 0.2f};
     for (int i = 0; i < 3; i++)
         assert_near(c[i], ob_composite_view_output_level(w.composite, expected[i]), 2.0);
     assert_int_equal(c[3], 255);
     /* Depth test and framing: a corner still shows the clear colour. */
-    const uint8_t *corner = ob_test_world_pixel(&w, 2, 2);
+    const uint8_t *corner = ob_world_pixel(&w, 2, 2);
     assert_near(corner[0], ob_composite_view_output_level(w.composite, small.clear_color[0]), 1);
     assert_near(corner[2], ob_composite_view_output_level(w.composite, small.clear_color[2]), 1);
     ob_test_world_destroy(&w);
@@ -73,17 +73,17 @@ static void rotating_cube_same_in_every_mode(void **state)
     for (int run = 0; run < 2; run++) {
         ob_test_world w;
         ob_test_world_create(&w, &small);
-        ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.3f, 0.7f, 0.9f, true);
-        ob_node *cube = ob_test_world_entity(&w, NULL, "cube", w.box, m, 0, 0.6, 0);
+        ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.3f, 0.7f, 0.9f, true);
+        ob_node *cube = ob_world_entity(&w, NULL, "cube", w.box, m, 0, 0.6, 0);
         ob_node_add_rotation_controller(cube, (const float[3]){0.3f, 1.0f, 0.1f}, 2.0f);
-        ob_material *g = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-        ob_test_world_entity(&w, NULL, "ground", w.plane, g, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
-        ob_test_world_look(&w, 0, 2.5, 4, 0, 0.3, 0);
+        ob_material *g = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+        ob_world_entity(&w, NULL, "ground", w.plane, g, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
+        ob_world_look(&w, 0, 2.5, 4, 0, 0.3, 0);
         for (int f = 0; f < 3; f++) {
             ob_threading mode = run == 0 ? OB_THREADING_SINGLE : OB_THREADING_MULTI;
             ob_test_world_frame(&w, mode, run == 0 ? 0 : 3);
-            ob_test_world_read(&w);
+            ob_world_read(&w);
             frames[run][f] = malloc((size_t)w.width * w.height * 4);
             memcpy(frames[run][f], w.pixels, (size_t)w.width * w.height * 4);
         }
@@ -117,18 +117,18 @@ static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
         ob_test_world_create(&w, NULL);
         assert_int_equal(ob_node_set_camera(w.camera, &(ob_camera_desc){.fovy = 1.0f, .znear = (float)(0.1 * sc)}),
                          OB_OK);
-        ob_test_world_look(&w, 0.0, 2.0 * sc, 5.0 * sc, 0.0, 0.0, 0.0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2 * sc, 6 * sc, 1 * sc);
+        ob_world_look(&w, 0.0, 2.0 * sc, 5.0 * sc, 0.0, 0.0, 0.0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2 * sc, 6 * sc, 1 * sc);
         /* Specular: the view vector, camera-relative and as small as the scene. */
         ob_result mr;
         ob_material *red = ob_material_create(w.lib, &(ob_material_desc){
             .name = "shiny", .kind = OB_MATERIAL_LIT, .diffuse = {0.9f, 0.1f, 0.1f, 1.0f},
             .specular = {0.8f, 0.8f, 0.8f, 16.0f}}, &mr);
         assert_non_null(red);
-        ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_node *box = ob_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         ob_node_set_scale(box, (const float[3]){(float)sc, (float)sc, (float)sc});
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
+        ob_world_read(&w);
 
         /* The box's corners (half-size 0.5) through the view's matrix. */
         const ob_view *v = ob_perspective_view_base(w.main);
@@ -147,7 +147,7 @@ static void tiny_and_huge_scenes_keep_clip_coordinates_normal(void **state)
         if (!(smallest * smallest >= 0x1p-126f))
             fail_msg("scale %g: a clip coordinate of %g; products of two flush to zero", sc, (double)smallest);
         if (i == 0) {
-            unit = ob_test_world_copy(&w);
+            unit = ob_world_copy(&w);
         } else {
             uint32_t d = ob_test_image_max_diff(unit, w.pixels, w.width, w.height);
             if (d) fail_msg("scale %g: %u levels from the unit scene", sc, d);
@@ -170,18 +170,18 @@ static void mirrored_entity_looks_like_the_original(void **state)
     for (int i = 0; i < 4; i++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
-        ob_test_world_look(&w, 1.5, 2.0, 4.0, 0.0, 0.0, 0.0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 3, 1);
-        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.3f, 0.1f, false);
-        ob_node *box = ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_world_look(&w, 1.5, 2.0, 4.0, 0.0, 0.0, 0.0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 3, 1);
+        ob_material *red = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.9f, 0.3f, 0.1f, false);
+        ob_node *box = ob_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         ob_node_set_scale(box, scales[i]);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-        ob_test_world_read(&w);
-        images[i] = ob_test_world_copy(&w);
+        ob_world_read(&w);
+        images[i] = ob_world_copy(&w);
         ob_test_world_destroy(&w);
     }
     for (int i = 1; i < 4; i++) {
-        uint32_t n = ob_test_image_diff_count(images[0], images[i], 160, 120, 2);
+        uint32_t n = ob_rgba_diff_count(images[0], images[i], 160 * 120, 2);
         if (n) fail_msg("scale (%g, %g, %g): %u pixels differ from the unmirrored box", (double)scales[i][0],
                         (double)scales[i][1], (double)scales[i][2], n);
     }

@@ -34,10 +34,10 @@ static void assert_each_view_once(const ob_frame_stats *st)
 /* Every dependency of v ran before v in st. */
 static void assert_deps_first(const ob_frame_stats *st, const ob_view *v)
 {
-    int at = ob_test_view_index(st, v->name);
+    int at = ob_world_view_index(st, v->name);
     if (at < 0) fail_msg("view '%s' did not run", v->name);
     for (uint32_t i = 0; i < v->dep_count; i++) {
-        int d = ob_test_view_index(st, v->deps[i]->name);
+        int d = ob_world_view_index(st, v->deps[i]->name);
         if (d < 0 || d >= at)
             fail_msg("view '%s' (position %d) depends on '%s' (position %d)", v->name, at,
                      v->deps[i]->name, d);
@@ -61,7 +61,7 @@ static bool all_pixels(const ob_test_world *w, const uint8_t rgba[4])
 {
     for (uint32_t y = 0; y < w->height; y++)
         for (uint32_t x = 0; x < w->width; x++)
-            if (memcmp(ob_test_world_pixel(w, x, y), rgba, 4) != 0) return false;
+            if (memcmp(ob_world_pixel(w, x, y), rgba, 4) != 0) return false;
     return true;
 }
 
@@ -115,13 +115,13 @@ static void dependencies_run_before_consumers(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 3, 7, 0, 0.5, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
-    ob_material *ground = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    ob_material *box = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true);
-    ob_test_world_entity(&w, NULL, "ground", w.plane, ground, 0, -0.5, 0);
-    ob_test_world_entity(&w, NULL, "box", w.box, box, -1.5, 0, 0);
-    ob_node *mirror = ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 1, 0.2, 0);
+    ob_world_look(&w, 0, 3, 7, 0, 0.5, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *ground = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_material *box = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true);
+    ob_world_entity(&w, NULL, "ground", w.plane, ground, 0, -0.5, 0);
+    ob_world_entity(&w, NULL, "box", w.box, box, -1.5, 0, 0);
+    ob_node *mirror = ob_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 1, 0.2, 0);
     ob_result r;
     ob_particle_system *ps = ob_particle_system_create(w.views, w.scene, NULL,
         &(ob_particle_desc){.name = "sparks", .count = 256, .seed = 7}, &r);
@@ -133,11 +133,11 @@ static void dependencies_run_before_consumers(void **state)
                                                                  : OB_THREADING_SINGLE, 0);
         assert_int_equal(st->view_count, 5);
         assert_each_view_once(st);
-        int shadow = ob_test_view_index(st, "shadow:sun");
-        int env = ob_test_view_index(st, "envmap:mirror");
-        int sim = ob_test_view_index(st, "sparks");
-        int at_main = ob_test_view_index(st, "main");
-        int at_composite = ob_test_view_index(st, "composite");
+        int shadow = ob_world_view_index(st, "shadow:sun");
+        int env = ob_world_view_index(st, "envmap:mirror");
+        int sim = ob_world_view_index(st, "sparks");
+        int at_main = ob_world_view_index(st, "main");
+        int at_composite = ob_world_view_index(st, "composite");
         assert_true(shadow >= 0 && env >= 0 && sim >= 0);
         assert_true(shadow < at_main && env < at_main && sim < at_main);
         assert_int_equal(at_main, 3);
@@ -148,7 +148,7 @@ static void dependencies_run_before_consumers(void **state)
         ob_view *env_view = ob_renderer_attached_view(w.r, mirror, OB_VIEW_PARABOLOID);
         assert_non_null(env_view);
         assert_deps_first(st, env_view);
-        assert_int_equal(ob_test_count_skipped(st, OB_SKIP_RECURSION), 0);
+        assert_int_equal(ob_world_count_skipped(st, OB_SKIP_RECURSION), 0);
     }
     assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
     ob_particle_system_destroy(w.views, ps);
@@ -182,7 +182,7 @@ static void shared_dependency_runs_before_every_consumer(void **state)
         assert_each_view_once(st);
         assert_int_equal(g[2].base.dep_count, 1);
         for (int i = 0; i < 4; i++) assert_deps_first(st, &g[i].base);
-        assert_int_equal(ob_test_view_index(st, "root"), 3);
+        assert_int_equal(ob_world_view_index(st, "root"), 3);
     }
     ob_test_world_destroy(&w);
     graph_release(g, 4);
@@ -214,13 +214,13 @@ static void second_camera_sees_this_frames_env_map(void **state)
     for (int run = 0; run < 2; run++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
-        ob_test_world_look(&w, 0, 1, 5, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
-        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, false);
-        ob_material *green = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.1f, 0.9f, 0.1f, false);
-        ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 0);
-        ob_test_world_entity(&w, NULL, "red", w.box, red, -1.5, 0, 0);
-        ob_test_world_entity(&w, NULL, "green", w.box, green, 1.5, 0, 0);
+        ob_world_look(&w, 0, 1, 5, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+        ob_material *red = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, false);
+        ob_material *green = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.1f, 0.9f, 0.1f, false);
+        ob_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 0);
+        ob_world_entity(&w, NULL, "red", w.box, red, -1.5, 0, 0);
+        ob_world_entity(&w, NULL, "green", w.box, green, 1.5, 0, 0);
         ob_perspective_view *side = side_view(&w, (const double[3]){0.5, 0.5, -3.0}, (const double[3]){0, 0, 0});
         /* Run 0: the side view alone. Run 1: the main camera first, which
          * queues the mirror's map before the side view asks for it. */
@@ -228,7 +228,7 @@ static void second_camera_sees_this_frames_env_map(void **state)
         const ob_frame_stats *st = run == 0 ? frame_from_roots(&w, &roots[1], 1, OB_THREADING_SINGLE)
                                             : frame_from_roots(&w, roots, 2, OB_THREADING_SINGLE);
         assert_each_view_once(st);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 1);
         assert_deps_first(st, ob_perspective_view_base(side));
         side_images[run] = malloc((size_t)w.width * w.height * 4);
         assert_int_equal(ob_image_read_rgba8(w.dev, ob_perspective_view_color(side),
@@ -254,15 +254,15 @@ static void second_camera_leaves_the_main_cameras_shadow(void **state)
     for (int run = 0; run < 4; run++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
-        ob_test_world_look(&w, 0, 3, 5, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, run != 3, 1.0f, 2, 6, 1);
-        ob_material *grey = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
-        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
-        ob_test_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
-        ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_world_look(&w, 0, 3, 5, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, run != 3, 1.0f, 2, 6, 1);
+        ob_material *grey = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
+        ob_material *red = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+        ob_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
+        ob_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         /* What only the side camera sees: casters 40 units away. */
-        ob_test_world_entity(&w, NULL, "far ground", w.plane, grey, 40, -0.5, 0);
-        ob_test_world_entity(&w, NULL, "far box", w.box, red, 40, 0, 0);
+        ob_world_entity(&w, NULL, "far ground", w.plane, grey, 40, -0.5, 0);
+        ob_world_entity(&w, NULL, "far box", w.box, red, 40, 0, 0);
         ob_perspective_view *side = side_view(&w, (const double[3]){40, 3, 5}, (const double[3]){40, 0, 0});
         /* Run 0: the main camera alone; 1: then the side camera, one
          * PreRender each; 2: both in one PreRender; 3: the main camera
@@ -277,17 +277,17 @@ static void second_camera_leaves_the_main_cameras_shadow(void **state)
             assert_int_equal(ob_renderer_end_frame(w.r), OB_OK);
             assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
         }
-        assert_int_equal(ob_test_count_views(ob_renderer_last_stats(w.r), OB_VIEW_SHADOW), run != 3);
-        ob_test_world_read(&w);
-        main_images[run] = ob_test_world_copy(&w);
+        assert_int_equal(ob_world_count_views(ob_renderer_last_stats(w.r), OB_VIEW_SHADOW), run != 3);
+        ob_world_read(&w);
+        main_images[run] = ob_world_copy(&w);
         ob_perspective_view_destroy(w.views, side);
         ob_test_world_destroy(&w);
     }
     /* The shadow is there to lose. */
-    uint32_t shadow_px = ob_test_image_diff_count(main_images[0], main_images[3], 160, 120, 2);
+    uint32_t shadow_px = ob_rgba_diff_count(main_images[0], main_images[3], 160 * 120, 2);
     assert_true(shadow_px > 40);
     for (int run = 1; run < 3; run++) {
-        uint32_t n = ob_test_image_diff_count(main_images[0], main_images[run], 160, 120, 0);
+        uint32_t n = ob_rgba_diff_count(main_images[0], main_images[run], 160 * 120, 0);
         if (n) fail_msg("run %d: %u pixels of the main camera differ from the one-camera frame", run, n);
     }
     for (int run = 0; run < 4; run++) free(main_images[run]);
@@ -305,22 +305,22 @@ static void second_shadow_casting_sun_leaves_the_first_ones_shadow(void **state)
     for (int run = 0; run < 2; run++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
-        ob_test_world_look(&w, 0, 3, 5, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 6, 1);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, run == 0, 1.0f, -6, 2, -1);
-        ob_material *grey = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
-        ob_material *red = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
-        ob_test_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
-        ob_test_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
+        ob_world_look(&w, 0, 3, 5, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 6, 1);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, run == 0, 1.0f, -6, 2, -1);
+        ob_material *grey = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false);
+        ob_material *red = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.9f, 0.1f, 0.1f, true);
+        ob_world_entity(&w, NULL, "ground", w.plane, grey, 0, -0.5, 0);
+        ob_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         ob_view *root = ob_composite_view_base(w.composite);
         const ob_frame_stats *st = frame_from_roots(&w, &root, 1, OB_THREADING_SINGLE);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 1);
-        if (run == 0) assert_int_equal(ob_test_count_skipped(st, OB_SKIP_NOT_NEEDED), 1);
-        ob_test_world_read(&w);
-        images[run] = ob_test_world_copy(&w);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        if (run == 0) assert_int_equal(ob_world_count_skipped(st, OB_SKIP_NOT_NEEDED), 1);
+        ob_world_read(&w);
+        images[run] = ob_world_copy(&w);
         ob_test_world_destroy(&w);
     }
-    uint32_t n = ob_test_image_diff_count(images[0], images[1], 160, 120, 0);
+    uint32_t n = ob_rgba_diff_count(images[0], images[1], 160 * 120, 0);
     if (n) fail_msg("%u pixels differ from the frame where only the first sun casts a shadow", n);
     free(images[0]);
     free(images[1]);
@@ -358,10 +358,10 @@ static void view_chain_stops_at_recursion_bound(void **state)
             assert_string_equal(st->views[i].name, name);
             assert_int_equal(g[bound - i].base.recursion_depth, bound - i);
         }
-        assert_int_equal(ob_test_count_skipped(st, OB_SKIP_RECURSION), 1);
+        assert_int_equal(ob_world_count_skipped(st, OB_SKIP_RECURSION), 1);
         char cut[16];
         snprintf(cut, sizeof cut, "chain%u", bound + 1);
-        assert_int_equal(ob_test_skip_reason(st, cut), OB_SKIP_RECURSION);
+        assert_int_equal(ob_world_skip_reason(st, cut), OB_SKIP_RECURSION);
     }
     ob_test_world_destroy(&w);
     graph_release(g, N);
@@ -398,7 +398,7 @@ static void view_cycle_is_queued_once(void **state)
         assert_string_equal(st->views[0].name, "c");
         assert_string_equal(st->views[1].name, "b");
         assert_string_equal(st->views[2].name, "a");
-        assert_int_equal(ob_test_count_skipped(st, OB_SKIP_RECURSION), 0);
+        assert_int_equal(ob_world_count_skipped(st, OB_SKIP_RECURSION), 0);
     }
     ob_test_world_destroy(&w);
     graph_release(g, 3);
@@ -414,34 +414,34 @@ static void mirror_spheres_stop_at_recursion_bound(void **state)
     for (uint32_t bound = 0; bound <= 4; bound++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
-        ob_test_world_look(&w, 0, 3, 6, 0, 0, 0);
-        ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+        ob_world_look(&w, 0, 3, 6, 0, 0, 0);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
         ob_material *mirror = mirror_material(&w);
-        ob_material *g = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
-        ob_test_world_entity(&w, NULL, "ground", w.plane, g, 0, -0.5, 0);
-        ob_test_world_entity(&w, NULL, "m0", w.sphere, mirror, -1, 0, 0);
-        ob_test_world_entity(&w, NULL, "m1", w.sphere, mirror, 1, 0, 0);
-        ob_test_world_entity(&w, NULL, "m2", w.sphere, mirror, 0, 0, -1.5);
+        ob_material *g = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+        ob_world_entity(&w, NULL, "ground", w.plane, g, 0, -0.5, 0);
+        ob_world_entity(&w, NULL, "m0", w.sphere, mirror, -1, 0, 0);
+        ob_world_entity(&w, NULL, "m1", w.sphere, mirror, 1, 0, 0);
+        ob_world_entity(&w, NULL, "m2", w.sphere, mirror, 0, 0, -1.5);
         ob_renderer_set_max_recursion(w.r, bound);
         for (int f = 0; f < 2; f++) {
             const ob_frame_stats *st =
                 ob_test_world_frame(&w, f ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
             assert_each_view_once(st);
-            uint32_t envs = ob_test_count_views(st, OB_VIEW_PARABOLOID);
-            uint32_t cut = ob_test_count_skipped(st, OB_SKIP_RECURSION);
+            uint32_t envs = ob_world_count_views(st, OB_VIEW_PARABOLOID);
+            uint32_t cut = ob_world_count_skipped(st, OB_SKIP_RECURSION);
             if (bound == 0) {
                 assert_int_equal(st->view_count, 1); /* the composite */
-                assert_int_equal(ob_test_skip_reason(st, "main"), OB_SKIP_RECURSION);
+                assert_int_equal(ob_world_skip_reason(st, "main"), OB_SKIP_RECURSION);
                 assert_int_equal(cut, 1);
             } else if (bound == 1) {
                 assert_int_equal(envs, 0);
-                assert_int_equal(ob_test_skip_reason(st, "envmap:m0"), OB_SKIP_RECURSION);
-                assert_int_equal(ob_test_skip_reason(st, "envmap:m1"), OB_SKIP_RECURSION);
-                assert_int_equal(ob_test_skip_reason(st, "envmap:m2"), OB_SKIP_RECURSION);
-                assert_int_equal(ob_test_skip_reason(st, "shadow:sun"), OB_SKIP_RECURSION);
+                assert_int_equal(ob_world_skip_reason(st, "envmap:m0"), OB_SKIP_RECURSION);
+                assert_int_equal(ob_world_skip_reason(st, "envmap:m1"), OB_SKIP_RECURSION);
+                assert_int_equal(ob_world_skip_reason(st, "envmap:m2"), OB_SKIP_RECURSION);
+                assert_int_equal(ob_world_skip_reason(st, "shadow:sun"), OB_SKIP_RECURSION);
                 assert_int_equal(cut, 4);
                 /* Without their maps the mirrors are drawn plainly lit. */
-                assert_int_equal(ob_test_view_stats(st, "main")->draws, 4);
+                assert_int_equal(ob_world_view_stats(st, "main")->draws, 4);
             } else {
                 assert_int_equal(envs, 3);
                 assert_int_equal(cut, 0);
@@ -453,11 +453,11 @@ static void mirror_spheres_stop_at_recursion_bound(void **state)
                 for (int i = 0; i < 3; i++) {
                     char name[16];
                     snprintf(name, sizeof name, "envmap:m%d", i);
-                    const ob_view_stats *vs = ob_test_view_stats(st, name);
+                    const ob_view_stats *vs = ob_world_view_stats(st, name);
                     assert_non_null(vs);
                     assert_int_equal(vs->items, 3);
                     assert_int_equal(vs->draws, expected_draws[i]);
-                    assert_true(ob_test_view_index(st, name) < ob_test_view_index(st, "main"));
+                    assert_true(ob_world_view_index(st, name) < ob_world_view_index(st, "main"));
                 }
             }
         }
@@ -472,11 +472,11 @@ static void no_reflective_entity_no_env_map(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, false);
-    ob_test_world_entity(&w, NULL, "ball", w.sphere, m, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, false);
+    ob_world_entity(&w, NULL, "ball", w.sphere, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 0);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 0);
     assert_int_equal(st->view_count, 2);
     assert_int_equal(st->skipped_count, 0);
     ob_test_world_destroy(&w);
@@ -487,12 +487,12 @@ static void light_without_shadows_no_shadow_view(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
-    ob_test_world_light(&w, OB_LIGHT_POINT, false, 1.0f, 0, 2, 2);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
-    ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+    ob_world_light(&w, OB_LIGHT_POINT, false, 1.0f, 0, 2, 2);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
+    ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 0);
     assert_int_equal(st->skipped_count, 0);
     ob_test_world_destroy(&w);
 }
@@ -504,22 +504,22 @@ static void switched_off_light_no_shadow_view(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_node *sun = ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
-    ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
+    ob_node *sun = ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
+    ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_non_null(ob_test_view_stats(st, "shadow:sun"));
+    assert_non_null(ob_world_view_stats(st, "shadow:sun"));
     ob_light_desc dark = *ob_node_get_light(sun);
     dark.intensity = 0.0f;
     assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
-    assert_int_equal(ob_test_skip_reason(st, "shadow:sun"), OB_SKIP_NOT_NEEDED);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 0);
+    assert_int_equal(ob_world_skip_reason(st, "shadow:sun"), OB_SKIP_NOT_NEEDED);
     dark.intensity = 1.0f;
     assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);
     ob_node_set_hidden(sun, true);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 0);
     ob_test_world_destroy(&w);
 }
 
@@ -528,18 +528,18 @@ static void no_caster_in_view_skips_shadow(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 2, 5, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
-    ob_material *caster = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.2f, 0.2f, true);
-    ob_material *plain = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
-    ob_test_world_entity(&w, NULL, "ground", w.plane, plain, 0, -0.5, 0);
-    ob_test_world_entity(&w, NULL, "caster-behind", w.box, caster, 0, 0, 12); /* behind the camera */
+    ob_world_look(&w, 0, 2, 5, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *caster = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.2f, true);
+    ob_material *plain = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    ob_world_entity(&w, NULL, "ground", w.plane, plain, 0, -0.5, 0);
+    ob_world_entity(&w, NULL, "caster-behind", w.box, caster, 0, 0, 12); /* behind the camera */
     for (int mode = 0; mode < 2; mode++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        assert_int_equal(ob_test_count_views(st, OB_VIEW_SHADOW), 0);
-        assert_int_equal(ob_test_skip_reason(st, "shadow:sun"), OB_SKIP_NO_CASTERS);
-        assert_int_equal(ob_test_view_stats(st, "main")->draws, 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 0);
+        assert_int_equal(ob_world_skip_reason(st, "shadow:sun"), OB_SKIP_NO_CASTERS);
+        assert_int_equal(ob_world_view_stats(st, "main")->draws, 1);
     }
     ob_test_world_destroy(&w);
 }
@@ -549,19 +549,19 @@ static void reflective_outside_frustum_no_env_map(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_test_world_look(&w, 0, 2, 5, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
-    ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
-    ob_node *mirror = ob_test_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 12);
+    ob_world_look(&w, 0, 2, 5, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
+    ob_node *mirror = ob_world_entity(&w, NULL, "mirror", w.sphere, mirror_material(&w), 0, 0, 12);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 0);
-    assert_int_equal(ob_test_view_stats(st, "main")->culled, 1);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 0);
+    assert_int_equal(ob_world_view_stats(st, "main")->culled, 1);
     assert_null(ob_renderer_attached_view(w.r, mirror, OB_VIEW_PARABOLOID));
     /* Turn the camera round: now it is needed. */
-    ob_test_world_look(&w, 0, 2, 5, 0, 0, 12);
+    ob_world_look(&w, 0, 2, 5, 0, 0, 12);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_int_equal(ob_test_count_views(st, OB_VIEW_PARABOLOID), 1);
+    assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 1);
     ob_test_world_destroy(&w);
 }
 
@@ -570,16 +570,16 @@ static void empty_view_records_nothing(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.clear_color = {0.2f, 0.4f, 0.6f, 1.0f}});
-    ob_test_world_look(&w, 0, 2, 5, 0, 0, 0);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
-    for (int i = 0; i < 5; i++) ob_test_world_entity(&w, NULL, "behind", w.box, m, i, 0, 20);
+    ob_world_look(&w, 0, 2, 5, 0, 0, 0);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    for (int i = 0; i < 5; i++) ob_world_entity(&w, NULL, "behind", w.box, m, i, 0, 20);
     uint8_t clear[4] = {ob_composite_view_output_level(w.composite, 0.2f),
                         ob_composite_view_output_level(w.composite, 0.4f),
                         ob_composite_view_output_level(w.composite, 0.6f), 255};
     for (int mode = 0; mode < 2; mode++) {
         const ob_frame_stats *st =
             ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         assert_non_null(main);
         assert_int_equal(main->skipped, OB_SKIP_EMPTY);
         assert_int_equal(main->draws, 0);
@@ -589,7 +589,7 @@ static void empty_view_records_nothing(void **state)
         assert_int_equal(main->hash.draws, 0);
         assert_true(main->hash.hash == ob_cmd_hash_empty().hash);
         assert_int_equal(st->draws, 1); /* the composite */
-        ob_test_world_read(&w);
+        ob_world_read(&w);
         assert_true(all_pixels(&w, clear));
     }
     ob_test_world_destroy(&w);
@@ -599,12 +599,12 @@ static void empty_view_records_nothing(void **state)
 
 static void basic_scene(ob_test_world *w)
 {
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
-    ob_material *ground = ob_test_world_material(w, OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
-    ob_material *ball = ob_test_world_material(w, OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, false);
-    ob_test_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.5, 0);
-    ob_test_world_entity(w, NULL, "ball", w->sphere, ball, 0, 0, 0);
-    ob_test_world_entity(w, NULL, "box", w->box, ball, 1.2, 0, 0.4);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+    ob_material *ground = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
+    ob_material *ball = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, false);
+    ob_world_entity(w, NULL, "ground", w->plane, ground, 0, -0.5, 0);
+    ob_world_entity(w, NULL, "ball", w->sphere, ball, 0, 0, 0);
+    ob_world_entity(w, NULL, "box", w->box, ball, 1.2, 0, 0.4);
 }
 
 /* A camera looking straight down with up = +Y: the basis is degenerate.
@@ -626,7 +626,7 @@ static void degenerate_camera_still_renders(void **state)
         if (c == 0) assert_true(ob_test_log_has("'camera'", "parallel", NULL));
         if (c == 2) ob_node_set_scale(w.camera, (const float[3]){0, 0, 0});
         ob_test_world_frame(&w, c == 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-        images[c] = ob_test_world_snapshot(&w);
+        images[c] = ob_world_snapshot(&w);
         /* NaN would turn pixels black (or into garbage); the scene has none. */
         for (uint32_t i = 0; i < w.width * w.height; i++) {
             const uint8_t *p = images[c] + 4 * i;
@@ -652,15 +652,15 @@ static void non_finite_entity_left_out(void **state)
         basic_scene(&w);
         ob_test_log_clear();
         if (c == 1) {
-            ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.1f, 0.9f, 0.1f, true);
-            ob_node *bad = ob_test_world_entity(&w, NULL, "broken-entity", w.box, m, NAN, 0, 0);
-            ob_test_world_entity(&w, bad, "child-of-broken", w.box, m, 0, 1, 0);
+            ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.1f, 0.9f, 0.1f, true);
+            ob_node *bad = ob_world_entity(&w, NULL, "broken-entity", w.box, m, NAN, 0, 0);
+            ob_world_entity(&w, bad, "child-of-broken", w.box, m, 0, 1, 0);
         }
         for (int mode = 0; mode < 2; mode++) {
             const ob_frame_stats *st =
                 ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
-            assert_int_equal(ob_test_view_stats(st, "main")->draws, 3);
-            images[c][mode] = ob_test_world_snapshot(&w);
+            assert_int_equal(ob_world_view_stats(st, "main")->draws, 3);
+            images[c][mode] = ob_world_snapshot(&w);
         }
         if (c == 1) assert_true(ob_test_log_has("'broken-entity'", "non-finite", NULL));
         ob_test_world_destroy(&w);

@@ -36,11 +36,11 @@ static uint32_t baseline_threads(void)
 
 static void lit_cube(ob_test_world *w)
 {
-    ob_material *m = ob_test_world_material(w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, true);
-    ob_test_world_entity(w, NULL, "cube", w->box, m, 0, 0, 0);
-    ob_material *g = ob_test_world_material(w, OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
-    ob_test_world_entity(w, NULL, "ground", w->plane, g, 0, -0.5, 0);
-    ob_test_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    ob_material *m = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, true);
+    ob_world_entity(w, NULL, "cube", w->box, m, 0, 0, 0);
+    ob_material *g = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    ob_world_entity(w, NULL, "ground", w->plane, g, 0, -0.5, 0);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
 }
 
 /* Five renderers with 1 to 8 workers: each starts its threads, records a
@@ -65,7 +65,7 @@ static void worker_pool_starts_and_stops_with_the_renderer(void **state)
             if (st->views[i].chunks == 0) continue;
             assert_true(st->views[i].worker >= 1 && (uint32_t)st->views[i].worker <= n);
         }
-        uint8_t *img = ob_test_world_snapshot(&w);
+        uint8_t *img = ob_world_snapshot(&w);
         if (!first) first = img;
         else {
             assert_int_equal(ob_test_image_max_diff(first, img, w.width, w.height), 0);
@@ -157,14 +157,14 @@ static void only_active_workers_record(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 6, .chunk_draws = 2});
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.4f, 0.2f, false);
     for (int i = 0; i < 60; i++)
-        ob_test_world_entity(&w, NULL, "box", w.box, m, (i % 10) - 4.5, 0, -(i / 10));
-    ob_test_world_look(&w, 0, 8, 8, 0, 0, -3);
+        ob_world_entity(&w, NULL, "box", w.box, m, (i % 10) - 4.5, 0, -(i / 10));
+    ob_world_look(&w, 0, 8, 8, 0, 0, -3);
     for (uint32_t n = 1; n <= 6; n++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, n);
         assert_int_equal(st->workers, n);
-        const ob_view_stats *main = ob_test_view_stats(st, "main");
+        const ob_view_stats *main = ob_world_view_stats(st, "main");
         assert_int_equal(main->draws, 60);
         assert_true(main->chunks >= 30);
         for (uint32_t i = 0; i < st->view_count; i++)

@@ -23,7 +23,7 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
         if (base && *base) strncat(s->cache_dir, "/stack", sizeof s->cache_dir - strlen(s->cache_dir) - 1);
     }
 
-    ob_stack_desc sd = {
+    ob_world_desc wd = {.stack = {
         .renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1, .adopt = d.adopt},
                      .worker_count = s->workers},
         .cache_dir = s->cache_dir,
@@ -31,15 +31,10 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
         .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
         .camera = {.fovy = 1.0f, .znear = 0.1f},
         .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size,
-    };
-    ob_result r;
-    if (!(s->stack = ob_stack_create(&sd, &r))) {
-        ob_test_stack_stop(s);
-        return r;
-    }
-    s->r = s->stack->renderer;
-    s->dev = s->stack->device;
-    return OB_OK;
+    }};
+    ob_result r = ob_world_create(&s->world, &wd);
+    if (r != OB_OK) ob_test_stack_stop(s);
+    return r;
 }
 
 /* Uploads the mesh `made` filled (a failed make passes its result on) and
@@ -49,7 +44,7 @@ static ob_result add_geometry(ob_test_stack *s, ob_result made, ob_mesh *m, cons
 {
     *out = NULL;
     ob_result r = made;
-    if (r == OB_OK) *out = ob_stack_add_geometry(s->stack, m, name, &r);
+    if (r == OB_OK) *out = ob_stack_add_geometry(s->world.stack, m, name, &r);
     ob_mesh_release(m);
     return r;
 }
@@ -57,14 +52,14 @@ static ob_result add_geometry(ob_test_stack *s, ob_result made, ob_mesh *m, cons
 static ob_node *add_entity(ob_test_stack *s, const char *name, ob_geometry *g, ob_material *m,
                            double x, double y, double z, ob_result *out_result)
 {
-    ob_node *n = ob_stack_add_entity(s->stack, NULL, name, g, m, out_result);
+    ob_node *n = ob_stack_add_entity(s->world.stack, NULL, name, g, m, out_result);
     if (n) ob_node_set_position(n, (const double[3]){x, y, z});
     return n;
 }
 
 ob_result ob_test_stack_build_scene(ob_test_stack *s)
 {
-    ob_stack *st = s->stack;
+    ob_stack *st = s->world.stack;
     ob_node_set_position(st->camera, (const double[3]){0.0, 1.6, 4.0});
     ob_result r = ob_node_look_at(st->camera, (const double[3]){0.0, 0.4, 0.0},
                                   (const double[3]){0, 1, 0});
@@ -127,31 +122,23 @@ ob_result ob_test_stack_frame(ob_test_stack *s, ob_threading mode, uint32_t work
 ob_result ob_test_stack_frame_begin(ob_test_stack *s, ob_threading mode, uint32_t workers)
 {
     s->frames++;
-    ob_renderer_set_threading(s->r, mode, workers);
-    ob_result r = ob_stack_frame_begin(s->stack, 1.0 / 60.0);
-    if (r != OB_OK) return r;
-    ob_views_render(s->stack->views, s->stack->final_view);
-    for (int k = 0; k < OB_FAULT_KIND_COUNT; k++)
+    ob_result r = ob_world_frame_begin(&s->world, mode, workers, NULL, 0);
+    for (int k = 0; r == OB_OK && k < OB_FAULT_KIND_COUNT; k++)
         s->fault_points_before_record[k] = ob_fault_count((ob_fault_kind)k);
-    return OB_OK;
+    return r;
 }
 
-ob_result ob_test_stack_frame_end(ob_test_stack *s)
-{
-    ob_result r = ob_renderer_end_frame(s->r);
-    ob_result w = ob_renderer_wait_idle(s->r);
-    return r != OB_OK ? r : w;
-}
+ob_result ob_test_stack_frame_end(ob_test_stack *s) { return ob_world_frame_end(&s->world); }
 
 ob_result ob_test_stack_read(ob_test_stack *s, uint8_t *out)
 {
-    return ob_image_read_rgba8(s->dev, ob_stack_final_image(s->stack), out);
+    return ob_image_read_rgba8(s->world.dev, ob_stack_final_image(s->world.stack), out);
 }
 
 void ob_test_stack_stop(ob_test_stack *s)
 {
-    if (s->r) ob_renderer_wait_idle(s->r);
-    if (s->stack) ob_particle_system_destroy(s->stack->views, s->particles);
-    ob_stack_destroy(s->stack);
+    if (s->world.r) ob_renderer_wait_idle(s->world.r);
+    if (s->world.stack) ob_particle_system_destroy(s->world.views, s->particles);
+    ob_world_destroy(&s->world);
     memset(s, 0, sizeof *s);
 }

@@ -1,7 +1,7 @@
-/* ob_test_stack.h — the whole engine stack (an ob_stack, views/scene/ob_stack.h)
- * for tests that expect things to fail: every step returns its ob_result
- * instead of failing the test, and ob_test_stack_stop destroys whatever
- * exists after any failure.
+/* ob_test_stack.h — the whole engine stack (an ob_world,
+ * demos/world/ob_world.h, without primitives) for tests that expect things
+ * to fail: every step returns its ob_result instead of failing the test,
+ * and ob_test_stack_stop destroys whatever exists after any failure.
  *
  * ob_test_world (ob_test_world.h) is the harness for tests where every step
  * must succeed; this one is for fault injection and device loss, where a
@@ -23,8 +23,8 @@
 #ifndef OB_TEST_STACK_H
 #define OB_TEST_STACK_H
 
-#include "ob_stack.h"
 #include "ob_test.h"
+#include "ob_world.h"
 
 typedef struct ob_test_stack_desc {
     uint32_t workers;          /* 0 → 2 */
@@ -38,10 +38,7 @@ typedef struct ob_test_stack_desc {
 } ob_test_stack_desc;
 
 typedef struct ob_test_stack {
-    ob_stack *stack;           /* owns everything below but the particle system */
-    /* The stack's renderer and device under their short names (borrowed). */
-    ob_renderer *r;
-    ob_device *dev;
+    ob_world world;            /* owns everything but the particle system */
     ob_particle_system *particles;
     uint32_t width, height, env_map_size, shadow_map_size, workers;
     uint64_t frames;           /* frames attempted (time = frames / 60 s) */
@@ -51,9 +48,9 @@ typedef struct ob_test_stack {
     char cache_dir[512];
 } ob_test_stack;
 
-/* The ob_stack: renderer (validation on), effect context, material
- * library, views, scene, camera (fovy 1, near 0.1), main perspective view
- * and composite. On failure everything created so far is destroyed and the
+/* The world: renderer (validation on), effect context, material library,
+ * views, scene, camera (fovy 1, near 0.1), main perspective view and
+ * composite. On failure everything created so far is destroyed and the
  * error returned. */
 ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc);
 /* The camera's place, geometry, materials, entities, lights and the
