@@ -14,7 +14,7 @@
  *   scene      (views/scene) ob_stack, the usual set-up in one call; scene
  *              files: parsing (ob_scene_file.h) and loading into a scene
  *              (ob_scene_load.h); models placed with their materials
- *              (ob_model_instance.h)
+ *              (ob_model_instance.h); bounds and framing (ob_framing.h)
  * Only the Vulkan headers come along; cglm, stb and cJSON stay inside the
  * library.
  */
@@ -43,6 +43,7 @@
 #include "ob_model.h"
 #include "ob_model_instance.h"
 
+#include "ob_framing.h"
 #include "ob_scene_file.h"
 #include "ob_scene_load.h"
 #include "ob_stack.h"
