@@ -32,7 +32,7 @@ set(OB_PUBLIC_HEADERS
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h geometry/ob_model.h
     views/ob_views.h views/ob_views_layer.h
-    views/scene/ob_stack.h views/scene/ob_framing.h
+    views/scene/ob_stack.h views/scene/ob_stack_content.h views/scene/ob_framing.h
     views/scene/ob_scene_file.h views/scene/ob_scene_load.h
     views/scene/ob_model_instance.h views/scene/obelisk.h)
 

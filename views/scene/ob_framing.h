@@ -1,8 +1,8 @@
 /* ob_framing.h — showing what is in a scene: the bounds of the renderables
  * under a node (or of the whole scene), and a camera placed so that a
  * bounding sphere fills its view. The one implementation behind the scene
- * loader's automatic camera (ob_scene_load.h: a file without a camera)
- * and obelisk-view's model framing.
+ * loader's automatic camera (ob_scene_load.h: a file without a camera),
+ * ob_stack_fit_camera (ob_stack_content.h) and obelisk-view's model framing.
  *
  * Lifecycle: plain functions on an existing scene and camera node; nothing
  * is kept. Thread rule: [render thread, between frames] (measuring updates

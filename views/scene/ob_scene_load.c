@@ -11,6 +11,7 @@
 #include "ob_framing.h"
 #include "ob_mesh.h"
 #include "ob_model_instance.h"
+#include "ob_scene_layer_internal.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define LOG_MODULE "scene"
@@ -238,13 +239,7 @@ static ob_result add_light(loader *L, const char *name, const ob_light_desc *des
      * light instead. Intensity 0 is literal and needs nothing here. */
     bool black = desc->color[0] == 0.0f && desc->color[1] == 0.0f && desc->color[2] == 0.0f;
     ob_node_set_hidden(n, black);
-    if (desc->type == OB_LIGHT_DIRECTIONAL) {
-        /* Aimed from the origin: position + direction could round back to a
-         * far-away position, and a directional light's position is unused. */
-        double up[3] = {0, 1, 0};
-        if (fabs(direction[1]) > 0.99) up[1] = 0, up[2] = -1;
-        if ((r = ob_node_look_at(n, direction, up)) != OB_OK) return r;
-    }
+    if (desc->type == OB_LIGHT_DIRECTIONAL && (r = ob_light_aim(n, direction)) != OB_OK) return r;
     ob_node_set_position(n, position);
     return OB_OK;
 }
@@ -312,10 +307,6 @@ static ob_result add_entity(loader *L, const ob_scene_file_entity *e)
     return OB_OK;
 }
 
-static const ob_light_desc default_sun = {.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 0.97f, 0.92f},
-                                          .intensity = 1.0f, .casts_shadows = true};
-static const double default_sun_direction[3] = {-0.11, -0.77, -0.63};
-
 static ob_result build(loader *L)
 {
     const ob_scene_file *sf = L->sf;
@@ -349,7 +340,7 @@ static ob_result build(loader *L)
         if ((r = add_entity(L, &sf->entities[i])) != OB_OK) return r;
     if (!sf->has_lights) {
         double origin[3] = {0, 0, 0};
-        if ((r = add_light(L, "sun", &default_sun, origin, default_sun_direction)) != OB_OK)
+        if ((r = add_light(L, "sun", &ob_sun_light, origin, ob_sun_direction)) != OB_OK)
             return fail(L, r, "", "the default light (no \"lights\" in the file) could not be made");
     }
     for (uint32_t i = 0; i < sf->light_count; i++) {
