@@ -3,8 +3,12 @@
 # cube_png (shared library) must find the shaders beside the library with no
 # help; cube_png_static gets them through $OB_SHADER_DIR. Each must write a
 # PNG and log no warning or error (the validation layer is on in tests).
-# Run by ctest: cmake -DSRC=<source> -DPREFIX=<dir> -DOUT=<dir> -DCC=<compiler> -P examples.cmake
-foreach(var SRC PREFIX OUT CC)
+# model_png renders BoxTextured (glTF, textured) and the same box with its
+# texture taken out of the file: the two must differ on many pixels (the
+# texture is drawn, ob_golden compares).
+# Run by ctest: cmake -DSRC=<source> -DPREFIX=<dir> -DOUT=<dir> -DCC=<compiler>
+#               -DGOLDEN=<ob_golden> -P examples.cmake
+foreach(var SRC PREFIX OUT CC GOLDEN)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "package examples: -D${var}=... is required")
   endif()
@@ -37,6 +41,28 @@ file(SHA256 ${OUT}/cube_static.png b)
 if(NOT a STREQUAL b)
   message(FATAL_ERROR "cube_png and cube_png_static wrote different images")
 endif()
+
+# model_png: BoxTextured with its texture, then without it (the same file
+# with the material's baseColorTexture removed).
+set(models /usr/share/assimp/models/glTF2/BoxTextured-glTF)
+ob_run_example2(${OUT}/build/model_png ${models}/BoxTextured.gltf ${OUT}/model_textured.png "")
+file(COPY ${models}/BoxTextured.gltf ${models}/BoxTextured0.bin DESTINATION ${OUT}/untextured)
+file(READ ${OUT}/untextured/BoxTextured.gltf gltf)
+string(REGEX REPLACE "\"baseColorTexture\"[^}]*},?" "" stripped "${gltf}")
+if(stripped STREQUAL gltf)
+  message(FATAL_ERROR "BoxTextured.gltf has no baseColorTexture to take out")
+endif()
+file(WRITE ${OUT}/untextured/BoxTextured.gltf "${stripped}")
+ob_run_example2(${OUT}/build/model_png ${OUT}/untextured/BoxTextured.gltf ${OUT}/model_untextured.png "")
+# 640 x 480: more than 2% of the pixels must differ by more than 8 levels.
+execute_process(COMMAND ${GOLDEN} ${OUT}/model_textured.png ${OUT}/model_untextured.png
+                        --tolerance 8 --max-pixels 6144
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 1)
+  message(FATAL_ERROR "model_png drew BoxTextured (nearly) as without its texture (ob_golden exit ${code}):\n"
+                      "${out}${err}")
+endif()
+message(STATUS "ok: model_png drew BoxTextured's texture: ${out}")
 
 # scene_window (built where GLFW is): a scene file shown for 5 frames in a
 # window on a virtual X server, when xvfb-run is there (./setup.sh installs
