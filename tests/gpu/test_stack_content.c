@@ -6,8 +6,9 @@
  * the origin in the middle of the image at a reasonable size; a missing or
  * broken model file and a missing scene file return an error naming the
  * file and the stack keeps rendering what it had; a scene file's missing
- * models are reported in the record the stack keeps; and ob_stack_destroy
- * frees all of it. */
+ * models are reported in the record the stack keeps; ob_stack_destroy
+ * frees all of it; and a failure at any allocation or Vulkan creation
+ * while a model is added leaves the stack rendering and nothing leaked. */
 #include "ob_test.h"
 
 #include <math.h>
@@ -17,6 +18,7 @@
 #include <unistd.h>
 
 #include "ob_stack_content.h"
+#include "ob_test_adopt.h"
 #include "ob_test_world.h"
 
 #define W 160u
@@ -24,9 +26,10 @@
 #define BOX_GLB "/usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb"
 #define SCENES OB_SOURCE_DIR "/tests/data/scenes/"
 
-static ob_stack *make_stack(void)
+static ob_stack *make_stack_on(const ob_vulkan_handles *adopt)
 {
-    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack-content", .validation = 1},
+    ob_stack_desc d = {.renderer = {.device = {.app_name = "obelisk-test-stack-content", .validation = 1,
+                                               .adopt = adopt},
                                     .worker_count = 2},
                        .width = W, .height = H, .shadow_map_size = 256,
                        .clear_color = {0.0f, 0.0f, 1.0f, 1.0f}};
@@ -35,6 +38,8 @@ static ob_stack *make_stack(void)
     assert_non_null(s);
     return s;
 }
+
+static ob_stack *make_stack(void) { return make_stack_on(NULL); }
 
 /* One frame, waited for, the final image into px (W * H * 4). */
 static void render(ob_stack *s, uint8_t *px)
@@ -312,6 +317,71 @@ static void test_scene_file_reports_what_was_left_out(void **state)
     assert_int_equal(after.live_bytes, before.live_bytes);
 }
 
+/* Every point of one fault kind while BoxTextured is added to a fresh
+ * stack, in turn: the add fails with an error and adds no node, or (a
+ * texture that could not be made) succeeds with the texture dropped and a
+ * warning; either way the next frame renders, adding the model again
+ * works, and ob_stack_destroy leaves Obelisk's heap as it was. All on one
+ * adopted instance (ob_test_adopt.h), as test_stack's walks. */
+static void walk_add_model_faults(ob_fault_kind kind)
+{
+    ob_test_vulkan tv;
+    ob_test_vulkan_create(&tv);
+    ob_result r;
+    ob_stack *s = make_stack_on(&tv.handles);
+    ob_fault_arm(kind, 0);   /* unarmed: counts the points */
+    assert_non_null(ob_stack_add_model(s, &(ob_stack_model_desc){.path = BOX_GLB}, &r));
+    uint64_t points = ob_fault_count(kind);
+    ob_stack_destroy(s);
+    assert_true(points > 0);
+    ob_test_log_set_echo(false);
+    uint64_t failed = 0;
+    for (uint64_t n = 1; n <= points; n++) {
+        ob_heap_stats before = ob_heap_stats_now();
+        s = make_stack_on(&tv.handles);
+        uint32_t nodes = ob_scene_node_count(s->scene);
+        ob_fault_arm(kind, n);
+        ob_node *box = ob_stack_add_model(s, &(ob_stack_model_desc){.path = BOX_GLB}, &r);
+        bool hit = ob_fault_hit(kind);
+        ob_fault_arm(kind, 0);
+        if (!box) {
+            if (!hit) fail_msg("fault %llu of %llu did not fire but the add failed", (unsigned long long)n,
+                               (unsigned long long)points);
+            assert_int_not_equal(r, OB_OK);
+            assert_int_equal(ob_scene_node_count(s->scene), nodes);
+            failed++;
+        }
+        assert_int_equal(ob_stack_frame(s, 0.0), OB_OK);
+        if (!box) assert_non_null(ob_stack_add_model(s, &(ob_stack_model_desc){.path = BOX_GLB}, &r));
+        assert_int_equal(ob_stack_fit_camera(s, NULL), OB_OK);
+        assert_int_equal(ob_stack_frame(s, 0.0), OB_OK);
+        assert_int_equal(ob_renderer_wait_idle(s->renderer), OB_OK);
+        ob_test_assert_no_validation(s->device);
+        ob_stack_destroy(s);
+        ob_heap_stats after = ob_heap_stats_now();
+        if (after.live_blocks != before.live_blocks)
+            fail_msg("fault %llu: %lld blocks left", (unsigned long long)n,
+                     (long long)(after.live_blocks - before.live_blocks));
+    }
+    ob_test_log_set_echo(true);
+    printf("%llu fault points, %llu failed the add\n", (unsigned long long)points,
+           (unsigned long long)failed);
+    assert_true(failed > 0);
+    ob_test_vulkan_destroy(&tv);
+}
+
+static void test_add_model_host_faults(void **state)
+{
+    (void)state;
+    walk_add_model_faults(OB_FAULT_HOST_ALLOC);
+}
+
+static void test_add_model_vk_faults(void **state)
+{
+    (void)state;
+    walk_add_model_faults(OB_FAULT_VK_OBJECT);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -320,6 +390,8 @@ int main(void)
         cmocka_unit_test(test_fit_camera_frames_the_model),
         cmocka_unit_test(test_bad_files_name_the_file_and_the_stack_renders_on),
         cmocka_unit_test(test_scene_file_reports_what_was_left_out),
+        cmocka_unit_test(test_add_model_host_faults),
+        cmocka_unit_test(test_add_model_vk_faults),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
