@@ -32,7 +32,8 @@ set(OB_PUBLIC_HEADERS
     materials/ob_effect.h materials/ob_material.h materials/ob_shader.h
     geometry/ob_geometry.h geometry/ob_mesh.h geometry/ob_model.h
     views/ob_views.h views/ob_views_layer.h
-    views/scene/ob_stack.h views/scene/ob_scene_file.h views/scene/ob_scene_load.h
+    views/scene/ob_stack.h views/scene/ob_stack_content.h views/scene/ob_framing.h
+    views/scene/ob_scene_file.h views/scene/ob_scene_load.h
     views/scene/ob_model_instance.h views/scene/obelisk.h)
 
 # ------------------------------------------------------------------ shaders
@@ -82,9 +83,11 @@ set_property(TARGET obelisk APPEND PROPERTY LINK_DEPENDS ${CMAKE_SOURCE_DIR}/cma
 target_link_libraries(obelisk PUBLIC Vulkan::Vulkan PRIVATE ${OB_LIBRARY_PRIVATE_LINK})
 # The installed static library's link interface comes from the package's
 # own look-ups (cmake/ObeliskConfig.cmake.in); in the build tree nothing links it.
+# LINK_ONLY: a program linking it gets the private dependencies' libraries,
+# never their include folders (the public headers need Vulkan's only).
 target_link_libraries(obelisk_static INTERFACE Vulkan::Vulkan
-    $<INSTALL_INTERFACE:PkgConfig::Obelisk_PRIVATE glslang-default-resource-limits stdc++
-                        Threads::Threads m ${CMAKE_DL_LIBS}>)
+    $<INSTALL_INTERFACE:$<LINK_ONLY:PkgConfig::Obelisk_PRIVATE>>
+    $<INSTALL_INTERFACE:glslang-default-resource-limits stdc++ Threads::Threads m ${CMAKE_DL_LIBS}>)
 foreach(lib obelisk obelisk_static)
   target_include_directories(${lib} INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_compile_definitions(${lib} INTERFACE CGLM_FORCE_DEPTH_ZERO_TO_ONE)
@@ -115,6 +118,29 @@ install(FILES ${CMAKE_BINARY_DIR}/package/ObeliskConfig.cmake
         DESTINATION ${OB_CMAKE_DIR})
 
 # obelisk.pc: the prefix is found from the file's own place (${pcfiledir}).
+# Its Libs.private is what linking libobelisk.a needs: the private
+# dependencies' static link flags as their pkg-config files gave them at
+# configure time, -L for folders the linker does not search anyway, each
+# library kept at its last place (static link order).
+set(OB_PC_PRIVATE_FLAGS -lglslang-default-resource-limits ${GLSLANG_STATIC_LDFLAGS})
+get_filename_component(OB_SPIRV_CROSS_DIR ${SPIRV_CROSS_C} DIRECTORY)
+list(APPEND OB_PC_PRIVATE_FLAGS -L${OB_SPIRV_CROSS_DIR} -lspirv-cross-c-shared ${ASSIMP_STATIC_LDFLAGS}
+     ${CJSON_STATIC_LDFLAGS} ${ZLIB_STATIC_LDFLAGS} -lstdc++ -lpthread -lm)
+foreach(lib ${CMAKE_DL_LIBS})
+  list(APPEND OB_PC_PRIVATE_FLAGS -l${lib})
+endforeach()
+set(OB_PC_LIBS_PRIVATE "")
+list(REVERSE OB_PC_PRIVATE_FLAGS)
+foreach(flag ${OB_PC_PRIVATE_FLAGS})
+  if(flag MATCHES "^-L(.*)$" AND CMAKE_MATCH_1 IN_LIST CMAKE_C_IMPLICIT_LINK_DIRECTORIES)
+    continue()
+  endif()
+  if(NOT flag IN_LIST OB_PC_LIBS_PRIVATE)
+    list(APPEND OB_PC_LIBS_PRIVATE ${flag})
+  endif()
+endforeach()
+list(REVERSE OB_PC_LIBS_PRIVATE)
+string(JOIN " " OB_PC_LIBS_PRIVATE ${OB_PC_LIBS_PRIVATE})
 file(RELATIVE_PATH OB_PC_PREFIX ${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig ${CMAKE_INSTALL_PREFIX})
 string(REGEX REPLACE "/$" "" OB_PC_PREFIX "${OB_PC_PREFIX}")
 configure_file(cmake/obelisk.pc.in ${CMAKE_BINARY_DIR}/package/obelisk.pc @ONLY)

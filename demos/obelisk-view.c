@@ -47,7 +47,7 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     uint32_t entities = 0;
     if ((r = ob_model_assets_instantiate(assets, d->scene, root, NULL, &entities)) != OB_OK) return r;
     double lo[3], hi[3], center[3], radius;
-    if ((r = ob_scene_load_measure(d->scene, lo, hi, center, &radius)) != OB_OK) return r;
+    if ((r = ob_framing_measure(d->scene, NULL, lo, hi, center, &radius)) != OB_OK) return r;
     /* Bounds that overflowed (node scales of 1e38 nested) or are too large to
      * frame (positions near 3e38) are the model's problem: said so here,
      * before the automatic ground and sun fail on sizes nobody asked for. */
@@ -89,7 +89,7 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     if ((r = ob_node_set_light(sun, &sun_desc)) != OB_OK || (r = ob_node_look_at(sun, sun_direction, up)) != OB_OK)
         return r;
     ob_node_set_position(sun, center);
-    return ob_scene_load_frame_sphere(d->camera, center, radius, (double)d->opt.width / d->opt.height);
+    return ob_framing_aim_camera(d->camera, center, radius, (double)d->opt.width / d->opt.height);
 }
 
 /* ------------------------------------------------------------ main */

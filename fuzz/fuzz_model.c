@@ -1,6 +1,6 @@
 /* fuzz_model — libFuzzer target for the model loaders (geometry/ob_model*.c):
  * assimp's parsers followed by our checks of the raw scene, post-processing
- * and the merge into one ob_mesh (ob_model_load); then the same file through
+ * and the merge into one ob_mesh (ob_model_load_mesh); then the same file through
  * ob_model_open (the glTF extension scan, nodes, primitives, materials,
  * images, tangents).
  *
@@ -12,7 +12,7 @@
  * too few matrices, joint indices past the joint count, weights that are
  * 0, negative, Inf or NaN), sparse accessors, morph targets, byte strides
  * shorter than their element, accessor offsets and counts past their
- * buffer view. ob_model_load takes a path, so the
+ * buffer view. ob_model_load_mesh takes a path, so the
  * bytes are written to a file in a per-process temporary folder first.
  * A successful load must give a mesh that passes ob_mesh_validate and has
  * finite bounds; a failed one must leave the mesh empty. A successful open
@@ -336,7 +336,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     ob_mesh mesh;
     ob_model_info info;
-    ob_result r = ob_model_load(&(ob_model_desc){.path = path}, &mesh, &info);
+    ob_result r = ob_model_load_mesh(&(ob_model_desc){.path = path}, &mesh, &info);
     if (r == OB_OK) {
         check_mesh(&mesh, &info);
         ob_mesh_release(&mesh);

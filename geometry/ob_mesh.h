@@ -1,18 +1,18 @@
 /* ob_mesh.h — CPU triangle meshes: the standard vertex, bounds, validation,
  * normal generation and the shape generators (box, sphere, plane, cone,
  * torus, full-screen triangle). Model files load into the same struct
- * (ob_model_load in this header, implemented in ob_model.c).
+ * (ob_model_load_mesh in this header, implemented in ob_model.c).
  *
  * Conventions: right-handed, +Y up; a mesh is an indexed triangle list whose
  * front faces wind counter-clockwise seen from outside; uv (0,0) is the
  * top-left of an image (Vulkan sampling convention).
  *
- * Lifecycle: a mesh is plain data. Generators and ob_model_load fill a
+ * Lifecycle: a mesh is plain data. Generators and ob_model_load_mesh fill a
  * caller-provided ob_mesh whose arrays come from ob_malloc; the caller owns
  * them and frees them with ob_mesh_release. A zeroed ob_mesh is empty.
  *
  * Thread rule: every function is [any thread]; a mesh is not synchronized,
- * so one thread writes it at a time. ob_model_load may run on several
+ * so one thread writes it at a time. ob_model_load_mesh may run on several
  * threads at once (see there).
  */
 #ifndef OB_MESH_H
@@ -50,7 +50,7 @@ typedef struct ob_mesh {
     uint8_t (*colors)[4];   /* vertex colour COLOR_0, linear, RGBA8 */
     uint32_t *indices;      /* triangle list: index_count / 3 triangles */
     uint32_t index_count;
-    ob_bounds bounds;       /* valid after a generator, ob_model_load or ob_mesh_compute_bounds */
+    ob_bounds bounds;       /* valid after a generator, ob_model_load_mesh or ob_mesh_compute_bounds */
 } ob_mesh;
 
 /* Frees the arrays (tangents and colours too) and zeroes the mesh. NULL or a zeroed mesh is a no-op. */
@@ -169,7 +169,16 @@ typedef struct ob_model_info {
     uint32_t triangle_count;
 } ob_model_info;
 
-/* Loads every mesh of a model file into one ob_mesh: each mesh instance is
+/* SHAPE ONLY: MATERIALS AND TEXTURES ARE DROPPED. A textured model loaded
+ * this way renders with whatever one material the caller gives it (a white
+ * cube for BoxTextured.glb). To show a model as its file describes it (its
+ * materials, textures and node structure), use ob_stack_add_model
+ * (ob_stack_content.h) in one call, or ob_model_open (ob_model.h) →
+ * ob_model_assets_create → ob_model_assets_instantiate
+ * (ob_model_instance.h) on a scene of your own. This function is for
+ * callers that want only the geometry: collision, bounds, one flat mesh.
+ *
+ * Loads every mesh of a model file into one ob_mesh: each mesh instance is
  * transformed by its node's accumulated transform (normals by the
  * inverse-transpose; a mirroring transform keeps faces counter-clockwise),
  * polygons are triangulated, missing normals generated (smooth), identical
@@ -187,7 +196,7 @@ typedef struct ob_model_info {
  * [any thread]: loads may run concurrently; only assimp's parse step is
  * serialized (its C API keeps the last error text in one process-wide string). */
 /* out_info may be NULL. */
-ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info);
+ob_result ob_model_load_mesh(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info);
 
 #ifdef __cplusplus
 }

@@ -524,12 +524,12 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
     return OB_OK;
 }
 
-ob_result ob_model_load(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info)
+ob_result ob_model_load_mesh(const ob_model_desc *desc, ob_mesh *out, ob_model_info *out_info)
 {
     if (out) memset(out, 0, sizeof *out);
     if (out_info) memset(out_info, 0, sizeof *out_info);
     if (!desc || !desc->path || !desc->path[0] || !out) {
-        OB_LOG_E(OB_MODEL_LOG, "ob_model_load: %s", !desc ? "NULL desc"
+        OB_LOG_E(OB_MODEL_LOG, "ob_model_load_mesh: %s", !desc ? "NULL desc"
                  : !out ? "NULL out mesh" : "no path given");
         return OB_ERR_INVALID_ARGUMENT;
     }

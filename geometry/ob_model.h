@@ -1,7 +1,7 @@
 /* ob_model.h — a model file with its structure: nodes (the hierarchy with
  * local transforms), primitives (one mesh and one material each), materials
  * (glTF 2 metallic-roughness data, from glTF, OBJ .mtl and the other formats
- * assimp reads) and the images their textures use. ob_model_load
+ * assimp reads) and the images their textures use. ob_model_load_mesh
  * (ob_mesh.h) still bakes a whole file into one ob_mesh for callers that want
  * only the shape; this is the path that keeps what the file says.
  *
@@ -11,7 +11,7 @@
  * device, nothing shared with another model.
  *
  * What is read, and the conventions (the file's data is checked before any
- * of it is used, as in ob_model_load):
+ * of it is used, as in ob_model_load_mesh):
  * - Nodes: every assimp node, depth first, so a node's parent always comes
  *   before it (parent index < own index; -1 for the root). assimp's root
  *   node is node 0 (glTF files with several scene roots get assimp's
@@ -20,7 +20,7 @@
  * - Primitives: one per assimp mesh that has triangles (assimp splits a
  *   glTF mesh into one aiMesh per glTF primitive, and a mesh with mixed
  *   primitive types into one per type); points and lines are dropped as in
- *   ob_model_load. Polygons are triangulated, missing normals generated
+ *   ob_model_load_mesh. Polygons are triangulated, missing normals generated
  *   (smooth), identical vertices joined. A primitive used by two nodes is
  *   listed by both (one mesh, drawn twice).
  * - uv: TEXCOORD_0 only. With desc->flip_uv (what a renderer sampling with
@@ -58,7 +58,7 @@
  *   crashes on some); names are made printable. docs/limits.md lists the
  *   bounds.
  *
- * Thread rule: [any thread], like ob_model_load (assimp's parse step is
+ * Thread rule: [any thread], like ob_model_load_mesh (assimp's parse step is
  * serialized inside); a model is not synchronized, one thread at a time.
  */
 #ifndef OB_MODEL_H
@@ -160,7 +160,7 @@ typedef struct ob_model {
     uint32_t image_count;
 } ob_model;
 
-/* Opens a model file (desc->path; desc->flip_uv as in ob_model_load) and
+/* Opens a model file (desc->path; desc->flip_uv as in ob_model_load_mesh) and
  * reads it whole into a new model (*out_model; the caller closes it).
  * Before assimp parses a glTF file, its JSON (a .gltf, or a .glb's JSON
  * chunk) is scanned: an extension listed in extensionsRequired that the
@@ -168,7 +168,7 @@ typedef struct ob_model {
  * file and the extension); extensions only in extensionsUsed get one info
  * line naming them and are ignored.
  * Errors, logged with the path and the mesh / node / material concerned,
- * *out_model NULL and nothing left allocated: as ob_model_load
+ * *out_model NULL and nothing left allocated: as ob_model_load_mesh
  * (OB_ERR_INVALID_ARGUMENT, OB_ERR_IO, OB_ERR_PARSE, OB_ERR_BAD_MODEL —
  * also a primitive naming a material the file lacks, a non-finite node
  * transform, tangent or colour —, OB_ERR_LIMIT, OB_ERR_OUT_OF_HOST_MEMORY),

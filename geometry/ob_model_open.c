@@ -1,7 +1,7 @@
 /* ob_model_open.c — a model file with its structure (ob_model.h): nodes and
  * primitives here, materials and images in ob_model_material.c.
  *
- * The order is ob_model_load's (ob_model.c explains why): PLY and glTF
+ * The order is ob_model_load_mesh's (ob_model.c explains why): PLY and glTF
  * prechecks, parse with no post-processing, check the raw scene, and only
  * then triangulate, generate missing normals and join identical vertices —
  * but without aiProcess_PreTransformVertices or our own merge: each aiMesh
@@ -139,7 +139,7 @@ static ob_result build_primitive(open_ctx *c, uint32_t mi, const struct aiMesh *
         }
         if (len > 1e-30 && isfinite(len)) {
             for (int k = 0; k < 3; k++) dst->normal[k] = (float)(n[k] / len);
-        } else {   /* as ob_model_load and ob_mesh_generate_normals */
+        } else {   /* as ob_model_load_mesh and ob_mesh_generate_normals */
             dst->normal[1] = 1.0f;
             c->fixed_normals++;
         }

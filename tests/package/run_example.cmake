@@ -1,9 +1,14 @@
 # ob_run_example(EXE PNG ENV): runs `EXE PNG` with ENV ("" or VAR=value) added
 # to the environment; fails unless it exits 0, logs no warning or error and
-# PNG is a non-empty PNG file.
+# PNG is a non-empty PNG file. ob_run_example2(EXE INPUT PNG ENV) runs
+# `EXE INPUT PNG` alike.
 function(ob_run_example exe png env)
+  ob_run_example2(${exe} "" ${png} "${env}")
+endfunction()
+
+function(ob_run_example2 exe input png env)
   file(REMOVE ${png})
-  set(cmd ${exe} ${png})
+  set(cmd ${exe} ${input} ${png})
   if(env)
     set(cmd ${CMAKE_COMMAND} -E env ${env} ${cmd})
   endif()

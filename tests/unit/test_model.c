@@ -79,7 +79,7 @@ static bool have_model(const char *path)
 static ob_result load(const char *path, bool flip_uv, ob_mesh *mesh, ob_model_info *info)
 {
     ob_model_desc desc = {.path = path, .flip_uv = flip_uv};
-    return ob_model_load(&desc, mesh, info);
+    return ob_model_load_mesh(&desc, mesh, info);
 }
 
 static void expect_loaded(const ob_mesh *m, const ob_model_info *info, uint32_t meshes,
@@ -423,8 +423,8 @@ static void rejects_missing_file_and_bad_arguments(void **state)
     expect_rejected(temp_dir, OB_ERR_IO, "not a regular file");
     ob_mesh m;
     ob_model_desc no_path = {0};
-    assert_int_equal(ob_model_load(&no_path, &m, NULL), OB_ERR_INVALID_ARGUMENT);
-    assert_int_equal(ob_model_load(NULL, &m, NULL), OB_ERR_INVALID_ARGUMENT);
+    assert_int_equal(ob_model_load_mesh(&no_path, &m, NULL), OB_ERR_INVALID_ARGUMENT);
+    assert_int_equal(ob_model_load_mesh(NULL, &m, NULL), OB_ERR_INVALID_ARGUMENT);
 }
 
 /* One triangle p0 (0,0,0), p1 (1,0,0), p2 (0,1,1) with its true normal

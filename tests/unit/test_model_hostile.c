@@ -195,10 +195,10 @@ static void lying_glb_lengths_are_refused(void **state)
     write_file(path, glb, sizeof glb);
     assert_int_equal(open_model(path, false, &m), OB_ERR_BAD_MODEL);
     assert_true(ob_test_log_has("total.glb: not a valid binary glTF: its header's total length claims", NULL));
-    /* The flattening loader (ob_model_load) checks the same. */
+    /* The flattening loader (ob_model_load_mesh) checks the same. */
     ob_mesh mesh;
     ob_test_log_clear();
-    assert_int_equal(ob_model_load(&(ob_model_desc){.path = path}, &mesh, NULL), OB_ERR_BAD_MODEL);
+    assert_int_equal(ob_model_load_mesh(&(ob_model_desc){.path = path}, &mesh, NULL), OB_ERR_BAD_MODEL);
     assert_null(mesh.vertices);
 }
 
@@ -312,7 +312,7 @@ static void skinned_gltf_opens_in_its_bind_pose(void **state)
     ob_model_close(m);
     ob_mesh mesh;
     ob_test_log_clear();
-    assert_int_equal(ob_model_load(&(ob_model_desc){.path = DATA "skin_no_ibm.gltf"}, &mesh, NULL), OB_OK);
+    assert_int_equal(ob_model_load_mesh(&(ob_model_desc){.path = DATA "skin_no_ibm.gltf"}, &mesh, NULL), OB_OK);
     assert_int_equal(mesh.index_count, 3);
     ob_mesh_release(&mesh);
 }

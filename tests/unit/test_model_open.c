@@ -575,7 +575,7 @@ static void engine_keeps_its_hierarchy(void **state)
         for (int32_t p = m->nodes[i].parent; p >= 0; p = m->nodes[p].parent) depth++;
         if (depth > deepest) deepest = depth;
     }
-    assert_int_equal(placements, 115);   /* as ob_model_load's merged instances */
+    assert_int_equal(placements, 115);   /* as ob_model_load_mesh's merged instances */
     assert_true(deepest >= 3);
     expect_materials_match_json(m, doc);
     cJSON_Delete(doc);

@@ -8,8 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ob_framing.h"
 #include "ob_mesh.h"
 #include "ob_model_instance.h"
+#include "ob_scene_layer_internal.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define LOG_MODULE "scene"
@@ -237,13 +239,7 @@ static ob_result add_light(loader *L, const char *name, const ob_light_desc *des
      * light instead. Intensity 0 is literal and needs nothing here. */
     bool black = desc->color[0] == 0.0f && desc->color[1] == 0.0f && desc->color[2] == 0.0f;
     ob_node_set_hidden(n, black);
-    if (desc->type == OB_LIGHT_DIRECTIONAL) {
-        /* Aimed from the origin: position + direction could round back to a
-         * far-away position, and a directional light's position is unused. */
-        double up[3] = {0, 1, 0};
-        if (fabs(direction[1]) > 0.99) up[1] = 0, up[2] = -1;
-        if ((r = ob_node_look_at(n, direction, up)) != OB_OK) return r;
-    }
+    if (desc->type == OB_LIGHT_DIRECTIONAL && (r = ob_light_aim(n, direction)) != OB_OK) return r;
     ob_node_set_position(n, position);
     return OB_OK;
 }
@@ -311,10 +307,6 @@ static ob_result add_entity(loader *L, const ob_scene_file_entity *e)
     return OB_OK;
 }
 
-static const ob_light_desc default_sun = {.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 0.97f, 0.92f},
-                                          .intensity = 1.0f, .casts_shadows = true};
-static const double default_sun_direction[3] = {-0.11, -0.77, -0.63};
-
 static ob_result build(loader *L)
 {
     const ob_scene_file *sf = L->sf;
@@ -348,7 +340,7 @@ static ob_result build(loader *L)
         if ((r = add_entity(L, &sf->entities[i])) != OB_OK) return r;
     if (!sf->has_lights) {
         double origin[3] = {0, 0, 0};
-        if ((r = add_light(L, "sun", &default_sun, origin, default_sun_direction)) != OB_OK)
+        if ((r = add_light(L, "sun", &ob_sun_light, origin, ob_sun_direction)) != OB_OK)
             return fail(L, r, "", "the default light (no \"lights\" in the file) could not be made");
     }
     for (uint32_t i = 0; i < sf->light_count; i++) {
@@ -374,39 +366,11 @@ static ob_result build(loader *L)
 
 /* ------------------------------------------------------------ bounds, camera */
 
-ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
-                                double *radius)
-{
-    for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY, center[k] = 0.0;
-    *radius = 1.0;
-    ob_result r = ob_scene_update(scene, 0.0);
-    if (r != OB_OK) return r;
-    uint32_t n = 0;
-    ob_node *const *nodes = ob_scene_renderables(scene, &n);
-    if (!n) return OB_OK;
-    for (uint32_t i = 0; i < n; i++) {
-        double c[3];
-        float rad;
-        ob_node_world_sphere(nodes[i], c, &rad);
-        for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], c[k] - rad), hi[k] = fmax(hi[k], c[k] + rad);
-    }
-    for (int k = 0; k < 3; k++) center[k] = 0.5 * (lo[k] + hi[k]);
-    *radius = 0.0;
-    for (uint32_t i = 0; i < n; i++) {
-        double c[3];
-        float rad;
-        ob_node_world_sphere(nodes[i], c, &rad);
-        double dx = c[0] - center[0], dy = c[1] - center[1], dz = c[2] - center[2];
-        *radius = fmax(*radius, sqrt(dx * dx + dy * dy + dz * dz) + rad);
-    }
-    return OB_OK;
-}
-
 /* Bounds of every renderable (after one update, so world bounds exist). */
 static ob_result scene_bounds(loader *L)
 {
     ob_scene_loaded *o = L->out;
-    ob_result r = ob_scene_load_measure(L->t.scene, o->min, o->max, o->center, &o->radius);
+    ob_result r = ob_framing_measure(L->t.scene, NULL, o->min, o->max, o->center, &o->radius);
     if (r != OB_OK) return fail(L, r, "", "the scene did not update");
     o->has_bounds = o->max[0] >= o->min[0];
     if (!o->has_bounds) {
@@ -414,31 +378,6 @@ static ob_result scene_bounds(loader *L)
         memset(o->max, 0, sizeof o->max);
     }
     return OB_OK;
-}
-
-ob_result ob_scene_load_frame_sphere(ob_node *camera, const double sphere_center[3], double radius,
-                                     double aspect)
-{
-    if (!camera || !sphere_center || !(aspect > 0.0) || !isfinite(aspect)) {
-        OB_LOG_E(LOG_MODULE, "ob_scene_load_frame_sphere: %s", !camera ? "no camera node"
-                 : !sphere_center ? "no centre" : "the aspect must be finite and > 0");
-        return OB_ERR_INVALID_ARGUMENT;
-    }
-    double center[3] = {0, 0, 0};
-    if (isfinite(sphere_center[0] + sphere_center[1] + sphere_center[2]))
-        memcpy(center, sphere_center, sizeof center);
-    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
-    const double fovy = 45.0 * DEG;
-    double half = fmin(fovy * 0.5, atan(tan(fovy * 0.5) * aspect));
-    double dist = radius / sin(half) * 1.08;
-    double dir[3] = {sin(35.0 * DEG) * cos(25.0 * DEG), sin(25.0 * DEG), cos(35.0 * DEG) * cos(25.0 * DEG)};
-    double eye[3], up[3] = {0, 1, 0};
-    for (int k = 0; k < 3; k++) eye[k] = center[k] + dir[k] * dist;
-    ob_camera_desc cam = {.fovy = (float)fovy, .znear = (float)fmax(dist * 0.01, 1e-4)};
-    ob_result r = ob_node_set_camera(camera, &cam);
-    if (r != OB_OK) return r;
-    ob_node_set_position(camera, eye);
-    return ob_node_look_at(camera, center, up);
 }
 
 /* The camera node as it was, to put back if the load fails after touching it. */
@@ -473,7 +412,7 @@ static ob_result place_camera(loader *L)
     if (!c->present) {
         if (!(L->desc->frame_aspect > 0.0)) return OB_OK;
         camera_state saved = camera_save(n);
-        if ((r = ob_scene_load_frame_sphere(n, o->center, o->radius, L->desc->frame_aspect)) != OB_OK) {
+        if ((r = ob_framing_aim_camera(n, o->center, o->radius, L->desc->frame_aspect)) != OB_OK) {
             camera_restore(n, &saved);
             return fail(L, r, "", "the camera could not be framed on the scene");
         }

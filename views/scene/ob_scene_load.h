@@ -55,6 +55,7 @@
 #ifndef OB_SCENE_LOAD_H
 #define OB_SCENE_LOAD_H
 
+#include "ob_framing.h"
 #include "ob_model_instance.h"
 #include "ob_scene_file.h"
 #include "ob_stack.h"
@@ -79,7 +80,7 @@ typedef struct ob_scene_load_desc {
      * has one (ob_scene_load_stack: the stack's camera). */
     ob_node *camera;
     /* > 0 and the file has no camera: `camera` (required then) is pointed at
-     * the scene's bounds for this width/height (ob_scene_load_frame_sphere).
+     * the scene's bounds for this width/height (ob_framing_aim_camera).
      * 0: left as it is (ob_scene_load_stack: the final image's aspect). */
     double frame_aspect;
     uint32_t seed;                /* particle system i is seeded seed + i */
@@ -176,23 +177,6 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_d
  * entities' maps are, on first need). [render thread, between frames] */
 void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
                                   const ob_scene_file_settings *settings);
-
-/* Updates the scene (dt 0) and measures every renderable in it (world
- * bounding spheres): the box around them in lo/hi, its centre, and the
- * radius of the sphere about that centre holding them all. No renderable:
- * lo = +inf, hi = −inf, centre 0, radius 1, OB_OK. Failure: the update's
- * result. [render thread, between frames] */
-ob_result ob_scene_load_measure(ob_scene *scene, double lo[3], double hi[3], double center[3],
-                                double *radius);
-
-/* Points camera at a bounding sphere from a 3/4 view above it, at the
- * distance where the sphere fills the narrower field of view (45 degrees
- * vertical) of an image of this aspect (width / height). A non-finite centre
- * is taken as the origin, a radius that is not > 0 and finite as 1.
- * Failure: the node's result (OB_ERR_INVALID_ARGUMENT for a bad aspect);
- * the camera is then changed only in part. [render thread, between frames] */
-ob_result ob_scene_load_frame_sphere(ob_node *camera, const double center[3], double radius,
-                                     double aspect);
 
 #ifdef __cplusplus
 }

@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "ob_scene_layer_internal.h"
+
 ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
 {
     ob_stack_desc d = desc ? *desc : (ob_stack_desc){0};
@@ -62,12 +64,14 @@ void ob_stack_destroy(ob_stack *s)
 {
     if (!s) return;
     if (s->renderer) ob_renderer_wait_idle(s->renderer);
+    ob_stack_content_unload_scenes(s);
     if (s->views) {
         ob_overlay_view_destroy(s->views, s->overlay);
         ob_composite_view_destroy(s->views, s->composite);
         ob_perspective_view_destroy(s->views, s->main);
     }
     ob_scene_destroy(s->scene);
+    ob_stack_content_destroy(s);   /* the models' materials and geometry, once no entity draws them */
     ob_views_destroy(s->views);
     ob_material_library_destroy(s->materials);
     for (uint32_t i = 0; i < s->geometry_count; i++) ob_geometry_destroy(s->device, s->geometry[i]);

@@ -9,7 +9,8 @@
  * point to.
  *
  * Lifecycle: ob_stack_create → [ob_stack_add_geometry, ob_stack_add_entity,
- * materials in s->materials, lights on nodes of s->scene] → frames
+ * materials in s->materials, lights on nodes of s->scene; models, a sun,
+ * scene files and the camera's framing through ob_stack_content.h] → frames
  * (ob_stack_frame, or ob_stack_frame_begin + the program's own PreRender
  * and end) → ob_stack_destroy. Views the program made itself on s->views (particle
  * systems, more perspective views) are destroyed by the program first.
@@ -64,15 +65,19 @@ typedef struct ob_stack {
     uint32_t geometry_count, geometry_cap;
     double time;                      /* seconds simulated by ob_stack_frame */
     uint64_t frames;                  /* frames ob_stack_frame started */
+    /* What ob_stack_content.h loaded into the stack (models with their
+     * textures, scene files); private, freed by ob_stack_destroy. */
+    struct ob_stack_content *content;
 } ob_stack;
 
 /* Creates the whole stack. Failure: NULL, *out_result set (out_result may
  * be NULL), the cause logged by the step that failed, and everything
  * created so far destroyed. */
 ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result);
-/* Waits idle, then destroys in reverse order: overlay, composite, main
- * view, scene (its nodes), views, material library (its materials),
- * geometry, effect context, renderer. NULL is a no-op. */
+/* Waits idle, then destroys in reverse order: the scene files loaded with
+ * ob_stack_load_scene, overlay, composite, main view, scene (its nodes), the
+ * models and textures of ob_stack_add_model, views, material library (its
+ * materials), geometry, effect context, renderer. NULL is a no-op. */
 void ob_stack_destroy(ob_stack *s);
 
 /* Uploads mesh (the caller keeps and releases it) as geometry the stack

@@ -2,6 +2,9 @@
  * #include <obelisk/obelisk.h>, link Obelisk::obelisk (CMake) or
  * `pkg-config --libs obelisk`. examples/cube_png.c is the smallest program.
  *
+ * examples/model_png.c shows a model file with its textures, lit and framed
+ * (ob_stack_content.h).
+ *
  * Layers, bottom up (each header says its lifecycle and thread rule):
  *   engine     results, logging, allocation (ob_core.h); device and resources;
  *              parameters; programs and the pipeline manager; scene graph and
@@ -11,10 +14,12 @@
  *   geometry   meshes and generators, model loading, GPU geometry
  *   views      the standard views (perspective, shadow, env map, simulation,
  *              overlay, composite)
- *   scene      (views/scene) ob_stack, the usual set-up in one call; scene
+ *   scene      (views/scene) ob_stack, the usual set-up in one call, and
+ *              content into it in one call each (ob_stack_content.h:
+ *              models, a sun, scene files, the camera framed); scene
  *              files: parsing (ob_scene_file.h) and loading into a scene
  *              (ob_scene_load.h); models placed with their materials
- *              (ob_model_instance.h)
+ *              (ob_model_instance.h); bounds and framing (ob_framing.h)
  * Only the Vulkan headers come along; cglm, stb and cJSON stay inside the
  * library.
  */
@@ -43,9 +48,11 @@
 #include "ob_model.h"
 #include "ob_model_instance.h"
 
+#include "ob_framing.h"
 #include "ob_scene_file.h"
 #include "ob_scene_load.h"
 #include "ob_stack.h"
+#include "ob_stack_content.h"
 #include "ob_views.h"
 
 #endif /* OBELISK_H */
