@@ -123,7 +123,7 @@ static void test_textured_model_shows_its_texture(void **state)
     ob_test_assert_no_validation(s->device);
     ob_stack_destroy(s);
 
-    uint32_t differ = ob_test_image_diff_count(textured, plain, W, H, 24);
+    uint32_t differ = ob_rgba_diff_count(textured, plain, W * H, 24);
     printf("textured: %.1f%% covered, %u colours; plain: %u colours; %u pixels differ\n",
            c.share * 100.0, c.colours, p.colours, differ);
     assert_true(c.share > 0.1 && c.share < 0.9);
@@ -265,7 +265,7 @@ static void test_bad_files_name_the_file_and_the_stack_renders_on(void **state)
     /* Nothing was added, and the frame is the one before. */
     assert_int_equal(ob_scene_node_count(s->scene), nodes);
     render(s, px);
-    assert_int_equal(ob_test_image_diff_count(good, px, W, H, 0), 0);
+    assert_int_equal(ob_rgba_diff_count(good, px, W * H, 0), 0);
     ob_test_assert_no_validation(s->device);
     ob_stack_destroy(s);
     free(good);
