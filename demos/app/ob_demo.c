@@ -36,6 +36,7 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --exposure F      linear scale of the scene colour before the tone map\n"
             "                    (default 1; 2 = one stop brighter; 1e-6 to 1e6)\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
+            "  --no-overlay      no text overlay, also with --window\n"
             "  --window          show the scene live (F1 toggles the mode; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
             "  --quiet           no per-frame lines\n"
@@ -80,6 +81,23 @@ static bool takes_value(const char *a)
     for (size_t i = 0; i < OB_ARRAY_COUNT(with_value); i++)
         if (!strcmp(a, with_value[i])) return true;
     return false;
+}
+
+/* Every option the parser knows, for the "did you mean" of a typo. */
+static const char *const known_options[] = {
+    "--help", "--overlay", "--no-overlay", "--window", "--quiet", "--no-instancing",
+    "--allow-missing", "--allow-any-folder", "--frames", "--threads", "--toggle", "--size", "--out",
+    "--stats-json", "--seed", "--objects", "--env-size", "--malloc-threshold", "--window-resize",
+    "--msaa", "--exposure", "--shadow-size"};
+
+/* An argument the parser does not know, with the nearest option when a typo
+ * explains it ("--frmaes": did you mean --frames?). */
+static void unknown_argument(const char *prog, const char *a)
+{
+    const char *near = a[0] == '-' ? ob_closest_name(a, known_options,
+                                                     OB_ARRAY_COUNT(known_options), 0) : NULL;
+    if (near) fprintf(stderr, "%s: unknown argument '%s' (did you mean %s?)\n", prog, a, near);
+    else fprintf(stderr, "%s: unknown argument '%s'\n", prog, a);
 }
 
 bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
@@ -187,7 +205,7 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
         } else if (a[0] != '-' && takes_input && !o->input) {
             o->input = a;
         } else {
-            fprintf(stderr, "%s: unknown argument '%s'\n", argv[0], a);
+            unknown_argument(argv[0], a);
             usage(stderr, argv[0], usage_extra, takes_input);
             return false;
         }
