@@ -195,9 +195,9 @@ int main(int argc, char **argv)
         /* The model's own bounds are bad input; the rest is the engine's. */
         code = !is_scene && assets && r == OB_ERR_BAD_MODEL ? EXIT_BAD_INPUT : 1;
     } else {
-        printf("obelisk-view: %s: %s, %ux%u, %s", opt.input, ob_device_name(ob_renderer_device(d.r)),
-               opt.width, opt.height,
-               opt.threads == 0 ? "single-threaded" : opt.threads < 0 ? "auto" : "multi-threaded");
+        printf("obelisk-view: %s: %s, %ux%u, threading %s (%u workers)", opt.input,
+               ob_device_name(ob_renderer_device(d.r)), opt.width, opt.height,
+               ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.r));
         if (is_scene)
             printf(", %u entities (%u left out), %u lights, %u particle systems%s%s", loaded.entity_count,
                    loaded.left_out_count, loaded.light_count, loaded.particle_count,

@@ -83,6 +83,11 @@ static bool takes_value(const char *a)
     return false;
 }
 
+ob_threading ob_demo_options_threading(const ob_demo_options *o)
+{
+    return o->threads == 0 ? OB_THREADING_SINGLE : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
+}
+
 /* Every option the parser knows, for the "did you mean" of a typo. */
 static const char *const known_options[] = {
     "--help", "--overlay", "--no-overlay", "--window", "--quiet", "--no-instancing",
@@ -286,15 +291,26 @@ static void on_stats(void *user, const ob_frame_stats *st)
                          sizeof *d->history) == OB_OK)
         d->history[d->history_count++] = (ob_demo_frame_times){
             st->workers, st->update_ns, st->pre_render_ns, st->record_ns, st->assemble_ns,
-            st->submit_ns, st->frame_ns, st->gpu_ms};
+            st->submit_ns, st->frame_ns, st->gpu_ms, ob_frame_stats_cpu_work_ns(st),
+            ob_frame_stats_wait_ns(st)};
     if (!d->opt.quiet) {
+        /* The stats of a frame come once the GPU is done with it, frames in
+         * flight after it was recorded: said once, with the first line. */
+        if (d->history_count == 1)
+            printf("(a frame's line comes when the GPU has finished it, at the start of the frame "
+                   "%u later; cpu = the engine's work, wait = for the GPU, an image and the "
+                   "present)\n", ob_device_frames_in_flight(ob_renderer_device(d->r)));
         printf("frame %4llu %-3s workers %u  cpu %7.3f ms (update %.3f pre-render %.3f record %.3f "
-               "assemble %.3f submit %.3f)  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
+               "assemble %.3f submit %.3f)  wait %7.3f ms (gpu %.3f image %.3f present %.3f)  "
+               "frame %7.3f ms  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
                (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
-               (double)st->frame_ns * 1e-6, (double)st->update_ns * 1e-6,
+               (double)ob_frame_stats_cpu_work_ns(st) * 1e-6, (double)st->update_ns * 1e-6,
                (double)st->pre_render_ns * 1e-6, (double)st->record_ns * 1e-6,
-               (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6, st->gpu_ms,
-               st->view_count, st->draws, st->culled, (unsigned long long)st->frame_hash);
+               (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6,
+               (double)ob_frame_stats_wait_ns(st) * 1e-6, (double)st->gpu_wait_ns * 1e-6,
+               (double)st->acquire_ns * 1e-6, (double)st->present_ns * 1e-6,
+               (double)st->frame_ns * 1e-6, st->gpu_ms, st->view_count, st->draws, st->culled,
+               (unsigned long long)st->frame_hash);
     }
     if (d->json) {
         if (d->history_count > 1) fputs(",\n", d->json);
@@ -397,8 +413,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
             .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
                        .instance_extension_count = ext_count, .swapchain = o->window},
             .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
-            .threading = o->threads == 0 ? OB_THREADING_SINGLE
-                         : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
+            .threading = ob_demo_options_threading(o),
             .gpu_timing = o->gpu_timing,
         },
         .width = o->width, .height = o->height,
@@ -512,7 +527,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
             "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\","
             "\"draw_calls\":%u,\"instances\":%u,\"descriptor_sets_allocated\":%u,"
-            "\"descriptor_sets_held\":%u,\"views\":[",
+            "\"descriptor_sets_held\":%u,\"threading\":\"%s\",\"cpu_work_ms\":%.4f,"
+            "\"waiting_ms\":%.4f,\"gpu_wait_ms\":%.4f,\"acquire_ms\":%.4f,\"present_ms\":%.4f,"
+            "\"views\":[",
             (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
             st->update_ns * 1e-6, st->pre_render_ns * 1e-6, st->record_ns * 1e-6,
             st->assemble_ns * 1e-6, st->submit_ns * 1e-6, st->wait_ns * 1e-6, st->frame_ns * 1e-6,
@@ -525,7 +542,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
             st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash,
             st->pm.draw_calls, st->pm.instances, st->pm.descriptor_sets_allocated,
-            st->pm.descriptor_sets_held);
+            st->pm.descriptor_sets_held, ob_threading_name(st->mode),
+            ob_frame_stats_cpu_work_ns(st) * 1e-6, ob_frame_stats_wait_ns(st) * 1e-6,
+            st->gpu_wait_ns * 1e-6, st->acquire_ns * 1e-6, st->present_ns * 1e-6);
     for (uint32_t i = 0; i < st->view_count; i++) {
         const ob_view_stats *v = &st->views[i];
         fprintf(f,
@@ -716,6 +735,8 @@ static void print_summary(const ob_demo *d)
         {"record", offsetof(ob_demo_frame_times, record_ns)},
         {"assemble", offsetof(ob_demo_frame_times, assemble_ns)},
         {"submit", offsetof(ob_demo_frame_times, submit_ns)},
+        {"cpu work", offsetof(ob_demo_frame_times, cpu_work_ns)},
+        {"waiting", offsetof(ob_demo_frame_times, waiting_ns)},
         {"frame", offsetof(ob_demo_frame_times, frame_ns)},
         {"gpu", offsetof(ob_demo_frame_times, gpu_ms)},
     };
@@ -746,8 +767,7 @@ static void print_summary(const ob_demo *d)
 
 static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame, bool flipped)
 {
-    ob_threading base = o->threads == 0 ? OB_THREADING_SINGLE
-                        : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
+    ob_threading base = ob_demo_options_threading(o);
     bool flip = flipped != (o->toggle && (frame / o->toggle) % 2 == 1);
     if (flip) return base == OB_THREADING_SINGLE ? OB_THREADING_MULTI : OB_THREADING_SINGLE;
     return base;
@@ -759,11 +779,11 @@ static void overlay_text(ob_demo *d)
     const ob_frame_stats *st = ob_renderer_last_stats(d->r);
     char text[512];
     snprintf(text, sizeof text,
-             "OBELISK  %s  workers %u\nframe %.2f ms  record %.2f ms  gpu %.2f ms\n"
+             "OBELISK  %s  workers %u\ncpu %.2f ms  wait %.2f ms  gpu %.2f ms\n"
              "views %u  draws %u  culled %u",
-             st->workers ? "multi-threaded" : "single-threaded", st->workers,
-             (double)st->frame_ns * 1e-6, (double)st->record_ns * 1e-6, st->gpu_ms,
-             st->view_count, st->draws, st->culled);
+             ob_threading_name(st->mode), st->workers,
+             (double)ob_frame_stats_cpu_work_ns(st) * 1e-6, (double)ob_frame_stats_wait_ns(st) * 1e-6,
+             st->gpu_ms, st->view_count, st->draws, st->culled);
     ob_overlay_view_set_text(d->overlay, text);
 }
 

@@ -54,6 +54,9 @@ typedef struct ob_demo_options {
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
 } ob_demo_options;
 
+/* The mode --threads asks for: 0 → single, N → multi, auto → auto. */
+ob_threading ob_demo_options_threading(const ob_demo_options *o);
+
 /* Parses argv into *o (defaults first). Prints usage and returns false on
  * --help or a bad option (*out_exit says the exit code). */
 bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
@@ -65,6 +68,9 @@ typedef struct ob_demo_frame_times {
     uint32_t workers;         /* 0 = single-threaded */
     uint64_t update_ns, pre_render_ns, record_ns, assemble_ns, submit_ns, frame_ns;
     double gpu_ms;
+    /* ob_frame_stats_cpu_work_ns and ob_frame_stats_wait_ns: the engine's
+     * CPU work apart from waiting for the GPU, an image and the present. */
+    uint64_t cpu_work_ns, waiting_ns;
 } ob_demo_frame_times;
 
 /* What the run's frames left out, for the lean-scene report: each view
