@@ -2,7 +2,8 @@
  * target at a distance, moved by input deltas (pixels dragged, wheel steps)
  * and turned into an eye, a target and a near plane the demo gives its
  * camera node. No window, no engine: the same calls serve GLFW's callbacks,
- * a scripted run (--input) and the unit test (tests/unit/test_orbit.c).
+ * a scripted run (--input, ob_input.h) and the unit test
+ * (tests/unit/test_orbit.c).
  *
  * Conventions: +Y is up; yaw turns about +Y (0 puts the eye on the target's
  * +Z side), pitch raises the eye (clamped to ±OB_ORBIT_MAX_PITCH so that
