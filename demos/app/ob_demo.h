@@ -16,6 +16,7 @@
 #include <stdio.h>
 
 #include "ob_geometry.h"
+#include "ob_input.h"
 #include "ob_mesh.h"
 #include "ob_stack.h"
 #include "ob_window.h"
@@ -52,6 +53,12 @@ typedef struct ob_demo_options {
     bool allow_missing, allow_any_folder;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
+    /* --input SCRIPT (ob_input.h; "@FILE" reads it from FILE): events fed to
+     * the same listener as the window's, before the update of their frame. */
+    const char *input_script;
+    /* --screenshot-prefix P: the S key writes P0001.png, P0002.png, ...
+     * (default "obelisk-shot-", in the working directory). */
+    const char *screenshot_prefix;
 } ob_demo_options;
 
 /* The mode --threads asks for: 0 → single, N → multi, auto → auto. */
@@ -107,7 +114,31 @@ typedef struct ob_demo {
     ob_window *window;        /* --window */
     bool flipped;             /* F1: the mode is the opposite of what the options say */
     ob_demo_lean lean;
+    /* Input (ob_demo_set_input): the window's and --input's events go to
+     * the runner's keys first (F1, S, W, O; Escape from a script stops the
+     * run), then all of them to the program's listener. */
+    ob_input_script *script;  /* --input, parsed; NULL without */
+    ob_input_handler app_input;
+    bool stop;                /* Escape from a script */
+    bool screenshot_pending;
+    uint32_t screenshots;     /* written so far (the next is numbered screenshots + 1) */
+    bool wireframe;           /* W: the main view draws edges */
+    uint32_t overlay_detail;  /* O: 0 = summary, 1 = phases and views */
+    /* A program's extra overlay lines (detail level 1), e.g. the camera. */
+    char overlay_extra[256];
 } ob_demo;
+
+/* The keys the runner handles, for a program's --help:
+ *   F1 single/multi-threaded; S screenshot; W wireframe; O overlay detail;
+ *   Escape quit. */
+#define OB_DEMO_KEYS_HELP                                                                      \
+    "keys (--window, or --input): F1 single/multi-threaded recording, S screenshot\n"          \
+    "                    (--screenshot-prefix, numbered PNGs; the path is printed), W wireframe\n" \
+    "                    (needs fillModeNonSolid), O overlay detail, Escape quit\n"
+
+/* Sets the program's listener (copied; NULL: none): it gets every input
+ * event after the runner's own keys have been handled. */
+void ob_demo_set_input(ob_demo *d, const ob_input_handler *h);
 
 /* The window (--window), then the stack: renderer (worker count from
  * --threads), effect context, material library, views, an empty scene with
