@@ -402,13 +402,15 @@ int main(int argc, char **argv)
                                "                    (without it: the rest renders, then exit 2)\n"
                                "  --allow-any-folder  let models and scene files refer to files outside\n"
                                "                    their own folder (trusted content only)\n"
-                               "obelisk-view's controls (the window, or --input):\n"
+                               "mouse and keys of obelisk-view (in the window, or from --input):\n"
                                "  left drag         orbit the camera round its target\n"
-                               "  middle or right drag, shift + left drag  pan (the scene follows the cursor)\n"
+                               "  middle or right drag, or shift + left drag\n"
+                               "                    pan (the scene follows the cursor)\n"
                                "  wheel             zoom towards / away from the target\n"
-                               "  F                 frame the whole scene\n"
-                               "  R                 reload the scene file now (it also reloads when it\n"
-                               "                    changes on disk; a broken file keeps the old scene)\n",
+                               "  F                 frame the whole scene (its bounds)\n"
+                               "  R                 reload the scene file now; it also reloads when it\n"
+                               "                    changes on disk (a file that does not parse keeps\n"
+                               "                    the old scene on screen and prints the error)\n",
                                true, &opt, &code))
         return code;
     viewer v = {.path = opt.input, .is_scene = has_suffix(opt.input, ".json")};

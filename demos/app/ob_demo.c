@@ -37,7 +37,7 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "                    (default 1; 2 = one stop brighter; 1e-6 to 1e6)\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
             "  --no-overlay      no text overlay, also with --window\n"
-            "  --window          show the scene live (F1 toggles the mode; resizable)\n"
+            "  --window          show the scene live (keys below; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
             "  --quiet           no per-frame lines\n"
             "  --no-instancing   one draw per entity instead of one per run of a material\n"
@@ -50,7 +50,7 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "                    keys A-Z 0-9 F1-F12 Escape); @FILE reads it from FILE\n"
             "  --screenshot-prefix P  where the S key writes: P0001.png, P0002.png, ...\n"
             "                    (default obelisk-shot-)\n"
-            OB_DEMO_KEYS_HELP "%s",
+            "%s" OB_DEMO_KEYS_HELP,
             prog, takes_input ? " FILE" : "", extra ? extra : "");
 }
 

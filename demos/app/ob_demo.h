@@ -131,10 +131,13 @@ typedef struct ob_demo {
 /* The keys the runner handles, for a program's --help:
  *   F1 single/multi-threaded; S screenshot; W wireframe; O overlay detail;
  *   Escape quit. */
-#define OB_DEMO_KEYS_HELP                                                                      \
-    "keys (--window, or --input): F1 single/multi-threaded recording, S screenshot\n"          \
-    "                    (--screenshot-prefix, numbered PNGs; the path is printed), W wireframe\n" \
-    "                    (needs fillModeNonSolid), O overlay detail, Escape quit\n"
+#define OB_DEMO_KEYS_HELP                                                                 \
+    "keys of every demo (in the window, or from --input):\n"                               \
+    "  F1                switch single/multi-threaded recording\n"                            \
+    "  S                 screenshot: the next numbered PNG (--screenshot-prefix), path printed\n" \
+    "  W                 wireframe on/off (needs the device feature fillModeNonSolid)\n"      \
+    "  O                 overlay detail: summary, or phases, waits, views and camera\n"       \
+    "  Escape            quit\n"
 
 /* Sets the program's listener (copied; NULL: none): it gets every input
  * event after the runner's own keys have been handled. */
