@@ -72,6 +72,13 @@ function(differs a b why)
   endif()
 endfunction()
 
+# says(WHAT REGEX): the last run's stdout has a line matching REGEX.
+function(says what regex)
+  if(NOT view_out MATCHES "${regex}")
+    message(FATAL_ERROR "${what}: no line matching '${regex}'\n${view_out}")
+  endif()
+endfunction()
+
 view(base ${scene})
 hashes(base base_hashes)
 
@@ -95,9 +102,7 @@ differs(zoom base "the wheel did not zoom")
 
 # Screenshot: numbered, path printed, the frame itself.
 view(shot ${scene} --input "4:key S" --screenshot-prefix ${OUT}/shot-)
-if(NOT view_out MATCHES "screenshot: wrote ${OUT}/shot-0001.png \\(320x200\\)")
-  message(FATAL_ERROR "S: no 'screenshot: wrote .../shot-0001.png (320x200)' line\n${view_out}")
-endif()
+says("S" "screenshot: wrote ${OUT}/shot-0001.png \\(320x200\\)")
 if(NOT EXISTS ${OUT}/shot-0001.png)
   message(FATAL_ERROR "S: ${OUT}/shot-0001.png was not written")
 endif()
@@ -106,9 +111,7 @@ same(shot_frame4 base "the screenshot after the last frame is not the final imag
 
 # Wireframe on: another image and other hashes; on and off again: exactly the filled run.
 view(wire ${scene} --input "1:key W")
-if(NOT view_out MATCHES "input: W: wireframe on")
-  message(FATAL_ERROR "W: no 'wireframe on' line\n${view_out}")
-endif()
+says("W" "input: W: wireframe on")
 differs(wire base "wireframe draws the same image as filled")
 view(wire_off ${scene} --input "1:key W\n2:key W")
 same(wire_off base "wireframe off again did not restore the filled image")
@@ -121,24 +124,18 @@ endif()
 
 # F frames the scene; R reloads it.
 view(frame_all ${scene} --input "1:drag left 200 0\n2:key F")
-if(NOT view_out MATCHES "input: F: framed the scene")
-  message(FATAL_ERROR "F: no 'framed the scene' line\n${view_out}")
-endif()
+says("F" "input: F: framed the scene")
 differs(frame_all base "F did not frame the scene")
 view(reload ${scene} --input "2:key R")
-if(NOT view_out MATCHES "obelisk-view: reloaded [^\n]*primitives.json: 17 entities")
-  message(FATAL_ERROR "R: no 'reloaded' line\n${view_out}")
-endif()
+says("R" "obelisk-view: reloaded [^\n]*primitives.json: 17 entities")
 
 # A reload of a file that stopped parsing keeps the scene.
 file(COPY ${scene} DESTINATION ${OUT}/broken)
 file(RENAME ${OUT}/broken/primitives.json ${OUT}/broken/snap-0001.png)
 file(CREATE_LINK snap-0001.png ${OUT}/broken/scene.json SYMBOLIC)
 view(broken ${OUT}/broken/scene.json --input "2:key S\n3:key R" --screenshot-prefix ${OUT}/broken/snap-)
-if(NOT view_out MATCHES "obelisk-view: reload: [^\n]*scene.json" OR
-   NOT view_out MATCHES "keeping the scene on screen")
-  message(FATAL_ERROR "a reload of a broken file did not say so\n${view_out}")
-endif()
+says("broken reload" "obelisk-view: reload: [^\n]*scene.json")
+says("broken reload" "keeping the scene on screen")
 same(broken base "a broken reload changed what is on screen")
 
 execute_process(COMMAND ${BIN}/obelisk-view ${scene} ${common} --input "1:drag up 1 1"
