@@ -1,7 +1,9 @@
 /* ob_demo.h — the demo runner the demo programs share: options, the
  * standard set-up (an ob_stack from views/scene/ob_stack.h, with the window when
- * --window is given), the frame loop with its ST/MT toggling, per-frame
- * lines, the JSON stats, the summary of medians per mode and the lean-scene
+ * --window is given), the frame loop with its ST/MT toggling, input (the
+ * window's events and --input scripts, one listener: ob_input.h) with the
+ * runner's keys, per-frame lines (the engine's CPU work apart from waiting),
+ * the JSON stats, the summary of medians per mode and the lean-scene
  * report (what the run left out).
  *
  * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
