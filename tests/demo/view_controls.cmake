@@ -4,7 +4,8 @@
 #   - input that moves nothing (a key the viewer ignores, the overlay key
 #     without an overlay) leaves the image and every frame's command hash
 #     exactly as a run without --input;
-#   - an orbit drag, a pan drag and a wheel zoom each change the image;
+#   - an orbit drag, a pan drag and a wheel zoom each change the image; the
+#     script read from a file (--input @FILE) does what it does inline;
 #   - S writes the numbered screenshot, prints its path, and the PNG is the
 #     frame (same size as --out);
 #   - W draws wireframe (another image), W again restores the filled image
@@ -92,6 +93,10 @@ endif()
 
 view(orbit ${scene} --input "1:drag left 80 30")
 differs(orbit base "an orbit drag did not move the camera")
+# The same script from a file (--input @FILE), with a comment.
+file(WRITE ${OUT}/orbit.input "# orbit once\n1:drag left 80 30\n")
+view(orbit_file ${scene} --input @${OUT}/orbit.input)
+same(orbit_file orbit "--input @FILE did not play the same events")
 view(pan ${scene} --input "1:drag middle 40 0")
 differs(pan base "a pan drag did not move the camera")
 differs(pan orbit "pan and orbit gave the same image")
