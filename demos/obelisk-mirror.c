@@ -38,9 +38,9 @@ int main(int argc, char **argv)
         ob_demo_shutdown(&d);
         return 1;
     }
-    printf("obelisk-mirror: %s, %u objects, %ux%u, %s\n",
+    printf("obelisk-mirror: %s, %u objects, %ux%u, threading %s (%u workers)\n",
            ob_device_name(ob_renderer_device(d.r)), opt.objects, opt.width, opt.height,
-           opt.threads == 0 ? "single-threaded" : opt.threads < 0 ? "auto" : "multi-threaded");
+           ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.r));
     code = ob_demo_run(&d, animate, NULL);
     ob_demo_shutdown(&d);
     return code;

@@ -402,6 +402,56 @@ double ob_median(double *v, uint32_t n)
     return k % 2 ? v[k / 2] : 0.5 * (v[k / 2 - 1] + v[k / 2]);
 }
 
+/* Optimal string alignment over two rows plus the one before (for swaps),
+ * on the stack: names are short, and a message about a typo should not
+ * fail for want of memory. */
+#define OB_EDIT_MAX 63
+static int fold_ascii(int c) { return c >= 'A' && c <= 'Z' ? c + ('a' - 'A') : c; }
+
+uint32_t ob_edit_distance(const char *a, const char *b)
+{
+    size_t n = strnlen(a, OB_EDIT_MAX), m = strnlen(b, OB_EDIT_MAX);
+    uint32_t rows[3][OB_EDIT_MAX + 1];
+    uint32_t *before = rows[0], *prev = rows[1], *cur = rows[2];
+    for (size_t j = 0; j <= m; j++) prev[j] = (uint32_t)j;
+    for (size_t i = 1; i <= n; i++) {
+        cur[0] = (uint32_t)i;
+        for (size_t j = 1; j <= m; j++) {
+            int ca = fold_ascii((unsigned char)a[i - 1]), cb = fold_ascii((unsigned char)b[j - 1]);
+            uint32_t best = prev[j - 1] + (ca != cb);
+            if (prev[j] + 1 < best) best = prev[j] + 1;
+            if (cur[j - 1] + 1 < best) best = cur[j - 1] + 1;
+            if (i > 1 && j > 1 && ca == fold_ascii((unsigned char)b[j - 2]) &&
+                fold_ascii((unsigned char)a[i - 2]) == cb && before[j - 2] + 1 < best)
+                best = before[j - 2] + 1;
+            cur[j] = best;
+        }
+        uint32_t *t = before;
+        before = prev;
+        prev = cur;
+        cur = t;
+    }
+    return prev[m];
+}
+
+const char *ob_closest_name(const char *name, const char *const *candidates, uint32_t count,
+                            uint32_t max_distance)
+{
+    if (!name || !candidates) return NULL;
+    if (!max_distance) {
+        size_t len = strnlen(name, OB_EDIT_MAX);
+        max_distance = len >= 6 ? (uint32_t)(len / 3) : 1;
+    }
+    const char *best = NULL;
+    uint32_t best_d = max_distance + 1;
+    for (uint32_t i = 0; i < count; i++) {
+        if (!candidates[i] || !strcmp(candidates[i], name)) continue;
+        uint32_t d = ob_edit_distance(name, candidates[i]);
+        if (d < best_d && d < strnlen(candidates[i], OB_EDIT_MAX)) best = candidates[i], best_d = d;
+    }
+    return best;
+}
+
 uint64_t ob_time_ns(void)
 {
     struct timespec ts;

@@ -206,6 +206,21 @@ double ob_median(double *v, uint32_t n);
 /* CPU time the calling thread has used, in nanoseconds. */
 uint64_t ob_thread_cpu_ns(void);
 
+/* Edit distance between a and b: insertions, deletions, substitutions and
+ * swaps of two neighbouring characters count 1 each ("--frmaes" is 1 from
+ * "--frames"); letters compare case-insensitively (ASCII) at no cost.
+ * Strings past 63 bytes are compared on their first 63. [any thread] */
+uint32_t ob_edit_distance(const char *a, const char *b);
+/* The candidate closest to name, for a "did you mean" in an error message:
+ * the first of the nearest, NULL when none is within max_distance (0: a
+ * third of name's length, at least 1, so that "--size" does not suggest
+ * "--seed"), nor one that every character would have to change (a
+ * one-letter name does not suggest "x"). An exact match is never suggested
+ * (the caller would not have failed); NULL names and candidates are skipped. Allocates nothing.
+ * [any thread] */
+const char *ob_closest_name(const char *name, const char *const *candidates, uint32_t count,
+                            uint32_t max_distance);
+
 /* One index of a parallel loop. `thread` (0 .. threads-1; 0 is the calling
  * thread) names the thread running it, for per-thread scratch: two calls
  * with the same thread never overlap. Results that must not depend on the

@@ -22,6 +22,26 @@ const char *ob_skip_reason_name(ob_skip_reason r)
     return "unknown";
 }
 
+const char *ob_threading_name(ob_threading mode)
+{
+    switch (mode) {
+    case OB_THREADING_SINGLE: return "single";
+    case OB_THREADING_MULTI: return "multi";
+    case OB_THREADING_AUTO: return "auto";
+    }
+    return "unknown";
+}
+
+uint64_t ob_frame_stats_cpu_work_ns(const ob_frame_stats *st)
+{
+    return st->update_ns + st->pre_render_ns + st->record_ns + st->assemble_ns + st->submit_ns;
+}
+
+uint64_t ob_frame_stats_wait_ns(const ob_frame_stats *st)
+{
+    return st->gpu_wait_ns + st->acquire_ns + st->present_ns;
+}
+
 /* ------------------------------------------------------------ lifecycle */
 
 static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t index)
@@ -204,8 +224,10 @@ void ob_renderer_set_max_recursion(ob_renderer *r, uint32_t depth)
 /* ------------------------------------------------------------ stats */
 
 /* The frame in `fs` has completed: read its timestamps into its stats and
- * make them the last complete stats. */
-static void collect_frame(ob_renderer *r, ob_frame_slot *fs)
+ * make them the last complete stats. The read may wait for the GPU
+ * (lavapipe's does, for the work the fence did not cover): its time is
+ * added to *wait_ns when that is not NULL. */
+static void collect_frame(ob_renderer *r, ob_frame_slot *fs, uint64_t *wait_ns)
 {
     if (!fs->pending) return;
     fs->pending = false;
@@ -215,9 +237,12 @@ static void collect_frame(ob_renderer *r, ob_frame_slot *fs)
     uint64_t ts[2 * OB_MAX_FRAME_VIEWS + 2];
     st->gpu_ms = -1.0;
     for (uint32_t i = 0; i < st->view_count; i++) st->views[i].gpu_ms = -1.0;
-    if (fs->queries && n <= fs->query_capacity &&
-        vkGetQueryPoolResults(ob_device_vk(r->dev), fs->queries, 0, n, sizeof ts, ts,
-                              sizeof ts[0], VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
+    uint64_t t_read = ob_time_ns();
+    bool read = fs->queries && n <= fs->query_capacity &&
+                vkGetQueryPoolResults(ob_device_vk(r->dev), fs->queries, 0, n, sizeof ts, ts,
+                                      sizeof ts[0], VK_QUERY_RESULT_64_BIT) == VK_SUCCESS;
+    if (wait_ns) *wait_ns += ob_time_ns() - t_read;
+    if (read) {
         st->gpu_ms = (double)(ts[1] - ts[0]) * period * 1e-6;
         for (uint32_t i = 0; i < fs->view_queries && i < st->view_count; i++) {
             uint64_t a = ts[2 + 2 * i], b = ts[3 + 2 * i];
@@ -304,6 +329,7 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     VkResult vr = VK_SUCCESS;
     if (!fs->unsubmitted)
         vr = OB_VK_CHECK(OB_VK_WAIT(vkWaitForFences(vk, 1, &fs->fence, VK_TRUE, UINT64_MAX)));
+    uint64_t gpu_wait_ns = ob_time_ns() - t0;
     if (vr != VK_SUCCESS) {
         ob_device_note_result(r->dev, vr);
         OB_LOG_E("renderer", "frame %llu: waiting for frame slot %u failed: %s",
@@ -311,7 +337,7 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
         return ob_result_from_vk(vr);
     }
     fs->unsubmitted = false;
-    collect_frame(r, fs);
+    collect_frame(r, fs, &gpu_wait_ns);
     r->serial++;
     ob_device_begin_frame_slot(r->dev, r->slot);
     vr = OB_VK_CHECK(vkResetCommandPool(vk, fs->pool, 0));
@@ -332,7 +358,9 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     ob_pipeline_manager_begin_frame(r->immediate, r->slot, r->serial);
     /* The slot's fence also covers the submission that waited on its
      * acquire semaphore, so the acquire may signal it again. */
+    uint64_t t_acquire = ob_time_ns();
     ob_result pres = ob_renderer_present_acquire(r);
+    uint64_t acquire_ns = ob_time_ns() - t_acquire;
     if (pres != OB_OK) {
         OB_LOG_E("renderer", "frame %llu: no swapchain image: %s", (unsigned long long)r->serial,
                  ob_result_name(pres));
@@ -372,6 +400,8 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     r->frame_start_ns = t0;
     r->in_frame = true;
     r->submitted = false;
+    r->cur.gpu_wait_ns = gpu_wait_ns;
+    r->cur.acquire_ns = r->present ? acquire_ns : 0;
     r->cur.wait_ns = ob_time_ns() - t0;
     return OB_OK;
 }
@@ -589,7 +619,9 @@ ob_result ob_renderer_end_frame(ob_renderer *r)
     ob_result res = r->submitted ? OB_OK : ob_renderer_process_views(r);
     /* A frame submitted with errors (a view not recorded) still releases
      * its swapchain image: the present waits on what was submitted. */
+    uint64_t t_present = ob_time_ns();
     ob_result pres = ob_renderer_present_queue(r);
+    r->cur.present_ns = r->present ? ob_time_ns() - t_present : 0;
     r->in_frame = false;
     r->acc_render_parallel = r->acc_pool = NULL;
     if (res != OB_OK) return res;
@@ -610,7 +642,7 @@ ob_result ob_renderer_wait_idle(ob_renderer *r)
     /* Collect in submission order so `last` ends as the newest frame. */
     for (uint64_t k = r->frames_in_flight; k > 0; k--) {
         uint32_t slot = (uint32_t)((r->serial + r->frames_in_flight - k) % r->frames_in_flight);
-        if (r->serial >= k - 1) collect_frame(r, &r->frames[slot]);
+        if (r->serial >= k - 1) collect_frame(r, &r->frames[slot], NULL);
     }
     return OB_OK;
 }

@@ -54,6 +54,10 @@ typedef enum ob_threading {
     OB_THREADING_MULTI = 1,    /* workers record secondaries */
     OB_THREADING_AUTO = 2,     /* decide per frame from last frames' measured cost */
 } ob_threading;
+/* Stable short name of a mode: "single", "multi" or "auto" (the words
+ * --threads and the benchmark's files use); "unknown" for other values.
+ * Never NULL. [any thread] */
+const char *ob_threading_name(ob_threading mode);
 
 /* GPU timestamps. A stamp written after a view's work waits for that work:
  * on lavapipe each one flushes the rasteriser, so stamping every view of
@@ -117,11 +121,31 @@ typedef struct ob_view_stats {
     ob_skip_reason skipped;
 } ob_view_stats;
 
+/* One frame's figures. Times are wall time (CLOCK_MONOTONIC) on the render
+ * thread unless said otherwise. They fall in two kinds, and only the first
+ * is the engine's CPU work:
+ *   work:    update_ns + pre_render_ns + record_ns + assemble_ns + submit_ns
+ *            (ob_frame_stats_cpu_work_ns)
+ *   waiting: gpu_wait_ns + acquire_ns + present_ns (ob_frame_stats_wait_ns):
+ *            in begin_frame for the GPU to finish the frame that last used
+ *            this slot (frame - frames_in_flight: its fence and its
+ *            timestamps) and for a swapchain image, and vkQueuePresentKHR
+ *            in end_frame
+ * wait_ns is all of begin_frame: those two waits, resetting the slot's
+ * pools and the stats callback of the completed frame. frame_ns spans
+ * begin_frame to the end of end_frame plus the update, so it holds work,
+ * waiting and whatever the application did in between. A slow GPU shows
+ * in gpu_wait_ns and gpu_ms, never in the work. */
 typedef struct ob_frame_stats {
-    uint64_t frame;
+    uint64_t frame;              /* the frame's serial: ob_renderer_frame_serial() after its
+                                    begin_frame; the first frame is 1 */
     ob_threading mode;
     uint32_t workers;            /* active workers (0 = single-threaded) */
     uint64_t update_ns, pre_render_ns, record_ns, assemble_ns, submit_ns, wait_ns, frame_ns;
+    /* Parts of wait_ns (gpu_wait_ns: this slot's fence and the timestamps
+     * of the frame it held; acquire_ns: the swapchain image, 0 headless)
+     * and the present in end_frame (0 headless). */
+    uint64_t gpu_wait_ns, acquire_ns, present_ns;
     double gpu_ms;
     uint32_t view_count;
     ob_view_stats views[OB_MAX_FRAME_VIEWS];
@@ -208,9 +232,21 @@ typedef struct ob_update_stats {
 void ob_renderer_last_update_stats(const ob_renderer *r, ob_update_stats *out);
 
 /* Called with each frame's final stats (GPU times included) once the frame
- * is known complete, in frame order. [render thread] */
+ * is known complete, in frame order, exactly once per submitted frame.
+ * Completion is learnt from the frame slot's fence, so the call comes late:
+ * the stats of frame N (stats->frame == N) arrive from inside the
+ * begin_frame of frame N + frames_in_flight (2 frames late by default,
+ * ob_device_frames_in_flight), when that frame reuses N's slot, or from
+ * ob_renderer_wait_idle (and so ob_renderer_destroy) for the last frames.
+ * During a call from begin_frame, ob_renderer_frame_serial() is still the
+ * newest frame submitted, N + frames_in_flight - 1. The same lag holds for
+ * ob_renderer_last_stats. [render thread] */
 typedef void (*ob_frame_stats_fn)(void *user, const ob_frame_stats *stats);
 void ob_renderer_set_stats_callback(ob_renderer *r, ob_frame_stats_fn fn, void *user);
+/* The two sums of ob_frame_stats' times (see there): the engine's CPU work
+ * and the waiting for the GPU, a swapchain image and the present. [any thread] */
+uint64_t ob_frame_stats_cpu_work_ns(const ob_frame_stats *stats);
+uint64_t ob_frame_stats_wait_ns(const ob_frame_stats *stats);
 
 /* Completes the frame: records and submits it if process_views did not,
  * then presents it when a surface is attached. A failure to record or
@@ -219,7 +255,8 @@ void ob_renderer_set_stats_callback(ob_renderer *r, ob_frame_stats_fn fn, void *
 ob_result ob_renderer_end_frame(ob_renderer *r);
 /* Waits for all submitted frames; their stats (with GPU times) become final. */
 ob_result ob_renderer_wait_idle(ob_renderer *r);
-/* Stats of the most recent frame whose GPU work is known complete. */
+/* Stats of the most recent frame whose GPU work is known complete: frames_in_flight
+ * frames behind the one being recorded (see the stats callback). */
 const ob_frame_stats *ob_renderer_last_stats(const ob_renderer *r);
 /* Stats of the frame just submitted (CPU parts final, GPU times pending). */
 const ob_frame_stats *ob_renderer_current_stats(const ob_renderer *r);

@@ -59,6 +59,19 @@ bool ob_view_resize(ob_view *v, uint32_t width, uint32_t height)
     return true;
 }
 
+ob_result ob_view_set_wireframe(ob_view *v, const ob_device *dev, bool on)
+{
+    if (!v || !dev) return OB_ERR_INVALID_ARGUMENT;
+    if (on && !ob_device_get_caps(dev)->fill_mode_non_solid) {
+        OB_LOG_E("view", "view '%s': wireframe refused: the device (%s) lacks the feature "
+                 "fillModeNonSolid (VK_POLYGON_MODE_LINE); the view stays filled", v->name,
+                 ob_device_name(dev));
+        return OB_ERR_UNSUPPORTED;
+    }
+    v->wireframe = on;
+    return OB_OK;
+}
+
 bool ob_view_take_resize(ob_view *v, uint32_t *out_width, uint32_t *out_height)
 {
     if (!v->resize_width || !v->resize_height) return false;

@@ -163,6 +163,11 @@ struct ob_view {
     uint64_t cull_ns;                 /* this frame's ob_view_cull time */
     bool range_reported;              /* an entity beyond float range was logged
                                          and has not gone away since */
+    /* Materials' triangles in this view are drawn as their edges
+     * (VK_POLYGON_MODE_LINE): part of the pipeline key, so a wireframe view
+     * has pipelines (and pipeline ids, hence command hashes) of its own and
+     * a filled one keeps its usual ones. Set with ob_view_set_wireframe. */
+    bool wireframe;
 };
 
 /* The colour and depth formats (VK_FORMAT_UNDEFINED when absent) and the
@@ -170,6 +175,12 @@ struct ob_view {
  * drawing in v must be made for. [any thread: only reads v] */
 void ob_view_attachment_formats(const ob_view *v, const ob_device *dev, VkFormat *out_color,
                                 VkFormat *out_depth, uint32_t *out_samples);
+
+/* Draws v's materials as wireframe (on) or filled (off, the default), from
+ * its next PreRender. Needs the device feature fillModeNonSolid: without it
+ * turning on is refused with OB_ERR_UNSUPPORTED and a log line saying so,
+ * and v stays filled. [render thread, between frames] */
+ob_result ob_view_set_wireframe(ob_view *v, const ob_device *dev, bool on);
 
 /* Asks for v's targets at width x height. Nothing changes now: the view's
  * owner makes the targets again at the

@@ -13,6 +13,7 @@
 typedef struct effect_pipeline {
     VkFormat color, depth;
     uint32_t samples;        /* rasterizationSamples: part of the key */
+    bool wireframe;          /* VK_POLYGON_MODE_LINE: part of the key */
     VkPipeline pipeline;     /* VK_NULL_HANDLE when creation failed */
     uint32_t id;
 } effect_pipeline;
@@ -488,7 +489,7 @@ static VkPipelineShaderStageCreateInfo stage_info(const ob_effect *e, uint32_t i
 }
 
 static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, uint32_t samples,
-                                const void *feedback, VkPipeline *out)
+                                bool wireframe, const void *feedback, VkPipeline *out)
 {
     VkPipelineShaderStageCreateInfo stages[2];
     for (uint32_t i = 0; i < e->stage_count; i++) stages[i] = stage_info(e, i);
@@ -515,7 +516,7 @@ static VkResult create_graphics(ob_effect *e, VkFormat color, VkFormat depth, ui
     bool bias = e->depth_bias_constant != 0.0f || e->depth_bias_slope != 0.0f;
     VkPipelineRasterizationStateCreateInfo rs = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-        .polygonMode = VK_POLYGON_MODE_FILL,
+        .polygonMode = wireframe ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
         .cullMode = e->cull,
         .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
         .depthBiasEnable = bias,
@@ -601,29 +602,32 @@ static VkResult create_compute(ob_effect *e, const void *feedback, VkPipeline *o
 }
 
 static const effect_pipeline *find_pipeline(const ob_effect *e, uint32_t count, VkFormat color,
-                                            VkFormat depth, uint32_t samples)
+                                            VkFormat depth, uint32_t samples, bool wireframe)
 {
     for (uint32_t i = 0; i < count; i++)
         if (e->pipelines[i].color == color && e->pipelines[i].depth == depth &&
-            e->pipelines[i].samples == samples)
+            e->pipelines[i].samples == samples && e->pipelines[i].wireframe == wireframe)
             return &e->pipelines[i];
     return NULL;
 }
 
-static uint32_t pipeline_id(const ob_effect *e, VkFormat color, VkFormat depth, uint32_t samples)
+static uint32_t pipeline_id(const ob_effect *e, VkFormat color, VkFormat depth, uint32_t samples,
+                            bool wireframe)
 {
     uint64_t h = ob_hash_str(OB_HASH_SEED, e->name);
     h = ob_hash_u64(h, ((uint64_t)(uint32_t)color << 32) | (uint32_t)depth);
-    /* Single-sampled pipelines keep the ids they had before sample counts
-     * were part of the key (command hashes stay comparable). */
+    /* Single-sampled filled pipelines keep the ids they had before sample
+     * counts and polygon modes were part of the key (command hashes stay
+     * comparable). */
     if (samples > 1) h = ob_hash_u64(h, samples);
+    if (wireframe) h = ob_hash_str(h, "wireframe");
     uint32_t id = (uint32_t)(h ^ (h >> 32));
     return id ? id : 1u;
 }
 
 /* Called with e->lock held and the pair known to be missing. */
 static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkFormat color,
-                                           VkFormat depth, uint32_t samples)
+                                           VkFormat depth, uint32_t samples, bool wireframe)
 {
     if (count >= OB_EFFECT_MAX_PIPELINES) {
         OB_LOG_E("effect", "effect '%s': more than %u target format pairs; no pipeline for "
@@ -641,10 +645,11 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
     };
     VkPipeline pipeline = VK_NULL_HANDLE;
     VkResult vr = e->compute ? create_compute(e, &feedback, &pipeline)
-                             : create_graphics(e, color, depth, samples, &feedback, &pipeline);
+                             : create_graphics(e, color, depth, samples, wireframe, &feedback,
+                                               &pipeline);
     effect_pipeline *entry = &e->pipelines[count];
-    *entry = (effect_pipeline){color, depth, samples, VK_NULL_HANDLE,
-                               pipeline_id(e, color, depth, samples)};
+    *entry = (effect_pipeline){color, depth, samples, wireframe, VK_NULL_HANDLE,
+                               pipeline_id(e, color, depth, samples, wireframe)};
     if (OB_VK_CHECK_AS(vr, e->compute ? "vkCreateComputePipelines" : "vkCreateGraphicsPipelines") !=
         VK_SUCCESS) {
         ob_device_note_result(e->ctx->dev, vr);
@@ -664,7 +669,8 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
             (whole.flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT))
             atomic_fetch_add(&e->ctx->pipelines_from_cache_hint, 1);
         char label[96];
-        snprintf(label, sizeof label, "%s/%d/%d/%ux", e->name, (int)color, (int)depth, samples);
+        snprintf(label, sizeof label, "%s/%d/%d/%ux%s", e->name, (int)color, (int)depth, samples,
+                 wireframe ? "/wireframe" : "");
         ob_device_set_name(e->ctx->dev, VK_OBJECT_TYPE_PIPELINE, (uint64_t)pipeline, label);
     }
     /* Failed pairs are published too, so later draws fail fast and quietly. */
@@ -675,7 +681,7 @@ static const effect_pipeline *create_entry(ob_effect *e, uint32_t count, VkForma
 VkPipeline ob_effect_pipeline(ob_effect *e, VkFormat color, VkFormat depth,
                               uint32_t *out_pipeline_id)
 {
-    return ob_effect_pipeline_for(e, &(ob_effect_targets){color, depth, 1}, out_pipeline_id);
+    return ob_effect_pipeline_for(e, &(ob_effect_targets){color, depth, 1, false}, out_pipeline_id);
 }
 
 VkPipeline ob_effect_pipeline_for(ob_effect *e, const ob_effect_targets *targets,
@@ -685,17 +691,24 @@ VkPipeline ob_effect_pipeline_for(ob_effect *e, const ob_effect_targets *targets
     if (!e || !targets) return VK_NULL_HANDLE;
     VkFormat color = targets->color, depth = targets->depth;
     uint32_t samples = targets->samples > 1 ? targets->samples : 1;
+    /* Edges of triangles only: points and lines draw as they are, and a
+     * device without fillModeNonSolid (ob_view_set_wireframe refuses it)
+     * never gets an invalid pipeline. */
+    bool wireframe = targets->wireframe && !e->compute &&
+                     e->topology >= VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST &&
+                     e->topology <= VK_PRIMITIVE_TOPOLOGY_TRIANGLE_FAN &&
+                     ob_device_get_caps(e->ctx->dev)->fill_mode_non_solid;
     if (e->compute) {
         color = depth = VK_FORMAT_UNDEFINED;
         samples = 1;
     }
     uint32_t count = atomic_load_explicit(&e->pipeline_count, memory_order_acquire);
-    const effect_pipeline *p = find_pipeline(e, count, color, depth, samples);
+    const effect_pipeline *p = find_pipeline(e, count, color, depth, samples, wireframe);
     if (!p) {
         pthread_mutex_lock(&e->lock);
         count = atomic_load_explicit(&e->pipeline_count, memory_order_acquire);
-        p = find_pipeline(e, count, color, depth, samples);
-        if (!p) p = create_entry(e, count, color, depth, samples);
+        p = find_pipeline(e, count, color, depth, samples, wireframe);
+        if (!p) p = create_entry(e, count, color, depth, samples, wireframe);
         pthread_mutex_unlock(&e->lock);
         if (!p) return VK_NULL_HANDLE;
     }

@@ -153,15 +153,20 @@ VkPipeline ob_effect_pipeline(ob_effect *e, VkFormat color, VkFormat depth,
                               uint32_t *out_pipeline_id);
 
 /* What a pipeline is made for: the target formats (VK_FORMAT_UNDEFINED =
- * none) and the rasterization sample count (0 or 1 → one sample). */
+ * none), the rasterization sample count (0 or 1 → one sample) and whether
+ * triangles are drawn as their edges (a wireframe view, ob_view.wireframe;
+ * ignored for point and line topologies, compute effects and devices
+ * without fillModeNonSolid, which ob_view_set_wireframe refuses). */
 typedef struct ob_effect_targets {
     VkFormat color, depth;
     uint32_t samples;
+    bool wireframe;
 } ob_effect_targets;
 
-/* ob_effect_pipeline for any targets, multisampled ones included: the
- * sample count is part of the key and of the id (single-sampled pipelines
- * have the ids ob_effect_pipeline gives them). Same failure rule.
+/* ob_effect_pipeline for any targets, multisampled and wireframe ones
+ * included: the sample count and the polygon mode are part of the key and
+ * of the id (single-sampled filled pipelines have the ids
+ * ob_effect_pipeline gives them). Same failure rule.
  * [any thread] */
 VkPipeline ob_effect_pipeline_for(ob_effect *e, const ob_effect_targets *targets,
                                   uint32_t *out_pipeline_id);

@@ -640,7 +640,7 @@ ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_vie
 /* What pipelines drawing in v are made for (formats and sample count). */
 static ob_effect_targets view_targets(ob_device *dev, const ob_view *v)
 {
-    ob_effect_targets t;
+    ob_effect_targets t = {.wireframe = v->wireframe};
     ob_view_attachment_formats(v, dev, &t.color, &t.depth, &t.samples);
     return t;
 }

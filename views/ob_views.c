@@ -248,7 +248,7 @@ void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_colo
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)
 {
     if (!e) return false;
-    ob_effect_targets t;
+    ob_effect_targets t = {.wireframe = false};   /* the views' own passes stay filled */
     ob_view_attachment_formats(v, ctx->dev, &t.color, &t.depth, &t.samples);
     uint32_t id = 0;
     VkPipeline p = ob_effect_pipeline_for(e, &t, &id);

@@ -36,13 +36,21 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --exposure F      linear scale of the scene colour before the tone map\n"
             "                    (default 1; 2 = one stop brighter; 1e-6 to 1e6)\n"
             "  --overlay         draw the text overlay (on by default with --window)\n"
-            "  --window          show the scene live (F1 toggles the mode; resizable)\n"
+            "  --no-overlay      no text overlay, also with --window\n"
+            "  --window          show the scene live (keys below; resizable)\n"
             "  --window-resize F:WxH  ask for a WxH window before frame F (tests a resize)\n"
             "  --quiet           no per-frame lines\n"
             "  --no-instancing   one draw per entity instead of one per run of a material\n"
             "                    and mesh (for comparison; the image is the same)\n"
             "  --malloc-threshold KIB  fix glibc's mmap and trim thresholds (steady RSS on\n"
-            "                    long runs, slower frames on lavapipe; docs/soak.md)\n%s",
+            "                    long runs, slower frames on lavapipe; docs/soak.md)\n"
+            "  --input SCRIPT    scripted input, as if typed in the window, also headless:\n"
+            "                    'FRAME:key W; FRAME:drag left DX DY; FRAME:wheel N' (frames\n"
+            "                    from 0; drag buttons left, middle, right, shift+left;\n"
+            "                    keys A-Z 0-9 F1-F12 Escape); @FILE reads it from FILE\n"
+            "  --screenshot-prefix P  where the S key writes: P0001.png, P0002.png, ...\n"
+            "                    (default obelisk-shot-)\n"
+            "%s" OB_DEMO_KEYS_HELP,
             prog, takes_input ? " FILE" : "", extra ? extra : "");
 }
 
@@ -76,10 +84,33 @@ static bool takes_value(const char *a)
     static const char *const with_value[] = {"--frames", "--threads", "--toggle", "--size", "--out",
                                              "--stats-json", "--seed", "--objects", "--env-size",
                                              "--malloc-threshold", "--window-resize", "--msaa",
-                                             "--exposure", "--shadow-size"};
+                                             "--exposure", "--shadow-size", "--input",
+                                             "--screenshot-prefix"};
     for (size_t i = 0; i < OB_ARRAY_COUNT(with_value); i++)
         if (!strcmp(a, with_value[i])) return true;
     return false;
+}
+
+ob_threading ob_demo_options_threading(const ob_demo_options *o)
+{
+    return o->threads == 0 ? OB_THREADING_SINGLE : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
+}
+
+/* Every option the parser knows, for the "did you mean" of a typo. */
+static const char *const known_options[] = {
+    "--help", "--overlay", "--no-overlay", "--window", "--quiet", "--no-instancing",
+    "--allow-missing", "--allow-any-folder", "--frames", "--threads", "--toggle", "--size", "--out",
+    "--stats-json", "--seed", "--objects", "--env-size", "--malloc-threshold", "--window-resize",
+    "--msaa", "--exposure", "--shadow-size", "--input", "--screenshot-prefix"};
+
+/* An argument the parser does not know, with the nearest option when a typo
+ * explains it ("--frmaes": did you mean --frames?). */
+static void unknown_argument(const char *prog, const char *a)
+{
+    const char *near = a[0] == '-' ? ob_closest_name(a, known_options,
+                                                     OB_ARRAY_COUNT(known_options), 0) : NULL;
+    if (near) fprintf(stderr, "%s: unknown argument '%s' (did you mean %s?)\n", prog, a, near);
+    else fprintf(stderr, "%s: unknown argument '%s'\n", prog, a);
 }
 
 bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool takes_input,
@@ -184,10 +215,26 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
                  o->shadow_size <= OB_SETTING_SHADOW_MAP_MAX;
             range = "an integer from 16 to 8192";
             i++;
+        } else if (!strcmp(a, "--input")) {
+            o->input_script = v;
+            i++;
+            /* A script in the argument is checked now (exit 2 like any bad
+             * value); @FILE when it is read, at init. */
+            ob_input_script check;   /* 12 KiB, on the stack for the check only */
+            char why[200];
+            if (v[0] != '@' && !ob_input_script_parse(v, &check, why, sizeof why)) {
+                fprintf(stderr, "%s: --input: %s\n", argv[0], why);
+                return false;
+            }
+        } else if (!strcmp(a, "--screenshot-prefix")) {
+            ok = v[0] != '\0';
+            o->screenshot_prefix = v;
+            range = "a path prefix";
+            i++;
         } else if (a[0] != '-' && takes_input && !o->input) {
             o->input = a;
         } else {
-            fprintf(stderr, "%s: unknown argument '%s'\n", argv[0], a);
+            unknown_argument(argv[0], a);
             usage(stderr, argv[0], usage_extra, takes_input);
             return false;
         }
@@ -268,15 +315,26 @@ static void on_stats(void *user, const ob_frame_stats *st)
                          sizeof *d->history) == OB_OK)
         d->history[d->history_count++] = (ob_demo_frame_times){
             st->workers, st->update_ns, st->pre_render_ns, st->record_ns, st->assemble_ns,
-            st->submit_ns, st->frame_ns, st->gpu_ms};
+            st->submit_ns, st->frame_ns, st->gpu_ms, ob_frame_stats_cpu_work_ns(st),
+            ob_frame_stats_wait_ns(st)};
     if (!d->opt.quiet) {
+        /* The stats of a frame come once the GPU is done with it, frames in
+         * flight after it was recorded: said once, with the first line. */
+        if (d->history_count == 1)
+            printf("(a frame's line comes when the GPU has finished it, at the start of the frame "
+                   "%u later; cpu = the engine's work, wait = for the GPU, an image and the "
+                   "present)\n", ob_device_frames_in_flight(ob_renderer_device(d->r)));
         printf("frame %4llu %-3s workers %u  cpu %7.3f ms (update %.3f pre-render %.3f record %.3f "
-               "assemble %.3f submit %.3f)  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
+               "assemble %.3f submit %.3f)  wait %7.3f ms (gpu %.3f image %.3f present %.3f)  "
+               "frame %7.3f ms  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
                (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
-               (double)st->frame_ns * 1e-6, (double)st->update_ns * 1e-6,
+               (double)ob_frame_stats_cpu_work_ns(st) * 1e-6, (double)st->update_ns * 1e-6,
                (double)st->pre_render_ns * 1e-6, (double)st->record_ns * 1e-6,
-               (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6, st->gpu_ms,
-               st->view_count, st->draws, st->culled, (unsigned long long)st->frame_hash);
+               (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6,
+               (double)ob_frame_stats_wait_ns(st) * 1e-6, (double)st->gpu_wait_ns * 1e-6,
+               (double)st->acquire_ns * 1e-6, (double)st->present_ns * 1e-6,
+               (double)st->frame_ns * 1e-6, st->gpu_ms, st->view_count, st->draws, st->culled,
+               (unsigned long long)st->frame_hash);
     }
     if (d->json) {
         if (d->history_count > 1) fputs(",\n", d->json);
@@ -358,6 +416,118 @@ static void set_allocator_policy(uint32_t threshold_kib)
 #endif
 }
 
+/* ------------------------------------------------------------ input */
+
+/* --input: the script in the argument, or in the file after '@'. */
+static ob_result load_script(ob_demo *d, const char *arg)
+{
+    ob_result r = OB_OK;
+    char *text = NULL;
+    if (arg[0] == '@') {
+        char why[200] = "";
+        text = ob_file_read_limited(arg + 1, "input script", 1u << 20, NULL, why, sizeof why, &r);
+        if (!text) {
+            fprintf(stderr, "--input: cannot read '%s': %s\n", arg + 1, why);
+            return r;
+        }
+    }
+    if (!(d->script = ob_malloc(sizeof *d->script))) {
+        ob_free(text);
+        return OB_ERR_OUT_OF_HOST_MEMORY;
+    }
+    char why[200];
+    if (!ob_input_script_parse(text ? text : arg, d->script, why, sizeof why)) {
+        fprintf(stderr, "--input: %s%s%s\n", text ? arg + 1 : "", text ? ": " : "", why);
+        r = OB_ERR_PARSE;
+    }
+    ob_free(text);
+    return r;
+}
+
+static void toggle_wireframe(ob_demo *d)
+{
+    ob_view *main = ob_perspective_view_base(d->main);
+    ob_result r = ob_view_set_wireframe(main, ob_renderer_device(d->r), !d->wireframe);
+    if (r == OB_OK) {
+        d->wireframe = !d->wireframe;
+        printf("input: W: wireframe %s\n", d->wireframe ? "on" : "off");
+    } else {
+        printf("input: W: no wireframe on this device (%s: it lacks fillModeNonSolid)\n",
+               ob_device_name(ob_renderer_device(d->r)));
+    }
+}
+
+/* The runner's keys, then the program's listener. */
+static void on_key(void *user, int key, bool shift)
+{
+    ob_demo *d = user;
+    if (key == OB_KEY_F1) {
+        d->flipped = !d->flipped;
+        printf("input: F1: single/multi-threaded recording flipped\n");
+    } else if (key == 'S' && !shift) {
+        d->screenshot_pending = true;
+    } else if (key == 'W' && !shift) {
+        toggle_wireframe(d);
+    } else if (key == 'O' && !shift) {
+        if (!d->overlay) {
+            printf("input: O: no overlay in this run (--no-overlay, or headless without --overlay)\n");
+        } else {
+            d->overlay_detail = (d->overlay_detail + 1) % 2;
+            printf("input: O: overlay %s\n", d->overlay_detail ? "detailed" : "summary");
+        }
+    } else if (key == OB_KEY_ESCAPE) {
+        d->stop = true;
+    }
+    if (d->app_input.key) d->app_input.key(d->app_input.user, key, shift);
+}
+
+static void on_button(void *user, ob_mouse_button b, bool down, bool shift)
+{
+    ob_demo *d = user;
+    if (d->app_input.button) d->app_input.button(d->app_input.user, b, down, shift);
+}
+
+static void on_cursor(void *user, double x, double y)
+{
+    ob_demo *d = user;
+    if (d->app_input.cursor) d->app_input.cursor(d->app_input.user, x, y);
+}
+
+static void on_scroll(void *user, double steps)
+{
+    ob_demo *d = user;
+    if (d->app_input.scroll) d->app_input.scroll(d->app_input.user, steps);
+}
+
+void ob_demo_set_input(ob_demo *d, const ob_input_handler *h)
+{
+    if (h) d->app_input = *h;
+    else memset(&d->app_input, 0, sizeof d->app_input);
+}
+
+/* S: the final image as the next numbered PNG, once the frame is done. */
+static ob_result take_screenshot(ob_demo *d)
+{
+    d->screenshot_pending = false;
+    ob_result r = ob_renderer_wait_idle(d->r);
+    if (r != OB_OK) return r;
+    char path[1024];
+    const char *prefix = d->opt.screenshot_prefix ? d->opt.screenshot_prefix : "obelisk-shot-";
+    snprintf(path, sizeof path, "%s%04u.png", prefix, d->screenshots + 1);
+    ob_image target = ob_composite_view_target(d->composite);
+    r = ob_image_write_png(ob_renderer_device(d->r), target, path);
+    if (r != OB_OK) {
+        /* A screenshot that cannot be written is said; the run goes on. */
+        printf("input: S: cannot write screenshot '%s': %s\n", path, ob_result_name(r));
+        return OB_OK;
+    }
+    d->screenshots++;
+    ob_image_info info = {0};
+    ob_image_get_info(ob_renderer_device(d->r), target, &info);
+    printf("screenshot: wrote %s (%ux%u)\n", path, info.width, info.height);
+    return OB_OK;
+}
+
 ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
 {
     set_allocator_policy(o->malloc_threshold_kib);
@@ -379,8 +549,7 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
             .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
                        .instance_extension_count = ext_count, .swapchain = o->window},
             .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
-            .threading = o->threads == 0 ? OB_THREADING_SINGLE
-                         : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI,
+            .threading = ob_demo_options_threading(o),
             .gpu_timing = o->gpu_timing,
         },
         .width = o->width, .height = o->height,
@@ -407,6 +576,8 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     /* The renderer presents the composite's target; main follows the window's size. */
     if (d->window) ob_composite_view_set_presenting(d->composite, true);
     if (o->stats_json && !(d->json = open_stats_json(o->stats_json))) return OB_ERR_IO;
+    if (o->input_script && (r = load_script(d, o->input_script)) != OB_OK) return r;
+    if (d->window) ob_window_set_input(d->window, &(ob_input_handler){on_key, on_button, on_cursor, on_scroll, d});
     /* The summary's 64 bytes per frame, taken once: a headless run's memory
      * then does not grow with its frames (what the soak measures). */
     if (frames_bound_run(o) &&
@@ -429,6 +600,7 @@ void ob_demo_shutdown(ob_demo *d)
     }
     ob_free(d->systems);
     ob_free(d->history);
+    ob_free(d->script);
     memset(d, 0, sizeof *d);
 }
 
@@ -494,7 +666,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
             "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\","
             "\"draw_calls\":%u,\"instances\":%u,\"descriptor_sets_allocated\":%u,"
-            "\"descriptor_sets_held\":%u,\"views\":[",
+            "\"descriptor_sets_held\":%u,\"threading\":\"%s\",\"cpu_work_ms\":%.4f,"
+            "\"waiting_ms\":%.4f,\"gpu_wait_ms\":%.4f,\"acquire_ms\":%.4f,\"present_ms\":%.4f,"
+            "\"views\":[",
             (unsigned long long)st->frame, st->workers ? "MT" : "ST", st->workers,
             st->update_ns * 1e-6, st->pre_render_ns * 1e-6, st->record_ns * 1e-6,
             st->assemble_ns * 1e-6, st->submit_ns * 1e-6, st->wait_ns * 1e-6, st->frame_ns * 1e-6,
@@ -507,7 +681,9 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
             st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash,
             st->pm.draw_calls, st->pm.instances, st->pm.descriptor_sets_allocated,
-            st->pm.descriptor_sets_held);
+            st->pm.descriptor_sets_held, ob_threading_name(st->mode),
+            ob_frame_stats_cpu_work_ns(st) * 1e-6, ob_frame_stats_wait_ns(st) * 1e-6,
+            st->gpu_wait_ns * 1e-6, st->acquire_ns * 1e-6, st->present_ns * 1e-6);
     for (uint32_t i = 0; i < st->view_count; i++) {
         const ob_view_stats *v = &st->views[i];
         fprintf(f,
@@ -698,6 +874,8 @@ static void print_summary(const ob_demo *d)
         {"record", offsetof(ob_demo_frame_times, record_ns)},
         {"assemble", offsetof(ob_demo_frame_times, assemble_ns)},
         {"submit", offsetof(ob_demo_frame_times, submit_ns)},
+        {"cpu work", offsetof(ob_demo_frame_times, cpu_work_ns)},
+        {"waiting", offsetof(ob_demo_frame_times, waiting_ns)},
         {"frame", offsetof(ob_demo_frame_times, frame_ns)},
         {"gpu", offsetof(ob_demo_frame_times, gpu_ms)},
     };
@@ -728,24 +906,42 @@ static void print_summary(const ob_demo *d)
 
 static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame, bool flipped)
 {
-    ob_threading base = o->threads == 0 ? OB_THREADING_SINGLE
-                        : o->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
+    ob_threading base = ob_demo_options_threading(o);
     bool flip = flipped != (o->toggle && (frame / o->toggle) % 2 == 1);
     if (flip) return base == OB_THREADING_SINGLE ? OB_THREADING_MULTI : OB_THREADING_SINGLE;
     return base;
 }
 
+/* The overlay shows the newest complete frame (ob_renderer_last_stats:
+ * frames in flight behind), in summary or, after O, in detail. */
 static void overlay_text(ob_demo *d)
 {
     if (!d->overlay) return;
     const ob_frame_stats *st = ob_renderer_last_stats(d->r);
-    char text[512];
-    snprintf(text, sizeof text,
-             "OBELISK  %s  workers %u\nframe %.2f ms  record %.2f ms  gpu %.2f ms\n"
-             "views %u  draws %u  culled %u",
-             st->workers ? "multi-threaded" : "single-threaded", st->workers,
-             (double)st->frame_ns * 1e-6, (double)st->record_ns * 1e-6, st->gpu_ms,
-             st->view_count, st->draws, st->culled);
+    char text[4096];
+    int n = snprintf(text, sizeof text,
+                     "OBELISK  %s  workers %u\ncpu %.2f ms  wait %.2f ms  gpu %.2f ms\n"
+                     "views %u  draws %u  culled %u",
+                     ob_threading_name(st->mode), st->workers,
+                     (double)ob_frame_stats_cpu_work_ns(st) * 1e-6,
+                     (double)ob_frame_stats_wait_ns(st) * 1e-6, st->gpu_ms, st->view_count,
+                     st->draws, st->culled);
+    if (d->overlay_detail) {
+        n += snprintf(text + n, sizeof text - (size_t)n,
+                      "\nframe %llu  update %.2f  pre-render %.2f  record %.2f  assemble %.2f  "
+                      "submit %.2f\nwait: gpu %.2f  image %.2f  present %.2f  (ms)%s%s",
+                      (unsigned long long)st->frame, (double)st->update_ns * 1e-6,
+                      (double)st->pre_render_ns * 1e-6, (double)st->record_ns * 1e-6,
+                      (double)st->assemble_ns * 1e-6, (double)st->submit_ns * 1e-6,
+                      (double)st->gpu_wait_ns * 1e-6, (double)st->acquire_ns * 1e-6,
+                      (double)st->present_ns * 1e-6, d->wireframe ? "\nwireframe" : "",
+                      d->overlay_extra[0] ? "\n" : "");
+        if (d->overlay_extra[0] && n < (int)sizeof text)
+            n += snprintf(text + n, sizeof text - (size_t)n, "%s", d->overlay_extra);
+        for (uint32_t i = 0; i < st->view_count && n < (int)sizeof text - 80; i++)
+            n += snprintf(text + n, sizeof text - (size_t)n, "\n  %-20.20s %5u draws %s", st->views[i].name,
+                          st->views[i].draws, ob_view_type_name(st->views[i].type));
+    }
     ob_overlay_view_set_text(d->overlay, text);
 }
 
@@ -757,6 +953,10 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
     for (uint32_t f = 0; (!counted || f < d->opt.frames) && (!d->window || ob_window_poll(d->window));
          f++) {
         if (d->window && ob_window_take_toggle(d->window)) d->flipped = !d->flipped;
+        if (d->script)
+            ob_input_script_play(d->script, f,
+                                 &(ob_input_handler){on_key, on_button, on_cursor, on_scroll, d});
+        if (d->stop) break;
         if (d->window && d->opt.resize_width && f == d->opt.resize_frame)
             ob_window_request_size(d->window, d->opt.resize_width, d->opt.resize_height);
         ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
@@ -772,6 +972,10 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
         r = ob_renderer_end_frame(d->r);
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
+            return 1;
+        }
+        if (d->screenshot_pending && (r = take_screenshot(d)) != OB_OK) {
+            fprintf(stderr, "frame %u: screenshot: %s\n", f, ob_result_name(r));
             return 1;
         }
     }

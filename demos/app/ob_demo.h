@@ -1,7 +1,9 @@
 /* ob_demo.h — the demo runner the demo programs share: options, the
  * standard set-up (an ob_stack from views/scene/ob_stack.h, with the window when
- * --window is given), the frame loop with its ST/MT toggling, per-frame
- * lines, the JSON stats, the summary of medians per mode and the lean-scene
+ * --window is given), the frame loop with its ST/MT toggling, input (the
+ * window's events and --input scripts, one listener: ob_input.h) with the
+ * runner's keys, per-frame lines (the engine's CPU work apart from waiting),
+ * the JSON stats, the summary of medians per mode and the lean-scene
  * report (what the run left out).
  *
  * Lifecycle: ob_demo_options_parse → ob_demo_init → build the scene →
@@ -16,6 +18,7 @@
 #include <stdio.h>
 
 #include "ob_geometry.h"
+#include "ob_input.h"
 #include "ob_mesh.h"
 #include "ob_stack.h"
 #include "ob_window.h"
@@ -52,7 +55,16 @@ typedef struct ob_demo_options {
     bool allow_missing, allow_any_folder;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
+    /* --input SCRIPT (ob_input.h; "@FILE" reads it from FILE): events fed to
+     * the same listener as the window's, before the update of their frame. */
+    const char *input_script;
+    /* --screenshot-prefix P: the S key writes P0001.png, P0002.png, ...
+     * (default "obelisk-shot-", in the working directory). */
+    const char *screenshot_prefix;
 } ob_demo_options;
+
+/* The mode --threads asks for: 0 → single, N → multi, auto → auto. */
+ob_threading ob_demo_options_threading(const ob_demo_options *o);
 
 /* Parses argv into *o (defaults first). Prints usage and returns false on
  * --help or a bad option (*out_exit says the exit code). */
@@ -65,6 +77,9 @@ typedef struct ob_demo_frame_times {
     uint32_t workers;         /* 0 = single-threaded */
     uint64_t update_ns, pre_render_ns, record_ns, assemble_ns, submit_ns, frame_ns;
     double gpu_ms;
+    /* ob_frame_stats_cpu_work_ns and ob_frame_stats_wait_ns: the engine's
+     * CPU work apart from waiting for the GPU, an image and the present. */
+    uint64_t cpu_work_ns, waiting_ns;
 } ob_demo_frame_times;
 
 /* What the run's frames left out, for the lean-scene report: each view
@@ -101,7 +116,34 @@ typedef struct ob_demo {
     ob_window *window;        /* --window */
     bool flipped;             /* F1: the mode is the opposite of what the options say */
     ob_demo_lean lean;
+    /* Input (ob_demo_set_input): the window's and --input's events go to
+     * the runner's keys first (F1, S, W, O; Escape from a script stops the
+     * run), then all of them to the program's listener. */
+    ob_input_script *script;  /* --input, parsed; NULL without */
+    ob_input_handler app_input;
+    bool stop;                /* Escape from a script */
+    bool screenshot_pending;
+    uint32_t screenshots;     /* written so far (the next is numbered screenshots + 1) */
+    bool wireframe;           /* W: the main view draws edges */
+    uint32_t overlay_detail;  /* O: 0 = summary, 1 = phases and views */
+    /* A program's extra overlay lines (detail level 1), e.g. the camera. */
+    char overlay_extra[256];
 } ob_demo;
+
+/* The keys the runner handles, for a program's --help:
+ *   F1 single/multi-threaded; S screenshot; W wireframe; O overlay detail;
+ *   Escape quit. */
+#define OB_DEMO_KEYS_HELP                                                                 \
+    "keys of every demo (in the window, or from --input):\n"                               \
+    "  F1                switch single/multi-threaded recording\n"                            \
+    "  S                 screenshot: the next numbered PNG (--screenshot-prefix), path printed\n" \
+    "  W                 wireframe on/off (needs the device feature fillModeNonSolid)\n"      \
+    "  O                 overlay detail: summary, or phases, waits, views and camera\n"       \
+    "  Escape            quit\n"
+
+/* Sets the program's listener (copied; NULL: none): it gets every input
+ * event after the runner's own keys have been handled. */
+void ob_demo_set_input(ob_demo *d, const ob_input_handler *h);
 
 /* The window (--window), then the stack: renderer (worker count from
  * --threads), effect context, material library, views, an empty scene with

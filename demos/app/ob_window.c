@@ -11,16 +11,56 @@ struct ob_window {
     VkInstance instance;
     VkSurfaceKHR surface;
     bool toggle;
+    bool has_input;
+    ob_input_handler input;
 };
+
+/* GLFW's key codes to ob_input's: letters and digits are ASCII in both. */
+static int input_key(int key)
+{
+    if ((key >= GLFW_KEY_A && key <= GLFW_KEY_Z) || (key >= GLFW_KEY_0 && key <= GLFW_KEY_9)) return key;
+    if (key >= GLFW_KEY_F1 && key <= GLFW_KEY_F12) return OB_KEY_F1 + (key - GLFW_KEY_F1);
+    if (key == GLFW_KEY_ESCAPE) return OB_KEY_ESCAPE;
+    return -1;
+}
 
 static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
 {
     (void)scancode;
-    (void)mods;
     ob_window *w = glfwGetWindowUserPointer(win);
     if (action != GLFW_PRESS) return;
-    if (key == GLFW_KEY_F1) w->toggle = true;
     if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(win, GLFW_TRUE);
+    int k = input_key(key);
+    if (w->has_input && k >= 0 && k != OB_KEY_ESCAPE)
+        ob_input_deliver(&(ob_input_event){.kind = OB_INPUT_KEY, .key = k,
+                                           .shift = (mods & GLFW_MOD_SHIFT) != 0},
+                         &w->input);
+    else if (key == GLFW_KEY_F1)
+        w->toggle = true;
+}
+
+static void on_button(GLFWwindow *win, int button, int action, int mods)
+{
+    ob_window *w = glfwGetWindowUserPointer(win);
+    if (!w->has_input || button > GLFW_MOUSE_BUTTON_MIDDLE || action == GLFW_REPEAT) return;
+    /* GLFW numbers left, right, middle as ob_mouse_button does. */
+    ob_input_deliver(&(ob_input_event){.kind = OB_INPUT_BUTTON, .button = (ob_mouse_button)button,
+                                       .down = action == GLFW_PRESS,
+                                       .shift = (mods & GLFW_MOD_SHIFT) != 0},
+                     &w->input);
+}
+
+static void on_cursor(GLFWwindow *win, double x, double y)
+{
+    ob_window *w = glfwGetWindowUserPointer(win);
+    if (w->has_input) ob_input_deliver(&(ob_input_event){.kind = OB_INPUT_CURSOR, .x = x, .y = y}, &w->input);
+}
+
+static void on_scroll(GLFWwindow *win, double dx, double dy)
+{
+    (void)dx;
+    ob_window *w = glfwGetWindowUserPointer(win);
+    if (w->has_input) ob_input_deliver(&(ob_input_event){.kind = OB_INPUT_SCROLL, .x = dy}, &w->input);
 }
 
 /* Pixels, not screen coordinates; 0x0 while minimised. */
@@ -60,6 +100,9 @@ ob_window *ob_window_open(uint32_t width, uint32_t height, const char *title,
     }
     glfwSetWindowUserPointer(w->win, w);
     glfwSetKeyCallback(w->win, on_key);
+    glfwSetMouseButtonCallback(w->win, on_button);
+    glfwSetCursorPosCallback(w->win, on_cursor);
+    glfwSetScrollCallback(w->win, on_scroll);
     glfwSetFramebufferSizeCallback(w->win, on_framebuffer_size);
     *out_exts = glfwGetRequiredInstanceExtensions(out_ext_count);
     return w;
@@ -105,6 +148,20 @@ bool ob_window_take_toggle(ob_window *w)
 void ob_window_request_size(ob_window *w, uint32_t width, uint32_t height)
 {
     glfwSetWindowSize(w->win, (int)width, (int)height);
+}
+
+void ob_window_set_input(ob_window *w, const ob_input_handler *h)
+{
+    w->has_input = h != NULL;
+    if (h) w->input = *h;
+}
+
+void ob_window_size(ob_window *w, uint32_t *out_width, uint32_t *out_height)
+{
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(w->win, &width, &height);
+    *out_width = (uint32_t)OB_MAX(width, 0);
+    *out_height = (uint32_t)OB_MAX(height, 0);
 }
 
 void ob_window_close(ob_window *w)
@@ -154,6 +211,16 @@ void ob_window_request_size(ob_window *w, uint32_t width, uint32_t height)
     (void)w;
     (void)width;
     (void)height;
+}
+void ob_window_set_input(ob_window *w, const ob_input_handler *h)
+{
+    (void)w;
+    (void)h;
+}
+void ob_window_size(ob_window *w, uint32_t *out_width, uint32_t *out_height)
+{
+    (void)w;
+    *out_width = *out_height = 0;
 }
 void ob_window_close(ob_window *w) { (void)w; }
 

@@ -7,14 +7,18 @@
  * headless builds keep these functions, which then say so). The window is
  * opened before the renderer (the instance needs its surface extensions) and
  * attached after it. F1 asks the demo to toggle single/multi-threaded
- * recording; closing the window or Escape ends the loop. Resizing is
- * followed: the renderer hears of the new size and rebuilds its swapchain.
+ * recording; closing the window or Escape ends the loop. Other keys, mouse
+ * buttons, the cursor and the wheel go to the listener set with
+ * ob_window_set_input (ob_input.h), the one scripted input (--input) also
+ * feeds; with a listener, F1 goes to it too. Resizing is followed: the
+ * renderer hears of the new size and rebuilds its swapchain.
  *
  * Thread rule: render thread only (GLFW's main-thread rule).
  */
 #ifndef OB_WINDOW_H
 #define OB_WINDOW_H
 
+#include "ob_input.h"
 #include "ob_renderer.h"
 
 typedef struct ob_window ob_window;
@@ -29,8 +33,13 @@ ob_window *ob_window_open(uint32_t width, uint32_t height, const char *title,
 ob_result ob_window_attach(ob_window *w, ob_renderer *r);
 /* Polls events; false once the window should close. */
 bool ob_window_poll(ob_window *w);
-/* True once per F1 press since the last call. */
+/* True once per F1 press since the last call (without a listener). */
 bool ob_window_take_toggle(ob_window *w);
+/* Sends the window's input events to h (copied; NULL: none) from
+ * ob_window_poll on. */
+void ob_window_set_input(ob_window *w, const ob_input_handler *h);
+/* The window's size in pixels (0x0 while minimised). */
+void ob_window_size(ob_window *w, uint32_t *out_width, uint32_t *out_height);
 /* Asks the window system for a new size, as a user dragging the border
  * would; the renderer follows once the window has it. */
 void ob_window_request_size(ob_window *w, uint32_t width, uint32_t height);

@@ -11,11 +11,6 @@ extern char **environ;
 
 /* ------------------------------------------------------------ helpers */
 
-static const char *threading_name(ob_threading t)
-{
-    return t == OB_THREADING_SINGLE ? "single" : t == OB_THREADING_MULTI ? "multi" : "auto";
-}
-
 /* A finite number as the files carry it: whole numbers (pixel sums, counts)
  * exactly, others to 9 significant digits (%.6g wrote 4100181 as 4.10018e+06). */
 static void num_text(double v, char buf[40])
@@ -281,7 +276,7 @@ static void json_result(FILE *f, const ob_bench_result *r)
     fputs("{\"mode\":", f);
     json_str(f, r->mode.name);
     fprintf(f, ",\"threading\":\"%s\",\"workers\":%u,\"workers_used\":",
-            threading_name(r->mode.threading), r->mode.workers);
+            ob_threading_name(r->mode.threading), r->mode.workers);
     json_num(f, r->workers_used);
     fprintf(f, ",\"frames\":%u,\"views\":%u,\"draws\":%u", r->frames, r->views, r->draws);
     static const char *const names[] = {"update_ms", "pre_render_ms", "record_ms", "assemble_ms",

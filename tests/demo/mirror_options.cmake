@@ -1,8 +1,19 @@
 # obelisk-mirror refuses bad options with a message and a non-zero exit, and
 # --help succeeds.
 execute_process(COMMAND ${BIN}/obelisk-mirror --help RESULT_VARIABLE rc OUTPUT_VARIABLE out)
-if(NOT rc EQUAL 0 OR NOT out MATCHES "--threads")
-  message(FATAL_ERROR "--help failed (${rc}): ${out}")
+if(NOT rc EQUAL 0 OR NOT out MATCHES "--threads" OR NOT out MATCHES "--no-overlay")
+  message(FATAL_ERROR "--help failed or leaves out --no-overlay (${rc}): ${out}")
+endif()
+# A mistyped option names the one it is closest to; one far from all does not.
+execute_process(COMMAND ${BIN}/obelisk-mirror --frmaes 3 RESULT_VARIABLE rc ERROR_VARIABLE err
+                OUTPUT_QUIET TIMEOUT 60)
+if(rc EQUAL 0 OR NOT err MATCHES "unknown argument '--frmaes' \\(did you mean --frames\\?\\)")
+  message(FATAL_ERROR "--frmaes: no suggestion of --frames (exit ${rc}): ${err}")
+endif()
+execute_process(COMMAND ${BIN}/obelisk-mirror --bogus RESULT_VARIABLE rc ERROR_VARIABLE err
+                OUTPUT_QUIET TIMEOUT 60)
+if(err MATCHES "did you mean")
+  message(FATAL_ERROR "--bogus got a suggestion: ${err}")
 endif()
 foreach(bad "--frames;0" "--threads;many" "--size;10" "--objects;200000" "--bogus"
             "--malloc-threshold;0" "--malloc-threshold;65536" "--msaa;3" "--msaa;16"

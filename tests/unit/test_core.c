@@ -119,6 +119,33 @@ static void missing_file_names_path(void **state)
     assert_true(ob_test_log_has("/nonexistent/obelisk.txt", NULL));
 }
 
+/* What a "did you mean" depends on: typos are near, unrelated names are
+ * not suggested, and an exact match never is. */
+static void closest_name_suggests_typos_only(void **state)
+{
+    (void)state;
+    assert_int_equal(ob_edit_distance("", ""), 0);
+    assert_int_equal(ob_edit_distance("gold", ""), 4);
+    assert_int_equal(ob_edit_distance("kitten", "sitting"), 3);
+    assert_int_equal(ob_edit_distance("--frmaes", "--frames"), 1);   /* a swap is one edit */
+    assert_int_equal(ob_edit_distance("Gold", "gold"), 0);           /* case is free */
+    static const char *const options[] = {"--frames", "--threads", "--size", "--seed", "--out",
+                                          "--no-overlay", "--overlay", NULL};
+    uint32_t n = OB_ARRAY_COUNT(options);
+    assert_string_equal(ob_closest_name("--frmaes", options, n, 0), "--frames");
+    assert_string_equal(ob_closest_name("--thread", options, n, 0), "--threads");
+    assert_string_equal(ob_closest_name("--no-overlya", options, n, 0), "--no-overlay");
+    assert_string_equal(ob_closest_name("--sizes", options, n, 0), "--size");
+    assert_null(ob_closest_name("--verbose", options, n, 0));
+    assert_null(ob_closest_name("--size", options, n, 0));            /* exact: nothing to say */
+    assert_null(ob_closest_name("x", options, n, 0));
+    assert_null(ob_closest_name(NULL, options, n, 0));
+    assert_null(ob_closest_name("--frames", NULL, 0, 0));
+    /* An explicit bound wins over the default. */
+    assert_string_equal(ob_closest_name("--thrads", options, n, 1), "--threads");
+    assert_null(ob_closest_name("--thrds", options, n, 1));
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -129,6 +156,7 @@ int main(void)
         cmocka_unit_test(nth_host_allocation_fails),
         cmocka_unit_test(heap_stats_follow_every_allocation),
         cmocka_unit_test(missing_file_names_path),
+        cmocka_unit_test(closest_name_suggests_typos_only),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -302,7 +302,12 @@ static const bad_case bad_cases[] = {
     {"{\"materials\": {\"m\": {}, \"m\": {}}, " E "[]}", "materials.m", "duplicate material name"},
     /* references */
     {"{\"materials\": {\"stone\": {}}, " E "[{" BOX ", \"material\": \"stoen\"}]}", "entities[0].material",
-     "unknown material 'stoen'"},
+     "unknown material 'stoen' (did you mean 'stone'?"},
+    {"{\"materials\": {\"stone\": {}, \"gold\": {}}, " E "[{" BOX ", \"material\": \"Glod\"}]}",
+     "entities[0].material", "unknown material 'Glod' (did you mean 'gold'?"},
+    /* nothing close: no suggestion, and an inline material's path is never one */
+    {"{\"materials\": {\"stone\": {}}, " E "[{" BOX ", \"material\": {}}, {" BOX ", \"material\": \"glass\"}]}",
+     "entities[1].material", "unknown material 'glass' (not among \"materials\")"},
     {"{" E "[{\"material\": {}}]}", "entities[0].material", "an entity without geometry"},
     {"{" E "[{\"name\": \"a\"}, {\"name\": \"b\", \"parent\": \"c\"}]}", "entities[1].parent",
      "no entity is named 'c'"},

@@ -252,36 +252,14 @@ cJSON *ob_json_parse(ob_json_reader *rd, const char *text, size_t size)
 
 /* ------------------------------------------------------------ keys */
 
-static uint32_t edit_distance(const char *a, const char *b)
-{
-    size_t n = strlen(a), m = strlen(b);
-    if (n > 40 || m > 40) return UINT32_MAX;
-    uint32_t row[41];
-    for (size_t j = 0; j <= m; j++) row[j] = (uint32_t)j;
-    for (size_t i = 1; i <= n; i++) {
-        uint32_t diag = row[0];
-        row[0] = (uint32_t)i;
-        for (size_t j = 1; j <= m; j++) {
-            uint32_t up = row[j];
-            uint32_t cost = tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]);
-            row[j] = OB_MIN(OB_MIN(row[j] + 1, row[j - 1] + 1), diag + cost);
-            diag = up;
-        }
-    }
-    return row[m];
-}
-
 static bool unknown_key(ob_json_reader *rd, const char *key, const char *const *keys, uint32_t n)
 {
     char list[400] = "";
-    const char *close = NULL;
-    uint32_t best = 3;
     for (uint32_t i = 0; i < n; i++) {
         size_t used = strlen(list);
         snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", keys[i]);
-        uint32_t d = edit_distance(key, keys[i]);
-        if (d < best && d < strlen(keys[i])) best = d, close = keys[i];
     }
+    const char *close = ob_closest_name(key, keys, n, 2);
     /* "speed" for "speed_degrees", "fov" for "fov_degrees": a shortened name. */
     size_t kl = strlen(key);
     for (uint32_t i = 0; i < n && !close && kl >= 3; i++) {

@@ -510,12 +510,29 @@ static uint32_t find_entity_json(const cJSON *entities, const char *name)
     return OB_SCENE_FILE_NONE;
 }
 
+/* A name "materials" does not hold, with the closest one it does when a
+ * typo explains it. The names of inline materials (paths) are no
+ * candidates; without memory for the list the message has no suggestion. */
+static bool unknown_material(sf_ctx *c, const char *name)
+{
+    const ob_scene_file *sf = c->sf;
+    const char **names = sf->material_count ? ob_malloc(sizeof *names * sf->material_count) : NULL;
+    uint32_t n = 0;
+    for (uint32_t i = 0; names && i < sf->material_count; i++)
+        if (!sf->materials[i].inline_material) names[n++] = sf->materials[i].name;
+    const char *near = ob_closest_name(name, names, n, 0);
+    bool r = near ? ob_json_fail(&c->rd, "unknown material '%.60s' (did you mean '%.60s'? not among \"materials\")",
+                                 name, near)
+                  : ob_json_fail(&c->rd, "unknown material '%.60s' (not among \"materials\")", name);
+    ob_free(names);
+    return r;
+}
+
 static bool parse_entity_material(sf_ctx *c, const cJSON *j, ob_scene_file_entity *e)
 {
     if (cJSON_IsString(j)) {
         e->material = ob_json_names_find(&c->materials, j->valuestring);
-        if (e->material == OB_SCENE_FILE_NONE)
-            return ob_json_fail(&c->rd, "unknown material '%.60s' (not among \"materials\")", j->valuestring);
+        if (e->material == OB_SCENE_FILE_NONE) return unknown_material(c, j->valuestring);
         return true;
     }
     if (!cJSON_IsObject(j))
