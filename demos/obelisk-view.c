@@ -159,7 +159,7 @@ static double aspect(const viewer *v)
 static bool scene_sphere(viewer *v, double center[3], double *radius)
 {
     double lo[3], hi[3];
-    if (ob_scene_load_measure(v->d->scene, lo, hi, center, radius) != OB_OK) return false;
+    if (ob_framing_measure(v->d->scene, NULL, lo, hi, center, radius) != OB_OK) return false;
     return hi[0] >= lo[0] && isfinite(*radius) && *radius > 0.0;
 }
 

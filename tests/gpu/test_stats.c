@@ -32,9 +32,9 @@ static void stats_arrive_frames_in_flight_late(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.7f, 0.7f, 0.7f, false);
-    ob_test_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
-    ob_test_world_look(&w, 2, 2, 3, 0, 0, 0);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.7f, 0.7f, false);
+    ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
+    ob_world_look(&w, 2, 2, 3, 0, 0, 0);
     recorder *rec = calloc(1, sizeof *rec);   /* 16 whole ob_frame_stats: 370 KB */
     assert_non_null(rec);
     rec->r = w.r;

@@ -58,37 +58,37 @@ static void wireframe_view_draws_edges_and_off_restores_the_frame(void **state)
     (void)state;
     ob_test_world w;
     ob_test_world_create(&w, NULL);
-    ob_material *m = ob_test_world_material(&w, OB_MATERIAL_LIT, 0.8f, 0.6f, 0.3f, true);
-    ob_test_world_entity(&w, NULL, "box", w.box, m, -0.8, 0.5, 0);
-    ob_test_world_entity(&w, NULL, "sphere", w.sphere, m, 0.8, 0.5, 0);
-    ob_test_world_entity(&w, NULL, "floor", w.plane, m, 0, 0, 0);
-    ob_test_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 4, 3);
-    ob_test_world_look(&w, 0, 2.5, 4.5, 0, 0.3, 0);
+    ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.8f, 0.6f, 0.3f, true);
+    ob_world_entity(&w, NULL, "box", w.box, m, -0.8, 0.5, 0);
+    ob_world_entity(&w, NULL, "sphere", w.sphere, m, 0.8, 0.5, 0);
+    ob_world_entity(&w, NULL, "floor", w.plane, m, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 4, 3);
+    ob_world_look(&w, 0, 2.5, 4.5, 0, 0.3, 0);
     ob_view *main = ob_perspective_view_base(w.main);
 
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint64_t filled_hash = st->frame_hash;
-    uint8_t *filled = ob_test_world_snapshot(&w);
+    uint8_t *filled = ob_world_snapshot(&w);
 
     assert_int_equal(ob_view_set_wireframe(main, w.dev, true), OB_OK);
     st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint64_t wire_hash = st->frame_hash;
-    uint8_t *wire = ob_test_world_snapshot(&w);
+    uint8_t *wire = ob_world_snapshot(&w);
     assert_true(wire_hash != filled_hash);
     /* Most of the faces' pixels now show the clear colour. */
-    uint32_t changed = ob_test_image_diff_count(filled, wire, w.width, w.height, 8);
+    uint32_t changed = ob_rgba_diff_count(filled, wire, w.width * w.height, 8);
     if (changed < w.width * w.height / 10) fail_msg("wireframe changed only %u pixels", changed);
     /* Multi-threaded recording draws the same wireframe. */
     st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
     assert_true(st->frame_hash == wire_hash);
-    uint8_t *wire_mt = ob_test_world_snapshot(&w);
+    uint8_t *wire_mt = ob_world_snapshot(&w);
     assert_memory_equal(wire, wire_mt, (size_t)w.width * w.height * 4);
 
     assert_int_equal(ob_view_set_wireframe(main, w.dev, false), OB_OK);
     for (int mode = 0; mode < 2; mode++) {
         st = ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
         assert_true(st->frame_hash == filled_hash);
-        uint8_t *again = ob_test_world_snapshot(&w);
+        uint8_t *again = ob_world_snapshot(&w);
         assert_memory_equal(filled, again, (size_t)w.width * w.height * 4);
         free(again);
     }
