@@ -212,7 +212,7 @@ int main(int argc, char **argv)
     if (d.r) ob_renderer_wait_idle(d.r);
     ob_scene_unload(&loaded);
     /* The model's entities draw with its assets: they go first. */
-    if (model_root) ob_node_destroy(d.scene, model_root);
+    if (model_root) ob_node_destroy(model_root);
     ob_model_assets_destroy(assets);
     ob_demo_shutdown(&d);
     ob_scene_file_release(&sf);

@@ -183,7 +183,7 @@ void ob_particle_system_destroy(ob_views *ctx, ob_particle_system *ps)
     if (!ps) return;
     ob_views_remove_system(ctx, ps);
     /* The entity goes first: it points at the material and the quads. */
-    if (ps->node) ob_node_destroy(ps->scene, ps->node);
+    if (ps->node) ob_node_destroy(ps->node);
     ob_material_destroy(ps->material);
     ob_geometry_destroy(ctx->dev, ps->quads);
     ob_buffer_destroy(ctx->dev, ps->buffer);

@@ -589,9 +589,9 @@ void ob_scene_unload(ob_scene_loaded *l)
     /* Children before parents: a particle system's emitter may hang under an
      * entity, and a later entity under an earlier one (the file's rule). */
     for (uint32_t i = l->particle_count; i-- > 0;) ob_particle_system_destroy(l->views, l->particles[i]);
-    if (l->camera_created) ob_node_destroy(l->scene, l->camera);
-    for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->scene, l->lights[i]);
-    for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->scene, l->entities[i]);
+    if (l->camera_created) ob_node_destroy(l->camera);
+    for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->lights[i]);
+    for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->entities[i]);
     for (uint32_t i = l->model_count; i-- > 0;) ob_model_assets_destroy(l->models[i]);
     ob_texture_cache_destroy(l->textures);   /* after the materials sampling its textures */
     for (uint32_t i = l->material_count; i-- > 0;) ob_material_destroy(l->materials[i]);

@@ -107,7 +107,7 @@ ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_
     ob_renderable rd = {.material = material, .geometry = geometry, .local_radius = b->radius};
     memcpy(rd.local_center, b->center, sizeof rd.local_center);
     if ((r = ob_node_set_renderable(n, &rd)) != OB_OK) {
-        ob_node_destroy(s->scene, n);
+        ob_node_destroy(n);
         n = NULL;
     }
 done:
