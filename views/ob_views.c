@@ -291,14 +291,14 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             if (!pv) {
                 OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
                          ob_node_name(entity), id, ob_result_name(res));
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+                ob_renderer_note_error(r, ob_node_name(entity), res);
                 return;
             }
             if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
                           (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
                 OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
                          "skipped this frame", ob_node_name(entity), id);
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+                ob_renderer_note_error(r, ob_node_name(entity), OB_ERR_OUT_OF_HOST_MEMORY);
                 ob_paraboloid_view_destroy(ctx, pv);
                 return;
             }
@@ -316,7 +316,7 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
                 OB_LOG_E("views", "entity '%s' (id %u): environment map not attached (%s); "
                          "drawn without reflections this frame", ob_node_name(entity), id,
                          ob_result_name(res));
-                ob_renderer_note_skipped(r, e->view->name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, e->view->name, res);
             }
         }
     }
@@ -350,14 +350,14 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             if (!sv) {
                 OB_LOG_E("views", "light '%s': cannot create its shadow map: %s",
                          ob_node_name(lights[i]), ob_result_name(res));
-                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, name, res);
                 continue;
             }
             if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
                           (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
                 OB_LOG_E("views", "light '%s': no memory to keep its shadow map; skipped this frame",
                          ob_node_name(lights[i]));
-                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, name, OB_ERR_OUT_OF_HOST_MEMORY);
                 ob_shadow_view_destroy(ctx, sv);
                 continue;
             }
@@ -493,12 +493,12 @@ void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
     ctx->shadow_map_size = size ? size : 1024;
 }
 
-void ob_views_render(ob_views *ctx, ob_view *final_view)
+ob_result ob_views_render(ob_views *ctx, ob_view *final_view)
 {
-    ob_views_render_many(ctx, &final_view, 1);
+    return ob_views_render_many(ctx, &final_view, 1);
 }
 
-void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
+ob_result ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
 {
     ob_renderer_pre_render_many(ctx->r, roots, count);
     /* Variants and pipelines are created on first need during PreRender
@@ -507,4 +507,5 @@ void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
     ob_renderer_note_created(ctx->r, now.pipelines_created - ctx->counted.pipelines_created,
                              now.variants_compiled - ctx->counted.variants_compiled);
     ctx->counted = now;
+    return ob_renderer_current_stats(ctx->r)->first_error;
 }

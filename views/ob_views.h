@@ -162,15 +162,19 @@ ob_node *ob_particle_system_node(ob_particle_system *ps);
 /* Start a frame's PreRender of a root view (the final view, or another
  * camera view the program renders: each root view queued first is executed
  * last), which pre-renders what it needs, and report the pipelines and
- * shader variants this created to the frame's stats. [render thread, between
- * begin_frame and end_frame] */
-void ob_views_render(ob_views *ctx, ob_view *final_view);
+ * shader variants this created to the frame's stats. Returns the frame's
+ * first error so far (ob_frame_stats.first_error of the current stats):
+ * OB_OK, or what a view, entity or material met and the frame went on
+ * without (an effect variant that does not compile, a pipeline or an env
+ * map that could not be made) — the frame still renders the rest, and the
+ * log names each. [render thread, between begin_frame and end_frame] */
+ob_result ob_views_render(ob_views *ctx, ob_view *final_view);
 /* ob_views_render of several root views as one PreRender: the standard
  * views among them and all they need are culled together, in waves on the
  * renderer's worker pool (ob_renderer_pre_render_many). Prefer it to
- * calling ob_views_render per root when a frame has several. [render
- * thread, between begin_frame and end_frame] */
-void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count);
+ * calling ob_views_render per root when a frame has several. Same result.
+ * [render thread, between begin_frame and end_frame] */
+ob_result ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count);
 
 /* Standard vertex layout of geometry, as an effect's vertex input: a
  * constant the library owns, made on first use. [any thread] */

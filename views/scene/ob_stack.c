@@ -132,8 +132,9 @@ ob_result ob_stack_frame(ob_stack *s, double dt)
 {
     ob_result r = ob_stack_frame_begin(s, dt);
     if (r != OB_OK) return r;
-    ob_views_render(s->views, s->final_view);
-    return ob_renderer_end_frame(s->renderer);
+    ob_result degraded = ob_views_render(s->views, s->final_view);
+    r = ob_renderer_end_frame(s->renderer);
+    return r != OB_OK ? r : degraded;
 }
 
 ob_image ob_stack_final_image(const ob_stack *s)
