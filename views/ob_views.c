@@ -245,6 +245,19 @@ void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_colo
     if (d.id && ob_image_get_info(ctx->dev, d, &info) == OB_OK) *out_depth = info.format;
 }
 
+bool ob_views_prepare_effect(ob_views *ctx, ob_renderer *r, ob_effect *e, ob_view *v)
+{
+    if (!e) {
+        ob_renderer_note_error(r, v->name, OB_ERR_NOT_FOUND);
+        return false;
+    }
+    ob_effect_targets t;
+    ob_view_attachment_formats(v, ctx->dev, &t.color, &t.depth, &t.samples);
+    if (ob_effect_pipeline_for(e, &t, NULL)) return true;
+    ob_renderer_note_error(r, v->name, OB_ERR_VULKAN);
+    return false;
+}
+
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)
 {
     if (!e) return false;
