@@ -132,6 +132,8 @@ static void apply_settings(ob_demo_options *o, const ob_scene_file_settings *s)
 int main(int argc, char **argv)
 {
     ob_demo_options opt;
+    /* cJSON's allocations counted with Obelisk's (the heap figures). */
+    ob_scene_file_hook_cjson();
     int code;
     if (!ob_demo_options_parse(argc, argv,
                                "  FILE              a scene (.json, docs/scene-format.md) or a model file\n"

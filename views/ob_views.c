@@ -1,7 +1,6 @@
 #include "ob_views_internal.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -410,12 +409,11 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
 /* ------------------------------------------------------------ vertex input */
 
 /* The standard layout as an effect's vertex input, made once: constant
- * after that, so any thread may read it (pthread_once orders the write
- * before every reader). */
+ * after that, so any thread may read it (ob_once_run orders the write
+ * before every reader; listed in ob_core.h). */
 static ob_effect_vertex_input standard_input;
-static pthread_once_t standard_input_once = PTHREAD_ONCE_INIT;
 
-static void make_standard_input(void)
+static ob_result make_standard_input(void)
 {
     const ob_vertex_layout *l = ob_vertex_layout_standard();
     standard_input.stride = l->stride;
@@ -425,11 +423,13 @@ static void make_standard_input(void)
         standard_input.attributes[i].format = l->attributes[i].format;
         standard_input.attributes[i].offset = l->attributes[i].offset;
     }
+    return OB_OK;
 }
+static ob_once standard_input_once = OB_ONCE_INIT("standard input", make_standard_input);
 
 const ob_effect_vertex_input *ob_views_standard_input(void)
 {
-    pthread_once(&standard_input_once, make_standard_input);
+    ob_once_run(&standard_input_once);
     return &standard_input;
 }
 
