@@ -187,11 +187,17 @@ const ob_geometry_iface *ob_renderer_get_geometry_iface(const ob_renderer *r)
     return r->has_geometry_iface ? &r->geometry_iface : NULL;
 }
 
-void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers)
+ob_result ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers)
 {
+    if ((unsigned)mode > OB_THREADING_AUTO) {
+        OB_LOG_E("renderer", "threading mode %d refused (single, multi or auto); it stays as it was",
+                 (int)mode);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     r->pending_mode = mode;
     if (active_workers == 0 || active_workers > r->worker_count) active_workers = r->worker_count;
     r->pending_active = active_workers;
+    return OB_OK;
 }
 
 ob_threading ob_renderer_get_threading(const ob_renderer *r) { return r->mode; }

@@ -176,8 +176,10 @@ ob_param_registry *ob_renderer_registry(ob_renderer *r);
 ob_params *ob_renderer_params(ob_renderer *r);
 uint32_t ob_renderer_worker_count(const ob_renderer *r);
 
-/* Takes effect at the next begin_frame. active_workers 0 → all. */
-void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
+/* Takes effect at the next begin_frame. active_workers 0 (or more than the
+ * pool has) → all. A mode outside ob_threading is refused
+ * (OB_ERR_INVALID_ARGUMENT, logged; the pending mode is unchanged). */
+ob_result ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
 ob_threading ob_renderer_get_threading(const ob_renderer *r);
 
 /* Waits for this frame slot's fence, collects its GPU timings, resets its

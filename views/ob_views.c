@@ -440,6 +440,8 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ob_result r = OB_OK;
     ob_views *ctx = NULL;
     if (!desc || !desc->renderer || !desc->materials || !desc->effects) {
+        OB_LOG_E("views", "ob_views_create: no %s", !desc ? "desc" : !desc->renderer ? "renderer"
+                 : !desc->materials ? "material library" : "effect context");
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
@@ -452,8 +454,9 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ctx->dev = ob_renderer_device(desc->renderer);
     ctx->materials = desc->materials;
     ctx->effects = desc->effects;
-    ctx->env_map_size = desc->env_map_size ? desc->env_map_size : 256;
-    ctx->shadow_map_size = desc->shadow_map_size ? desc->shadow_map_size : 1024;
+    r = ob_views_set_env_map_size(ctx, desc->env_map_size);
+    if (r == OB_OK) r = ob_views_set_shadow_map_size(ctx, desc->shadow_map_size);
+    if (r != OB_OK) goto fail_destroy_views;
     static const float default_ambient[4] = {1.0f, 1.0f, 1.0f, 0.15f};
     memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
     ctx->dt = 1.0 / 60.0;
@@ -500,10 +503,27 @@ void ob_views_set_time(ob_views *ctx, double time, double dt)
     ctx->dt = dt;
 }
 
-void ob_views_set_env_map_size(ob_views *ctx, uint32_t size) { ctx->env_map_size = size ? size : 256; }
-void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
+/* Whether a map of size x size can be made on this device (logged when not). */
+static ob_result check_map_size(const ob_views *ctx, const char *what, uint32_t size)
 {
-    ctx->shadow_map_size = size ? size : 1024;
+    uint32_t max = ob_device_properties(ctx->dev)->limits.maxImageDimension2D;
+    if (size <= max) return OB_OK;
+    OB_LOG_E("views", "%s size %u refused: the device's images are at most %u", what, size, max);
+    return OB_ERR_OUT_OF_RANGE;
+}
+
+ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size)
+{
+    ob_result r = check_map_size(ctx, "environment map", size);
+    if (r == OB_OK) ctx->env_map_size = size ? size : 256;
+    return r;
+}
+
+ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
+{
+    ob_result r = check_map_size(ctx, "shadow map", size);
+    if (r == OB_OK) ctx->shadow_map_size = size ? size : 1024;
+    return r;
 }
 
 ob_result ob_views_render(ob_views *ctx, ob_view *final_view)

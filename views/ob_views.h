@@ -52,9 +52,12 @@ void ob_views_destroy(ob_views *ctx);
 ob_renderer *ob_views_renderer(ob_views *ctx);
 /* Simulation time: every view reads it, so ST and MT agree. */
 void ob_views_set_time(ob_views *ctx, double time, double dt);
-/* Quality settings (take effect for views created afterwards). */
-void ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
-void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
+/* Quality settings (take effect for views created afterwards; 0 → the
+ * default). A size over the device's maxImageDimension2D is refused
+ * (OB_ERR_OUT_OF_RANGE, logged; the size stays): the maps could never be
+ * made. ob_views_create refuses such a desc size the same way. */
+ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
+ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
 
 /* ---------------------------------------------------------- perspective */
 
