@@ -186,6 +186,9 @@ ob_result ob_views_resize_target(ob_views *ctx, ob_view *v, uint32_t width, uint
     if (r != OB_OK) {
         OB_LOG_E("views", "view '%s': cannot resize from %ux%u to %ux%u (%s); it keeps its size",
                  v->name, old.width, old.height, width, height, ob_result_name(r));
+        /* In a frame (a resize asked for with ob_view_resize applies in
+         * PreRender), the frame reports it: no-op between frames. */
+        ob_renderer_note_error(ctx->r, v->name, r);
         return r;
     }
     /* Deferred: frames in flight still use the old images. */
