@@ -13,7 +13,6 @@
 #define _GNU_SOURCE
 #include "ob_test.h"
 
-#include <dirent.h>
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,7 +22,6 @@
 
 #include "ob_model_instance.h"
 #include "ob_scene_load.h"
-#include "ob_shader_source.h"   /* ob_shader_dir_default: where the copies come from */
 #include "ob_stack.h"
 #include "ob_texture.h"
 
@@ -33,44 +31,7 @@
 
 static char tmp_root[256];
 
-#define assert_logged(...)                                                      \
-    do {                                                                        \
-        if (!ob_test_log_has(__VA_ARGS__, NULL)) {                              \
-            ob_test_log_dump(OB_LOG_DEBUG, 30);                                 \
-            fail_msg("no log line with: %s", #__VA_ARGS__);                     \
-        }                                                                       \
-    } while (0)
-
-static int quiet(void **state)
-{
-    (void)state;
-    ob_test_log_set_echo(false);   /* every test provokes errors on purpose */
-    ob_test_log_clear();
-    return 0;
-}
-
-static int loud(void **state)
-{
-    (void)state;
-    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
-    ob_fault_arm(OB_FAULT_VK_OBJECT, 0);
-    ob_test_log_set_echo(true);
-    return 0;
-}
-
 /* ---------------------------------------------------------------- helpers */
-
-static void copy_file(const char *from, const char *to)
-{
-    FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
-    assert_non_null(in);
-    assert_non_null(out);
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, in)) > 0) assert_int_equal(fwrite(buf, 1, n, out), n);
-    fclose(in);
-    assert_int_equal(fclose(out), 0);
-}
 
 static void write_file(const char *path, const char *text)
 {
@@ -89,19 +50,7 @@ static void shader_folder(const char *name, const char *broken, char *out, size_
 {
     snprintf(out, size, "%s/%s", tmp_root, name);
     assert_int_equal(mkdir(out, 0755), 0);
-    char *from = ob_shader_dir_default();
-    assert_non_null(from);
-    DIR *d = opendir(from);
-    assert_non_null(d);
-    for (struct dirent *e; (e = readdir(d));) {
-        if (e->d_name[0] == '.') continue;
-        char a[1024], b[1024];
-        snprintf(a, sizeof a, "%s/%s", from, e->d_name);
-        snprintf(b, sizeof b, "%s/%s", out, e->d_name);
-        copy_file(a, b);
-    }
-    closedir(d);
-    ob_free(from);
+    assert_true(ob_test_copy_shader_folder(out) >= 10);
     if (broken) {
         char b[1024];
         snprintf(b, sizeof b, "%s/%s", out, broken);
@@ -655,29 +604,29 @@ int main(void)
     if (!mkdtemp(tmp_root)) return 1;
     unsetenv("OB_SHADER_DIR");
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(device_with_a_missing_extension_fails, quiet, loud),
-        cmocka_unit_test_setup_teardown(renderer_with_a_missing_extension_fails, quiet, loud),
-        cmocka_unit_test_setup_teardown(resources_refuse_bad_descs, quiet, loud),
-        cmocka_unit_test_setup_teardown(pipeline_manager_failure_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(texture_missing_file_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(geometry_with_a_bad_index_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(effect_with_a_missing_shader_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(effect_that_does_not_compile_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(effect_allocation_failures_are_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(effect_context_failures_are_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(material_library_without_shaders_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(material_bad_descs_are_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(views_bad_descs_are_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(renderer_bad_threading_mode_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(composite_shader_that_does_not_compile_fails_the_stack, quiet, loud),
-        cmocka_unit_test_setup_teardown(overlay_shader_that_does_not_compile_fails_the_stack, quiet, loud),
-        cmocka_unit_test_setup_teardown(particle_shader_that_does_not_compile_fails_the_system, quiet, loud),
-        cmocka_unit_test_setup_teardown(frame_with_a_material_that_does_not_compile_returns_it, quiet, loud),
-        cmocka_unit_test_setup_teardown(resize_the_device_cannot_make_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(correct_frame_reports_none, quiet, loud),
-        cmocka_unit_test_setup_teardown(stack_entity_without_geometry_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(scene_load_missing_file_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(model_assets_without_a_desc_are_refused, quiet, loud),
+        ob_test_expecting_errors(device_with_a_missing_extension_fails),
+        ob_test_expecting_errors(renderer_with_a_missing_extension_fails),
+        ob_test_expecting_errors(resources_refuse_bad_descs),
+        ob_test_expecting_errors(pipeline_manager_failure_is_returned),
+        ob_test_expecting_errors(texture_missing_file_is_io),
+        ob_test_expecting_errors(geometry_with_a_bad_index_is_refused),
+        ob_test_expecting_errors(effect_with_a_missing_shader_is_io),
+        ob_test_expecting_errors(effect_that_does_not_compile_is_returned),
+        ob_test_expecting_errors(effect_allocation_failures_are_returned),
+        ob_test_expecting_errors(effect_context_failures_are_returned),
+        ob_test_expecting_errors(material_library_without_shaders_is_io),
+        ob_test_expecting_errors(material_bad_descs_are_refused),
+        ob_test_expecting_errors(views_bad_descs_are_refused),
+        ob_test_expecting_errors(renderer_bad_threading_mode_is_refused),
+        ob_test_expecting_errors(composite_shader_that_does_not_compile_fails_the_stack),
+        ob_test_expecting_errors(overlay_shader_that_does_not_compile_fails_the_stack),
+        ob_test_expecting_errors(particle_shader_that_does_not_compile_fails_the_system),
+        ob_test_expecting_errors(frame_with_a_material_that_does_not_compile_returns_it),
+        ob_test_expecting_errors(resize_the_device_cannot_make_is_returned),
+        ob_test_expecting_errors(correct_frame_reports_none),
+        ob_test_expecting_errors(stack_entity_without_geometry_is_refused),
+        ob_test_expecting_errors(scene_load_missing_file_is_io),
+        ob_test_expecting_errors(model_assets_without_a_desc_are_refused),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     nftw(tmp_root, remove_entry, 8, FTW_DEPTH | FTW_PHYS);

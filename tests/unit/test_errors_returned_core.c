@@ -25,32 +25,6 @@
 
 #define MISSING "/nonexistent/obelisk-errors/missing"
 
-/* The log since the last clear has a line containing every given needle;
- * on failure, shows what was logged. */
-#define assert_logged(...)                                                      \
-    do {                                                                        \
-        if (!ob_test_log_has(__VA_ARGS__, NULL)) {                              \
-            ob_test_log_dump(OB_LOG_DEBUG, 20);                                 \
-            fail_msg("no log line with: %s", #__VA_ARGS__);                     \
-        }                                                                       \
-    } while (0)
-
-static int quiet(void **state)
-{
-    (void)state;
-    ob_test_log_set_echo(false);   /* every test provokes errors on purpose */
-    ob_test_log_clear();
-    return 0;
-}
-
-static int loud(void **state)
-{
-    (void)state;
-    ob_fault_arm(OB_FAULT_HOST_ALLOC, 0);
-    ob_test_log_set_echo(true);
-    return 0;
-}
-
 /* ------------------------------------------------------------------ core */
 
 static void file_read_missing_is_io(void **state)
@@ -319,24 +293,24 @@ int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(file_read_missing_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(once_keeps_a_failure_and_names_it, quiet, loud),
-        cmocka_unit_test_setup_teardown(process_wide_setups_are_the_listed_ones, quiet, loud),
-        cmocka_unit_test_setup_teardown(registry_too_many_slots_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(registry_out_of_memory_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(param_registered_twice_differently_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(scene_out_of_memory_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(node_under_a_foreign_parent_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(node_destroy_misuse_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(shader_source_missing_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(shader_missing_file_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(shader_compile_error_names_file_and_line, quiet, loud),
-        cmocka_unit_test_setup_teardown(shader_compiler_out_of_memory_is_returned, quiet, loud),
-        cmocka_unit_test_setup_teardown(mesh_generator_bad_input_is_refused, quiet, loud),
-        cmocka_unit_test_setup_teardown(model_load_missing_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(model_open_missing_is_io, quiet, loud),
-        cmocka_unit_test_setup_teardown(scene_file_missing_is_io_with_message, quiet, loud),
-        cmocka_unit_test_setup_teardown(scene_file_bad_value_names_its_path, quiet, loud),
+        ob_test_expecting_errors(file_read_missing_is_io),
+        ob_test_expecting_errors(once_keeps_a_failure_and_names_it),
+        ob_test_expecting_errors(process_wide_setups_are_the_listed_ones),
+        ob_test_expecting_errors(registry_too_many_slots_is_refused),
+        ob_test_expecting_errors(registry_out_of_memory_is_returned),
+        ob_test_expecting_errors(param_registered_twice_differently_is_refused),
+        ob_test_expecting_errors(scene_out_of_memory_is_returned),
+        ob_test_expecting_errors(node_under_a_foreign_parent_is_refused),
+        ob_test_expecting_errors(node_destroy_misuse_is_returned),
+        ob_test_expecting_errors(shader_source_missing_is_io),
+        ob_test_expecting_errors(shader_missing_file_is_io),
+        ob_test_expecting_errors(shader_compile_error_names_file_and_line),
+        ob_test_expecting_errors(shader_compiler_out_of_memory_is_returned),
+        ob_test_expecting_errors(mesh_generator_bad_input_is_refused),
+        ob_test_expecting_errors(model_load_missing_is_io),
+        ob_test_expecting_errors(model_open_missing_is_io),
+        ob_test_expecting_errors(scene_file_missing_is_io_with_message),
+        ob_test_expecting_errors(scene_file_bad_value_names_its_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
