@@ -151,13 +151,14 @@ typedef struct ob_frame_stats {
     uint32_t pipelines_created, variants_created;
     uint64_t frame_hash;         /* all view hashes in order */
     /* Failures this frame met and went on without (the frame still ran,
-     * without what failed): a view not made or not culled, a material
+     * without what failed): a view not made, resized or culled, a material
      * whose effect variant or pipeline could not be made. Each is logged
      * naming the view, entity or material, listed in skipped[] with
      * OB_SKIP_ERROR, and counted here; first_error is the result of the
-     * first (OB_OK when there was none). A program that must not show a
-     * degraded picture checks these after end_frame (ob_views_render and
-     * ob_stack_frame return first_error). */
+     * first that came with one (ob_renderer_note_error; OB_OK when none
+     * did). A program that must not show a degraded picture checks these
+     * after end_frame (ob_views_render and ob_stack_frame return
+     * first_error). */
     uint32_t errors;
     ob_result first_error;
 } ob_frame_stats;
