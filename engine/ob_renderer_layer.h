@@ -155,7 +155,10 @@ void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t varia
  * sizes differ, into the acquired swapchain image. A presenting composite
  * view calls it from its pre_render. No-op when headless or outside a frame;
  * a frame with a swapchain image and nothing to present shows black (and
- * logs a warning once). [render thread, PreRender] */
+ * logs a warning once). An image that is stale or lacks
+ * OB_IMAGE_TRANSFER_SRC is refused here, where the frame can report it:
+ * logged, the frame's error (OB_ERR_INVALID_ARGUMENT, named "present"),
+ * and the window shows black. [render thread, PreRender] */
 void ob_renderer_present_image(ob_renderer *r, ob_image image);
 /* The size of this frame's swapchain image; false (and 0x0) when headless,
  * outside a frame, or when this frame is not presented (minimised). Views
