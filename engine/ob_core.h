@@ -171,7 +171,10 @@ bool ob_fault_should_fail(ob_fault_kind kind);
  *                         effect's vertex input, a constant made once;
  *  - one lock that needs no set-up: geometry/ob_model.c's around assimp's
  *    import, whose error text (aiGetErrorString) is one process-wide string.
- * Nothing else in the library changes after start-up outside an object. */
+ * stb is compiled into the engine (engine/ob_stb_impl.c, its own copy, not
+ * a program's): its failure text is per thread and its global flags are
+ * never set. Nothing else in the library changes after start-up outside an
+ * object. */
 typedef struct ob_once {
     const char *name;        /* as listed above */
     ob_result (*init)(void); /* runs once; must not run another ob_once */
