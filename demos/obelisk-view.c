@@ -394,6 +394,8 @@ static void apply_settings(ob_demo_options *o, const ob_scene_file_settings *s)
 int main(int argc, char **argv)
 {
     ob_demo_options opt;
+    /* cJSON's allocations counted with Obelisk's (the heap figures). */
+    ob_scene_file_hook_cjson();
     int code;
     if (!ob_demo_options_parse(argc, argv,
                                "  FILE              a scene (.json, docs/scene-format.md) or a model file\n"
@@ -484,7 +486,7 @@ int main(int argc, char **argv)
     if (d.r) ob_renderer_wait_idle(d.r);
     ob_scene_unload(&v.loaded);
     /* The model's entities draw with its assets: they go first. */
-    if (model_root) ob_node_destroy(d.scene, model_root);
+    if (model_root) ob_node_destroy(model_root);
     ob_model_assets_destroy(assets);
     ob_demo_shutdown(&d);
     ob_scene_file_release(&v.sf);

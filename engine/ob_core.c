@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -37,6 +38,44 @@ const char *ob_result_name(ob_result r)
 const char *ob_result_text(ob_result r)
 {
     return (unsigned)r < OB_RESULT_COUNT ? result_texts[r] : "unknown result";
+}
+
+/* ------------------------------------------------------ process-wide state */
+
+/* One lock for every set-up: they run once per process, so contention is
+ * nil, and one lock cannot be taken in two orders. */
+static pthread_mutex_t once_lock = PTHREAD_MUTEX_INITIALIZER;
+static ob_once *once_ran;   /* newest first; guarded by once_lock */
+
+ob_result ob_once_run(ob_once *once)
+{
+    if (__atomic_load_n(&once->state, __ATOMIC_ACQUIRE)) return once->result;
+    pthread_mutex_lock(&once_lock);
+    if (!once->state) {
+        once->result = once->init ? once->init() : OB_OK;
+        if (once->result != OB_OK)
+            OB_LOG_E("core", "one-time set-up '%s' failed: %s; what needs it fails too", once->name,
+                     ob_result_name(once->result));
+        once->next = once_ran;
+        once_ran = once;
+        __atomic_store_n(&once->state, 1, __ATOMIC_RELEASE);
+    }
+    pthread_mutex_unlock(&once_lock);
+    return once->result;
+}
+
+uint32_t ob_once_list(const char **names, uint32_t cap)
+{
+    pthread_mutex_lock(&once_lock);
+    uint32_t n = 0;
+    for (const ob_once *o = once_ran; o; o = o->next) n++;
+    uint32_t i = n;
+    for (const ob_once *o = once_ran; o; o = o->next) {
+        i--;
+        if (i < cap) names[i] = o->name;
+    }
+    pthread_mutex_unlock(&once_lock);
+    return n;
 }
 
 /* ---------------------------------------------------------------- logging */

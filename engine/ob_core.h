@@ -3,9 +3,11 @@
  * The bottom of the engine: every other module includes this header and
  * nothing below it but libc. It has no lifecycle of its own.
  *
- * Thread rule: every function here is [any thread]. The log sink and the
- * fault-injection counters are the only process-wide state in Obelisk; both
- * are atomics, set up by tests or the application before renderers exist.
+ * Thread rule: every function here is [any thread]. This header is the one
+ * place that lists Obelisk's process-wide state ("process-wide state" below:
+ * the log sink, the fault-injection and heap counters, and the one-time
+ * set-up of third-party libraries, each run through ob_once_run); anything
+ * else hangs off an explicit object.
  */
 #ifndef OB_CORE_H
 #define OB_CORE_H
@@ -107,9 +109,10 @@ char *ob_strdup(const char *s);
 /* Live blocks allocated through the functions above and not yet freed, and
  * their bytes as the allocator sized them (sized = false where the C library
  * cannot tell a block's size: then live_bytes stays 0). Everything Obelisk
- * allocates on the host, the libraries it hooks (stb, cJSON in the demos)
- * included; not the driver's or the validation layer's memory. [any thread;
- * a snapshot: other threads may allocate meanwhile] */
+ * allocates on the host, the libraries it hooks (stb; cJSON when the
+ * program asks: ob_scene_file_hook_cjson) included; not the driver's or the
+ * validation layer's memory. [any thread; a snapshot: other threads may
+ * allocate meanwhile] */
 typedef struct ob_heap_stats {
     uint64_t live_bytes, live_blocks;
     bool sized;
@@ -143,6 +146,52 @@ bool ob_fault_hit(ob_fault_kind kind);
 uint64_t ob_fault_count(ob_fault_kind kind);
 /* Called at each fault point; true means "fail this one". */
 bool ob_fault_should_fail(ob_fault_kind kind);
+
+/* ------------------------------------------------------ process-wide state */
+
+/* Obelisk's process-wide state, all of it:
+ *  - the log sink and the log counters, the fault-injection counters and
+ *    the heap counters above: atomics, set up by tests or the application
+ *    before renderers exist;
+ *  - one-time set-up, each an ob_once defined in the one file of the layer
+ *    that needs it (the engine links no third-party library, and a lower
+ *    layer never calls a higher one), run through ob_once_run on first use
+ *    and listed by ob_once_list under these names:
+ *      "glslang"          materials/ob_shader.c: glslang_initialize_process
+ *                         and a warm-up compile per stage, at the first
+ *                         ob_shader_compiler_create; never finalised, since
+ *                         a compiler may be made again (the OS reclaims it);
+ *      "cJSON hooks"      views/scene/ob_json_read.c: cJSON_InitHooks with
+ *                         ob_malloc/ob_free, only when the program calls
+ *                         ob_scene_file_hook_cjson: cJSON's hooks are
+ *                         process-wide, and a program that uses cJSON itself
+ *                         must not find them changed behind its back (its
+ *                         own hooks replaced, or its blocks freed by ours);
+ *      "standard input"   views/ob_views.c: the standard vertex layout as an
+ *                         effect's vertex input, a constant made once;
+ *  - one lock that needs no set-up: geometry/ob_model.c's around assimp's
+ *    import, whose error text (aiGetErrorString) is one process-wide string.
+ * stb is compiled into the engine (engine/ob_stb_impl.c, its own copy, not
+ * a program's): its failure text is per thread and its global flags are
+ * never set. Nothing else in the library changes after start-up outside an
+ * object. */
+typedef struct ob_once {
+    const char *name;        /* as listed above */
+    ob_result (*init)(void); /* runs once; must not run another ob_once */
+    int state;               /* 0 until init has run (atomic, read by ob_once_run) */
+    ob_result result;        /* init's result, kept */
+    struct ob_once *next;    /* the list of set-ups that ran */
+} ob_once;
+#define OB_ONCE_INIT(name, init) {(name), (init), 0, OB_OK, NULL}
+
+/* Runs once->init the first time any thread gets here (others wait for it)
+ * and returns its result, then and on every later call: a set-up that
+ * failed stays failed (logged once, naming it). [any thread] */
+ob_result ob_once_run(ob_once *once);
+/* The names of the set-ups that have run, in the order they ran: up to cap
+ * into names (may be NULL with cap 0); returns how many have run.
+ * [any thread] */
+uint32_t ob_once_list(const char **names, uint32_t cap);
 
 /* ---------------------------------------------------------------- handles */
 

@@ -31,7 +31,11 @@ static int member_param_type(const ob_block_member *m, uint32_t *out_count)
 
 /* Members the application has not registered yet become parameters of the
  * declared type, so a shader can add a member and have it set by name. */
-static void register_block_params(ob_param_registry *reg, const ob_block_layout *b)
+/* A member whose parameter cannot be registered (out of memory, the
+ * registry full) fails the program: its mapping would leave the member
+ * unfed, a silently wrong picture. */
+static ob_result register_block_params(ob_param_registry *reg, const ob_block_layout *b,
+                                       const char *program)
 {
     for (uint32_t i = 0; i < b->member_count; i++) {
         const ob_block_member *m = &b->members[i];
@@ -39,9 +43,14 @@ static void register_block_params(ob_param_registry *reg, const ob_block_layout 
         uint32_t count;
         int type = member_param_type(m, &count);
         if (type < 0) continue;
-        ob_result r;
-        ob_param_register(reg, m->name, (ob_param_type)type, count, &r);
+        ob_result r = OB_OK;
+        if (!ob_param_register(reg, m->name, (ob_param_type)type, count, &r).id) {
+            OB_LOG_E("program", "program '%s': parameter '%s' of block '%s' not registered: %s",
+                     program, m->name, b->name, ob_result_name(r));
+            return r != OB_OK ? r : OB_ERR_OUT_OF_HOST_MEMORY;
+        }
     }
+    return OB_OK;
 }
 
 static ob_param resource_param(ob_param_registry *reg, const char *name, ob_param_type type)
@@ -140,7 +149,8 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
                 goto fail_destroy_program;
             }
             const ob_block_layout *layout = &refl->blocks[b->block];
-            register_block_params(reg, layout);
+            r = register_block_params(reg, layout, prog->name);
+            if (r != OB_OK) goto fail_destroy_program;
             ob_program_ubo *u = &prog->ubos[prog->ubo_count];
             u->binding = b->binding;
             u->size = (layout->size + 15u) & ~15u;
@@ -166,7 +176,8 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
     }
     if (refl->push_block >= 0) {
         const ob_block_layout *pb = &refl->blocks[refl->push_block];
-        register_block_params(reg, pb);
+        r = register_block_params(reg, pb, prog->name);
+        if (r != OB_OK) goto fail_destroy_program;
         prog->push_mapping = ob_param_mapping_create(reg, pb, prog->name, &r);
         if (!prog->push_mapping) goto fail_destroy_program;
         prog->push_size = (pb->size + 3u) & ~3u;

@@ -207,11 +207,17 @@ const ob_geometry_iface *ob_renderer_get_geometry_iface(const ob_renderer *r)
     return r->has_geometry_iface ? &r->geometry_iface : NULL;
 }
 
-void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers)
+ob_result ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers)
 {
+    if ((unsigned)mode > OB_THREADING_AUTO) {
+        OB_LOG_E("renderer", "threading mode %d refused (single, multi or auto); it stays as it was",
+                 (int)mode);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     r->pending_mode = mode;
     if (active_workers == 0 || active_workers > r->worker_count) active_workers = r->worker_count;
     r->pending_active = active_workers;
+    return OB_OK;
 }
 
 ob_threading ob_renderer_get_threading(const ob_renderer *r) { return r->mode; }
@@ -296,15 +302,30 @@ ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
     return res;
 }
 
+/* Adds (name, reason) to the frame's skipped list; false when it was there
+ * already. */
+static bool add_skipped(ob_frame_stats *st, const char *name, ob_skip_reason reason)
+{
+    for (uint32_t i = 0; i < st->skipped_count; i++)
+        if (strcmp(st->skipped[i].name, name) == 0 && st->skipped[i].reason == reason) return false;
+    if (st->skipped_count < OB_MAX_FRAME_VIEWS) {
+        snprintf(st->skipped[st->skipped_count].name, sizeof st->skipped[0].name, "%s", name);
+        st->skipped[st->skipped_count].reason = reason;
+        st->skipped_count++;
+    }
+    return true;
+}
+
 void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason)
 {
-    ob_frame_stats *st = &r->cur;
-    for (uint32_t i = 0; i < st->skipped_count; i++)
-        if (strcmp(st->skipped[i].name, name) == 0 && st->skipped[i].reason == reason) return;
-    if (st->skipped_count >= OB_MAX_FRAME_VIEWS) return;
-    snprintf(st->skipped[st->skipped_count].name, sizeof st->skipped[0].name, "%s", name);
-    st->skipped[st->skipped_count].reason = reason;
-    st->skipped_count++;
+    if (add_skipped(&r->cur, name, reason) && reason == OB_SKIP_ERROR) r->cur.errors++;
+}
+
+void ob_renderer_note_error(ob_renderer *r, const char *name, ob_result error)
+{
+    if (!r || error == OB_OK || !r->in_frame) return;
+    if (add_skipped(&r->cur, name ? name : "", OB_SKIP_ERROR)) r->cur.errors++;
+    if (r->cur.first_error == OB_OK) r->cur.first_error = error;
 }
 
 /* ------------------------------------------------------------ frame */
@@ -442,13 +463,13 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     if (v->input_count > OB_VIEW_MAX_INPUTS) {
         OB_LOG_E("renderer", "view '%s' not queued: %u inputs, at most %u", v->name, v->input_count,
                  OB_VIEW_MAX_INPUTS);
-        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        ob_renderer_note_error(r, v->name, OB_ERR_LIMIT);
         return false;
     }
     if (r->queue_count >= OB_MAX_FRAME_VIEWS) {
         OB_LOG_E("renderer", "view '%s' not queued: more than %u views this frame", v->name,
                  OB_MAX_FRAME_VIEWS);
-        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        ob_renderer_note_error(r, v->name, OB_ERR_LIMIT);
         return false;
     }
     v->queued_frame = r->serial;

@@ -174,6 +174,17 @@ typedef struct ob_frame_stats {
     uint64_t update_cpu_render_ns, update_cpu_render_parallel_ns, update_cpu_pool_ns;
     uint32_t pipelines_created, variants_created;
     uint64_t frame_hash;         /* all view hashes in order */
+    /* Failures this frame met and went on without (the frame still ran,
+     * without what failed): a view not made, resized or culled, a material
+     * whose effect variant or pipeline could not be made. Each is logged
+     * naming the view, entity or material, listed in skipped[] with
+     * OB_SKIP_ERROR, and counted here; first_error is the result of the
+     * first that came with one (ob_renderer_note_error; OB_OK when none
+     * did). A program that must not show a degraded picture checks these
+     * after end_frame (ob_views_render and ob_stack_frame return
+     * first_error). */
+    uint32_t errors;
+    ob_result first_error;
 } ob_frame_stats;
 
 /* Creates the device (or adopts the application's: desc.device.adopt), the
@@ -190,8 +201,10 @@ ob_param_registry *ob_renderer_registry(ob_renderer *r);
 ob_params *ob_renderer_params(ob_renderer *r);
 uint32_t ob_renderer_worker_count(const ob_renderer *r);
 
-/* Takes effect at the next begin_frame. active_workers 0 → all. */
-void ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
+/* Takes effect at the next begin_frame. active_workers 0 (or more than the
+ * pool has) → all. A mode outside ob_threading is refused
+ * (OB_ERR_INVALID_ARGUMENT, logged; the pending mode is unchanged). */
+ob_result ob_renderer_set_threading(ob_renderer *r, ob_threading mode, uint32_t active_workers);
 ob_threading ob_renderer_get_threading(const ob_renderer *r);
 
 /* Waits for this frame slot's fence, collects its GPU timings, resets its

@@ -134,8 +134,16 @@ ob_view *ob_renderer_attached_view(const ob_renderer *r, const ob_node *entity, 
 /* ---- reporting into the frame's stats ------------------------------------ */
 
 /* A view left out this frame, and why (once per name and reason; beyond
- * OB_MAX_FRAME_VIEWS entries the rest are dropped). [render thread] */
+ * OB_MAX_FRAME_VIEWS entries the rest are dropped). OB_SKIP_ERROR counts in
+ * the frame's errors; prefer ob_renderer_note_error, which keeps the result
+ * too. [render thread] */
 void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason reason);
+/* Something named `name` (a view, an entity, a material) failed with
+ * `error` and the frame goes on without it: listed in the frame's skipped[]
+ * with OB_SKIP_ERROR (once per name), counted in ob_frame_stats.errors, and
+ * the frame's first_error when it is the first. The caller logs the cause.
+ * No-op for OB_OK or outside a frame. [render thread] */
+void ob_renderer_note_error(ob_renderer *r, const char *name, ob_result error);
 /* Pipelines and shader variants the higher layers created this frame
  * (added to the frame's stats). [render thread] */
 void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants);
@@ -147,7 +155,10 @@ void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t varia
  * sizes differ, into the acquired swapchain image. A presenting composite
  * view calls it from its pre_render. No-op when headless or outside a frame;
  * a frame with a swapchain image and nothing to present shows black (and
- * logs a warning once). [render thread, PreRender] */
+ * logs a warning once). An image that is stale or lacks
+ * OB_IMAGE_TRANSFER_SRC is refused here, where the frame can report it:
+ * logged, the frame's error (OB_ERR_INVALID_ARGUMENT, named "present"),
+ * and the window shows black. [render thread, PreRender] */
 void ob_renderer_present_image(ob_renderer *r, ob_image image);
 /* The size of this frame's swapchain image; false (and 0x0) when headless,
  * outside a frame, or when this frame is not presented (minimised). Views

@@ -330,6 +330,14 @@ void ob_renderer_present_image(ob_renderer *r, ob_image image)
 {
     ob_present *p = r->present;
     if (!p || !r->in_frame) return;
+    ob_image_info info = {0};
+    if (ob_image_get_info(r->dev, image, &info) != OB_OK || !(info.usage & OB_IMAGE_TRANSFER_SRC)) {
+        OB_LOG_E("present", "image 0x%08x cannot be presented (%s): the window shows black this "
+                 "frame", image.id, info.usage ? "no OB_IMAGE_TRANSFER_SRC usage" : "not a live image");
+        ob_renderer_note_error(r, "present", OB_ERR_INVALID_ARGUMENT);
+        p->source = (ob_image){0};
+        return;
+    }
     p->source = image;
 }
 

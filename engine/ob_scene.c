@@ -439,7 +439,7 @@ ob_node *ob_node_create(ob_scene *s, ob_node *parent, const char *name, ob_resul
 /* Whether n may be destroyed through s (logged when not). */
 static bool destroy_allowed(ob_scene *s, const ob_node *n)
 {
-    if (n->scene != s) {
+    if (n->scene != s || n->by_id_index >= s->by_id_count || s->by_id[n->by_id_index] != n) {
         OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): destroy through another scene; ignored",
                  n->name, n->id);
         return false;
@@ -474,16 +474,24 @@ static void free_subtree(ob_scene *s, ob_node *top)
     }
 }
 
-void ob_node_destroy(ob_scene *s, ob_node *n) { ob_nodes_destroy(s, &n, 1); }
-
-void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count)
+ob_result ob_node_destroy(ob_node *n)
 {
-    if (count == 0) return;
+    return n ? ob_nodes_destroy(n->scene, &n, 1) : OB_OK;
+}
+
+ob_result ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count)
+{
+    if (count == 0) return OB_OK;
+    if (!s || !nodes) {
+        OB_LOG_E(SCENE_LOG, "ob_nodes_destroy: no scene or no node list");
+        return OB_ERR_INVALID_ARGUMENT;
+    }
     if (s->in_update) {
         const ob_node *n = nodes[0];
         refuse_in_update(s, "destroy", n);
-        return;
+        return OB_ERR_WRONG_STATE;
     }
+    ob_result result = OB_OK;
     /* Mark every subtree first, so that the snapshot loses them all in one
      * pass while the nodes still exist, from the first of them in it on:
      * the work is the subtrees' size plus the snapshot's tail past them,
@@ -493,7 +501,11 @@ void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count)
     bool lights = false;
     for (uint32_t i = 0; i < count; i++) {
         ob_node *n = nodes[i];
-        if (!n || n->dying || !destroy_allowed(s, n)) continue;
+        if (!n || n->dying) continue;
+        if (!destroy_allowed(s, n)) {
+            result = OB_ERR_INVALID_ARGUMENT;
+            continue;
+        }
         for (ob_node *m = n; m; m = ob_scene_preorder_next(m, n)) {
             m->dying = true;
             uint8_t st = s->state[m->by_id_index];
@@ -523,6 +535,7 @@ void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count)
         tops = next;
     }
     s->order_dirty = true;
+    return result;
 }
 
 ob_result ob_node_set_parent(ob_scene *s, ob_node *n, ob_node *parent)

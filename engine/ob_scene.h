@@ -176,15 +176,23 @@ static inline bool ob_render_proxy_per_draw(const ob_render_proxy *p, const doub
  * never reused, so it breaks draw-order ties deterministically. NULL with
  * *out_result set on failure. */
 ob_node *ob_node_create(ob_scene *s, ob_node *parent, const char *name, ob_result *out_result);
-/* Destroys n and its whole subtree (iteratively). The root cannot be
- * destroyed (logged, ignored); NULL is a no-op. */
-void ob_node_destroy(ob_scene *s, ob_node *n);
+/* Destroys n and its whole subtree (iteratively). The node knows its
+ * scene, so there is no scene argument to get wrong (an earlier two-argument
+ * form, called with its arguments guessed, compiled with a warning and
+ * crashed). NULL is a no-op (OB_OK). Refused, logged with the node's name
+ * and id, nothing destroyed: the root (OB_ERR_INVALID_ARGUMENT: destroy the
+ * scene instead) and any call from a controller during ob_scene_update
+ * (OB_ERR_WRONG_STATE). [render thread] */
+ob_result ob_node_destroy(ob_node *n);
 /* Destroys each of nodes[0..count) with its subtree, as many calls of
  * ob_node_destroy would, in time linear in the nodes destroyed (plus the
  * snapshot's entries of newer nodes), where one call per node costs the
  * whole snapshot each. A node may lie in another's subtree, be listed
- * twice, or be NULL. */
-void ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count);
+ * twice, or be NULL. A node that is not a live node of s (another scene's,
+ * or the root) is refused, logged with its name, and the others are still
+ * destroyed: the result is then OB_ERR_INVALID_ARGUMENT; during
+ * ob_scene_update nothing is destroyed (OB_ERR_WRONG_STATE). [render thread] */
+ob_result ob_nodes_destroy(ob_scene *s, ob_node *const *nodes, uint32_t count);
 /* Moves n (with its subtree) under parent (NULL → root), keeping its local
  * transform. Refuses cycles, the root and nodes of another scene
  * (OB_ERR_INVALID_ARGUMENT, logged). */

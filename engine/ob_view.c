@@ -441,7 +441,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
         /* The view goes on empty this frame; the next frame tries again. */
         OB_LOG_E("view", "view '%s': no draw list for %u renderables (%s); it draws nothing this frame",
                  v->name, count, ob_result_name(res));
-        ob_renderer_note_skipped(r, v->name, OB_SKIP_ERROR);
+        ob_renderer_note_error(r, v->name, res);
         v->material_count = 0;
         return res;
     }
@@ -566,7 +566,7 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
                  count);
         for (uint32_t k = 0; k < count; k++) {
             views[k]->item_count = 0;
-            ob_renderer_note_skipped(r, views[k]->name, OB_SKIP_ERROR);
+            ob_renderer_note_error(r, views[k]->name, OB_ERR_OUT_OF_HOST_MEMORY);
         }
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }

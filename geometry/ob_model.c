@@ -47,7 +47,8 @@
  * would race on it, so the parse step and the copy of its error text hold
  * this lock. Post-processing, checks and merging run unlocked: they use only
  * the per-import aiScene. assimp keeps no other process state as long as no
- * log stream is attached (we attach none, so it stays quiet). */
+ * log stream is attached (we attach none, so it stays quiet). Listed with
+ * the rest of Obelisk's process-wide state in ob_core.h. */
 static pthread_mutex_t ob_assimp_parse_lock = PTHREAD_MUTEX_INITIALIZER;
 
 typedef struct model_ctx {

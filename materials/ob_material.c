@@ -645,12 +645,27 @@ static ob_effect_targets view_targets(ob_device *dev, const ob_view *v)
     return t;
 }
 
+/* A material that cannot draw as asked in v this frame (its effect variant
+ * failed, maybe drawn with a simpler one, or its pipeline failed, its draws
+ * skipped) goes into the frame's errors as "material:<name>": the cause is
+ * logged where it happened, and the frame goes on. */
+static void note_failure(const ob_material *m, ob_renderer *r, ob_result res)
+{
+    char name[64];
+    snprintf(name, sizeof name, "material:%s", m->name);
+    ob_renderer_note_error(r, name, res);
+}
+
 static void prepare(ob_material *m, ob_renderer *r, ob_node *entity, const ob_view *v,
                     const ob_effect_targets *targets)
 {
     uint32_t variant;
-    ob_effect *e = resolve(m, r, entity, v, true, &variant, NULL);
-    if (e) ob_effect_pipeline_for(e, targets, NULL);
+    ob_result res = OB_OK;
+    ob_effect *e = resolve(m, r, entity, v, true, &variant, &res);
+    /* NOT_FOUND: the material does not draw in v (or its custom effect
+     * is unset): nothing failed. */
+    if (res != OB_OK && res != OB_ERR_NOT_FOUND) note_failure(m, r, res);
+    if (e && !ob_effect_pipeline_for(e, targets, NULL)) note_failure(m, r, OB_ERR_VULKAN);
 }
 
 typedef struct prepare_ctx {

@@ -338,7 +338,9 @@ ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
         if (!e && res == OB_OK) res = OB_ERR_NOT_FOUND;
     }
     *out_env = e && slot < OB_PBR_PASS_PARABOLOID && (slot & 2u);
-    if (out_result) *out_result = e ? OB_OK : res;
+    /* A fallback drawn in place of a variant that failed still reports the
+     * failure, as the standard kinds do (resolve in ob_material.c). */
+    if (out_result) *out_result = res;
     return e;
 }
 

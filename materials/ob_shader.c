@@ -62,10 +62,6 @@ struct ob_shader_compiler {
 
 /* ---------------------------------------------------------------- glslang */
 
-/* The one process-wide third-party initialisation in Obelisk. */
-static pthread_once_t glslang_once = PTHREAD_ONCE_INIT;
-static bool glslang_ready;
-
 static const glslang_stage_t glslang_stages[OB_SHADER_STAGE_COUNT] = {
     GLSLANG_STAGE_VERTEX, GLSLANG_STAGE_FRAGMENT, GLSLANG_STAGE_COMPUTE};
 
@@ -86,12 +82,16 @@ static glslang_input_t glslang_input(ob_shader_stage stage, const char *code)
     };
 }
 
-static void glslang_init(void)
+/* glslang's process-wide set-up, listed with the rest of Obelisk's
+ * process-wide state in ob_core.h. */
+static ob_result glslang_init(void)
 {
-    glslang_ready = glslang_initialize_process() != 0;
-    if (!glslang_ready) return;
+    if (!glslang_initialize_process()) {
+        OB_LOG_E("shader", "glslang failed to initialise (glslang_initialize_process)");
+        return OB_ERR_UNSUPPORTED;
+    }
     /* glslang builds some tables lazily in function-local statics on the
-     * first compile of each stage. Doing that here, inside pthread_once,
+     * first compile of each stage. Doing that here, inside ob_once_run,
      * orders it before every concurrent compile in a way the thread
      * sanitizer can see (glslang itself is not instrumented). */
     static const char *const warm_up[OB_SHADER_STAGE_COUNT] = {
@@ -113,7 +113,9 @@ static void glslang_init(void)
         glslang_program_delete(prog);
         glslang_shader_delete(sh);
     }
+    return OB_OK;
 }
+static ob_once glslang_once = OB_ONCE_INIT("glslang", glslang_init);
 
 /* ------------------------------------------------------------ create/destroy */
 
@@ -137,13 +139,9 @@ ob_shader_compiler *ob_shader_compiler_create(const ob_shader_compiler_desc *des
                                               ob_result *out_result)
 {
     ob_shader_compiler_desc d = desc ? *desc : (ob_shader_compiler_desc){0};
-    ob_result r = OB_ERR_OUT_OF_HOST_MEMORY;
-    pthread_once(&glslang_once, glslang_init);
-    if (!glslang_ready) {
-        OB_LOG_E("shader", "glslang failed to initialise");
-        r = OB_ERR_UNSUPPORTED;
-        goto fail_log;
-    }
+    ob_result r = ob_once_run(&glslang_once);
+    if (r != OB_OK) goto fail_log;
+    r = OB_ERR_OUT_OF_HOST_MEMORY;
     ob_shader_compiler *c = ob_calloc(1, sizeof *c);
     if (!c) goto fail_log;
     const char *env_shaders = getenv("OB_SHADER_DIR");

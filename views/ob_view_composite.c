@@ -30,18 +30,20 @@ struct ob_composite_view {
     bool presenting;
 };
 
-static ob_effect *composite_effect(ob_views *ctx)
+/* The context's one composite effect, made by the first composite view's
+ * creation so that a shader that cannot be read or compiled fails there
+ * (the caller gets the result) instead of giving a black frame and OB_OK. */
+static ob_result composite_effect(ob_views *ctx)
 {
-    if (!ctx->composite_effect) {
-        ob_effect_desc d = {
-            .name = "composite",
-            .vertex = "fullscreen.vert",
-            .fragment = "composite.frag",
-        };
-        ob_result r;
-        ctx->composite_effect = ob_effect_create(ctx->effects, &d, &r);
-    }
-    return ctx->composite_effect;
+    if (ctx->composite_effect) return OB_OK;
+    ob_effect_desc d = {
+        .name = "composite",
+        .vertex = "fullscreen.vert",
+        .fragment = "composite.frag",
+    };
+    ob_result r = OB_OK;
+    ctx->composite_effect = ob_effect_create(ctx->effects, &d, &r);
+    return r;
 }
 
 static void composite_pre_render(ob_view *v, ob_renderer *r)
@@ -70,7 +72,7 @@ static void composite_pre_render(ob_view *v, ob_renderer *r)
     }
     v->inputs[0] = src->color;
     if (cv->presenting) ob_renderer_present_image(r, v->color);
-    composite_effect(cv->ctx);
+    ob_views_prepare_effect(cv->ctx, r, cv->ctx->composite_effect, v);
 }
 
 static void composite_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
@@ -105,10 +107,7 @@ ob_composite_view *ob_composite_view_create(ob_views *ctx, ob_view *source, ob_r
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
-    /* Its effect is made in its first frame: a shader that cannot be read
-     * fails here instead, where the caller sees it. */
-    static const char *const shaders[] = {"fullscreen.vert", "composite.frag"};
-    r = ob_effect_context_check_shaders(ctx->effects, "composite view", shaders, OB_ARRAY_COUNT(shaders));
+    r = composite_effect(ctx);
     if (r != OB_OK) goto done;
     cv = ob_calloc(1, sizeof *cv);
     if (!cv) {

@@ -39,9 +39,12 @@ struct ob_overlay_view {
     ob_param diffuse;
 };
 
-static ob_effect *text_effect(ob_views *ctx)
+/* The context's one text effect, made by the first overlay's creation so
+ * that a shader that cannot be read or compiled fails there, where the
+ * caller sees the result, instead of in every frame, logged only. */
+static ob_result text_effect(ob_views *ctx)
 {
-    if (ctx->text_effect) return ctx->text_effect;
+    if (ctx->text_effect) return OB_OK;
     static const ob_shader_define defines[] = {{"SCREEN_SPACE", "1"}, {"VERTEX_COLOR", "1"}};
     ob_effect_vertex_input input = {
         .stride = sizeof(overlay_vertex),
@@ -57,9 +60,9 @@ static ob_effect *text_effect(ob_views *ctx)
         .layout = &input,
         .blend = true,
     };
-    ob_result r;
+    ob_result r = OB_OK;
     ctx->text_effect = ob_effect_create(ctx->effects, &d, &r);
-    return ctx->text_effect;
+    return r;
 }
 
 static void overlay_pre_render(ob_view *v, ob_renderer *r)
@@ -70,7 +73,7 @@ static void overlay_pre_render(ob_view *v, ob_renderer *r)
     v->color = ov->source->color;
     v->width = ov->source->width;
     v->height = ov->source->height;
-    text_effect(ov->ctx);
+    ob_views_prepare_effect(ov->ctx, r, ov->ctx->text_effect, v);
 
     /* Build this frame's quads into the slot the GPU is no longer reading. */
     ov->slot = (uint32_t)(ob_renderer_frame_serial(r) % OVERLAY_SLOTS);
@@ -141,9 +144,12 @@ ob_overlay_view *ob_overlay_view_create(ob_views *ctx, ob_view *source, ob_resul
     ob_overlay_view *ov = NULL;
     uint32_t *idx = NULL;
     if (!ctx || !source || !source->color.id) {
+        OB_LOG_E("views", "overlay view: needs a source view with a colour target");
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
+    r = text_effect(ctx);
+    if (r != OB_OK) goto done;
     ov = ob_calloc(1, sizeof *ov);
     idx = ob_malloc(sizeof *idx * 6 * OVERLAY_MAX_QUADS);
     if (!ov || !idx) {
@@ -181,6 +187,8 @@ fail_destroy_overlay:
     ob_overlay_view_destroy(ctx, ov);
     ov = NULL;
 done:
+    if (r != OB_OK && r != OB_ERR_INVALID_ARGUMENT)
+        OB_LOG_E("views", "overlay view of '%s' not created: %s", source->name, ob_result_name(r));
     if (out_result) *out_result = r;
     return ov;
 }

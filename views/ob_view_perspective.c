@@ -98,6 +98,14 @@ ob_perspective_view *ob_perspective_view_create(ob_views *ctx, const ob_perspect
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
+    /* The view cannot be given a camera later: without one it could only
+     * ever render its clear colour. */
+    if (!desc->camera) {
+        OB_LOG_E("views", "perspective view '%s': needs a camera node (desc.camera is NULL)",
+                 desc->name ? desc->name : "camera");
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto done;
+    }
     pv = ob_calloc(1, sizeof *pv);
     if (!pv) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;

@@ -33,8 +33,9 @@ static void sim_pre_render(ob_view *v, ob_renderer *r)
 {
     if (!ob_renderer_queue_view(r, v)) return;
     sim_view *sv = (sim_view *)v;
-    ob_result res;
-    ob_material_library_effect(sv->ps->ctx->materials, OB_STD_PARTICLES_SIM, 0, &res);
+    ob_views *ctx = sv->ps->ctx;
+    ob_views_prepare_effect(ctx, r, ob_material_library_find_effect(ctx->materials,
+                                                                    OB_STD_PARTICLES_SIM, 0), v);
 }
 
 static void sim_params(ob_particle_system *ps, ob_params *params)
@@ -141,6 +142,10 @@ ob_particle_system *ob_particle_system_create(ob_views *ctx, ob_scene *scene, ob
     ob_geometry_desc gd = {.name = name, .vertex_count = 6, .instance_count = d->count};
     ps->quads = ob_geometry_create(ctx->dev, &gd, &r);
     if (!ps->quads) goto fail_destroy_system;
+    /* Both effects now: a shader that does not compile fails the creation
+     * instead of leaving a system that never moves, logged only. */
+    if (!ob_material_library_effect(ctx->materials, OB_STD_PARTICLES_SIM, 0, &r))
+        goto fail_destroy_system;
     ob_effect *draw = ob_material_library_effect(ctx->materials, OB_STD_PARTICLES_DRAW, 0, &r);
     if (!draw) goto fail_destroy_system;
     ob_material_desc md = {.name = name, .kind = OB_MATERIAL_CUSTOM, .blended = true};
@@ -183,7 +188,7 @@ void ob_particle_system_destroy(ob_views *ctx, ob_particle_system *ps)
     if (!ps) return;
     ob_views_remove_system(ctx, ps);
     /* The entity goes first: it points at the material and the quads. */
-    if (ps->node) ob_node_destroy(ps->scene, ps->node);
+    if (ps->node) ob_node_destroy(ps->node);
     ob_material_destroy(ps->material);
     ob_geometry_destroy(ctx->dev, ps->quads);
     ob_buffer_destroy(ctx->dev, ps->buffer);

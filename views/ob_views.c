@@ -1,7 +1,6 @@
 #include "ob_views_internal.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -187,6 +186,9 @@ ob_result ob_views_resize_target(ob_views *ctx, ob_view *v, uint32_t width, uint
     if (r != OB_OK) {
         OB_LOG_E("views", "view '%s': cannot resize from %ux%u to %ux%u (%s); it keeps its size",
                  v->name, old.width, old.height, width, height, ob_result_name(r));
+        /* In a frame (a resize asked for with ob_view_resize applies in
+         * PreRender), the frame reports it: no-op between frames. */
+        ob_renderer_note_error(ctx->r, v->name, r);
         return r;
     }
     /* Deferred: frames in flight still use the old images. */
@@ -245,6 +247,19 @@ void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_colo
     if (d.id && ob_image_get_info(ctx->dev, d, &info) == OB_OK) *out_depth = info.format;
 }
 
+bool ob_views_prepare_effect(ob_views *ctx, ob_renderer *r, ob_effect *e, ob_view *v)
+{
+    if (!e) {
+        ob_renderer_note_error(r, v->name, OB_ERR_NOT_FOUND);
+        return false;
+    }
+    ob_effect_targets t;
+    ob_view_attachment_formats(v, ctx->dev, &t.color, &t.depth, &t.samples);
+    if (ob_effect_pipeline_for(e, &t, NULL)) return true;
+    ob_renderer_note_error(r, v->name, OB_ERR_VULKAN);
+    return false;
+}
+
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm)
 {
     if (!e) return false;
@@ -291,14 +306,14 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
             if (!pv) {
                 OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
                          ob_node_name(entity), id, ob_result_name(res));
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+                ob_renderer_note_error(r, ob_node_name(entity), res);
                 return;
             }
             if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
                           (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
                 OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
                          "skipped this frame", ob_node_name(entity), id);
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+                ob_renderer_note_error(r, ob_node_name(entity), OB_ERR_OUT_OF_HOST_MEMORY);
                 ob_paraboloid_view_destroy(ctx, pv);
                 return;
             }
@@ -316,7 +331,7 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
                 OB_LOG_E("views", "entity '%s' (id %u): environment map not attached (%s); "
                          "drawn without reflections this frame", ob_node_name(entity), id,
                          ob_result_name(res));
-                ob_renderer_note_skipped(r, e->view->name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, e->view->name, res);
             }
         }
     }
@@ -350,14 +365,14 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             if (!sv) {
                 OB_LOG_E("views", "light '%s': cannot create its shadow map: %s",
                          ob_node_name(lights[i]), ob_result_name(res));
-                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, name, res);
                 continue;
             }
             if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
                           (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
                 OB_LOG_E("views", "light '%s': no memory to keep its shadow map; skipped this frame",
                          ob_node_name(lights[i]));
-                ob_renderer_note_skipped(r, name, OB_SKIP_ERROR);
+                ob_renderer_note_error(r, name, OB_ERR_OUT_OF_HOST_MEMORY);
                 ob_shadow_view_destroy(ctx, sv);
                 continue;
             }
@@ -397,12 +412,11 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
 /* ------------------------------------------------------------ vertex input */
 
 /* The standard layout as an effect's vertex input, made once: constant
- * after that, so any thread may read it (pthread_once orders the write
- * before every reader). */
+ * after that, so any thread may read it (ob_once_run orders the write
+ * before every reader; listed in ob_core.h). */
 static ob_effect_vertex_input standard_input;
-static pthread_once_t standard_input_once = PTHREAD_ONCE_INIT;
 
-static void make_standard_input(void)
+static ob_result make_standard_input(void)
 {
     const ob_vertex_layout *l = ob_vertex_layout_standard();
     standard_input.stride = l->stride;
@@ -412,11 +426,13 @@ static void make_standard_input(void)
         standard_input.attributes[i].format = l->attributes[i].format;
         standard_input.attributes[i].offset = l->attributes[i].offset;
     }
+    return OB_OK;
 }
+static ob_once standard_input_once = OB_ONCE_INIT("standard input", make_standard_input);
 
 const ob_effect_vertex_input *ob_views_standard_input(void)
 {
-    pthread_once(&standard_input_once, make_standard_input);
+    ob_once_run(&standard_input_once);
     return &standard_input;
 }
 
@@ -427,6 +443,8 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ob_result r = OB_OK;
     ob_views *ctx = NULL;
     if (!desc || !desc->renderer || !desc->materials || !desc->effects) {
+        OB_LOG_E("views", "ob_views_create: no %s", !desc ? "desc" : !desc->renderer ? "renderer"
+                 : !desc->materials ? "material library" : "effect context");
         r = OB_ERR_INVALID_ARGUMENT;
         goto done;
     }
@@ -439,8 +457,9 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ctx->dev = ob_renderer_device(desc->renderer);
     ctx->materials = desc->materials;
     ctx->effects = desc->effects;
-    ctx->env_map_size = desc->env_map_size ? desc->env_map_size : 256;
-    ctx->shadow_map_size = desc->shadow_map_size ? desc->shadow_map_size : 1024;
+    r = ob_views_set_env_map_size(ctx, desc->env_map_size);
+    if (r == OB_OK) r = ob_views_set_shadow_map_size(ctx, desc->shadow_map_size);
+    if (r != OB_OK) goto fail_destroy_views;
     static const float default_ambient[4] = {1.0f, 1.0f, 1.0f, 0.15f};
     memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
     ctx->dt = 1.0 / 60.0;
@@ -487,18 +506,35 @@ void ob_views_set_time(ob_views *ctx, double time, double dt)
     ctx->dt = dt;
 }
 
-void ob_views_set_env_map_size(ob_views *ctx, uint32_t size) { ctx->env_map_size = size ? size : 256; }
-void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
+/* Whether a map of size x size can be made on this device (logged when not). */
+static ob_result check_map_size(const ob_views *ctx, const char *what, uint32_t size)
 {
-    ctx->shadow_map_size = size ? size : 1024;
+    uint32_t max = ob_device_properties(ctx->dev)->limits.maxImageDimension2D;
+    if (size <= max) return OB_OK;
+    OB_LOG_E("views", "%s size %u refused: the device's images are at most %u", what, size, max);
+    return OB_ERR_OUT_OF_RANGE;
 }
 
-void ob_views_render(ob_views *ctx, ob_view *final_view)
+ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size)
 {
-    ob_views_render_many(ctx, &final_view, 1);
+    ob_result r = check_map_size(ctx, "environment map", size);
+    if (r == OB_OK) ctx->env_map_size = size ? size : 256;
+    return r;
 }
 
-void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
+ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
+{
+    ob_result r = check_map_size(ctx, "shadow map", size);
+    if (r == OB_OK) ctx->shadow_map_size = size ? size : 1024;
+    return r;
+}
+
+ob_result ob_views_render(ob_views *ctx, ob_view *final_view)
+{
+    return ob_views_render_many(ctx, &final_view, 1);
+}
+
+ob_result ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
 {
     ob_renderer_pre_render_many(ctx->r, roots, count);
     /* Variants and pipelines are created on first need during PreRender
@@ -507,4 +543,5 @@ void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count)
     ob_renderer_note_created(ctx->r, now.pipelines_created - ctx->counted.pipelines_created,
                              now.variants_compiled - ctx->counted.variants_compiled);
     ctx->counted = now;
+    return ob_renderer_current_stats(ctx->r)->first_error;
 }

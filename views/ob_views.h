@@ -52,9 +52,12 @@ void ob_views_destroy(ob_views *ctx);
 ob_renderer *ob_views_renderer(ob_views *ctx);
 /* Simulation time: every view reads it, so ST and MT agree. */
 void ob_views_set_time(ob_views *ctx, double time, double dt);
-/* Quality settings (take effect for views created afterwards). */
-void ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
-void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
+/* Quality settings (take effect for views created afterwards; 0 → the
+ * default). A size over the device's maxImageDimension2D is refused
+ * (OB_ERR_OUT_OF_RANGE, logged; the size stays): the maps could never be
+ * made. ob_views_create refuses such a desc size the same way. */
+ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
+ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
 
 /* ---------------------------------------------------------- perspective */
 
@@ -162,15 +165,19 @@ ob_node *ob_particle_system_node(ob_particle_system *ps);
 /* Start a frame's PreRender of a root view (the final view, or another
  * camera view the program renders: each root view queued first is executed
  * last), which pre-renders what it needs, and report the pipelines and
- * shader variants this created to the frame's stats. [render thread, between
- * begin_frame and end_frame] */
-void ob_views_render(ob_views *ctx, ob_view *final_view);
+ * shader variants this created to the frame's stats. Returns the frame's
+ * first error so far (ob_frame_stats.first_error of the current stats):
+ * OB_OK, or what a view, entity or material met and the frame went on
+ * without (an effect variant that does not compile, a pipeline or an env
+ * map that could not be made) — the frame still renders the rest, and the
+ * log names each. [render thread, between begin_frame and end_frame] */
+ob_result ob_views_render(ob_views *ctx, ob_view *final_view);
 /* ob_views_render of several root views as one PreRender: the standard
  * views among them and all they need are culled together, in waves on the
  * renderer's worker pool (ob_renderer_pre_render_many). Prefer it to
- * calling ob_views_render per root when a frame has several. [render
- * thread, between begin_frame and end_frame] */
-void ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count);
+ * calling ob_views_render per root when a frame has several. Same result.
+ * [render thread, between begin_frame and end_frame] */
+ob_result ob_views_render_many(ob_views *ctx, ob_view *const *roots, uint32_t count);
 
 /* Standard vertex layout of geometry, as an effect's vertex input: a
  * constant the library owns, made on first use. [any thread] */

@@ -61,6 +61,14 @@ void ob_views_release_target(ob_views *ctx, ob_view *v);
 void ob_views_target_formats(ob_views *ctx, const ob_view *v, VkFormat *out_color,
                              VkFormat *out_depth);
 
+/* Make e's pipeline for v's target formats now, in PreRender, where a
+ * failure can reach the frame: when e is NULL or the pipeline cannot be
+ * made, v's name goes into the frame's errors (ob_renderer_note_error:
+ * OB_ERR_NOT_FOUND for no effect, OB_ERR_VULKAN for the pipeline, whose
+ * cause the effect logs) and false is returned; v's draws are then skipped
+ * while recording. [render thread, PreRender] */
+bool ob_views_prepare_effect(ob_views *ctx, ob_renderer *r, ob_effect *e, ob_view *v);
+
 /* ---- recording ----------------------------------------------------------- */
 
 /* Bind e's pipeline for v's target formats on pm. false (nothing bound) when

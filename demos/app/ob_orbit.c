@@ -31,7 +31,7 @@ bool ob_orbit_frame(ob_orbit *o, const double center[3], double radius, double f
     if (!finite3(center) || !(radius > 0.0) || !isfinite(radius) || !(fovy > 0.0) || !(fovy < PI) ||
         !(aspect > 0.0) || !isfinite(aspect))
         return false;
-    /* The sphere fills the narrower half-angle, as ob_scene_load_frame_sphere frames it. */
+    /* The sphere fills the narrower half-angle, as ob_framing_aim_camera frames it. */
     double half = fmin(fovy * 0.5, atan(tan(fovy * 0.5) * aspect));
     memcpy(o->target, center, sizeof o->target);
     o->distance = radius / sin(half) * 1.08;

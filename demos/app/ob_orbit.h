@@ -60,7 +60,7 @@ bool ob_orbit_zoom(ob_orbit *o, double steps);
 /* Where the eye is, and the camera's up and right axes (unit vectors). */
 void ob_orbit_eye(const ob_orbit *o, double dest[3]);
 void ob_orbit_axes(const ob_orbit *o, double right[3], double up[3]);
-/* A near plane for this distance: 1% of it, as ob_scene_load_frame_sphere
+/* A near plane for this distance: 1% of it, as ob_framing_aim_camera
  * picks, so that zooming keeps depth precision where the target is. */
 double ob_orbit_znear(const ob_orbit *o);
 

@@ -528,7 +528,7 @@ static double teardown_once(uint32_t count, bool batch)
         uint64_t t0 = ob_time_ns();
         if (batch) ob_nodes_destroy(s, nodes, count);
         else
-            for (uint32_t i = count; i-- > 0;) ob_node_destroy(s, nodes[i]);
+            for (uint32_t i = count; i-- > 0;) ob_node_destroy(nodes[i]);
         ns = (double)(ob_time_ns() - t0) / count;
     }
     ob_free(nodes);

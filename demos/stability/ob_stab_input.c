@@ -269,7 +269,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     const ob_frame_stats *st;
     uint8_t *off = ob_stab_render(&w, &st);
     bool absent = !ob_world_view_stats(st, "shadow:sun");
-    if (lamp) ob_node_destroy(w.world.stack->scene, lamp);
+    if (lamp) ob_node_destroy(lamp);
     ob_stab_hide(b.sun, false);
     ob_result set = OB_OK;
     if (b.sun) {
@@ -280,7 +280,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     uint8_t *zero = ob_stab_render(&w, &st);
     absent &= !ob_world_view_stats(st, "shadow:sun");
     ob_skip_reason skip = ob_world_skip_reason(st, "shadow:sun");
-    if (b.sun) ob_node_destroy(w.world.stack->scene, b.sun);
+    if (b.sun) ob_node_destroy(b.sun);
     uint8_t *none = ob_stab_render(&w, NULL);
     ob_result r = OB_OK;
     if (w.world.err == OB_OK) {
@@ -393,7 +393,7 @@ ob_result ob_stab_non_finite_light_camera(ob_stab_ctx *c)
     uint8_t *no_sun = ob_stab_render(&w, NULL);
     ob_stab_hide(b.sun, false);
     ob_stab_position(b.sun, 3, 8, 4);
-    if (lamp) ob_node_destroy(w.world.stack->scene, lamp);
+    if (lamp) ob_node_destroy(lamp);
     double light_ms = ob_stab_take_ms(c);
 
     ob_stab_expect(c, expect);

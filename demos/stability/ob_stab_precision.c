@@ -587,7 +587,7 @@ ob_result ob_stab_deep_hierarchy(ob_stab_ctx *c, uint32_t levels)
     ob_result cycle = ob_node_set_parent(s, chain[0], chain[levels - 1]);
     bool named = ob_stab_log_has(c, "'link'", "would make a cycle", NULL);
     ob_stab_expect(c, NULL);
-    ob_node_destroy(s, chain[0]);
+    ob_node_destroy(chain[0]);
     ob_scene_renderables(s, &after);
     bool edits = before == 1 && cycle == OB_ERR_INVALID_ARGUMENT && named &&
                  ob_scene_node_count(s) == 1 && after == 0 && ob_scene_update(s, 0.0) == OB_OK;

@@ -328,7 +328,7 @@ static void set_cache_holds_its_bound_across_changing_scenes(void **state)
         }
         assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
         for (uint32_t i = 0; i < N; i++) {
-            ob_node_destroy(w.scene, nodes[i]);
+            ob_node_destroy(nodes[i]);
             ob_material_destroy(materials[i]);
             ob_effect_destroy(effects[i]);
         }

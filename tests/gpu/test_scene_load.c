@@ -471,6 +471,9 @@ static void test_load_vk_faults(void **state)
 int main(void)
 {
     ob_test_setup_log();
+    /* The fault walks reach cJSON's allocations too (the program's choice:
+     * cJSON's hooks are process-wide). */
+    ob_scene_file_hook_cjson();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_load_small_scene),
         cmocka_unit_test(test_load_missing_model),

@@ -7,14 +7,12 @@
 #define _GNU_SOURCE
 #include "ob_test.h"
 
-#include <dirent.h>
 #include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "ob_shader_source.h"   /* ob_shader_dir_default: where the copy comes from */
 #include "ob_stack.h"
 
 #define W 64u
@@ -27,39 +25,6 @@ static void make_dir(char *out, size_t size, const char *name)
 {
     snprintf(out, size, "%s/%s", tmp_root, name);
     assert_int_equal(mkdir(out, 0755), 0);
-}
-
-static void copy_file(const char *from, const char *to)
-{
-    FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
-    assert_non_null(in);
-    assert_non_null(out);
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, in)) > 0) assert_int_equal(fwrite(buf, 1, n, out), n);
-    fclose(in);
-    assert_int_equal(fclose(out), 0);
-}
-
-/* Every file of the library's default shader folder into `to`. */
-static uint32_t copy_shaders(const char *to)
-{
-    char *from = ob_shader_dir_default();
-    assert_non_null(from);
-    DIR *d = opendir(from);
-    assert_non_null(d);
-    uint32_t count = 0;
-    for (struct dirent *e; (e = readdir(d));) {
-        if (e->d_name[0] == '.') continue;
-        char a[1024], b[1024];
-        snprintf(a, sizeof a, "%s/%s", from, e->d_name);
-        snprintf(b, sizeof b, "%s/%s", to, e->d_name);
-        copy_file(a, b);
-        count++;
-    }
-    closedir(d);
-    ob_free(from);
-    return count;
 }
 
 /* A red box lit by a shadow-casting light, two frames: the image and the
@@ -109,7 +74,7 @@ static void test_desc_folder_reaches_every_effect(void **state)
     char copy[300], empty[300];
     make_dir(copy, sizeof copy, "copy");
     make_dir(empty, sizeof empty, "empty");
-    assert_true(copy_shaders(copy) >= 10);
+    assert_true(ob_test_copy_shader_folder(copy) >= 10);
 
     uint8_t *a = malloc((size_t)W * H * 4), *b = malloc((size_t)W * H * 4);
     assert_non_null(a);

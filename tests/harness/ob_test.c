@@ -57,22 +57,64 @@ void ob_test_log_clear(void) { free_captured(); }
 
 void ob_test_log_set_echo(bool on) { atomic_store(&echo_off, !on); }
 
-bool ob_test_log_has(const char *needle, ...)
+/* Whether one captured line contains needle and every string of ap. */
+static bool log_has_v(const char *needle, va_list ap)
 {
     bool found = false;
     pthread_mutex_lock(&capture_lock);
     for (uint32_t i = 0; i < captured_count && !found; i++) {
-        va_list ap;
-        va_start(ap, needle);
+        va_list each;
+        va_copy(each, ap);
         bool all = true;
-        for (const char *n = needle; n; n = va_arg(ap, const char *)) {
+        for (const char *n = needle; n; n = va_arg(each, const char *)) {
             if (!strstr(captured[i], n)) { all = false; break; }
         }
-        va_end(ap);
+        va_end(each);
         found = all;
     }
     pthread_mutex_unlock(&capture_lock);
     return found;
+}
+
+bool ob_test_log_has(const char *needle, ...)
+{
+    va_list ap;
+    va_start(ap, needle);
+    bool found = log_has_v(needle, ap);
+    va_end(ap);
+    return found;
+}
+
+void ob_test_assert_logged(const char *file, int line, const char *needle, ...)
+{
+    va_list ap;
+    va_start(ap, needle);
+    bool found = log_has_v(needle, ap);
+    va_end(ap);
+    if (found) return;
+    print_error("no captured log line contains all of:");
+    va_start(ap, needle);
+    for (const char *n = needle; n; n = va_arg(ap, const char *)) print_error(" \"%s\"", n);
+    va_end(ap);
+    print_error("\n");
+    ob_test_log_dump(OB_LOG_DEBUG, 30);
+    _fail(file, line);
+}
+
+int ob_test_errors_setup(void **state)
+{
+    (void)state;
+    ob_test_log_set_echo(false);
+    ob_test_log_clear();
+    return 0;
+}
+
+int ob_test_errors_teardown(void **state)
+{
+    (void)state;
+    for (int k = 0; k < OB_FAULT_KIND_COUNT; k++) ob_fault_arm((ob_fault_kind)k, 0);
+    ob_test_log_set_echo(true);
+    return 0;
 }
 
 uint32_t ob_test_log_count(ob_log_level min_level)

@@ -31,6 +31,24 @@ uint32_t ob_test_log_count(ob_log_level min_level);
 /* Print up to max captured lines at or above level (since the last clear)
  * to stderr, to show what led to a failed assertion. */
 void ob_test_log_dump(ob_log_level min_level, uint32_t max);
+/* Fails the test, showing what was captured, unless one captured line
+ * (since the last clear) contains every given substring:
+ * assert_logged("'box'", "lit.frag"). */
+#define assert_logged(...) ob_test_assert_logged(__FILE__, __LINE__, __VA_ARGS__, (const char *)NULL)
+void ob_test_assert_logged(const char *file, int line, const char *needle, ...);
+/* cmocka setup and teardown for a test that provokes errors on purpose:
+ * before, echo off and the captured lines forgotten; after, echo on and
+ * every fault kind disarmed. */
+int ob_test_errors_setup(void **state);
+int ob_test_errors_teardown(void **state);
+/* A cmocka test entry with those two around it. */
+#define ob_test_expecting_errors(f) cmocka_unit_test_setup_teardown(f, ob_test_errors_setup, ob_test_errors_teardown)
+
+/* Copies every file of the library's default shader folder into the
+ * existing folder `to` (for tests that point a device at a folder of their
+ * own, or break one shader in a copy); returns the number copied. Fails
+ * the test on any error. */
+uint32_t ob_test_copy_shader_folder(const char *to);
 
 /* A device with validation (and synchronization validation) forced on.
  * Fails the test if no device exists. */

@@ -121,7 +121,7 @@ static void zoom_scales_the_distance_within_bounds(void **state)
 }
 
 /* Framing keeps the direction and puts the sphere in the narrower field of
- * view the way ob_scene_load_frame_sphere does (radius / sin(half) * 1.08). */
+ * view the way ob_framing_aim_camera does (radius / sin(half) * 1.08). */
 static void frame_fits_the_sphere(void **state)
 {
     (void)state;

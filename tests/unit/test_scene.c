@@ -165,7 +165,7 @@ static void cycles_and_foreign_nodes_refused(void **state)
     ob_result r = OB_OK;
     assert_null(ob_node_create(s, x, "bad", &r));
     assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
-    ob_node_destroy(s, ob_scene_root(s)); /* refused, logged */
+    assert_int_equal(ob_node_destroy(ob_scene_root(s)), OB_ERR_INVALID_ARGUMENT); /* logged */
     assert_true(ob_test_log_has("root", "cannot be destroyed", NULL));
     /* Structure unchanged. */
     assert_ptr_equal(ob_node_get_parent(c), b);
@@ -346,7 +346,7 @@ static void script_controllers_run_in_order_before_world(void **state)
 typedef struct meddler {
     ob_scene *scene;
     ob_node *victim;
-    ob_result create_r, parent_r, update_r;
+    ob_result create_r, parent_r, destroy_r, update_r;
     bool created;
 } meddler;
 
@@ -358,7 +358,7 @@ static void script_meddles(ob_node *n, double dt, void *user)
     m->create_r = OB_OK;
     m->created = ob_node_create(m->scene, NULL, "late", &m->create_r) != NULL;
     m->parent_r = ob_node_set_parent(m->scene, m->victim, NULL);
-    ob_node_destroy(m->scene, m->victim);
+    m->destroy_r = ob_node_destroy(m->victim);
     m->update_r = ob_scene_update(m->scene, 0.0);
 }
 
@@ -373,6 +373,7 @@ static void structure_changes_refused_inside_controllers(void **state)
     assert_false(m.created);
     assert_int_equal(m.create_r, OB_ERR_WRONG_STATE);
     assert_int_equal(m.parent_r, OB_ERR_WRONG_STATE);
+    assert_int_equal(m.destroy_r, OB_ERR_WRONG_STATE);
     assert_int_equal(m.update_r, OB_ERR_WRONG_STATE);
     assert_int_equal(ob_scene_node_count(s), 4);
     assert_ptr_equal(ob_node_get_parent(m.victim), g);
@@ -411,7 +412,7 @@ static void destroy_subtree_frees_everything(void **state)
     ob_scene_renderables(s, &count);
     assert_int_equal(count, 51);
     uint32_t keep_id = ob_node_id(keep);
-    ob_node_destroy(s, doomed);
+    ob_node_destroy(doomed);
     /* Gone from the snapshot at once, before the next update. */
     ob_node *const *items = ob_scene_renderables(s, &count);
     assert_int_equal(count, 1);
@@ -426,7 +427,7 @@ static void destroy_subtree_frees_everything(void **state)
     /* Ids are never reused. */
     ob_node *fresh = new_node(s, NULL, "fresh");
     assert_true(ob_node_id(fresh) > keep_id + 51);
-    ob_node_destroy(s, NULL);
+    ob_node_destroy(NULL);
     ob_scene_destroy(s); /* ASan: no leak of nodes, names or controller state */
 }
 
@@ -455,7 +456,7 @@ static void destroy_many_matches_one_at_a_time(void **state)
                        nodes[0][0]};
     ob_nodes_destroy(batch, list, OB_ARRAY_COUNT(list));
     int order[] = {34, 20, 6, 0};
-    for (size_t i = 0; i < OB_ARRAY_COUNT(order); i++) ob_node_destroy(single, nodes[1][order[i]]);
+    for (size_t i = 0; i < OB_ARRAY_COUNT(order); i++) ob_node_destroy(nodes[1][order[i]]);
     for (int pass = 0; pass < 2; pass++) {
         uint32_t nb, ns, lb, ls;
         ob_node *const *rb = ob_scene_renderables(batch, &nb);
@@ -556,7 +557,7 @@ static void controller_state_kept_by_the_node(void **state)
     assert_int_equal(ob_node_add_controller_state(a, &(ob_controller_desc){.fn = counter_step},
                                                   big, sizeof big), OB_ERR_INVALID_ARGUMENT);
     assert_true(ob_test_log_has("'a'", "state", NULL));
-    ob_node_destroy(s, b);
+    ob_node_destroy(b);
     /* b's counter was added by a's script in the first update and ran in the
      * two after it (parallel ones run before serial ones); each of the 200
      * children's ran three times. */
@@ -861,7 +862,7 @@ static ob_result fault_scenario(void)
     }
     if (r == OB_OK) r = ob_scene_update(s, 0.1);
     if (r == OB_OK) {
-        ob_node_destroy(s, mid);
+        ob_node_destroy(mid);
         r = ob_scene_update(s, 0.1);
     }
     if (r == OB_OK) {

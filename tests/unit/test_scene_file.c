@@ -667,6 +667,9 @@ static void every_allocation_failure_is_clean(void **state)
 int main(void)
 {
     ob_test_setup_log();
+    /* The fault walks reach cJSON's allocations too (the program's choice:
+     * cJSON's hooks are process-wide). */
+    ob_scene_file_hook_cjson();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(full_file_parses_to_its_description),
         cmocka_unit_test(minimal_file_gets_documented_defaults),

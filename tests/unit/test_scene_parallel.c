@@ -224,7 +224,7 @@ static void destroy_subtree(world *w, uint32_t top)
         }
     }
     w->nodes[top] = NULL;
-    ob_node_destroy(w->s, t);
+    ob_node_destroy(t);
 }
 
 /* The same edits on both worlds between frames. */

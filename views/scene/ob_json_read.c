@@ -4,7 +4,6 @@
 #include <ctype.h>
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -98,17 +97,20 @@ const char *ob_json_type_name(const cJSON *j)
 
 /* ------------------------------------------------------------ parsing */
 
-static pthread_once_t hooks_once = PTHREAD_ONCE_INIT;
-
 static void *hook_malloc(size_t size) { return ob_malloc(size); }
 static void hook_free(void *p) { ob_free(p); }
 
-/* cJSON's allocations go through ob_malloc too, so fault injection reaches them. */
-static void install_hooks(void)
+/* Process-wide (cJSON keeps one set of hooks), so only on the program's
+ * request: see ob_scene_file_hook_cjson. */
+static ob_result install_hooks(void)
 {
     cJSON_Hooks hooks = {.malloc_fn = hook_malloc, .free_fn = hook_free};
     cJSON_InitHooks(&hooks);
+    return OB_OK;
 }
+static ob_once hooks_once = OB_ONCE_INIT("cJSON hooks", install_hooks);
+
+void ob_json_hook_allocations(void) { ob_once_run(&hooks_once); }
 
 static bool syntax_error(ob_json_reader *rd, const char *text, size_t size, size_t pos, const char *what)
 {
@@ -213,7 +215,6 @@ cJSON *ob_json_parse(ob_json_reader *rd, const char *text, size_t size)
         ob_json_fail(rd, "no text to parse");
         return NULL;
     }
-    pthread_once(&hooks_once, install_hooks);
     const char *nul = memchr(text, '\0', size);
     if (nul) {
         syntax_error(rd, text, size, (size_t)(nul - text), "a NUL byte in the text");

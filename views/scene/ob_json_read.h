@@ -14,9 +14,9 @@
  * Lifecycle: ob_json_reader_init → ob_json_parse → check and read →
  * cJSON_Delete(root). Internal to the views layer (the scene-file parser
  * uses it); not installed, so cJSON never reaches a program's include path.
- * Thread rule: [any thread], one reader per thread;
- * cJSON's allocation hooks are set once (to ob_malloc) on first parse, and
- * cJSON's global error pointer is never used.
+ * Thread rule: [any thread], one reader per thread; cJSON's global error
+ * pointer is never used, and its allocation hooks are changed only through
+ * ob_json_hook_allocations (the program's choice: ob_scene_file_hook_cjson).
  */
 #ifndef OB_JSON_READ_H
 #define OB_JSON_READ_H
@@ -74,6 +74,10 @@ void ob_json_reader_init(ob_json_reader *rd, const char *file, ob_json_error *er
  * fail with the line and column. Returns the root (cJSON_Delete it) or NULL
  * with the error set (OB_ERR_PARSE, or OB_ERR_OUT_OF_HOST_MEMORY). */
 cJSON *ob_json_parse(ob_json_reader *rd, const char *text, size_t size);
+
+/* cJSON_InitHooks with ob_malloc/ob_free, once per process (the ob_once
+ * "cJSON hooks" listed in ob_core.h). [any thread] */
+void ob_json_hook_allocations(void);
 
 /* Records an error at the current path (the first one only); returns false. */
 bool ob_json_fail(ob_json_reader *rd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -352,7 +352,7 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
                  ob_node_name(root), made, ob_result_name(r));
         /* Roots of the model's subtrees: destroying them takes the rest. */
         for (uint32_t i = model->node_count; i-- > 0;)
-            if (nodes[i] && model->nodes[i].parent < 0) ob_node_destroy(scene, nodes[i]);
+            if (nodes[i] && model->nodes[i].parent < 0) ob_node_destroy(nodes[i]);
         made = 0;
     }
 done:

@@ -829,3 +829,5 @@ const char *ob_scene_file_geometry_kind_name(ob_scene_file_geometry_kind kind)
     static const char *const names[] = {"none", "box", "sphere", "plane", "cone", "torus", "model"};
     return (unsigned)kind < OB_ARRAY_COUNT(names) ? names[kind] : "unknown";
 }
+
+void ob_scene_file_hook_cjson(void) { ob_json_hook_allocations(); }

@@ -19,7 +19,8 @@
  * empty and may be released.
  * Thread rule: [any thread]; a description is plain data, written by one
  * thread at a time. Parses may run concurrently (cJSON's global error pointer
- * is never used; its allocation hooks are installed once, to ob_malloc).
+ * is never used). cJSON's allocation hooks are left as the program has them
+ * unless it calls ob_scene_file_hook_cjson.
  */
 #ifndef OB_SCENE_FILE_H
 #define OB_SCENE_FILE_H
@@ -214,6 +215,16 @@ ob_result ob_scene_file_load(const char *path, ob_scene_file *out, ob_scene_file
 
 /* Frees everything the description owns and zeroes it. NULL is a no-op. */
 void ob_scene_file_release(ob_scene_file *sf);
+
+/* Routes cJSON's allocations through ob_malloc/ob_free, so that
+ * fault injection (ob_fault_*) reaches the parser's and ob_heap_stats_now
+ * counts them. cJSON's hooks are process-wide: this changes cJSON for
+ * every user of it in the process, which is why the library never does it
+ * by itself (a program with its own cJSON hooks keeps them). Call it once,
+ * before anything in the process uses cJSON (blocks cJSON allocated before
+ * would be freed through ob_free); later calls do nothing. Obelisk's tests
+ * and demos call it. Cannot fail. [any thread] */
+void ob_scene_file_hook_cjson(void);
 
 /* Same generator and parameters, or the same model path. */
 bool ob_scene_file_geometry_equal(const ob_scene_file_geometry *a, const ob_scene_file_geometry *b);

@@ -517,7 +517,14 @@ ob_result ob_scene_load_stack(ob_stack *s, const ob_scene_load_desc *desc, ob_sc
     ob_scene_load_target t = {.renderer = s->renderer, .materials = s->materials,
                               .views = s->views, .scene = s->scene};
     r = ob_scene_load(&t, &d, out, out_error);
-    if (r == OB_OK) ob_scene_load_apply_settings(s->renderer, s->views, &d.file->settings);
+    /* A setting the device cannot take fails the load like any other part
+     * of the file: what the load made is taken back. */
+    if (r == OB_OK && (r = ob_scene_load_apply_settings(s->renderer, s->views,
+                                                        &d.file->settings)) != OB_OK) {
+        OB_LOG_E("scene", "%s: settings not applied (%s); the scene is unloaded",
+                 d.path ? d.path : "scene", ob_result_name(r));
+        ob_scene_unload(out);
+    }
     ob_scene_file_release(&parsed);
     return r;
 }
@@ -528,9 +535,9 @@ void ob_scene_unload(ob_scene_loaded *l)
     /* Children before parents: a particle system's emitter may hang under an
      * entity, and a later entity under an earlier one (the file's rule). */
     for (uint32_t i = l->particle_count; i-- > 0;) ob_particle_system_destroy(l->views, l->particles[i]);
-    if (l->camera_created) ob_node_destroy(l->scene, l->camera);
-    for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->scene, l->lights[i]);
-    for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->scene, l->entities[i]);
+    if (l->camera_created) ob_node_destroy(l->camera);
+    for (uint32_t i = l->light_count; i-- > 0;) ob_node_destroy(l->lights[i]);
+    for (uint32_t i = l->entity_count; i-- > 0;) ob_node_destroy(l->entities[i]);
     for (uint32_t i = l->model_count; i-- > 0;) ob_model_assets_destroy(l->models[i]);
     ob_texture_cache_destroy(l->textures);   /* after the materials sampling its textures */
     for (uint32_t i = l->material_count; i-- > 0;) ob_material_destroy(l->materials[i]);
@@ -563,16 +570,23 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *s, ob_stack_desc *de
     if (s->exposure > 0.0f) desc->exposure = s->exposure;
 }
 
-void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views, const ob_scene_file_settings *s)
+ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
+                                       const ob_scene_file_settings *s)
 {
-    if (!s) return;
+    if (!s) return OB_OK;
+    ob_result first = OB_OK, res;
     if (r && s->has_threads) {
         ob_threading mode = s->threads == 0 ? OB_THREADING_SINGLE
                             : s->threads < 0 ? OB_THREADING_AUTO : OB_THREADING_MULTI;
         uint32_t active = s->threads > 0 ? (uint32_t)s->threads : 0;
         if (active > ob_renderer_worker_count(r)) active = 0;   /* all the renderer has */
-        ob_renderer_set_threading(r, mode, active);
+        if ((res = ob_renderer_set_threading(r, mode, active)) != OB_OK && first == OB_OK) first = res;
     }
-    if (views && s->env_map_size) ob_views_set_env_map_size(views, s->env_map_size);
-    if (views && s->shadow_map_size) ob_views_set_shadow_map_size(views, s->shadow_map_size);
+    if (views && s->env_map_size && (res = ob_views_set_env_map_size(views, s->env_map_size)) != OB_OK &&
+        first == OB_OK)
+        first = res;
+    if (views && s->shadow_map_size &&
+        (res = ob_views_set_shadow_map_size(views, s->shadow_map_size)) != OB_OK && first == OB_OK)
+        first = res;
+    return first;
 }

@@ -174,9 +174,11 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_d
 
 /* The file's settings a live set-up can take: threading (from the next
  * frame) and env-map and shadow-map sizes (for views made afterwards, as
- * entities' maps are, on first need). [render thread, between frames] */
-void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
-                                  const ob_scene_file_settings *settings);
+ * entities' maps are, on first need). Failure: the first setting refused
+ * (OB_ERR_OUT_OF_RANGE for a map size the device cannot make, logged); the
+ * others are still applied. [render thread, between frames] */
+ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
+                                       const ob_scene_file_settings *settings);
 
 #ifdef __cplusplus
 }

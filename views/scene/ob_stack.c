@@ -111,7 +111,7 @@ ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_
     ob_renderable rd = {.material = material, .geometry = geometry, .local_radius = b->radius};
     memcpy(rd.local_center, b->center, sizeof rd.local_center);
     if ((r = ob_node_set_renderable(n, &rd)) != OB_OK) {
-        ob_node_destroy(s->scene, n);
+        ob_node_destroy(n);
         n = NULL;
     }
 done:
@@ -136,8 +136,9 @@ ob_result ob_stack_frame(ob_stack *s, double dt)
 {
     ob_result r = ob_stack_frame_begin(s, dt);
     if (r != OB_OK) return r;
-    ob_views_render(s->views, s->final_view);
-    return ob_renderer_end_frame(s->renderer);
+    ob_result degraded = ob_views_render(s->views, s->final_view);
+    r = ob_renderer_end_frame(s->renderer);
+    return r != OB_OK ? r : degraded;
 }
 
 ob_image ob_stack_final_image(const ob_stack *s)

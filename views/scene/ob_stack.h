@@ -95,7 +95,11 @@ ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_
  * views' time, begins the frame, runs the PreRender from s->final_view and
  * ends the frame (records and submits; it does not wait: ob_renderer_wait_idle
  * or a read-back such as ob_image_write_png does). s->time advances by dt
- * even when a step fails. Returns the first failure of those steps. */
+ * even when a step fails. Returns the first failure of those steps; when
+ * they all succeed but the PreRender went on without something that failed
+ * (a material's effect that does not compile, an env map that could not be
+ * made: ob_frame_stats.errors), the frame is submitted and its first_error
+ * is returned, so a degraded picture never comes with OB_OK. */
 ob_result ob_stack_frame(ob_stack *s, double dt);
 
 /* The first half of ob_stack_frame, for a program that acts between the

@@ -132,7 +132,7 @@ ob_node *ob_stack_add_model(ob_stack *s, const ob_stack_model_desc *desc, ob_res
     goto done;
 
 fail_destroy_root:
-    ob_node_destroy(s->scene, root);
+    ob_node_destroy(root);
     root = NULL;
 fail_log:
     OB_LOG_E(LOG_MODULE, "model '%s' not added (%s: %s); the stack renders without it", path,
@@ -159,7 +159,7 @@ ob_node *ob_stack_add_sun(ob_stack *s, const double direction[3], ob_result *out
     double len = sqrt(len2), unit[3] = {dir[0] / len, dir[1] / len, dir[2] / len};
     if (!(n = ob_node_create(s->scene, NULL, "sun", &r))) goto done;
     if ((r = ob_node_set_light(n, &ob_sun_light)) != OB_OK || (r = ob_light_aim(n, unit)) != OB_OK) {
-        ob_node_destroy(s->scene, n);
+        ob_node_destroy(n);
         n = NULL;
     }
 done:
