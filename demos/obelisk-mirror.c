@@ -19,7 +19,7 @@ static void animate(ob_demo *d, uint32_t frame, double time, void *user)
 {
     (void)frame;
     (void)user;
-    ob_mirror_scene_camera(d->camera, time);
+    ob_mirror_scene_camera(d->world.camera, time);
 }
 
 int main(int argc, char **argv)
@@ -39,8 +39,8 @@ int main(int argc, char **argv)
         return 1;
     }
     printf("obelisk-mirror: %s, %u objects, %ux%u, threading %s (%u workers)\n",
-           ob_device_name(ob_renderer_device(d.r)), opt.objects, opt.width, opt.height,
-           ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.r));
+           ob_device_name(ob_renderer_device(d.world.r)), opt.objects, opt.width, opt.height,
+           ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.world.r));
     code = ob_demo_run(&d, animate, NULL);
     ob_demo_shutdown(&d);
     return code;

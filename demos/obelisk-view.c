@@ -54,13 +54,13 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
 {
     ob_result r = OB_OK;
     const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-    ob_node *root = ob_node_create(d->scene, NULL, base, &r);
+    ob_node *root = ob_node_create(d->world.scene, NULL, base, &r);
     if (!root) return r;
     *out_root = root;
     uint32_t entities = 0;
-    if ((r = ob_model_assets_instantiate(assets, d->scene, root, NULL, &entities)) != OB_OK) return r;
+    if ((r = ob_model_assets_instantiate(assets, d->world.scene, root, NULL, &entities)) != OB_OK) return r;
     double lo[3], hi[3], center[3], radius;
-    if ((r = ob_framing_measure(d->scene, NULL, lo, hi, center, &radius)) != OB_OK) return r;
+    if ((r = ob_framing_measure(d->world.scene, NULL, lo, hi, center, &radius)) != OB_OK) return r;
     /* Bounds that overflowed (node scales of 1e38 nested) or are too large to
      * frame (positions near 3e38) are the model's problem: said so here,
      * before the automatic ground and sun fail on sizes nobody asked for. */
@@ -85,7 +85,7 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     if (!ground) return OB_ERR_OUT_OF_DEVICE_MEMORY;
     ob_material_desc gd = {.name = "ground", .kind = OB_MATERIAL_LIT,
                            .diffuse = {0.45f, 0.47f, 0.5f, 1.0f}, .specular = {0.05f, 0.05f, 0.05f, 8.0f}};
-    ob_material *gm = ob_material_create(d->lib, &gd, &r);
+    ob_material *gm = ob_material_create(d->world.lib, &gd, &r);
     if (!gm) return r;
     ob_node *floor = ob_demo_entity(d, NULL, "ground", ground, gm);
     if (!floor) return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -97,12 +97,12 @@ static ob_result build_model_view(ob_demo *d, ob_model_assets *assets, const cha
     static const ob_light_desc sun_desc = {.type = OB_LIGHT_DIRECTIONAL, .color = {1.0f, 0.97f, 0.92f},
                                            .intensity = 1.0f, .casts_shadows = true};
     static const double sun_direction[3] = {-0.11, -0.77, -0.63}, up[3] = {0, 1, 0};
-    ob_node *sun = ob_node_create(d->scene, NULL, "sun", &r);
+    ob_node *sun = ob_node_create(d->world.scene, NULL, "sun", &r);
     if (!sun) return r;
     if ((r = ob_node_set_light(sun, &sun_desc)) != OB_OK || (r = ob_node_look_at(sun, sun_direction, up)) != OB_OK)
         return r;
     ob_node_set_position(sun, center);
-    return ob_framing_aim_camera(d->camera, center, radius, (double)d->opt.width / d->opt.height);
+    return ob_framing_aim_camera(d->world.camera, center, radius, (double)d->opt.width / d->opt.height);
 }
 
 /* ------------------------------------------------------------ controls */
@@ -137,7 +137,7 @@ typedef struct viewer {
 
 static double camera_fovy(const viewer *v)
 {
-    const ob_camera_desc *c = ob_node_get_camera(v->d->camera);
+    const ob_camera_desc *c = ob_node_get_camera(v->d->world.camera);
     return c && c->fovy > 0.0f ? c->fovy : 1.0;
 }
 
@@ -159,7 +159,7 @@ static double aspect(const viewer *v)
 static bool scene_sphere(viewer *v, double center[3], double *radius)
 {
     double lo[3], hi[3];
-    if (ob_framing_measure(v->d->scene, NULL, lo, hi, center, radius) != OB_OK) return false;
+    if (ob_framing_measure(v->d->world.scene, NULL, lo, hi, center, radius) != OB_OK) return false;
     return hi[0] >= lo[0] && isfinite(*radius) && *radius > 0.0;
 }
 
@@ -171,8 +171,8 @@ static void orbit_from_camera(viewer *v)
     bool bounded = scene_sphere(v, center, &radius);
     double eye[3];
     float right[3], up[3], fwd[3];
-    ob_node_world_position(v->d->camera, eye);
-    ob_node_world_axes(v->d->camera, right, up, fwd);
+    ob_node_world_position(v->d->world.camera, eye);
+    ob_node_world_axes(v->d->world.camera, right, up, fwd);
     double depth = 0.0;
     for (int k = 0; k < 3; k++) depth += (center[k] - eye[k]) * fwd[k];
     if (!(depth > radius * 1e-3)) depth = radius;   /* the scene behind or around the eye */
@@ -202,12 +202,12 @@ static void apply_camera(viewer *v)
     double eye[3];
     static const double up[3] = {0, 1, 0};
     ob_orbit_eye(&v->orbit, eye);
-    ob_node_set_position(v->d->camera, eye);
-    ob_node_look_at(v->d->camera, v->orbit.target, up);
-    const ob_camera_desc *c = ob_node_get_camera(v->d->camera);
+    ob_node_set_position(v->d->world.camera, eye);
+    ob_node_look_at(v->d->world.camera, v->orbit.target, up);
+    const ob_camera_desc *c = ob_node_get_camera(v->d->world.camera);
     ob_camera_desc cam = c ? *c : (ob_camera_desc){.fovy = 1.0f};
     cam.znear = (float)ob_orbit_znear(&v->orbit);
-    ob_node_set_camera(v->d->camera, &cam);
+    ob_node_set_camera(v->d->world.camera, &cam);
     note_camera(v);
 }
 
@@ -284,7 +284,7 @@ static bool file_mtime(const char *path, struct timespec *out)
 static ob_result load_scene(viewer *v, ob_scene_file_error *err)
 {
     ob_demo *d = v->d;
-    ob_scene_load_target t = {.renderer = d->r, .materials = d->lib, .views = d->views, .scene = d->scene};
+    ob_scene_load_target t = {.renderer = d->world.r, .materials = d->world.lib, .views = d->world.views, .scene = d->world.scene};
     v->ld.file = &v->sf;
     return ob_scene_load(&t, &v->ld, &v->loaded, err);
 }
@@ -303,7 +303,7 @@ static void reload_scene(viewer *v)
         ob_scene_file_release(&next);
         return;
     }
-    if ((r = ob_renderer_wait_idle(v->d->r)) != OB_OK) {
+    if ((r = ob_renderer_wait_idle(v->d->world.r)) != OB_OK) {
         ob_scene_file_release(&next);
         return;
     }
@@ -444,15 +444,15 @@ int main(int argc, char **argv)
                 ob_result_text(r));
     } else if (v.is_scene) {
         /* Settings were applied to the options above (the command line wins). */
-        v.ld = (ob_scene_load_desc){.camera = d.camera, .frame_aspect = (double)opt.width / opt.height,
-                                    .seed = opt.seed, .first_geometry_id = d.stack->geometry_count + 1,
+        v.ld = (ob_scene_load_desc){.camera = d.world.camera, .frame_aspect = (double)opt.width / opt.height,
+                                    .seed = opt.seed, .first_geometry_id = d.world.stack->geometry_count + 1,
                                     .allow_any_folder = opt.allow_any_folder};
         ob_scene_file_error err;
         if ((r = load_scene(&v, &err)) != OB_OK) fprintf(stderr, "obelisk-view: %s\n", err.message);
     } else {
         /* Geometry ids derived from the contents: the ground uploaded after
          * takes the stack's next id. */
-        ob_model_assets_desc ad = {.renderer = d.r, .materials = d.lib};
+        ob_model_assets_desc ad = {.renderer = d.world.r, .materials = d.world.lib};
         assets = ob_model_assets_create(&ad, model, &r);   /* takes the model */
         model = NULL;
         if (assets) r = build_model_view(&d, assets, opt.input, &model_root);
@@ -466,8 +466,8 @@ int main(int argc, char **argv)
         code = !v.is_scene && assets && r == OB_ERR_BAD_MODEL ? EXIT_BAD_INPUT : 1;
     } else {
         printf("obelisk-view: %s: %s, %ux%u, threading %s (%u workers)", opt.input,
-               ob_device_name(ob_renderer_device(d.r)), opt.width, opt.height,
-               ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.r));
+               ob_device_name(ob_renderer_device(d.world.r)), opt.width, opt.height,
+               ob_threading_name(ob_demo_options_threading(&opt)), ob_renderer_worker_count(d.world.r));
         if (v.is_scene)
             printf(", %u entities (%u left out), %u lights, %u particle systems%s%s", v.loaded.entity_count,
                    v.loaded.left_out_count, v.loaded.light_count, v.loaded.particle_count,
@@ -483,7 +483,7 @@ int main(int argc, char **argv)
     }
     /* The loaded scene's geometry and particle systems are its own: they go
      * once no frame uses them, before the demo takes the scene and views down. */
-    if (d.r) ob_renderer_wait_idle(d.r);
+    if (d.world.r) ob_renderer_wait_idle(d.world.r);
     ob_scene_unload(&v.loaded);
     /* The model's entities draw with its assets: they go first. */
     if (model_root) ob_node_destroy(model_root);

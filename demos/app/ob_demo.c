@@ -323,7 +323,7 @@ static void on_stats(void *user, const ob_frame_stats *st)
         if (d->history_count == 1)
             printf("(a frame's line comes when the GPU has finished it, at the start of the frame "
                    "%u later; cpu = the engine's work, wait = for the GPU, an image and the "
-                   "present)\n", ob_device_frames_in_flight(ob_renderer_device(d->r)));
+                   "present)\n", ob_device_frames_in_flight(ob_renderer_device(d->world.r)));
         printf("frame %4llu %-3s workers %u  cpu %7.3f ms (update %.3f pre-render %.3f record %.3f "
                "assemble %.3f submit %.3f)  wait %7.3f ms (gpu %.3f image %.3f present %.3f)  "
                "frame %7.3f ms  gpu %7.3f ms  views %u draws %u culled %u  hash %016llx\n",
@@ -446,14 +446,14 @@ static ob_result load_script(ob_demo *d, const char *arg)
 
 static void toggle_wireframe(ob_demo *d)
 {
-    ob_view *main = ob_perspective_view_base(d->main);
-    ob_result r = ob_view_set_wireframe(main, ob_renderer_device(d->r), !d->wireframe);
+    ob_view *main = ob_perspective_view_base(d->world.main);
+    ob_result r = ob_view_set_wireframe(main, ob_renderer_device(d->world.r), !d->wireframe);
     if (r == OB_OK) {
         d->wireframe = !d->wireframe;
         printf("input: W: wireframe %s\n", d->wireframe ? "on" : "off");
     } else {
         printf("input: W: no wireframe on this device (%s: it lacks fillModeNonSolid)\n",
-               ob_device_name(ob_renderer_device(d->r)));
+               ob_device_name(ob_renderer_device(d->world.r)));
     }
 }
 
@@ -469,7 +469,7 @@ static void on_key(void *user, int key, bool shift)
     } else if (key == 'W' && !shift) {
         toggle_wireframe(d);
     } else if (key == 'O' && !shift) {
-        if (!d->overlay) {
+        if (!d->world.overlay) {
             printf("input: O: no overlay in this run (--no-overlay, or headless without --overlay)\n");
         } else {
             d->overlay_detail = (d->overlay_detail + 1) % 2;
@@ -509,13 +509,13 @@ void ob_demo_set_input(ob_demo *d, const ob_input_handler *h)
 static ob_result take_screenshot(ob_demo *d)
 {
     d->screenshot_pending = false;
-    ob_result r = ob_renderer_wait_idle(d->r);
+    ob_result r = ob_renderer_wait_idle(d->world.r);
     if (r != OB_OK) return r;
     char path[1024];
     const char *prefix = d->opt.screenshot_prefix ? d->opt.screenshot_prefix : "obelisk-shot-";
     snprintf(path, sizeof path, "%s%04u.png", prefix, d->screenshots + 1);
-    ob_image target = ob_composite_view_target(d->composite);
-    r = ob_image_write_png(ob_renderer_device(d->r), target, path);
+    ob_image target = ob_composite_view_target(d->world.composite);
+    r = ob_image_write_png(ob_renderer_device(d->world.r), target, path);
     if (r != OB_OK) {
         /* A screenshot that cannot be written is said; the run goes on. */
         printf("input: S: cannot write screenshot '%s': %s\n", path, ob_result_name(r));
@@ -523,7 +523,7 @@ static ob_result take_screenshot(ob_demo *d)
     }
     d->screenshots++;
     ob_image_info info = {0};
-    ob_image_get_info(ob_renderer_device(d->r), target, &info);
+    ob_image_get_info(ob_renderer_device(d->world.r), target, &info);
     printf("screenshot: wrote %s (%ux%u)\n", path, info.width, info.height);
     return OB_OK;
 }
@@ -561,20 +561,12 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     };
     memcpy(sd.clear_color, o->clear_color, sizeof sd.clear_color);
     memcpy(sd.ambient, o->ambient, sizeof sd.ambient);
-    if (!(d->stack = ob_stack_create(&sd, &r))) return r;
-    d->r = d->stack->renderer;
-    d->lib = d->stack->materials;
-    if (o->no_instancing) ob_material_library_set_instancing(d->lib, false);
-    d->views = d->stack->views;
-    d->scene = d->stack->scene;
-    d->camera = d->stack->camera;
-    d->main = d->stack->main;
-    d->composite = d->stack->composite;
-    d->overlay = d->stack->overlay;
-    ob_renderer_set_stats_callback(d->r, on_stats, d);
-    if (d->window && (r = ob_window_attach(d->window, d->r)) != OB_OK) return r;
+    if ((r = ob_world_create(&d->world, &(ob_world_desc){.stack = sd})) != OB_OK) return r;
+    if (o->no_instancing) ob_material_library_set_instancing(d->world.lib, false);
+    ob_renderer_set_stats_callback(d->world.r, on_stats, d);
+    if (d->window && (r = ob_window_attach(d->window, d->world.r)) != OB_OK) return r;
     /* The renderer presents the composite's target; main follows the window's size. */
-    if (d->window) ob_composite_view_set_presenting(d->composite, true);
+    if (d->window) ob_composite_view_set_presenting(d->world.composite, true);
     if (o->stats_json && !(d->json = open_stats_json(o->stats_json))) return OB_ERR_IO;
     if (o->input_script && (r = load_script(d, o->input_script)) != OB_OK) return r;
     if (d->window) ob_window_set_input(d->window, &(ob_input_handler){on_key, on_button, on_cursor, on_scroll, d});
@@ -589,11 +581,11 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
 
 void ob_demo_shutdown(ob_demo *d)
 {
-    if (d->r) ob_renderer_wait_idle(d->r);
-    for (uint32_t i = 0; i < d->system_count; i++) ob_particle_system_destroy(d->views, d->systems[i]);
+    if (d->world.r) ob_renderer_wait_idle(d->world.r);
+    for (uint32_t i = 0; i < d->system_count; i++) ob_particle_system_destroy(d->world.views, d->systems[i]);
     /* The swapchain goes before the device it lives on. */
     ob_window_close(d->window);
-    ob_stack_destroy(d->stack);
+    ob_world_destroy(&d->world);
     if (d->json) {   /* a run that stopped early: close the array, best effort */
         fputs("\n]\n", d->json);
         fclose(d->json);
@@ -606,13 +598,13 @@ void ob_demo_shutdown(ob_demo *d)
 
 ob_geometry *ob_demo_geometry(ob_demo *d, const ob_mesh *mesh, const char *name)
 {
-    return ob_stack_add_geometry(d->stack, mesh, name, NULL);
+    return ob_stack_add_geometry(d->world.stack, mesh, name, NULL);
 }
 
 ob_node *ob_demo_entity(ob_demo *d, ob_node *parent, const char *name, ob_geometry *g,
                         ob_material *m)
 {
-    return ob_stack_add_entity(d->stack, parent, name, g, m, NULL);
+    return ob_stack_add_entity(d->world.stack, parent, name, g, m, NULL);
 }
 
 ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_particle_desc *desc,
@@ -624,7 +616,7 @@ ob_particle_system *ob_demo_particles(ob_demo *d, ob_node *parent, const ob_part
     if (r != OB_OK)
         OB_LOG_E("demo", "particle system '%s': out of memory for the demo's list",
                  desc && desc->name ? desc->name : "(unnamed)");
-    else if ((ps = ob_particle_system_create(d->views, d->scene, parent, desc, &r)))
+    else if ((ps = ob_particle_system_create(d->world.views, d->world.scene, parent, desc, &r)))
         d->systems[d->system_count++] = ps;
     if (out_result) *out_result = ps ? OB_OK : r;
     return ps;
@@ -724,13 +716,13 @@ typedef struct lean_row {
 static uint32_t lean_rows(ob_demo *d, lean_row rows[LEAN_MATERIALS], uint32_t *out_other)
 {
     uint32_t row_count = 0, other_entities = 0, count = 0;
-    const ob_render_proxy *proxies = d->scene ? ob_scene_render_proxies(d->scene, &count) : NULL;
-    ob_view *main = d->main ? ob_perspective_view_base(d->main) : NULL;
+    const ob_render_proxy *proxies = d->world.scene ? ob_scene_render_proxies(d->world.scene, &count) : NULL;
+    ob_view *main = d->world.main ? ob_perspective_view_base(d->world.main) : NULL;
     for (uint32_t i = 0; i < count; i++) {
         ob_material *m = proxies[i].material;
         if (!m) continue;
         ob_result r = OB_OK;
-        const ob_effect *e = main ? ob_material_get_view_effect(m, d->r, proxies[i].node, main,
+        const ob_effect *e = main ? ob_material_get_view_effect(m, d->world.r, proxies[i].node, main,
                                                                 false, &r)
                                   : NULL;
         const char *name = ob_material_name(m), *effect = e ? ob_effect_name(e) : NULL;
@@ -766,7 +758,7 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
     fputs(l->view_count ? "\n" : " none\n", f);
     fprintf(f, "lean: draws: %u entities in %u draw calls (%u as instances, longest run %u; "
                "last frame)\n", l->draws, l->draw_calls, l->instances, l->longest_run);
-    uint32_t samples = d->main ? ob_perspective_view_samples(d->main) : 1;
+    uint32_t samples = d->world.main ? ob_perspective_view_samples(d->world.main) : 1;
     if (samples > 1)
         fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
                    "targets, resolved before the composite\n", samples);
@@ -816,7 +808,7 @@ static void write_lean_json(ob_demo *d, FILE *f)
     }
     fprintf(f, "],\"views_left_out_more\":%u,\"msaa_samples\":%u,\"draws\":%u,"
             "\"draw_calls\":%u,\"instances\":%u,\"longest_run\":%u,\"materials\":[",
-            l->views_more, d->main ? ob_perspective_view_samples(d->main) : 1, l->draws,
+            l->views_more, d->world.main ? ob_perspective_view_samples(d->world.main) : 1, l->draws,
             l->draw_calls, l->instances, l->longest_run);
     lean_row rows[LEAN_MATERIALS];
     uint32_t other_entities;
@@ -916,8 +908,8 @@ static ob_threading frame_mode(const ob_demo_options *o, uint32_t frame, bool fl
  * frames in flight behind), in summary or, after O, in detail. */
 static void overlay_text(ob_demo *d)
 {
-    if (!d->overlay) return;
-    const ob_frame_stats *st = ob_renderer_last_stats(d->r);
+    if (!d->world.overlay) return;
+    const ob_frame_stats *st = ob_renderer_last_stats(d->world.r);
     char text[4096];
     int n = snprintf(text, sizeof text,
                      "OBELISK  %s  workers %u\ncpu %.2f ms  wait %.2f ms  gpu %.2f ms\n"
@@ -942,7 +934,7 @@ static void overlay_text(ob_demo *d)
             n += snprintf(text + n, sizeof text - (size_t)n, "\n  %-20.20s %5u draws %s", st->views[i].name,
                           st->views[i].draws, ob_view_type_name(st->views[i].type));
     }
-    ob_overlay_view_set_text(d->overlay, text);
+    ob_overlay_view_set_text(d->world.overlay, text);
 }
 
 int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
@@ -959,17 +951,17 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
         if (d->stop) break;
         if (d->window && d->opt.resize_width && f == d->opt.resize_frame)
             ob_window_request_size(d->window, d->opt.resize_width, d->opt.resize_height);
-        ob_renderer_set_threading(d->r, frame_mode(&d->opt, f, d->flipped),
+        ob_renderer_set_threading(d->world.r, frame_mode(&d->opt, f, d->flipped),
                                   d->opt.threads > 0 ? (uint32_t)d->opt.threads : 0);
-        if (update) update(d, f, d->stack->time, user);
-        ob_result r = ob_stack_frame_begin(d->stack, dt);
+        if (update) update(d, f, d->world.stack->time, user);
+        ob_result r = ob_stack_frame_begin(d->world.stack, dt);
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: begin_frame failed: %s\n", f, ob_result_name(r));
             return 1;
         }
         overlay_text(d);
-        ob_views_render(d->views, d->stack->final_view);
-        r = ob_renderer_end_frame(d->r);
+        ob_views_render(d->world.views, d->world.stack->final_view);
+        r = ob_renderer_end_frame(d->world.r);
         if (r != OB_OK) {
             fprintf(stderr, "frame %u: %s\n", f, ob_result_name(r));
             return 1;
@@ -979,7 +971,7 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
             return 1;
         }
     }
-    if (ob_renderer_wait_idle(d->r) != OB_OK) return 1;
+    if (ob_renderer_wait_idle(d->world.r) != OB_OK) return 1;
     print_summary(d);
     ob_demo_print_lean_report(d, stdout);
     ob_demo_memory mem = ob_demo_memory_now();
@@ -988,27 +980,27 @@ int ob_demo_run(ob_demo *d, ob_demo_update_fn update, void *user)
                "Obelisk's %.1f MiB\n", mem.rss_kb / 1024.0, mem.peak_rss_kb / 1024.0,
                mem.heap_in_use_kb / 1024.0, mem.obelisk_heap_kb / 1024.0);
     if (d->window) {
-        ob_present_stats ps = ob_renderer_present_stats(d->r);
+        ob_present_stats ps = ob_renderer_present_stats(d->world.r);
         printf("window: %u frames presented, %u skipped (minimised or swapchain out of date), "
                "%u swapchains, last %ux%u\n", ps.presented, ps.skipped, ps.swapchains, ps.width,
                ps.height);
     }
-    ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->r));
-    if (ob_device_validation_enabled(ob_renderer_device(d->r)))
+    ob_validation_counts vc = ob_device_validation_counts(ob_renderer_device(d->world.r));
+    if (ob_device_validation_enabled(ob_renderer_device(d->world.r)))
         printf("validation: %u errors, %u warnings\n", vc.errors, vc.warnings);
     if (d->json && !finish_stats_json(d)) return 1;
     if (d->opt.out) {
-        ob_result r = ob_image_write_png(ob_renderer_device(d->r),
-                                         ob_composite_view_target(d->composite), d->opt.out);
+        ob_result r = ob_image_write_png(ob_renderer_device(d->world.r),
+                                         ob_composite_view_target(d->world.composite), d->opt.out);
         if (r != OB_OK) {
             fprintf(stderr, "cannot write '%s': %s\n", d->opt.out, ob_result_name(r));
             return 1;
         }
         ob_image_info info = {0};
-        ob_image_get_info(ob_renderer_device(d->r), ob_composite_view_target(d->composite), &info);
+        ob_image_get_info(ob_renderer_device(d->world.r), ob_composite_view_target(d->world.composite), &info);
         printf("wrote %s (%ux%u)\n", d->opt.out, info.width, info.height);
     }
-    if (ob_device_validation_enabled(ob_renderer_device(d->r)) && (vc.errors || vc.warnings))
+    if (ob_device_validation_enabled(ob_renderer_device(d->world.r)) && (vc.errors || vc.warnings))
         return 3;
     return 0;
 }

@@ -20,7 +20,7 @@
 #include "ob_geometry.h"
 #include "ob_input.h"
 #include "ob_mesh.h"
-#include "ob_stack.h"
+#include "ob_world.h"
 #include "ob_window.h"
 
 typedef struct ob_demo_options {
@@ -98,16 +98,10 @@ typedef struct ob_demo_lean {
 
 typedef struct ob_demo {
     ob_demo_options opt;
-    ob_stack *stack;          /* owns everything below but the window and the systems */
-    /* The stack's objects under their short names (borrowed, read-only). */
-    ob_renderer *r;
-    ob_material_library *lib;
-    ob_views *views;
-    ob_scene *scene;
-    ob_node *camera;
-    ob_perspective_view *main;
-    ob_composite_view *composite;
-    ob_overlay_view *overlay;        /* NULL unless --overlay (or --window) */
+    /* The stack under its short names (world.r, world.scene, world.camera,
+     * ...; world.overlay is NULL unless --overlay or --window); owns
+     * everything but the window and the systems. */
+    ob_world world;
     ob_particle_system **systems;
     uint32_t system_count, system_cap;
     ob_demo_frame_times *history;  /* completed frames' times, in order */

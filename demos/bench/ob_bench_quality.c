@@ -117,9 +117,9 @@ static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t en
     ob_result r = ob_demo_init(&d, &o);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_MIRROR, .objects = o.objects, .seed = o.seed};
     if (r == OB_OK) {
-        const VkPhysicalDeviceLimits *lim = &ob_device_properties(ob_renderer_device(d.r))->limits;
+        const VkPhysicalDeviceLimits *lim = &ob_device_properties(ob_renderer_device(d.world.r))->limits;
         out->offered = lim->framebufferColorSampleCounts & lim->framebufferDepthSampleCounts;
-        out->samples = ob_perspective_view_samples(d.main);
+        out->samples = ob_perspective_view_samples(d.world.main);
         /* The format's own counts may be fewer than the limits say: the
          * view was made with fewer samples (logged), so there is no row. */
         if (how.exact && out->samples != OB_MAX(how.msaa, 1u)) {
@@ -129,20 +129,20 @@ static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t en
     }
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
     /* Drop the demo's per-frame history: these frames are counted here. */
-    if (r == OB_OK) ob_renderer_set_stats_callback(d.r, NULL, NULL);
+    if (r == OB_OK) ob_renderer_set_stats_callback(d.world.r, NULL, NULL);
     const double dt = 1.0 / 60.0;
     uint32_t frames = OB_MIN(desc->image_frames, (uint32_t)MAX_IMAGE_FRAMES);
     for (uint32_t f = 0; f < frames && r == OB_OK; f++) {
-        ob_bench_set_mode(d.r, mode);
+        ob_bench_set_mode(d.world.r, mode);
         r = ob_bench_scene_frame(&s, true, dt);
-        if (r == OB_OK) out->hashes[f] = ob_renderer_current_stats(d.r)->frame_hash;
+        if (r == OB_OK) out->hashes[f] = ob_renderer_current_stats(d.world.r)->frame_hash;
         if (desc->tick) desc->tick(desc->tick_user);
     }
-    if (r == OB_OK) r = ob_renderer_wait_idle(d.r);
+    if (r == OB_OK) r = ob_renderer_wait_idle(d.world.r);
     if (r == OB_OK) {
         out->pixels = ob_malloc((size_t)o.width * o.height * 4);
-        r = out->pixels ? ob_image_read_rgba8(ob_renderer_device(d.r),
-                                              ob_composite_view_target(d.composite), out->pixels)
+        r = out->pixels ? ob_image_read_rgba8(ob_renderer_device(d.world.r),
+                                              ob_composite_view_target(d.world.composite), out->pixels)
                         : OB_ERR_OUT_OF_HOST_MEMORY;
     }
     if (r == OB_OK && how.timed && (desc->rounds || desc->flight)) {
@@ -155,7 +155,7 @@ static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t en
         OB_LOG_E("bench", "mirror scene %ux%u with env map %u, shadow map %u, MSAA %ux, mode %s "
                  "failed: %s", o.width, o.height, env, shadow, OB_MAX(how.msaa, 1u), mode->name,
                  ob_result_name(r));
-    if (d.r) ob_renderer_wait_idle(d.r);
+    if (d.world.r) ob_renderer_wait_idle(d.world.r);
     ob_bench_scene_release(&s);
     ob_demo_shutdown(&d);
     return r;

@@ -74,11 +74,11 @@ static ob_result make_module(ob_demo *d, const char *name, const char *source, o
 {
     ob_result r;
     ob_shader_desc sd = {.path = name, .source = source, .stage = stage};
-    const ob_shader *sh = ob_shader_get(ob_effect_context_compiler(d->stack->effects), &sd, &r);
+    const ob_shader *sh = ob_shader_get(ob_effect_context_compiler(d->world.stack->effects), &sd, &r);
     if (!sh) return r;
     VkShaderModuleCreateInfo ci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
                                    .codeSize = sh->spirv_words * 4, .pCode = sh->spirv};
-    VkResult vr = OB_VK_CHECK(vkCreateShaderModule(ob_device_vk(ob_renderer_device(d->r)), &ci, NULL, out));
+    VkResult vr = OB_VK_CHECK(vkCreateShaderModule(ob_device_vk(ob_renderer_device(d->world.r)), &ci, NULL, out));
     return ob_result_from_vk(vr);
 }
 
@@ -165,7 +165,7 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
 {
     VkCommandPoolCreateInfo pci = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                    .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
-                                   .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->r))};
+                                   .queueFamilyIndex = ob_device_queue_family(ob_renderer_device(d->world.r))};
     ob_arena_allocator_init(&s->pool_alloc);
     VkResult vr = OB_VK_CHECK(vkCreateCommandPool(s->vk, &pci, &s->pool_alloc.callbacks, &s->pool));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
@@ -180,7 +180,7 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
 /* World and normal matrices as the engine computes them for v. */
 static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
 {
-    ob_device *dev = ob_renderer_device(d->r);
+    ob_device *dev = ob_renderer_device(d->world.r);
     s->draws = ob_calloc(v->item_count, sizeof *s->draws);
     s->push = ob_aligned_alloc(32, sizeof(float) * 32 * v->item_count);
     if (!s->draws || !s->push) return OB_ERR_OUT_OF_HOST_MEMORY;
@@ -316,8 +316,8 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
         *out_result = OB_ERR_OUT_OF_HOST_MEMORY;
         return NULL;
     }
-    *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->r)),
-                        .dev = ob_renderer_device(d->r), .width = v->width, .height = v->height};
+    *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->world.r)),
+                        .dev = ob_renderer_device(d->world.r), .width = v->width, .height = v->height};
     ob_result r = gather(d, v, s);
     if (r == OB_OK) r = make_pipeline(d, s, false);
     if (r == OB_OK) r = make_pipeline(d, s, true);

@@ -106,7 +106,7 @@ static double serial_fraction(const ob_frame_stats *st, const ob_update_stats *u
 static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                        uint32_t mode, uint32_t round, uint32_t pass, sample_kind kind, bool advance)
 {
-    ob_renderer *r = s->demo->r;
+    ob_renderer *r = s->demo->world.r;
     ob_bench_set_mode(r, &desc->modes[mode]);
     ob_result res = ob_bench_scene_frame(s, advance, desc->dt);
     if (res == OB_OK && desc->tick) desc->tick(desc->tick_user);
@@ -176,7 +176,7 @@ static void order_of(uint64_t k, uint32_t n, uint32_t *out)
 static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                                uint32_t round, const uint32_t *order)
 {
-    ob_renderer *r = s->demo->r;
+    ob_renderer *r = s->demo->world.r;
     ob_result res = ob_renderer_wait_idle(r);
     for (uint32_t i = 0; i < desc->mode_count && res == OB_OK; i++) {
         uint32_t m = order[i];
@@ -193,7 +193,7 @@ static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc,
 
 static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c)
 {
-    ob_renderer *r = s->demo->r;
+    ob_renderer *r = s->demo->world.r;
     ob_bench_round_sample round_modes[OB_BENCH_MAX_MODES];
     uint32_t passes = OB_MAX(desc->passes, 1u);
     for (uint32_t round = 0; round < desc->warmup + desc->rounds; round++) {
@@ -241,7 +241,7 @@ static ob_result idle_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, col
 
 static ob_result flight_loop(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c)
 {
-    ob_renderer *r = s->demo->r;
+    ob_renderer *r = s->demo->world.r;
     for (uint32_t m = 0; m < desc->mode_count && desc->flight > 0; m++) {
         ob_result res = ob_renderer_wait_idle(r);
         /* One unmeasured frame fills the pipeline and applies the mode. */
@@ -502,7 +502,7 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
 ob_result ob_bench_run_modes(ob_bench_scene *s, const ob_bench_run_desc *desc,
                              ob_bench_result *out)
 {
-    ob_renderer *r = s->demo->r;
+    ob_renderer *r = s->demo->world.r;
     if (desc->mode_count == 0 || desc->mode_count > OB_BENCH_MAX_MODES)
         return OB_ERR_INVALID_ARGUMENT;
     collector c = {0};

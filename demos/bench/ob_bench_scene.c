@@ -36,11 +36,11 @@ static ob_result add_views(ob_bench_scene *s, ob_demo *d)
 {
     ob_result r = OB_OK;
     ob_camera_desc cam = {.fovy = 1.0f, .znear = 0.05f};
-    place_sweep_camera(d->camera, s->ring_radius, 0, s->view_count);
+    place_sweep_camera(d->world.camera, s->ring_radius, 0, s->view_count);
     for (uint32_t k = 1; k < s->view_count; k++) {
         char name[32];
         snprintf(name, sizeof name, "camera%u", k);
-        s->cameras[k] = ob_node_create(d->scene, NULL, name, &r);
+        s->cameras[k] = ob_node_create(d->world.scene, NULL, name, &r);
         if (!s->cameras[k]) return r;
         if ((r = ob_node_set_camera(s->cameras[k], &cam)) != OB_OK) return r;
         place_sweep_camera(s->cameras[k], s->ring_radius, k, s->view_count);
@@ -48,7 +48,7 @@ static ob_result add_views(ob_bench_scene *s, ob_demo *d)
         ob_perspective_desc pd = {.name = name, .camera = s->cameras[k], .width = d->opt.width,
                                   .height = d->opt.height,
                                   .clear_color = {0.08f, 0.09f, 0.12f, 1.0f}};
-        s->extra[k] = ob_perspective_view_create(d->views, &pd, &r);
+        s->extra[k] = ob_perspective_view_create(d->world.views, &pd, &r);
         if (!s->extra[k]) return r;
         s->views[k] = ob_perspective_view_base(s->extra[k]);
     }
@@ -91,8 +91,8 @@ ob_result ob_bench_scene_build(ob_bench_scene *s, ob_demo *d, const ob_bench_sce
         OB_LOG_E("bench", "%u views asked for; at most %u", s->view_count, OB_BENCH_MAX_VIEWS);
         return OB_ERR_LIMIT;
     }
-    s->views[0] = ob_perspective_view_base(d->main);
-    s->cameras[0] = d->camera;
+    s->views[0] = ob_perspective_view_base(d->world.main);
+    s->cameras[0] = d->world.camera;
     ob_result r;
     if (mirror) {
         s->ring_radius = 20.0;
@@ -111,7 +111,7 @@ void ob_bench_scene_release(ob_bench_scene *s)
 {
     if (!s->demo) return;
     for (uint32_t k = 1; k < OB_BENCH_MAX_VIEWS; k++)
-        ob_perspective_view_destroy(s->demo->views, s->extra[k]);
+        ob_perspective_view_destroy(s->demo->world.views, s->extra[k]);
     memset(s, 0, sizeof *s);
 }
 
@@ -119,8 +119,8 @@ ob_result ob_bench_scene_advance(ob_bench_scene *s, double dt)
 {
     ob_demo *d = s->demo;
     s->time += dt;
-    if (s->kind == OB_BENCH_SCENE_MIRROR) ob_mirror_scene_camera(d->camera, s->time);
-    return ob_renderer_update_scene(d->r, d->scene, dt);
+    if (s->kind == OB_BENCH_SCENE_MIRROR) ob_mirror_scene_camera(d->world.camera, s->time);
+    return ob_renderer_update_scene(d->world.r, d->world.scene, dt);
 }
 
 ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt)
@@ -130,15 +130,15 @@ ob_result ob_bench_scene_frame(ob_bench_scene *s, bool advance, double dt)
         ob_result r = ob_bench_scene_advance(s, dt);
         if (r != OB_OK) return r;
     }
-    ob_views_set_time(d->views, s->time, dt);
-    ob_result r = ob_renderer_begin_frame(d->r, d->scene);
+    ob_views_set_time(d->world.views, s->time, dt);
+    ob_result r = ob_renderer_begin_frame(d->world.r, d->world.scene);
     if (r != OB_OK) return r;
     /* Every root of the frame in one PreRender, so that their culling
      * shares the worker pool: the extra cameras, then the final image. */
     ob_view *roots[OB_BENCH_MAX_VIEWS + 1];
     uint32_t n = 0;
     for (uint32_t k = 1; k < s->view_count; k++) roots[n++] = s->views[k];
-    roots[n++] = ob_composite_view_base(d->composite);
-    ob_views_render_many(d->views, roots, n);
-    return ob_renderer_end_frame(d->r);
+    roots[n++] = ob_composite_view_base(d->world.composite);
+    ob_views_render_many(d->world.views, roots, n);
+    return ob_renderer_end_frame(d->world.r);
 }

@@ -396,11 +396,11 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     ob_demo d;
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &dopt);
-    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.stack->materials, false);
+    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.world.stack->materials, false);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_SWEEP, .objects = objects, .views = views,
                               .seed = o->seed};
     if (r == OB_OK && !rep->device_name[0]) {
-        ob_device *dev = ob_renderer_device(d.r);
+        ob_device *dev = ob_renderer_device(d.world.r);
         snprintf(rep->device_name, sizeof rep->device_name, "%s", ob_device_name(dev));
         snprintf(rep->driver_info, sizeof rep->driver_info, "%s", ob_device_driver_info(dev));
         rep->validation = ob_device_validation_enabled(dev);
@@ -440,7 +440,7 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
         const ob_bench_result *st = &out->results[0];
         rep->engine_ns_per_draw = st->record_total_ms * 1e6 / st->draws;
     }
-    if (d.r) ob_renderer_wait_idle(d.r);
+    if (d.world.r) ob_renderer_wait_idle(d.world.r);
     ob_bench_raw_destroy(rr.raw);
     ob_free(rr.raw_ms);
     ob_bench_scene_release(&s);
@@ -454,7 +454,7 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
     ob_demo d;
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &dopt);
-    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.stack->materials, false);
+    if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.world.stack->materials, false);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_MIRROR, .objects = 200, .seed = o->seed};
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
     ob_bench_mode modes[3] = {{"ST", OB_THREADING_SINGLE, 0},
@@ -467,7 +467,7 @@ static ob_result scene200(const bench_options *o, ob_bench_report *rep, ob_bench
                             .tick = ob_bench_progress_tick, .tick_user = prog};
     rep->scene200 = (ob_bench_sweep_entry){.views = 1, .objects = 200, .mode_count = 3};
     if (r == OB_OK) r = ob_bench_run_modes(&s, &rd, rep->scene200.results);
-    if (d.r) ob_renderer_wait_idle(d.r);
+    if (d.world.r) ob_renderer_wait_idle(d.world.r);
     ob_bench_scene_release(&s);
     ob_demo_shutdown(&d);
     return r;
@@ -661,7 +661,7 @@ static ob_result check_effects(const bench_options *o, uint32_t pool)
                 ob_result_text(r), r == OB_ERR_IO ? "; nothing measured. Are the shaders where the library "
                 "looks ($OB_SHADER_DIR, else share/obelisk/shaders beside the library)?" : "");
     for (uint32_t k = 0; r == OB_OK && k < OB_STD_EFFECT_COUNT; k++) {
-        if (ob_material_library_effect(d.lib, (ob_std_effect)k, 0, &r)) continue;
+        if (ob_material_library_effect(d.world.lib, (ob_std_effect)k, 0, &r)) continue;
         fprintf(stderr, "obelisk-bench: the standard effect '%s' does not compile: %s (%s); "
                         "nothing measured. Are the shaders where the library looks "
                         "($OB_SHADER_DIR, else share/obelisk/shaders beside the library)?\n",

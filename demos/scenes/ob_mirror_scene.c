@@ -161,7 +161,7 @@ ob_result ob_mirror_scene_palette(ob_demo *d, bool casts_shadows,
         ob_material_desc md = {.name = "diffuse", .kind = OB_MATERIAL_LIT,
                                .casts_shadows = casts_shadows, .diffuse = {0, 0, 0, 1.0f}};
         linear3(c, md.diffuse);
-        if (!(out[i] = ob_material_create(d->lib, &md, &r))) return r;
+        if (!(out[i] = ob_material_create(d->world.lib, &md, &r))) return r;
     }
     return OB_OK;
 }
@@ -169,7 +169,7 @@ ob_result ob_mirror_scene_palette(ob_demo *d, bool casts_shadows,
 ob_material *ob_mirror_scene_ground_material(ob_demo *d, ob_result *out_result)
 {
     ob_material_desc md = linear_material(&ground_material);
-    return ob_material_create(d->lib, &md, out_result);
+    return ob_material_create(d->world.lib, &md, out_result);
 }
 
 ob_result ob_mirror_scene_objects(ob_demo *d, uint32_t objects, uint32_t seed, double spread_to,
@@ -194,7 +194,7 @@ ob_result ob_mirror_scene_objects(ob_demo *d, uint32_t objects, uint32_t seed, d
 ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows)
 {
     ob_result r;
-    ob_node *sun_node = ob_node_create(d->scene, NULL, sun.name, &r);
+    ob_node *sun_node = ob_node_create(d->world.scene, NULL, sun.name, &r);
     if (!sun_node) return r;
     ob_light_desc ld = sun.desc;
     ld.casts_shadows = sun_shadows;
@@ -205,7 +205,7 @@ ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows)
     if ((r = ob_node_look_at(sun_node, origin, up)) != OB_OK) return r;
 
     for (int i = 0; i < 2; i++) {
-        ob_node *pl = ob_node_create(d->scene, NULL, points[i].name, &r);
+        ob_node *pl = ob_node_create(d->world.scene, NULL, points[i].name, &r);
         if (!pl) return r;
         ob_light_desc pd = points[i].desc;
         linear3(points[i].desc.color, pd.color);
@@ -218,7 +218,7 @@ ob_result ob_mirror_scene_lights(ob_demo *d, bool sun_shadows)
 static ob_result add_fountain(ob_demo *d, uint32_t seed)
 {
     ob_result r;
-    ob_node *fountain = ob_node_create(d->scene, NULL, "fountain", &r);
+    ob_node *fountain = ob_node_create(d->world.scene, NULL, "fountain", &r);
     if (!fountain) return r;
     ob_node_set_position(fountain, fountain_position);
     ob_particle_desc pdesc = fountain_particles(seed);
@@ -245,7 +245,7 @@ ob_result ob_mirror_scene_build(ob_demo *d, const ob_mirror_scene_desc *desc)
     ob_material *ground_mat = ob_mirror_scene_ground_material(d, &r);
     if (!ground_mat) goto done;
     ob_material_desc mirror_desc = linear_material(&mirror_material);
-    ob_material *mirror_mat = ob_material_create(d->lib, &mirror_desc, &r);
+    ob_material *mirror_mat = ob_material_create(d->world.lib, &mirror_desc, &r);
     if (!mirror_mat) goto done;
 
     if (!ob_demo_entity(d, NULL, "ground", ground_geometry, ground_mat)) {

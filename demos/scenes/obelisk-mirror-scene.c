@@ -116,7 +116,7 @@ static int check(const ob_mirror_scene_desc *md, const char *path)
     ob_demo d;
     ob_result r = ob_demo_init(&d, &dopt);
     if (r == OB_OK) r = ob_mirror_scene_build(&d, md);
-    if (r == OB_OK) ob_mirror_scene_camera(d.camera, 0.0);
+    if (r == OB_OK) ob_mirror_scene_camera(d.world.camera, 0.0);
     ob_stack *s = NULL;
     ob_scene_loaded loaded = {0};
     ob_scene_file_error err = {0};
@@ -130,24 +130,24 @@ static int check(const ob_mirror_scene_desc *md, const char *path)
         r = ob_scene_load_stack(s, &(ob_scene_load_desc){.path = path, .seed = md->seed}, &loaded, &err);
         if (r != OB_OK) fprintf(stderr, "obelisk-mirror-scene: %s\n", err.message);
     }
-    checker c = {.built = d.scene, .loaded = s ? s->scene : NULL};
+    checker c = {.built = d.world.scene, .loaded = s ? s->scene : NULL};
     uint8_t *a = NULL, *b = NULL;
     uint32_t image_differing = 0;
     for (uint32_t f = 0; r == OB_OK && f < CHECK_FRAMES && !c.failures; f++) {
-        if ((r = ob_stack_frame(d.stack, 0.25)) != OB_OK || (r = ob_stack_frame(s, 0.25)) != OB_OK) break;
-        if (ob_scene_node_count(d.scene) != ob_scene_node_count(s->scene)) {
+        if ((r = ob_stack_frame(d.world.stack, 0.25)) != OB_OK || (r = ob_stack_frame(s, 0.25)) != OB_OK) break;
+        if (ob_scene_node_count(d.world.scene) != ob_scene_node_count(s->scene)) {
             fprintf(stderr, "obelisk-mirror-scene: %u nodes built, %u loaded\n",
-                    ob_scene_node_count(d.scene), ob_scene_node_count(s->scene));
+                    ob_scene_node_count(d.world.scene), ob_scene_node_count(s->scene));
             c.failures++;
         }
-        for (const ob_node *k = ob_node_first_child(ob_scene_root(d.scene)); k; k = ob_node_next_sibling(k))
+        for (const ob_node *k = ob_node_first_child(ob_scene_root(d.world.scene)); k; k = ob_node_next_sibling(k))
             check_node(&c, k);
     }
     if (r == OB_OK && !c.failures) {
         a = malloc((size_t)CHECK_W * CHECK_H * 4);
         b = malloc((size_t)CHECK_W * CHECK_H * 4);
         r = a && b ? OB_OK : OB_ERR_OUT_OF_HOST_MEMORY;
-        if (r == OB_OK) r = ob_image_read_rgba8(d.stack->device, ob_stack_final_image(d.stack), a);
+        if (r == OB_OK) r = ob_image_read_rgba8(d.world.stack->device, ob_stack_final_image(d.world.stack), a);
         if (r == OB_OK) r = ob_image_read_rgba8(s->device, ob_stack_final_image(s), b);
         uint32_t differing = 0, max = 0;
         for (size_t i = 0; r == OB_OK && i < (size_t)CHECK_W * CHECK_H * 4; i++) {

@@ -25,13 +25,16 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
 
     ob_world_desc wd = {.stack = {
         .renderer = {.device = {.app_name = "obelisk-test-stack", .validation = 1, .adopt = d.adopt},
-                     .worker_count = s->workers},
+                     .worker_count = s->workers, .chunk_draws = d.chunk_draws,
+                     .parallel_grain = d.parallel_grain},
         .cache_dir = s->cache_dir,
         .width = s->width, .height = s->height,
         .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
         .camera = {.fovy = 1.0f, .znear = 0.1f},
         .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size,
+        .msaa = d.msaa,
     }};
+    if (d.clear_color[3] > 0.0f) memcpy(wd.stack.clear_color, d.clear_color, sizeof d.clear_color);
     ob_result r = ob_world_create(&s->world, &wd);
     if (r != OB_OK) ob_test_stack_stop(s);
     return r;

@@ -23,19 +23,13 @@
 #ifndef OB_TEST_STACK_H
 #define OB_TEST_STACK_H
 
-#include "ob_test.h"
-#include "ob_world.h"
+#include "ob_test_world.h"
 
-typedef struct ob_test_stack_desc {
-    uint32_t workers;          /* 0 → 2 */
-    uint32_t width, height;    /* 0 → 48 x 32 */
-    uint32_t env_map_size;     /* 0 → 16 */
-    uint32_t shadow_map_size;  /* 0 → 32 */
-    const char *cache_dir;     /* NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack */
-    /* The application's instance and device (ob_test_adopt.h) for walks
-     * that start many stacks; NULL → the engine's own. */
-    const ob_vulkan_handles *adopt;
-} ob_test_stack_desc;
+/* The test world's settings, with smaller defaults: workers 0 → 2, size
+ * 0 → 48 x 32, env_map_size 0 → 16, shadow_map_size 0 → 32; cache_dir
+ * NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack. clear_color,
+ * chunk_draws, parallel_grain and msaa are the world's defaults. */
+typedef ob_test_world_desc ob_test_stack_desc;
 
 typedef struct ob_test_stack {
     ob_world world;            /* owns everything but the particle system */

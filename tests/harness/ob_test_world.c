@@ -27,6 +27,8 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     if (d.shadow_map_size) sd->shadow_map_size = d.shadow_map_size;
     if (d.clear_color[3] > 0.0f) memcpy(sd->clear_color, d.clear_color, sizeof sd->clear_color);
     sd->msaa = d.msaa;
+    sd->cache_dir = d.cache_dir;
+    sd->renderer.device.adopt = d.adopt;
     ob_world_create(w, &wd);
 }
 

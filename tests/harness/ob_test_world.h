@@ -27,6 +27,10 @@ typedef struct ob_test_world_desc {
     uint32_t chunk_draws;      /* renderer's draws per job; 0 → the renderer's default */
     uint32_t parallel_grain;   /* renderer's entities per parallel-loop index; 0 → default */
     uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
+    const char *cache_dir;     /* pipeline cache folder; NULL → the effect context's default */
+    /* The application's instance and device (ob_test_adopt.h) for walks
+     * that start many stacks; NULL → the engine's own. */
+    const ob_vulkan_handles *adopt;
 } ob_test_world_desc;
 
 /* The world itself: its fields (w.r, w.lib, w.box, w.pixels, ...) are the
