@@ -282,6 +282,11 @@ void ob_renderer_note_skipped(ob_renderer *r, const char *name, ob_skip_reason r
     st->skipped_count++;
 }
 
+void ob_renderer_note_lights_over_limit(ob_renderer *r, uint32_t count)
+{
+    if (count > r->cur.lights_over_limit) r->cur.lights_over_limit = count;
+}
+
 /* ------------------------------------------------------------ frame */
 
 ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
