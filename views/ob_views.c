@@ -472,6 +472,8 @@ void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
     ctx->shadow_map_size = size ? size : 1024;
 }
 
+void ob_views_set_light_tiles(ob_views *ctx, bool on) { ctx->light_tiles_off = !on; }
+
 void ob_views_render(ob_views *ctx, ob_view *final_view)
 {
     ob_views_render_many(ctx, &final_view, 1);

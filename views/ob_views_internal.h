@@ -36,6 +36,7 @@ struct ob_views {
     uint32_t system_count, system_cap;
     uint32_t *over_limit;        /* ids of lights logged as over OB_MAX_LIGHTS, ascending */
     uint32_t over_limit_count, over_limit_cap;
+    bool light_tiles_off;        /* ob_views_set_light_tiles(false): every light in tile 0 */
 
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };

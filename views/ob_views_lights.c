@@ -103,7 +103,8 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
      * keeps another view's lights. */
     light_block b;
     memset(&b, 0, sizeof b);
-    bool tiled = v->type == OB_VIEW_PERSPECTIVE && v->width > 0 && v->height > 0;
+    bool tiled = v->type == OB_VIEW_PERSPECTIVE && v->width > 0 && v->height > 0 &&
+                 !ctx->light_tiles_off;
     if (tiled) {
         b.grid[0] = (float)((v->width + OB_LIGHT_TILES_X - 1) / OB_LIGHT_TILES_X);
         b.grid[1] = (float)((v->height + OB_LIGHT_TILES_Y - 1) / OB_LIGHT_TILES_Y);
