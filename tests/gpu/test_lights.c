@@ -108,6 +108,14 @@ static void add_point_grid(ob_test_world *w, ob_node *out[LIGHTS], float intensi
     }
 }
 
+/* The grey lit wall under the 256 point lights. */
+static void wall_under_point_grid(ob_test_world *w, uint32_t workers, float grey, ob_node *out[LIGHTS])
+{
+    setup(w, workers);
+    wall(w, grey, grey, grey);
+    add_point_grid(w, out, 0.6f);
+}
+
 static void set_intensity(ob_node *n, float intensity)
 {
     ob_light_desc d = *ob_node_get_light(n);
@@ -226,10 +234,8 @@ static void lights_over_the_limit_are_reported_once_by_name(void **state)
 {
     (void)state;
     ob_test_world w;
-    setup(&w, 0);
-    wall(&w, 0.8f, 0.8f, 0.8f);
     ob_node *lights[LIGHTS];
-    add_point_grid(&w, lights, 0.6f);
+    wall_under_point_grid(&w, 0, 0.8f, lights);
     ob_light_desc d = {.type = OB_LIGHT_SPOT, .intensity = 1.0f};
     for (int i = 0; i < 3; i++) {
         char name[32];
@@ -260,10 +266,8 @@ static void many_lights_same_in_every_threading_mode(void **state)
 {
     (void)state;
     ob_test_world w;
-    setup(&w, 4);
-    wall(&w, 0.7f, 0.7f, 0.7f);
     ob_node *lights[LIGHTS];
-    add_point_grid(&w, lights, 0.6f);
+    wall_under_point_grid(&w, 4, 0.7f, lights);
     set_intensity(lights[LIGHTS - 1], 0.0f);   /* room for the spot under the limit */
     ob_light_desc spot = {.type = OB_LIGHT_SPOT, .intensity = 6.0f, .range = 9.0f,
                           .inner_angle = 0.3f, .outer_angle = 0.5f};
