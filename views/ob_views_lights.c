@@ -147,6 +147,7 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
                 for (uint32_t x = r[0]; x <= r[1]; x++) b.tiles[y * OB_LIGHT_TILES_X + x][word] |= bit;
         used++;
     }
+    b.grid[2] = (float)((used + 31) / 32);   /* mask words the shaders walk */
     ob_params_set_vec4(params, grid, b.grid);
     ob_params_set_bytes(params, table, b.table, sizeof b.table);
     ob_params_set_bytes(params, tiles, b.tiles, sizeof b.tiles);

@@ -174,7 +174,7 @@ void main()
     // Point and spot lights of this fragment's tile, in light order
     // (lighting.glsl).
     uint tile = ob_light_tile();
-    for (uint w = 0u; w < uint(OB_MAX_LIGHTS / 32); w++) {
+    for (uint w = 0u; w < uint(LightGrid.z); w++) {
         uint bits = ob_light_word(tile, w);
         while (bits != 0u) {
             uint i = w * 32u + uint(findLSB(bits));
