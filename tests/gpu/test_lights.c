@@ -6,6 +6,8 @@
  *   the ambient term every render adds once).
  * - A spot light lights inside its cone like a point light, nothing outside
  *   it, and something in between on the soft edge.
+ * - glTF KHR_lights_punctual lights of a model, loaded through a scene
+ *   file, are light nodes placed by the model entity's transform.
  * - Lights over OB_MAX_LIGHTS are logged once by name and counted in the
  *   frame stats every frame.
  * - The same many-light scene renders byte-identically single- and
@@ -20,7 +22,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ob_scene_load.h"
 #include "ob_test_world.h"
+
+#define DATA OB_SOURCE_DIR "/tests/data/scenes/"
 
 #define GRID 16                  /* 16 x 16 = 256 point lights */
 #define LIGHTS (GRID * GRID)
@@ -299,6 +304,55 @@ static void many_lights_same_in_every_threading_mode(void **state)
     ob_test_world_destroy(&w);
 }
 
+static ob_node *find_light(ob_scene *scene, const char *name)
+{
+    uint32_t count = 0;
+    ob_node *const *lights = ob_scene_lights(scene, &count);
+    for (uint32_t i = 0; i < count; i++)
+        if (strcmp(ob_node_name(lights[i]), name) == 0) return lights[i];
+    fail_msg("no light node '%s'", name);
+    return NULL;
+}
+
+static void gltf_lights_are_light_nodes_of_the_model(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_scene_loaded l;
+    ob_scene_file_error err;
+    /* "../models/" is outside the scene's folder: trusted test content. */
+    ob_result r = ob_scene_load_stack(w.stack, &(ob_scene_load_desc){.path = DATA "load_lights.json",
+                                                                     .allow_any_folder = true},
+                                      &l, &err);
+    if (r != OB_OK) fail_msg("load failed: %s", err.message);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);   /* updates the snapshot */
+
+    const ob_light_desc *spot = ob_node_get_light(find_light(w.scene, "scene-spot"));
+    assert_int_equal(spot->type, OB_LIGHT_SPOT);
+    assert_float_equal(spot->outer_angle, 20.0 * OB_PI / 180.0, 1e-6);
+
+    /* lights.gltf under the entity at (10, 0, 0): the lamp at (0, 0, 2) of
+     * the model, the torch at (1, 0, 3) aimed down (-Y). */
+    ob_node *lamp = find_light(w.scene, "lamp_node");
+    assert_int_equal(ob_node_get_light(lamp)->type, OB_LIGHT_POINT);
+    assert_float_equal(ob_node_get_light(lamp)->range, 5.0, 1e-6);
+    double p[3];
+    ob_node_world_position(lamp, p);
+    assert_float_equal(p[0], 10.0, 1e-9);
+    assert_float_equal(p[2], 2.0, 1e-9);
+    ob_node *torch = find_light(w.scene, "torch_node");
+    assert_int_equal(ob_node_get_light(torch)->type, OB_LIGHT_SPOT);
+    float right[3], up[3], fwd[3];
+    ob_node_world_axes(torch, right, up, fwd);
+    assert_float_equal(fwd[1], -1.0, 1e-5);
+    ob_node_world_position(torch, p);
+    assert_float_equal(p[0], 11.0, 1e-9);
+    assert_int_equal(ob_node_get_light(find_light(w.scene, "sky_node"))->type, OB_LIGHT_DIRECTIONAL);
+    ob_scene_unload(&l);
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -306,6 +360,7 @@ int main(void)
         cmocka_unit_test(every_point_light_adds_its_contribution),
         cmocka_unit_test(every_point_light_adds_its_contribution_pbr),
         cmocka_unit_test(spot_light_lights_its_cone_with_a_soft_edge),
+        cmocka_unit_test(gltf_lights_are_light_nodes_of_the_model),
         cmocka_unit_test(lights_over_the_limit_are_reported_once_by_name),
         cmocka_unit_test(many_lights_same_in_every_threading_mode),
     };
