@@ -328,6 +328,11 @@ void ob_renderer_note_error(ob_renderer *r, const char *name, ob_result error)
     if (r->cur.first_error == OB_OK) r->cur.first_error = error;
 }
 
+void ob_renderer_note_lights_over_limit(ob_renderer *r, uint32_t count)
+{
+    if (count > r->cur.lights_over_limit) r->cur.lights_over_limit = count;
+}
+
 /* ------------------------------------------------------------ frame */
 
 ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)

@@ -173,6 +173,9 @@ typedef struct ob_frame_stats {
      * ob_renderer_update_scene before this frame's begin_frame). */
     uint64_t update_cpu_render_ns, update_cpu_render_parallel_ns, update_cpu_pool_ns;
     uint32_t pipelines_created, variants_created;
+    /* Point and spot lights that lit nothing this frame because the scene
+     * has more than OB_MAX_LIGHTS (each is also logged once by name). */
+    uint32_t lights_over_limit;
     uint64_t frame_hash;         /* all view hashes in order */
     /* Failures this frame met and went on without (the frame still ran,
      * without what failed): a view not made, resized or culled, a material

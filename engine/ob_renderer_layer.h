@@ -147,6 +147,10 @@ void ob_renderer_note_error(ob_renderer *r, const char *name, ob_result error);
 /* Pipelines and shader variants the higher layers created this frame
  * (added to the frame's stats). [render thread] */
 void ob_renderer_note_created(ob_renderer *r, uint32_t pipelines, uint32_t variants);
+/* Point and spot lights left out this frame for being over OB_MAX_LIGHTS
+ * (ob_frame_stats.lights_over_limit is set to the largest count noted in the
+ * frame, so every camera view may note the same scene). [render thread] */
+void ob_renderer_note_lights_over_limit(ob_renderer *r, uint32_t count);
 
 /* ---- the present image --------------------------------------------------- */
 

@@ -928,7 +928,8 @@ ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d)
         return OB_OK;
     }
     ob_light_desc l = *d;
-    bool ok = (l.type == OB_LIGHT_DIRECTIONAL || l.type == OB_LIGHT_POINT) &&
+    bool ok = (l.type == OB_LIGHT_DIRECTIONAL || l.type == OB_LIGHT_POINT ||
+               l.type == OB_LIGHT_SPOT) &&
               floats_finite(l.color, 3) && isfinite(l.intensity) && isfinite(l.range) &&
               l.color[0] >= 0.0f && l.color[1] >= 0.0f && l.color[2] >= 0.0f &&
               l.intensity >= 0.0f && l.range >= 0.0f;
@@ -936,6 +937,19 @@ ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d)
         OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): light needs a known type and finite, "
                  "non-negative colour, intensity and range; refused", n->name, n->id);
         return OB_ERR_INVALID_ARGUMENT;
+    }
+    if (l.type == OB_LIGHT_SPOT) {
+        if (l.outer_angle == 0.0f) l.outer_angle = (float)(OB_PI / 4.0);
+        /* The comparisons are false for NaN, so non-finite angles fail too. */
+        if (!(l.inner_angle >= 0.0f && l.inner_angle <= l.outer_angle &&
+              l.outer_angle < (float)(OB_PI / 2.0))) {
+            OB_LOG_E(SCENE_LOG, "entity '%s' (id %u): spot light needs finite angles with "
+                     "0 <= inner_angle <= outer_angle < pi/2 (got %g, %g radians); refused",
+                     n->name, n->id, (double)d->inner_angle, (double)d->outer_angle);
+            return OB_ERR_INVALID_ARGUMENT;
+        }
+    } else {
+        l.inner_angle = l.outer_angle = 0.0f;
     }
     if (l.color[0] == 0.0f && l.color[1] == 0.0f && l.color[2] == 0.0f)
         l.color[0] = l.color[1] = l.color[2] = 1.0f;

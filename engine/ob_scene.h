@@ -332,20 +332,35 @@ typedef struct ob_camera_desc {
 ob_result ob_node_set_camera(ob_node *n, const ob_camera_desc *d);
 const ob_camera_desc *ob_node_get_camera(const ob_node *n);   /* NULL if none */
 
-typedef enum ob_light_type { OB_LIGHT_DIRECTIONAL, OB_LIGHT_POINT } ob_light_type;
+typedef enum ob_light_type { OB_LIGHT_DIRECTIONAL, OB_LIGHT_POINT, OB_LIGHT_SPOT } ob_light_type;
 
-/* The direction of a directional light is its node's forward (-Z). */
+/* The direction of a directional or spot light is its node's forward (-Z);
+ * point and spot lights sit at the node's world position. Any number of
+ * point and spot lights may light a scene up to OB_MAX_LIGHTS (docs/
+ * limits.md); only the first directional light (node-id order) is shaded. */
 typedef struct ob_light_desc {
     ob_light_type type;
     float color[3];       /* linear RGB, (0,0,0) → white */
     float intensity;      /* literal: 0 switches the light off (it lights nothing and
                              its shadow view is left out); set 1 for a plain light */
-    float range;          /* point lights; 0 → no cut-off */
-    bool casts_shadows;
+    float range;          /* point and spot lights; 0 → no cut-off */
+    bool casts_shadows;   /* directional lights only; ignored by point and spot */
+    /* Spot lights: half-angles of the cone from its axis, in radians. Full
+     * intensity inside inner_angle, smoothly down to none at outer_angle;
+     * 0 ≤ inner_angle ≤ outer_angle < pi/2. outer_angle 0 → pi/4 (glTF's
+     * default); inner_angle 0 is a cone with no fully lit core. */
+    float inner_angle, outer_angle;
 } ob_light_desc;
 
+/* Most point and spot lights that light one scene: the first OB_MAX_LIGHTS
+ * visible ones of non-zero intensity in node-id order. Each light over the
+ * limit is logged once by name and counted in ob_frame_stats.lights_over_limit
+ * every frame it is left out. */
+#define OB_MAX_LIGHTS 256u
+
 /* Copies d with defaults filled in (NULL removes the light). Refuses unknown
- * types, negative or non-finite values (OB_ERR_INVALID_ARGUMENT). */
+ * types, negative or non-finite values, and spot angles outside
+ * 0 ≤ inner ≤ outer < pi/2 (OB_ERR_INVALID_ARGUMENT, logged naming the node). */
 ob_result ob_node_set_light(ob_node *n, const ob_light_desc *d);
 const ob_light_desc *ob_node_get_light(const ob_node *n);     /* NULL if none */
 

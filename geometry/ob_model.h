@@ -50,6 +50,15 @@
  *   dropped (image -1), so the material keeps its factors. One that
  *   resolves outside the model's folder refuses the model (see
  *   ob_model_desc.allow_any_folder).
+ * - Lights: glTF KHR_lights_punctual lights (assimp's aiLight), each on the
+ *   node that names it: at the node's origin, shining along its -Z. assimp
+ *   folds glTF's intensity into the colour; it is split again as intensity
+ *   = the largest component (so a white light of intensity I comes back as
+ *   colour 1, intensity I). glTF's range (node metadata PBR_LightRange) is
+ *   the range; spot cone angles are glTF's half-angles, outer clamped below
+ *   pi/2 and inner to [0, outer]. A light naming no node, of another type
+ *   (area, ambient) or with non-finite values is warned about and dropped;
+ *   beyond OB_MODEL_MAX_LIGHTS the rest are dropped with one warning.
  * - Hostile input: every file assimp opens is a regular file inside the
  *   model's folder (ob_model_desc.allow_any_folder), opened without
  *   blocking, at most 1 GiB; a glTF file is scanned first (lying .glb
@@ -65,6 +74,7 @@
 #define OB_MODEL_H
 
 #include "ob_mesh.h"
+#include "ob_scene.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -148,6 +158,14 @@ typedef struct ob_model_node {
     uint32_t primitive_count;
 } ob_model_node;
 
+/* Most lights one model keeps (docs/limits.md). */
+#define OB_MODEL_MAX_LIGHTS 1024u
+
+typedef struct ob_model_light {
+    uint32_t node;              /* index into model->nodes: at its origin, shining along its -Z */
+    ob_light_desc desc;         /* directional, point or spot; valid for ob_node_set_light */
+} ob_model_light;
+
 typedef struct ob_model {
     char *path;                 /* as given to ob_model_open */
     ob_model_node *nodes;       /* parents first; node 0 is the root */
@@ -158,6 +176,8 @@ typedef struct ob_model {
     uint32_t material_count;
     ob_model_image *images;
     uint32_t image_count;
+    ob_model_light *lights;     /* in the file's light order */
+    uint32_t light_count;
 } ob_model;
 
 /* Opens a model file (desc->path; desc->flip_uv as in ob_model_load_mesh) and

@@ -28,12 +28,13 @@
 #define GLTF_MAX_NAMES 32u
 #define GLTF_NAME_MAX 96u
 
-/* Extensions the engine honours when a file requires them. None yet: the
- * ones assimp 5.2 reads (texture transform, the KHR_materials_* family,
+/* Extensions the engine honours when a file requires them: lights
+ * (ob_model_open.c reads assimp's aiLight into ob_model_light). The others
+ * assimp 5.2 reads (texture transform, the KHR_materials_* family,
  * specular-glossiness, unlit) are not carried into ob_model_material, and
  * quantized or Draco-compressed geometry is not decoded. Add a name here
  * only together with the code that honours it. */
-static const char *const supported_required[] = {NULL};
+static const char *const supported_required[] = {"KHR_lights_punctual", NULL};
 
 #define GLTF_NONE UINT32_MAX
 
@@ -794,8 +795,8 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
         bool req = false;
         for (uint32_t k = 0; k < required->count && !req; k++)
             req = strcmp(required->names[k], used->names[i]) == 0;
-        optional[i] = !req;
-        optional_count += !req;
+        optional[i] = !req && !is_supported(used->names[i]);
+        optional_count += optional[i];
     }
     if (optional_count || used->dropped) {
         join_names(used, optional, text_names, sizeof text_names);

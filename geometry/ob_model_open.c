@@ -13,12 +13,14 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ob_model.h"
 #include "ob_model_internal.h"
+#include "ob_math.h"
 
 #include <assimp/cimport.h>
 #include <assimp/scene.h>
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct open_ctx {
@@ -28,6 +30,8 @@ typedef struct open_ctx {
     bool flip_uv;
     uint32_t *mesh_primitive;   /* per aiMesh: its primitive, UINT32_MAX when dropped */
     uint32_t dropped_meshes;    /* points / lines only */
+    struct light_name *light_names;   /* the file's lights sorted by name, for the nodes to find */
+    uint32_t light_name_count;
     uint32_t fixed_normals;
 } open_ctx;
 
@@ -252,6 +256,103 @@ static ob_result count_nodes(open_ctx *c, const struct aiNode *n, uint32_t depth
     return OB_OK;
 }
 
+/* ------------------------------------------------------------ lights */
+
+typedef struct light_name {
+    const char *name;
+    uint32_t light;             /* index into scene->mLights */
+    bool placed;
+} light_name;
+
+static int compare_light_names(const void *a, const void *b)
+{
+    const light_name *x = a, *y = b;
+    int c = strcmp(x->name, y->name);
+    return c ? c : (x->light > y->light) - (x->light < y->light);
+}
+
+/* The file's lights by name, so each node finds its own in log time. */
+static ob_result index_lights(open_ctx *c)
+{
+    const struct aiScene *s = c->scene;
+    if (!s->mNumLights || !s->mLights) return OB_OK;
+    uint32_t n = s->mNumLights < OB_MODEL_MAX_LIGHTS ? s->mNumLights : OB_MODEL_MAX_LIGHTS;
+    if (s->mNumLights > n)
+        OB_LOG_W(OB_MODEL_LOG, "%s: %u lights; only the first %u are kept (OB_MODEL_MAX_LIGHTS)",
+                 c->chk.path, s->mNumLights, n);
+    c->light_names = ob_calloc(n, sizeof *c->light_names);
+    c->model->lights = ob_calloc(n, sizeof *c->model->lights);
+    if (!c->light_names || !c->model->lights) return out_of_memory(c, "the lights");
+    for (uint32_t i = 0; i < n; i++) {
+        if (!s->mLights[i]) continue;
+        c->light_names[c->light_name_count++] = (light_name){s->mLights[i]->mName.data, i, false};
+    }
+    qsort(c->light_names, c->light_name_count, sizeof *c->light_names, compare_light_names);
+    return OB_OK;
+}
+
+/* glTF's range, which assimp keeps in the node's metadata; 0 (none) when absent. */
+static float light_range(const struct aiNode *n)
+{
+    const struct aiMetadata *m = n->mMetaData;
+    for (uint32_t i = 0; m && m->mKeys && m->mValues && i < m->mNumProperties; i++) {
+        if (strcmp(m->mKeys[i].data, "PBR_LightRange") != 0 || !m->mValues[i].mData) continue;
+        if (m->mValues[i].mType == AI_FLOAT) return *(const float *)m->mValues[i].mData;
+        if (m->mValues[i].mType == AI_DOUBLE) return (float)*(const double *)m->mValues[i].mData;
+    }
+    return 0.0f;
+}
+
+/* The light named like node `index`, if any, onto it. A bad light is
+ * warned about and dropped; the model still loads. */
+static void place_light(open_ctx *c, const struct aiNode *n, uint32_t index)
+{
+    if (!c->light_name_count) return;
+    light_name key = {n->mName.data, 0, false};
+    light_name *hit = NULL;
+    /* The first unplaced light of that name (two nodes may share a name). */
+    for (uint32_t lo = 0, hi = c->light_name_count; lo < hi;) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (strcmp(c->light_names[mid].name, key.name) < 0) lo = mid + 1;
+        else hi = mid, hit = &c->light_names[mid];
+    }
+    while (hit && hit < c->light_names + c->light_name_count && strcmp(hit->name, key.name) == 0 &&
+           hit->placed)
+        hit++;
+    if (!hit || hit >= c->light_names + c->light_name_count || strcmp(hit->name, key.name) != 0) return;
+    hit->placed = true;
+    const struct aiLight *al = c->scene->mLights[hit->light];
+    const char *name = c->model->nodes[index].name;
+    ob_light_desc d = {0};
+    switch (al->mType) {
+    case aiLightSource_DIRECTIONAL: d.type = OB_LIGHT_DIRECTIONAL; break;
+    case aiLightSource_POINT: d.type = OB_LIGHT_POINT; break;
+    case aiLightSource_SPOT: d.type = OB_LIGHT_SPOT; break;
+    default:
+        OB_LOG_W(OB_MODEL_LOG, "%s: light '%s' is of a type Obelisk does not draw (%d); dropped",
+                 c->chk.path, name, (int)al->mType);
+        return;
+    }
+    float rgb[3] = {al->mColorDiffuse.r, al->mColorDiffuse.g, al->mColorDiffuse.b};
+    float range = light_range(n), inner = al->mAngleInnerCone, outer = al->mAngleOuterCone;
+    float peak = fmaxf(rgb[0], fmaxf(rgb[1], rgb[2]));
+    if (!isfinite(rgb[0] + rgb[1] + rgb[2] + range) || rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0 ||
+        range < 0 || (d.type == OB_LIGHT_SPOT && !isfinite(inner + outer))) {
+        OB_LOG_W(OB_MODEL_LOG, "%s: light '%s' has a negative or non-finite colour, range or "
+                 "cone angle; dropped", c->chk.path, name);
+        return;
+    }
+    d.intensity = peak;
+    for (int k = 0; k < 3; k++) d.color[k] = peak > 0.0f ? rgb[k] / peak : 1.0f;
+    if (d.type != OB_LIGHT_DIRECTIONAL) d.range = range;
+    if (d.type == OB_LIGHT_SPOT) {
+        const float max_outer = 89.9f * (float)(OB_PI / 180.0);
+        d.outer_angle = outer > max_outer ? max_outer : outer > 0.0f ? outer : 1e-6f;
+        d.inner_angle = inner < 0.0f ? 0.0f : inner > d.outer_angle ? d.outer_angle : inner;
+    }
+    c->model->lights[c->model->light_count++] = (ob_model_light){index, d};
+}
+
 /* Depth first, the node before its children: parents come first. */
 static ob_result add_node(open_ctx *c, const struct aiNode *n, int32_t parent, uint32_t depth)
 {
@@ -291,6 +392,7 @@ static ob_result add_node(open_ctx *c, const struct aiNode *n, int32_t parent, u
             if (p != UINT32_MAX) node->primitives[node->primitive_count++] = p;
         }
     }
+    place_light(c, n, index);
     for (uint32_t k = 0; k < n->mNumChildren; k++) {
         ob_result r = add_node(c, n->mChildren[k], (int32_t)index, depth + 1);
         if (r != OB_OK) return r;
@@ -310,8 +412,13 @@ static ob_result build_nodes(open_ctx *c)
     if (r != OB_OK) return r;
     c->model->nodes = ob_calloc((size_t)count, sizeof *c->model->nodes);
     if (!c->model->nodes) return out_of_memory(c, "the nodes");
-    r = add_node(c, root, -1, 0);
+    r = index_lights(c);
+    if (r == OB_OK) r = add_node(c, root, -1, 0);
     if (r != OB_OK) return r;
+    for (uint32_t i = 0; i < c->light_name_count; i++)
+        if (!c->light_names[i].placed)
+            OB_LOG_W(OB_MODEL_LOG, "%s: light '%s' is on no node; dropped", c->chk.path,
+                     c->light_names[i].name);
     uint32_t placements = 0;
     for (uint32_t i = 0; i < c->model->node_count; i++) placements += c->model->nodes[i].primitive_count;
     if (placements == 0) {
@@ -368,7 +475,10 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
              "%u materials, %u images", path, model->node_count, model->primitive_count,
              (unsigned long long)vertices, (unsigned long long)triangles, model->material_count,
              model->image_count);
+    if (model->light_count)
+        OB_LOG_I(OB_MODEL_LOG, "%s: %u lights", path, model->light_count);
     ob_free(c.mesh_primitive);
+    ob_free(c.light_names);
     aiReleaseImport(scene);
     ob_model_io_release(&io);
     *out_model = model;
@@ -377,6 +487,7 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
 fail_close_model:
     ob_model_report_more(&c.chk);
     ob_free(c.mesh_primitive);
+    ob_free(c.light_names);
     ob_model_close(model);
     aiReleaseImport(scene);
     ob_model_io_release(&io);
@@ -404,6 +515,7 @@ void ob_model_close(ob_model *model)
     ob_free(model->primitives);
     ob_free(model->materials);
     ob_free(model->images);
+    ob_free(model->lights);
     ob_free(model->path);
     ob_free(model);
 }

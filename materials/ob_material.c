@@ -202,11 +202,8 @@ static ob_result register_standard_params(ob_material_library *lib)
     } params[] = {
         {"CameraPosition", OB_PARAM_VEC4},      {"ScreenSize", OB_PARAM_VEC4},
         {"AmbientColor", OB_PARAM_VEC4},        {"LightDirection", OB_PARAM_VEC4},
-        {"LightColor", OB_PARAM_VEC4},          {"PointLight0Position", OB_PARAM_VEC4},
-        {"PointLight1Position", OB_PARAM_VEC4}, {"PointLight2Position", OB_PARAM_VEC4},
-        {"PointLight3Position", OB_PARAM_VEC4}, {"PointLight0Color", OB_PARAM_VEC4},
-        {"PointLight1Color", OB_PARAM_VEC4},    {"PointLight2Color", OB_PARAM_VEC4},
-        {"PointLight3Color", OB_PARAM_VEC4},    {"ParaboloidDirection", OB_PARAM_VEC4},
+        {"LightColor", OB_PARAM_VEC4},          {"LightGrid", OB_PARAM_VEC4},
+        {"ParaboloidDirection", OB_PARAM_VEC4},
         {"SimStep", OB_PARAM_VEC4},             {"SimEmitter", OB_PARAM_VEC4},
         {"SimForce", OB_PARAM_VEC4},            {"ShadowMatrix", OB_PARAM_MAT4},
         {"EnvMapMatrix", OB_PARAM_MAT4},        {"ShadowMap", OB_PARAM_TEXTURE},
@@ -216,6 +213,17 @@ static ob_result register_standard_params(ob_material_library *lib)
     ob_result r = OB_OK;
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(params); i++)
         if (!register_param(lib->reg, params[i].name, params[i].type, &r).id) return r;
+    static const struct {
+        const char *name;
+        uint32_t bytes;
+    } blocks[] = {{"LightTable", OB_LIGHT_TABLE_BYTES}, {"LightTiles", OB_LIGHT_TILES_BYTES}};
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(blocks); i++) {
+        if (!ob_param_register(lib->reg, blocks[i].name, OB_PARAM_BYTES, blocks[i].bytes, &r).id) {
+            OB_LOG_E("material", "parameter '%s' (%u bytes) not registered: %s", blocks[i].name,
+                     blocks[i].bytes, ob_result_text(r));
+            return r;
+        }
+    }
     lib->diffuse = register_param(lib->reg, "DiffuseColor", OB_PARAM_VEC4, &r);
     if (lib->diffuse.id) lib->specular = register_param(lib->reg, "SpecularColor", OB_PARAM_VEC4, &r);
     if (lib->specular.id) lib->emissive = register_param(lib->reg, "EmissiveColor", OB_PARAM_VEC4, &r);

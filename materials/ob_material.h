@@ -71,6 +71,16 @@
 extern "C" {
 #endif
 
+/* The lit shaders' PerViewLights block (materials/shaders/lighting.glsl):
+ * "LightGrid" (vec4), "LightTable" (OB_LIGHT_TABLE_BYTES: four vec4 a light,
+ * OB_MAX_LIGHTS lights) and "LightTiles" (OB_LIGHT_TILES_BYTES: a 256-bit
+ * mask per tile of a 16 x 16 screen grid), registered by the library and
+ * filled per view by the views layer. */
+#define OB_LIGHT_TILES_X 16u
+#define OB_LIGHT_TILES_Y 16u
+#define OB_LIGHT_TABLE_BYTES (OB_MAX_LIGHTS * 4u * 16u)
+#define OB_LIGHT_TILES_BYTES (OB_LIGHT_TILES_X * OB_LIGHT_TILES_Y * (OB_MAX_LIGHTS / 8u))
+
 typedef struct ob_material_library ob_material_library;
 struct ob_material;  /* the engine forward-declares it */
 typedef struct ob_material ob_material;

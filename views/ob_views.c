@@ -8,40 +8,32 @@
 
 typedef struct view_params {
     ob_param screen, ambient, light_dir, light_color;
-    ob_param point_pos[4], point_color[4];
     ob_param shadow_matrix, paraboloid;
 } view_params;
 
 static view_params params_of(ob_param_registry *reg)
 {
     view_params p;
-    char name[32];
     p.screen = ob_param_find(reg, "ScreenSize");
     p.ambient = ob_param_find(reg, "AmbientColor");
     p.light_dir = ob_param_find(reg, "LightDirection");
     p.light_color = ob_param_find(reg, "LightColor");
     p.shadow_matrix = ob_param_find(reg, "ShadowMatrix");
     p.paraboloid = ob_param_find(reg, "ParaboloidDirection");
-    for (int i = 0; i < 4; i++) {
-        snprintf(name, sizeof name, "PointLight%dPosition", i);
-        p.point_pos[i] = ob_param_find(reg, name);
-        snprintf(name, sizeof name, "PointLight%dColor", i);
-        p.point_color[i] = ob_param_find(reg, name);
-    }
     return p;
 }
 
 static ob_result register_params(ob_param_registry *reg)
 {
     static const char *const vec4s[] = {
-        "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "PointLight0Position",
-        "PointLight1Position", "PointLight2Position", "PointLight3Position", "PointLight0Color",
-        "PointLight1Color", "PointLight2Color", "PointLight3Color", "ParaboloidDirection",
-        "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
+        "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "LightGrid",
+        "ParaboloidDirection", "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
     };
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
         ob_param_register(reg, vec4s[i], OB_PARAM_VEC4, 1, &r);
+    if (r == OB_OK) ob_param_register(reg, "LightTable", OB_PARAM_BYTES, OB_LIGHT_TABLE_BYTES, &r);
+    if (r == OB_OK) ob_param_register(reg, "LightTiles", OB_PARAM_BYTES, OB_LIGHT_TILES_BYTES, &r);
     if (r == OB_OK) ob_param_register(reg, "ShadowMatrix", OB_PARAM_MAT4, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "ShadowMap", OB_PARAM_TEXTURE, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "EnvMap", OB_PARAM_TEXTURE, 1, &r);
@@ -74,8 +66,6 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
     /* Lights, relative to the view's origin like everything else. */
     float zero[4] = {0, 0, 0, 0};
     float dir[4] = {0, 1, 0, 0}, dcolor[4] = {0, 0, 0, 0};
-    float ppos[4][4] = {{0}}, pcolor[4][4] = {{0}};
-    uint32_t points = 0;
     bool have_dir = false;
     uint32_t count = 0;
     ob_scene *scene = ob_renderer_scene(ctx->r);
@@ -93,24 +83,11 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
             dcolor[2] = l->color[2];
             dcolor[3] = l->intensity;
             have_dir = true;
-        } else if (l->type == OB_LIGHT_POINT && points < 4) {
-            double pos[3];
-            ob_node_world_position(lights[i], pos);
-            ppos[points][0] = (float)(pos[0] - v->origin[0]);
-            ppos[points][1] = (float)(pos[1] - v->origin[1]);
-            ppos[points][2] = (float)(pos[2] - v->origin[2]);
-            ppos[points][3] = l->range;
-            memcpy(pcolor[points], l->color, sizeof l->color);
-            pcolor[points][3] = l->intensity;
-            points++;
         }
     }
     ob_params_set_vec4(params, p.light_dir, dir);
     ob_params_set_vec4(params, p.light_color, have_dir ? dcolor : zero);
-    for (uint32_t i = 0; i < 4; i++) {
-        ob_params_set_vec4(params, p.point_pos[i], ppos[i]);
-        ob_params_set_vec4(params, p.point_color[i], pcolor[i]);
-    }
+    ob_views_set_light_params(ctx, v, params, view, proj);
 }
 
 /* ------------------------------------------------------------ targets */
@@ -253,7 +230,7 @@ bool ob_views_prepare_effect(ob_views *ctx, ob_renderer *r, ob_effect *e, ob_vie
         ob_renderer_note_error(r, v->name, OB_ERR_NOT_FOUND);
         return false;
     }
-    ob_effect_targets t;
+    ob_effect_targets t = {.wireframe = false};   /* as ob_views_bind_effect binds it */
     ob_view_attachment_formats(v, ctx->dev, &t.color, &t.depth, &t.samples);
     if (ob_effect_pipeline_for(e, &t, NULL)) return true;
     ob_renderer_note_error(r, v->name, OB_ERR_VULKAN);
@@ -339,6 +316,7 @@ static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *req
 
 void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
 {
+    ob_views_report_light_limit(ctx, r);
     uint32_t count = 0;
     ob_node *const *lights = ob_scene_lights(ob_renderer_scene(r), &count);
     bool shaded_found = false;
@@ -491,6 +469,7 @@ void ob_views_destroy(ob_views *ctx)
     ob_free(ctx->shadows);
     ob_free(ctx->envs);
     ob_free(ctx->systems);
+    ob_free(ctx->over_limit);
     ob_effect_destroy(ctx->text_effect);
     ob_effect_destroy(ctx->composite_effect);
     ob_effect_destroy(ctx->particle_sim_effect);
@@ -514,6 +493,8 @@ static ob_result check_map_size(const ob_views *ctx, const char *what, uint32_t 
     OB_LOG_E("views", "%s size %u refused: the device's images are at most %u", what, size, max);
     return OB_ERR_OUT_OF_RANGE;
 }
+
+void ob_views_set_light_tiles(ob_views *ctx, bool on) { ctx->light_tiles_off = !on; }
 
 ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size)
 {

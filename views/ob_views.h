@@ -58,6 +58,12 @@ void ob_views_set_time(ob_views *ctx, double time, double dt);
  * made. ob_views_create refuses such a desc size the same way. */
 ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
 ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
+/* Screen-tile culling of point and spot lights (docs/architecture.md,
+ * "Many lights"), on by default. Off, every fragment of a camera view loops
+ * over all the scene's lights: the same pixels (a light adds exactly zero
+ * beyond its range), only slower; for measuring and checking the grid.
+ * [render thread, between frames] */
+void ob_views_set_light_tiles(ob_views *ctx, bool on);
 
 /* ---------------------------------------------------------- perspective */
 

@@ -34,6 +34,9 @@ struct ob_views {
     uint32_t env_count, env_cap;
     ob_views_entry *systems;     /* particle systems by emitter node */
     uint32_t system_count, system_cap;
+    uint32_t *over_limit;        /* ids of lights logged as over OB_MAX_LIGHTS, ascending */
+    uint32_t over_limit_count, over_limit_cap;
+    bool light_tiles_off;        /* ob_views_set_light_tiles(false): every light in tile 0 */
 
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };
@@ -47,6 +50,16 @@ void ob_shadow_view_set_consumer(ob_shadow_view *v, ob_view *consumer);
 ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
 void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v);
 ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v);
+
+/* Fill the lit shaders' PerViewLights block (LightGrid, LightTable,
+ * LightTiles) for v: the scene's first OB_MAX_LIGHTS point and spot lights
+ * relative to v->origin and, for a perspective view, the screen tiles each
+ * may reach. Cannot fail. [recording thread: writes only params] */
+void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *params,
+                               const float view[16], const float proj[16]);
+/* Log each point or spot light over OB_MAX_LIGHTS once by name and note how
+ * many are over in the frame's stats. [render thread, PreRender] */
+void ob_views_report_light_limit(ob_views *ctx, ob_renderer *r);
 
 /* Particle systems by emitter node: the perspective view queues the
  * simulation of every emitter it sees (ob_views_queue_simulations). */

@@ -77,8 +77,10 @@ bool ob_views_prepare_effect(ob_views *ctx, ob_renderer *r, ob_effect *e, ob_vie
 bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipeline_manager *pm);
 /* Write the PerView block every camera-like view sets into `params`: View and
  * Projection, ScreenSize from v's size, the ambient colour given to
- * ob_views_create, the scene's first directional light and first four point
- * lights relative to v->origin, and defaults for ShadowMatrix (identity) and
+ * ob_views_create, the scene's first directional light relative to
+ * v->origin, the PerViewLights block (up to OB_MAX_LIGHTS point and spot
+ * lights and, for a perspective view, the screen tiles each may reach:
+ * docs/architecture.md, "Many lights"), and defaults for ShadowMatrix (identity) and
  * ParaboloidDirection (zero) that dependencies override. Call it from
  * set_render_params with the slot given. Cannot fail. [recording thread:
  * writes only `params`] */

@@ -12,10 +12,9 @@
 // plane (depth 1 at the near plane, 0 at infinity) in Vulkan clip space (y
 // already flipped).
 //
-// Lights: one directional light plus four point lights, as separate vec4
-// parameters PointLight<i>Position / PointLight<i>Color (i = 0..3) rather than
-// a packed mat4 array, so that an application sets a light with two named
-// vec4 writes and an unused light costs nothing but intensity 0.
+// Lights: one directional light here, as vec4 parameters; point and spot
+// lights, any number up to OB_MAX_LIGHTS, come in the PerViewLights block of
+// lighting.glsl (a table and a screen-tile grid the views fill per view).
 #ifndef OB_COMMON_GLSL
 #define OB_COMMON_GLSL
 
@@ -29,14 +28,6 @@ layout(set = 0, binding = 0, std140) uniform PerView {
     vec4 AmbientColor;         // rgb, w = intensity
     vec4 LightDirection;       // xyz toward the light (need not be unit length)
     vec4 LightColor;           // rgb, w = intensity (0 = no directional light)
-    vec4 PointLight0Position;  // xyz camera-relative, w = range (0 = unbounded)
-    vec4 PointLight1Position;
-    vec4 PointLight2Position;
-    vec4 PointLight3Position;
-    vec4 PointLight0Color;     // rgb, w = intensity (0 = light off)
-    vec4 PointLight1Color;
-    vec4 PointLight2Color;
-    vec4 PointLight3Color;
     vec4 ParaboloidDirection;  // x: +1 front layer (0), -1 back layer (1); y: near distance
 };
 

@@ -1,5 +1,15 @@
-// lighting.glsl — Blinn-Phong for one directional and four point lights, in
-// camera-relative world space (the eye is at the origin).
+// lighting.glsl — Blinn-Phong for one directional light and any number of
+// point and spot lights, in camera-relative world space (the eye is at the
+// origin).
+//
+// Point and spot lights: views/ob_views_lights.c fills PerViewLights per view
+// with the scene's first OB_MAX_LIGHTS lights (node-id order) and a 16 x 16
+// grid of screen tiles, each a 256-bit mask of the lights whose range sphere
+// may reach it. A fragment loops over its tile's bits in ascending order, so
+// the sum runs in node-id order whatever the tiling: every view, thread count
+// and instancing run lights a point with the same lights in the same order.
+// Views that are not perspective (paraboloid) set LightGrid.w = 0: tile 0
+// then holds every light.
 #ifndef OB_LIGHTING_GLSL
 #define OB_LIGHTING_GLSL
 
@@ -13,6 +23,53 @@ float ob_point_attenuation(float dist, float range)
     return falloff * window * window;
 }
 
+#define OB_MAX_LIGHTS 256
+#define OB_LIGHT_TILES_X 16
+#define OB_LIGHT_TILES 256
+
+layout(set = 0, binding = 4, std140) uniform PerViewLights {
+    vec4 LightGrid;                        // tile width, height in pixels; mask words in use
+                                           // (ceil(lights / 32)); 1 = tiled, 0 = tile 0 only
+    vec4 LightTable[4 * OB_MAX_LIGHTS];    // per light: position.xyz, range (0 = unbounded) |
+                                           // colour rgb, intensity | axis xyz (where it shines),
+                                           // cos outer (< -1: a point light) | cos inner
+    uvec4 LightTiles[2 * OB_LIGHT_TILES];  // 8 words a tile: bit i = light i may reach it
+};
+
+// The tile gl_FragCoord falls in (fragment stage only).
+uint ob_light_tile()
+{
+    if (LightGrid.w <= 0.0) return 0u;
+    uvec2 t = min(uvec2(gl_FragCoord.xy / LightGrid.xy), uvec2(OB_LIGHT_TILES_X - 1));
+    return t.y * uint(OB_LIGHT_TILES_X) + t.x;
+}
+
+// Word w (0..7) of a tile's mask.
+uint ob_light_word(uint tile, uint w)
+{
+    return LightTiles[tile * 2u + w / 4u][w % 4u];
+}
+
+// Light i seen from p: the unit direction toward it and the radiance
+// arriving (colour * intensity * distance attenuation * spot cone).
+void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
+{
+    vec4 position = LightTable[4u * i];
+    vec4 color = LightTable[4u * i + 1u];
+    vec4 axis = LightTable[4u * i + 2u];
+    vec3 to_light = position.xyz - p;
+    l = ob_safe_normalize(to_light);
+    float att = ob_point_attenuation(length(to_light), position.w);
+    if (axis.w >= -1.0) {
+        // Spot: full inside the inner cone, smoothstep down to zero at the
+        // outer one (the divisor is kept positive for inner == outer).
+        float cos_inner = LightTable[4u * i + 3u].x;
+        float t = clamp((dot(-l, axis.xyz) - axis.w) / max(cos_inner - axis.w, 1e-4), 0.0, 1.0);
+        att *= t * t * (3.0 - 2.0 * t);
+    }
+    radiance = color.rgb * color.w * att;
+}
+
 vec3 ob_blinn_phong(vec3 n, vec3 v, vec3 l, vec3 radiance, vec3 diffuse, vec4 specular)
 {
     float ndotl = max(dot(n, l), 0.0);
@@ -20,17 +77,6 @@ vec3 ob_blinn_phong(vec3 n, vec3 v, vec3 l, vec3 radiance, vec3 diffuse, vec4 sp
     vec3 h = ob_safe_normalize(l + v);
     float spec = specular.w > 0.0 ? pow(max(dot(n, h), 0.0), specular.w) : 0.0;
     return radiance * (diffuse * ndotl + specular.rgb * spec);
-}
-
-vec3 ob_point_light(vec4 position, vec4 color, vec3 p, vec3 n, vec3 v,
-                    vec3 diffuse, vec4 specular)
-{
-    if (color.w <= 0.0) return vec3(0.0);
-    vec3 to_light = position.xyz - p;
-    float dist = length(to_light);
-    vec3 l = ob_safe_normalize(to_light);
-    float att = ob_point_attenuation(dist, position.w);
-    return ob_blinn_phong(n, v, l, color.rgb * color.w * att, diffuse, specular);
 }
 
 // Directional light contribution; `visibility` is the shadow term (1 = lit).
@@ -41,12 +87,24 @@ vec3 ob_directional_light(vec3 n, vec3 v, vec3 diffuse, vec4 specular, float vis
     return visibility * ob_blinn_phong(n, v, l, LightColor.rgb * LightColor.w, diffuse, specular);
 }
 
-vec3 ob_point_lights(vec3 p, vec3 n, vec3 v, vec3 diffuse, vec4 specular)
+// Every point and spot light of the fragment's tile, summed in light order.
+vec3 ob_local_lights(vec3 p, vec3 n, vec3 v, vec3 diffuse, vec4 specular)
 {
-    return ob_point_light(PointLight0Position, PointLight0Color, p, n, v, diffuse, specular)
-         + ob_point_light(PointLight1Position, PointLight1Color, p, n, v, diffuse, specular)
-         + ob_point_light(PointLight2Position, PointLight2Color, p, n, v, diffuse, specular)
-         + ob_point_light(PointLight3Position, PointLight3Color, p, n, v, diffuse, specular);
+    vec3 sum = vec3(0.0);
+    uint tile = ob_light_tile();
+    // Only the words that can hold a light: walking all eight costs a
+    // scene of two lights three times its frame time on lavapipe.
+    for (uint w = 0u; w < uint(LightGrid.z); w++) {
+        uint bits = ob_light_word(tile, w);
+        while (bits != 0u) {
+            uint i = w * 32u + uint(findLSB(bits));
+            bits &= bits - 1u;
+            vec3 l, radiance;
+            ob_local_light(i, p, l, radiance);
+            sum += ob_blinn_phong(n, v, l, radiance, diffuse, specular);
+        }
+    }
+    return sum;
 }
 
 #endif

@@ -1,6 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// lit.frag — Blinn-Phong with one directional and four point lights.
+// lit.frag — Blinn-Phong with one directional light and the point and spot
+// lights of lighting.glsl's tile grid.
 //
 // Variants (each compiled only when a material needs it):
 //   SHADOWS     the directional light is shadowed by "ShadowMap"
@@ -57,7 +58,7 @@ void main()
     vec3 diffuse = DiffuseColor.rgb;
     vec3 color = AmbientColor.rgb * AmbientColor.w * diffuse + EmissiveColor.rgb
                + ob_directional_light(n, v, diffuse, SpecularColor, visibility)
-               + ob_point_lights(vPosition, n, v, diffuse, SpecularColor);
+               + ob_local_lights(vPosition, n, v, diffuse, SpecularColor);
 #if defined(ENVMAP)
     vec3 r = reflect(-v, n);
     vec3 env = texture(EnvMap, ob_paraboloid_lookup(mat3(EnvMapMatrix) * r)).rgb;

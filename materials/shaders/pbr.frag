@@ -9,8 +9,8 @@
 //          + ENVMAP:   env(R) * F_a * occlusion * Reflectivity.x * (1 - roughness)^2
 //   with the BRDF of pbr.glsl (Cook-Torrance: GGX D, height-correlated Smith
 //   visibility, Schlick F with F0 = mix(0.04, base, metallic); Lambert
-//   diffuse) for the directional light (shadowed with SHADOWS) and the four
-//   point lights of common.glsl; F_a is Schlick at n.v with roughness-limited
+//   diffuse) for the directional light (shadowed with SHADOWS) and the
+//   point and spot lights of lighting.glsl's tile grid; F_a is Schlick at n.v with roughness-limited
 //   reflectance (ob_fresnel_ambient).
 //   The environment map is one sharp dual-paraboloid image with no
 //   prefiltered mips, so it cannot show the blur of a rough surface: its
@@ -171,13 +171,18 @@ void main()
 #endif
         color += visibility * ob_pbr_light(s, ob_safe_normalize(LightDirection.xyz), LightColor.rgb * LightColor.w);
     }
-    vec4 positions[4] = vec4[4](PointLight0Position, PointLight1Position, PointLight2Position, PointLight3Position);
-    vec4 colors[4] = vec4[4](PointLight0Color, PointLight1Color, PointLight2Color, PointLight3Color);
-    for (int i = 0; i < 4; i++) {
-        if (colors[i].w <= 0.0) continue;
-        vec3 to_light = positions[i].xyz - vPosition;
-        float att = ob_point_attenuation(length(to_light), positions[i].w);
-        color += ob_pbr_light(s, ob_safe_normalize(to_light), colors[i].rgb * colors[i].w * att);
+    // Point and spot lights of this fragment's tile, in light order
+    // (lighting.glsl).
+    uint tile = ob_light_tile();
+    for (uint w = 0u; w < uint(LightGrid.z); w++) {
+        uint bits = ob_light_word(tile, w);
+        while (bits != 0u) {
+            uint i = w * 32u + uint(findLSB(bits));
+            bits &= bits - 1u;
+            vec3 l, radiance;
+            ob_local_light(i, vPosition, l, radiance);
+            color += ob_pbr_light(s, l, radiance);
+        }
     }
     vec3 fa = ob_fresnel_ambient(s);
     vec3 ambient = AmbientColor.rgb * AmbientColor.w;

@@ -11,7 +11,7 @@
 //     f_diffuse = (1 - F) (1 - metallic) base / pi          Lambert
 //
 // Light units: the engine's lights are given as radiance at normal
-// incidence (LightColor.rgb * w, PointLight<i>Color.rgb * w times the
+// incidence (LightColor.rgb * w, a local light's colour * intensity times the
 // attenuation), and lit.frag shows a white surface under a unit light as
 // white (diffuse * NdotL, no 1/pi). pbr.frag keeps that: every BRDF term is
 // multiplied by pi (the usual "punctual light intensity" convention), so a

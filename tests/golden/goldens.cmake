@@ -42,3 +42,7 @@ ob_golden_device_tolerance(texturetransform 70 "bilinear sub-texel precision is 
 ob_golden(mtl_quad tests/data/models/mtl_quad.obj --frames 2)
 ob_golden(features tests/data/models/features.gltf --frames 2)
 ob_golden(colour_cube tests/golden/models/colour_cube.ply --frames 2)
+# Lights (issue 28): two spot lights, one soft-edged and one nearly hard,
+# and 64 coloured point lights, all through the screen-tile light grid.
+ob_golden(spot tests/golden/scenes/spot.json --frames 2)
+ob_golden(lights64 tests/golden/scenes/lights64.json --frames 2)

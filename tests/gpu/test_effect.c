@@ -117,8 +117,9 @@ static void test_standard_effects_build(void **state)
     ob_effect_local_size(sim, ls);
     assert_int_equal(ls[0], 64);
     assert_int_equal(ob_effect_program(sim)->bind_point, VK_PIPELINE_BIND_POINT_COMPUTE);
-    /* The lit program's uniform blocks: PerView and PerMaterial in set 0. */
-    assert_int_equal(ob_effect_program(ob_material_library_find_effect(lib, OB_STD_LIT, 0))->ubo_count, 2);
+    /* The lit program's uniform blocks: PerView, PerMaterial and
+     * PerViewLights (the point and spot lights) in set 0. */
+    assert_int_equal(ob_effect_program(ob_material_library_find_effect(lib, OB_STD_LIT, 0))->ubo_count, 3);
 
     ob_effect_counters c = ob_effect_context_counters(ctx);
     assert_int_equal(c.variants_compiled, OB_ARRAY_COUNT(cases));

@@ -719,7 +719,7 @@ static void test_library_registers_standard_interface(void **state)
         ob_param_type type;
     } expect[] = {
         {"DiffuseColor", OB_PARAM_VEC4},  {"Reflectivity", OB_PARAM_VEC4},
-        {"PointLight3Color", OB_PARAM_VEC4}, {"ParaboloidDirection", OB_PARAM_VEC4},
+        {"LightTable", OB_PARAM_BYTES}, {"ParaboloidDirection", OB_PARAM_VEC4},
         {"ShadowMatrix", OB_PARAM_MAT4},  {"EnvMapMatrix", OB_PARAM_MAT4},
         {"ShadowMap", OB_PARAM_TEXTURE},  {"EnvMapSampler", OB_PARAM_SAMPLER},
         {"Particles", OB_PARAM_STORAGE_BUFFER}, {"SimStep", OB_PARAM_VEC4},

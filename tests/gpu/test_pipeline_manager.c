@@ -66,16 +66,17 @@ static ob_pipeline_manager_stats composite_only(ob_test_world *w, ob_threading m
     return st->pm;
 }
 
-/* Sizes of the lit effect's PerView and PerMaterial blocks. */
+/* Sizes of the lit effect's per-view blocks (PerView and PerViewLights,
+ * packed once per view and slot) and its PerMaterial block. */
 static void lit_block_sizes(ob_test_world *w, uint32_t *per_view, uint32_t *per_material)
 {
     ob_effect *e = ob_material_library_find_effect(w->lib, OB_STD_LIT, 0);
     assert_non_null(e);
     const ob_program *p = ob_effect_program(e);
-    assert_int_equal(p->ubo_count, 2);
+    assert_int_equal(p->ubo_count, 3);
     *per_view = *per_material = 0;
     for (uint32_t i = 0; i < p->ubo_count; i++) {
-        if (p->ubos[i].binding == 0) *per_view = p->ubos[i].size;
+        if (p->ubos[i].binding == 0 || p->ubos[i].binding == 4) *per_view += p->ubos[i].size;
         if (p->ubos[i].binding == 1) *per_material = p->ubos[i].size;
     }
     assert_true(*per_view > 0 && *per_material > 0);
@@ -112,9 +113,10 @@ static void shared_state_bound_once_single_threaded(void **state)
     assert_int_equal(s.index_binds_issued, 1);
     assert_int_equal(s.descriptor_binds_requested, 100);
     assert_int_equal(s.descriptor_binds_issued, 1);
-    /* PerView and PerMaterial packed once, reused by the other 99 draws. */
-    assert_int_equal(s.blocks_packed, 2);
-    assert_int_equal(s.blocks_reused, 2 * 99);
+    /* PerView, PerViewLights and PerMaterial packed once, reused by the
+     * other 99 draws. */
+    assert_int_equal(s.blocks_packed, 3);
+    assert_int_equal(s.blocks_reused, 3 * 99);
     assert_int_equal(s.uniform_bytes, per_view + per_material);
     /* Every box has its own world matrix: push constants change per draw. */
     assert_int_equal(s.push_constant_requested, 100);
@@ -157,8 +159,8 @@ static void shared_state_bound_once_per_secondary(void **state)
         assert_int_equal(s.descriptor_binds_requested, 100);
         assert_int_equal(s.descriptor_binds_issued, chunks);
         /* A worker keeps its packed blocks across the chunks it records. */
-        assert_true(s.blocks_packed >= 2 && s.blocks_packed <= 2 * chunks);
-        assert_int_equal(s.blocks_packed + s.blocks_reused, 200);
+        assert_true(s.blocks_packed >= 3 && s.blocks_packed <= 3 * chunks);
+        assert_int_equal(s.blocks_packed + s.blocks_reused, 300);
         assert_true(s.uniform_bytes <= (uint64_t)chunks * (per_view + per_material));
         assert_int_equal(s.skipped_draws, 0);
     }
@@ -198,14 +200,14 @@ static void uniforms_packed_only_after_a_change(void **state)
         assert_int_equal(pm_minus(again->pm, &base).blocks_packed, got[c].blocks_packed);
         ob_test_world_destroy(&w);
     }
-    assert_int_equal(got[SHARED_50].blocks_packed, 2);
-    assert_int_equal(got[SHARED_100].blocks_packed, 2);
+    assert_int_equal(got[SHARED_50].blocks_packed, 3);
+    assert_int_equal(got[SHARED_100].blocks_packed, 3);
     assert_int_equal(got[SHARED_50].uniform_bytes, got[SHARED_100].uniform_bytes);
-    assert_int_equal(got[SAME_VALUES].blocks_packed, 2);
+    assert_int_equal(got[SAME_VALUES].blocks_packed, 3);
     assert_int_equal(got[SAME_VALUES].uniform_bytes, per_view + per_material);
     assert_int_equal(got[SAME_VALUES].descriptor_binds_issued, 1);
-    assert_int_equal(got[DISTINCT].blocks_packed, 1 + 100);
-    assert_int_equal(got[DISTINCT].blocks_reused, 99);
+    assert_int_equal(got[DISTINCT].blocks_packed, 2 + 100);
+    assert_int_equal(got[DISTINCT].blocks_reused, 2 * 99);
     assert_int_equal(got[DISTINCT].uniform_bytes, per_view + 100 * per_material);
     /* One effect for all of them: still one pipeline bind. */
     assert_int_equal(got[DISTINCT].pipeline_binds_issued, 1);

@@ -373,7 +373,7 @@ static void test_load_malformed_leaves_scene(void **state)
     assert_int_equal(r, OB_ERR_PARSE);
     assert_string_equal(err.json_path, "lights[1].type");
     assert_string_equal(err.message, DATA "bad_light_type.json: lights[1].type: missing "
-                                     "(expected \"directional\" or \"point\")");
+                                     "(expected \"directional\", \"point\" or \"spot\")");
     assert_int_equal(ob_scene_node_count(s->scene), nodes_before);
     assert_int_equal(l.entity_count, 0);
     assert_null(l.materials);

@@ -703,6 +703,39 @@ static void concurrent_opens_agree_with_serial_ones(void **state)
     }
 }
 
+/* KHR_lights_punctual (tests/data/models/make_models.py, lights.gltf): each
+ * light lands on the node that names it, intensity split back out of
+ * assimp's colour, glTF's range and half-angles kept; a directional light
+ * too. */
+static void gltf_lights_land_on_their_nodes(void **state)
+{
+    (void)state;
+    ob_model *m = open_ok(DATA "lights.gltf", true);
+    assert_int_equal(m->light_count, 3);
+    const char *nodes[3] = {"lamp_node", "torch_node", "sky_node"};
+    const ob_light_type types[3] = {OB_LIGHT_POINT, OB_LIGHT_SPOT, OB_LIGHT_DIRECTIONAL};
+    for (uint32_t i = 0; i < 3; i++) {
+        assert_string_equal(m->nodes[m->lights[i].node].name, nodes[i]);
+        assert_int_equal(m->lights[i].desc.type, types[i]);
+    }
+    const ob_light_desc *lamp = &m->lights[0].desc;
+    assert_float_equal(lamp->intensity, 4.0, 1e-6);
+    assert_float_equal(lamp->color[0], 1.0, 1e-6);
+    assert_float_equal(lamp->color[1], 0.5, 1e-6);
+    assert_float_equal(lamp->color[2], 0.25, 1e-6);
+    assert_float_equal(lamp->range, 5.0, 1e-6);
+    const ob_light_desc *torch = &m->lights[1].desc;
+    assert_float_equal(torch->intensity, 2.0, 1e-6);
+    assert_float_equal(torch->inner_angle, 0.25, 1e-6);
+    assert_float_equal(torch->outer_angle, 0.5, 1e-6);
+    assert_float_equal(torch->range, 0.0, 0.0);   /* none given: no cut-off */
+    assert_float_equal(m->lights[2].desc.color[2], 1.0, 1e-6);
+    assert_float_equal(m->lights[2].desc.intensity, 1.0, 1e-6);
+    /* Read, so not reported as an ignored extension. */
+    assert_false(ob_test_log_has("lights.gltf", "ignored", NULL));
+    ob_model_close(m);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -723,6 +756,7 @@ int main(void)
         cmocka_unit_test(obj_and_ply_from_the_package),
         cmocka_unit_test(raw_embedded_texture_becomes_png),
         cmocka_unit_test(concurrent_opens_agree_with_serial_ones),
+        cmocka_unit_test(gltf_lights_land_on_their_nodes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

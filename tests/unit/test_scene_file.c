@@ -223,6 +223,44 @@ static void minimal_file_gets_documented_defaults(void **state)
     ob_scene_file_release(&sf);
 }
 
+/* Spot lights: cone half-angles in degrees become radians in the light's
+ * desc, aimed like a directional light; many point lights parse (the
+ * renderer, not the parser, applies OB_MAX_LIGHTS and names what is over). */
+static void spot_and_many_point_lights_parse(void **state)
+{
+    (void)state;
+    ob_scene_file sf;
+    ob_scene_file_error err;
+    static const char text[] =
+        "{\"lights\": [{\"name\": \"torch\", \"type\": \"spot\", \"position\": [0, 4, 0],"
+        " \"target\": [0, 0, 0], \"range\": 9, \"inner_angle\": 15, \"outer_angle\": 30},"
+        " {\"type\": \"spot\"}], \"entities\": []}";
+    assert_int_equal(parse(text, &sf, &err), OB_OK);
+    assert_int_equal(sf.light_count, 2);
+    const ob_scene_file_light *l = &sf.lights[0];
+    assert_int_equal(l->desc.type, OB_LIGHT_SPOT);
+    assert_string_equal(l->name, "torch");
+    assert_float_equal(l->desc.range, 9.0, 1e-6);
+    assert_float_equal(l->desc.inner_angle, 15.0 * OB_PI / 180.0, 1e-6);
+    assert_float_equal(l->desc.outer_angle, 30.0 * OB_PI / 180.0, 1e-6);
+    assert_float_equal(l->direction[1], -1.0, 1e-12);
+    /* Defaults: no fully lit core, a 45-degree cone, no cut-off. */
+    l = &sf.lights[1];
+    assert_float_equal(l->desc.inner_angle, 0.0, 0.0);
+    assert_float_equal(l->desc.outer_angle, OB_PI / 4.0, 1e-6);
+    assert_float_equal(l->desc.range, 0.0, 0.0);
+    ob_scene_file_release(&sf);
+
+    char many[300 * 24 + 64];
+    size_t n = (size_t)snprintf(many, sizeof many, "{\"lights\": [");
+    for (int i = 0; i < 300; i++)
+        n += (size_t)snprintf(many + n, sizeof many - n, "%s{\"type\": \"point\"}", i ? ", " : "");
+    snprintf(many + n, sizeof many - n, "], \"entities\": []}");
+    assert_int_equal(parse(many, &sf, &err), OB_OK);
+    assert_int_equal(sf.light_count, 300);
+    ob_scene_file_release(&sf);
+}
+
 /* ------------------------------------------------------------ malformed files */
 
 typedef struct bad_case {
@@ -237,7 +275,7 @@ typedef struct bad_case {
 static const bad_case bad_cases[] = {
     /* missing required keys */
     {"{}", "entities", "missing (expected an array of entities)"},
-    {"{\"lights\": [{}], " E "[]}", "lights[0].type", "missing (expected \"directional\" or \"point\")"},
+    {"{\"lights\": [{}], " E "[]}", "lights[0].type", "missing (expected \"directional\", \"point\" or \"spot\")"},
     {"{" E "[{\"geometry\": {}}]}", "entities[0].geometry", "expected \"generator\""},
     {"{" E "[{\"geometry\": {\"size\": 1}}]}", "entities[0].geometry", "or \"model\" (a file path)"},
     {"{" E "[{\"transform\": {\"rotation\": {}}}]}", "entities[0].transform.rotation",
@@ -261,7 +299,8 @@ static const bad_case bad_cases[] = {
      "expected a number, got null"},
     {"{\"settings\": {\"threads\": \"many\"}, " E "[]}", "settings.threads",
      "expected an integer from 0 to 16 or \"auto\", got a string"},
-    {"{\"lights\": [{\"type\": 1}], " E "[]}", "lights[0].type", "expected \"directional\" or \"point\", got a number"},
+    {"{\"lights\": [{\"type\": 1}], " E "[]}", "lights[0].type",
+     "expected \"directional\", \"point\" or \"spot\", got a number"},
     {"{\"materials\": {\"m\": {\"kind\": \"shiny\"}}, " E "[]}", "materials.m.kind",
      "expected \"lit\", \"reflective\" or \"unlit\", got a string"},
     /* wrong array lengths */
@@ -365,17 +404,29 @@ static const bad_case bad_cases[] = {
     {"{\"lights\": [{\"type\": \"point\", \"shadows\": true}], " E "[]}", "lights[0].shadows",
      "only directional lights cast shadows"},
     {"{\"lights\": [{\"type\": \"point\", \"direction\": [0, -1, 0]}], " E "[]}", "lights[0].direction",
-     "only a directional light has a direction"},
+     "only a directional or spot light has a direction"},
     {"{\"lights\": [{\"type\": \"directional\", \"range\": 3}], " E "[]}", "lights[0].range",
-     "only a point light has a range"},
+     "only a point or spot light has a range"},
     {"{\"lights\": [{\"type\": \"directional\", \"target\": [0, 0, 0], \"direction\": [0, -1, 0]}], " E "[]}",
      "lights[0].direction", "either target or direction, not both"},
     {"{\"lights\": [{\"type\": \"directional\", \"direction\": [0, 0, 0]}], " E "[]}", "lights[0].direction",
      "expected a non-zero vector"},
     {"{\"lights\": [{\"type\": \"directional\"}, {\"type\": \"directional\"}], " E "[]}", "lights[1]",
      "only one directional light is drawn"},
-    {"{\"lights\": [{\"type\": \"point\"}, {\"type\": \"point\"}, {\"type\": \"point\"}, {\"type\": \"point\"}, "
-     "{\"type\": \"point\"}], " E "[]}", "lights[4]", "at most 4 point lights"},
+    {"{\"lights\": [{\"type\": \"spot\", \"shadows\": true}], " E "[]}", "lights[0].shadows",
+     "only directional lights cast shadows"},
+    {"{\"lights\": [{\"type\": \"spot\", \"inner_angle\": 30, \"outer_angle\": 20}], " E "[]}",
+     "lights[0].inner_angle", "must not be larger than outer_angle (20 degrees), got 30"},
+    {"{\"lights\": [{\"type\": \"spot\", \"outer_angle\": 90}], " E "[]}", "lights[0].outer_angle",
+     "expected a number from 0 to 89.9, got 90"},
+    {"{\"lights\": [{\"type\": \"spot\", \"inner_angle\": -5}], " E "[]}", "lights[0].inner_angle",
+     "expected a number from 0 to 89.9, got -5"},
+    {"{\"lights\": [{\"type\": \"spot\", \"outer_angle\": \"wide\"}], " E "[]}", "lights[0].outer_angle",
+     "expected a number"},
+    {"{\"lights\": [{\"type\": \"point\", \"outer_angle\": 30}], " E "[]}", "lights[0].outer_angle",
+     "only a spot light has cone angles"},
+    {"{\"lights\": [{\"type\": \"directional\", \"inner_angle\": 10}], " E "[]}", "lights[0].inner_angle",
+     "only a spot light has cone angles"},
     {"{\"materials\": {\"m\": {\"reflectivity\": 0.5}}, " E "[]}", "materials.m.reflectivity",
      "only a \"reflective\" material has a reflectivity"},
     {"{" E "[{\"controllers\": [{\"rotate\": {}, \"orbit\": {}}]}]}", "entities[0].controllers[0]",
@@ -673,6 +724,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(full_file_parses_to_its_description),
         cmocka_unit_test(minimal_file_gets_documented_defaults),
+        cmocka_unit_test(spot_and_many_point_lights_parse),
         cmocka_unit_test(every_malformed_case_names_its_path),
         cmocka_unit_test(syntax_errors_give_line_and_column),
         cmocka_unit_test(only_the_first_error_is_reported),

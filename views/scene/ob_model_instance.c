@@ -318,6 +318,7 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto done;
     }
+    uint32_t next_light = 0;   /* model->lights are in node order */
     for (uint32_t i = 0; i < model->node_count && r == OB_OK; i++) {
         const ob_model_node *mn = &model->nodes[i];
         ob_node *parent = mn->parent >= 0 ? nodes[mn->parent] : root;
@@ -331,6 +332,10 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
         ob_node_set_position(n, pos);
         ob_node_set_rotation_d(n, quat);
         ob_node_set_scale(n, scale);
+        /* A glTF light sits on its node: the node's origin and -Z. */
+        for (; next_light < model->light_count && model->lights[next_light].node == i; next_light++)
+            if ((r = ob_node_set_light(n, &model->lights[next_light].desc)) != OB_OK) break;
+        if (r != OB_OK) break;
         for (uint32_t k = 0; k < mn->primitive_count && r == OB_OK; k++) {
             uint32_t p = mn->primitives[k];
             uint32_t mat = model->primitives[p].material;

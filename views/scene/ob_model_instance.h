@@ -113,7 +113,8 @@ ob_material *ob_model_assets_material(const ob_model_assets *a, uint32_t model_m
 
 /* Creates the model's entities under `root` (an existing node: the model's
  * root, whose transform places the model): one per model node, named as
- * the node, and under each one per primitive it places, named as the
+ * the node (carrying the node's glTF light, if any: ob_model_light), and
+ * under each one per primitive it places, named as the
  * primitive, renderable with the primitive's geometry and material (or
  * `override`, when not NULL, for every primitive: it must read the standard
  * layout, like every material of the library's standard kinds).

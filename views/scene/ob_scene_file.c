@@ -156,26 +156,32 @@ static bool parse_camera(sf_ctx *c, const cJSON *j, ob_scene_file_camera *cam)
 /* ------------------------------------------------------------ lights */
 
 static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directional,
-                        uint32_t *points, ob_scene_file_light *l)
+                        ob_scene_file_light *l)
 {
     static const char *const keys[] = {"name", "type", "position", "target", "direction", "color",
-                                       "intensity", "range", "shadows"};
+                                       "intensity", "range", "shadows", "inner_angle",
+                                       "outer_angle"};
     if (!ob_json_check_object(&c->rd, j, "a light object", keys, OB_ARRAY_COUNT(keys))) return false;
     const cJSON *type = ob_json_member(j, "type");
-    if (!type) return ob_json_missing(&c->rd, "type", "\"directional\" or \"point\"");
+    if (!type) return ob_json_missing(&c->rd, "type", "\"directional\", \"point\" or \"spot\"");
     size_t mark = ob_json_push_key(&c->rd, "type");
     if (cJSON_IsString(type) && strcmp(type->valuestring, "directional") == 0)
         l->desc.type = OB_LIGHT_DIRECTIONAL;
     else if (cJSON_IsString(type) && strcmp(type->valuestring, "point") == 0)
         l->desc.type = OB_LIGHT_POINT;
+    else if (cJSON_IsString(type) && strcmp(type->valuestring, "spot") == 0)
+        l->desc.type = OB_LIGHT_SPOT;
     else if (cJSON_IsString(type))
-        return ob_json_fail(&c->rd, "expected \"directional\" or \"point\", got \"%.40s\"", type->valuestring);
+        return ob_json_fail(&c->rd, "expected \"directional\", \"point\" or \"spot\", got \"%.40s\"",
+                            type->valuestring);
     else
-        return ob_json_fail(&c->rd, "expected \"directional\" or \"point\", got %s", ob_json_type_name(type));
+        return ob_json_fail(&c->rd, "expected \"directional\", \"point\" or \"spot\", got %s",
+                            ob_json_type_name(type));
     ob_json_pop(&c->rd, mark);
-    bool point = l->desc.type == OB_LIGHT_POINT;
+    bool point = l->desc.type == OB_LIGHT_POINT, spot = l->desc.type == OB_LIGHT_SPOT;
     if (!(l->name = name_or_default(c, j, "lights", i))) return false;
     float color[4] = {1, 1, 1, 1};
+    float inner_degrees = 0.0f, outer_degrees = 45.0f;
     l->desc.intensity = 1.0f;
     l->direction[0] = -1.0, l->direction[1] = -2.0, l->direction[2] = -1.0;
     ob_json_normalize(l->direction, 3);
@@ -189,13 +195,36 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
     for (int k = 0; k < 2; k++)
         if (point && ob_json_member(j, directional_only[k])) {
             ob_json_push_key(&c->rd, directional_only[k]);
-            return ob_json_fail(&c->rd, "only a directional light has a direction (a point light shines every way)");
+            return ob_json_fail(&c->rd, "only a directional or spot light has a direction (a point light shines every way)");
         }
-    if (!point && ob_json_member(j, "range")) {
+    if (!point && !spot && ob_json_member(j, "range")) {
         ob_json_push_key(&c->rd, "range");
-        return ob_json_fail(&c->rd, "only a point light has a range");
+        return ob_json_fail(&c->rd, "only a point or spot light has a range");
     }
-    if (point && l->desc.casts_shadows) {
+    if (!spot) {
+        static const char *const spot_only[] = {"inner_angle", "outer_angle"};
+        for (int k = 0; k < 2; k++)
+            if (ob_json_member(j, spot_only[k])) {
+                ob_json_push_key(&c->rd, spot_only[k]);
+                return ob_json_fail(&c->rd, "only a spot light has cone angles");
+            }
+    }
+    /* Half-angles of the cone in degrees: 0 <= inner <= outer < 90. */
+    if (spot && (!ob_json_opt_float(&c->rd, j, "outer_angle", OB_JSON_RANGE(0, 89.9), &outer_degrees) ||
+                 !ob_json_opt_float(&c->rd, j, "inner_angle", OB_JSON_RANGE(0, 89.9), &inner_degrees)))
+        return false;
+    if (spot && inner_degrees > outer_degrees) {
+        ob_json_push_key(&c->rd, "inner_angle");
+        return ob_json_fail(&c->rd, "must not be larger than outer_angle (%g degrees), got %g",
+                            (double)outer_degrees, (double)inner_degrees);
+    }
+    if (spot) {
+        l->desc.inner_angle = inner_degrees * (float)(OB_PI / 180.0);
+        l->desc.outer_angle = outer_degrees * (float)(OB_PI / 180.0);
+        /* outer_angle 0 is a zero-width cone here, not the engine's default. */
+        if (l->desc.outer_angle == 0.0f) l->desc.outer_angle = 1e-6f;
+    }
+    if ((point || spot) && l->desc.casts_shadows) {
         ob_json_push_key(&c->rd, "shadows");
         return ob_json_fail(&c->rd, "only directional lights cast shadows");
     }
@@ -213,11 +242,10 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
             return ob_json_fail(&c->rd, "must differ from position (the light points from position to target)");
         }
     }
-    /* The lit shader has one directional light and four point lights. */
-    if (!point && (*directional)++)
+    /* The lit shaders shade one directional light; point and spot lights
+     * over OB_MAX_LIGHTS are reported by the renderer, by name. */
+    if (!point && !spot && (*directional)++)
         return ob_json_fail(&c->rd, "only one directional light is drawn, and this is the second");
-    if (point && (*points)++ == 4)
-        return ob_json_fail(&c->rd, "at most 4 point lights are drawn, and this is the fifth");
     return true;
 }
 
@@ -717,12 +745,12 @@ static bool parse_document(sf_ctx *c, const cJSON *root)
         mark = ob_json_push_key(&c->rd, "lights");
         if (!cJSON_IsArray(j)) return ob_json_fail(&c->rd, "expected an array of lights, got %s", ob_json_type_name(j));
         sf->has_lights = true;
-        uint32_t n = (uint32_t)cJSON_GetArraySize(j), i = 0, directional = 0, points = 0;
+        uint32_t n = (uint32_t)cJSON_GetArraySize(j), i = 0, directional = 0;
         if (n && !(sf->lights = ob_calloc(n, sizeof *sf->lights))) return ob_json_out_of_memory(&c->rd);
         for (const cJSON *it = j->child; it; it = it->next, i++) {
             size_t m = ob_json_push_index(&c->rd, i);
             sf->light_count = i + 1;
-            if (!parse_light(c, it, i, &directional, &points, &sf->lights[i])) return false;
+            if (!parse_light(c, it, i, &directional, &sf->lights[i])) return false;
             ob_json_pop(&c->rd, m);
         }
         ob_json_pop(&c->rd, mark);

@@ -239,7 +239,10 @@ static ob_result add_light(loader *L, const char *name, const ob_light_desc *des
      * light instead. Intensity 0 is literal and needs nothing here. */
     bool black = desc->color[0] == 0.0f && desc->color[1] == 0.0f && desc->color[2] == 0.0f;
     ob_node_set_hidden(n, black);
-    if (desc->type == OB_LIGHT_DIRECTIONAL && (r = ob_light_aim(n, direction)) != OB_OK) return r;
+    /* Directional and spot lights shine along the node's forward. Aimed
+     * from the origin: position + direction could round back to a far-away
+     * position, and a directional light's position is unused. */
+    if (desc->type != OB_LIGHT_POINT && (r = ob_light_aim(n, direction)) != OB_OK) return r;
     ob_node_set_position(n, position);
     return OB_OK;
 }

@@ -206,3 +206,29 @@ mirror = {
 }
 mirror.update(buf.gltf_fields())
 dump("mirror.gltf", mirror)
+
+# lights.gltf: KHR_lights_punctual on nodes: a point light with a range, a
+# spot light aimed down (rotated -90 degrees about X: its -Z becomes -Y) and
+# a directional one, over a white quad. glTF folds nothing: assimp
+# multiplies colour by intensity, the loader splits them again.
+buf = Buffer()
+s = 0.5 ** 0.5
+lights = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2, 3]}],
+    "extensionsUsed": ["KHR_lights_punctual"],
+    "extensions": {"KHR_lights_punctual": {"lights": [
+        {"name": "lamp", "type": "point", "color": [1, 0.5, 0.25], "intensity": 4, "range": 5},
+        {"name": "torch", "type": "spot", "intensity": 2,
+         "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}},
+        {"name": "sky", "type": "directional", "color": [0.5, 0.5, 1]}]}},
+    "nodes": [{"name": "floor", "mesh": 0},
+              {"name": "lamp_node", "translation": [0, 0, 2],
+               "extensions": {"KHR_lights_punctual": {"light": 0}}},
+              {"name": "torch_node", "translation": [1, 0, 3], "rotation": [-s, 0, 0, s],
+               "extensions": {"KHR_lights_punctual": {"light": 1}}},
+              {"name": "sky_node", "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+    "meshes": [{"name": "quad", "primitives": [dict(quad(buf), material=0)]}],
+    "materials": [{"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}}],
+}
+lights.update(buf.gltf_fields())
+dump("lights.gltf", lights)
