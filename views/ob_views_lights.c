@@ -172,7 +172,9 @@ void ob_views_report_light_limit(ob_views *ctx, ob_renderer *r)
         }
         over++;
         uint32_t id = ob_node_id(lights[i]);
-        if (bsearch(&id, ctx->over_limit, ctx->over_limit_count, sizeof id, compare_ids)) continue;
+        if (ctx->over_limit_count &&
+            bsearch(&id, ctx->over_limit, ctx->over_limit_count, sizeof id, compare_ids))
+            continue;   /* (bsearch takes no NULL array, even an empty one) */
         OB_LOG_W("views", "light '%s' (id %u): over the limit of %u point and spot lights a "
                  "scene (docs/limits.md); it lights nothing", ob_node_name(lights[i]), id,
                  OB_MAX_LIGHTS);
