@@ -245,6 +245,14 @@ static ob_result create_samplers(ob_material_library *lib)
             .compare_op = VK_COMPARE_OP_GREATER_OR_EQUAL,   /* reversed-Z: nearer is greater */
             .name = specs[i].param,
         };
+        if (i == SAMPLER_ENV) {
+            /* Env maps have mips, sampled by roughness (envmap.glsl). */
+            sd.detailed = true;
+            sd.mag_filter = sd.min_filter = VK_FILTER_LINEAR;
+            sd.mipmap_mode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+            sd.address_u = sd.address_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+            sd.max_lod = VK_LOD_CLAMP_NONE;
+        }
         lib->samplers[i] = ob_sampler_create(lib->dev, &sd, &r);
         if (!lib->samplers[i].id) {
             OB_LOG_E("material", "default sampler '%s' not created: %s", specs[i].param,
@@ -362,11 +370,13 @@ static void set_render_flags(ob_material *m)
     case OB_MATERIAL_REFLECTIVE:
         m->render[OB_VIEW_PERSPECTIVE] = true;
         m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_CUBE] = true;
         m->render[OB_VIEW_SHADOW] = m->casts_shadows;
         break;
     case OB_MATERIAL_PBR:
         m->render[OB_VIEW_PERSPECTIVE] = true;
         m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_CUBE] = true;
         m->render[OB_VIEW_SHADOW] = m->casts_shadows;
         break;
     case OB_MATERIAL_UNLIT:
@@ -516,7 +526,9 @@ bool ob_material_view_depends_on(const ob_view *v, ob_view_type type)
 
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity)
 {
-    return r && entity ? ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID) : NULL;
+    if (!r || !entity) return NULL;
+    ob_view *env = ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID);
+    return env ? env : ob_renderer_attached_view(r, entity, OB_VIEW_CUBE);
 }
 
 /* The effect a material wants in view v; false when it is not drawn there. */
@@ -551,6 +563,12 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
         return true;
     case OB_VIEW_PARABOLOID:
         out->kind = OB_STD_PARABOLOID;
+        out->variant = blended | instanced;
+        return true;
+    case OB_VIEW_CUBE:
+        /* A cube face is a plain 90-degree camera: no shadows, and no
+         * reflections (as in a paraboloid map) — it depends on no other map. */
+        out->kind = m->kind == OB_MATERIAL_UNLIT ? OB_STD_UNLIT : OB_STD_LIT;
         out->variant = blended | instanced;
         return true;
     case OB_VIEW_OVERLAY:

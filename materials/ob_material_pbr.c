@@ -295,6 +295,11 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
         *out_key = key;
         return true;
     }
+    case OB_VIEW_CUBE:
+        /* A cube face draws like a camera without shadows or reflections. */
+        *out_slot = OB_PBR_PASS_MAIN;
+        *out_key = f | inst;
+        return true;
     case OB_VIEW_PARABOLOID:
         *out_slot = OB_PBR_PASS_PARABOLOID;
         *out_key = OB_PBR_P_PARABOLOID | inst | (f & ~OB_PBR_F_DOUBLE_SIDED);

@@ -7,12 +7,20 @@
 /* Dual-paraboloid environment map of one entity: layer 0 holds the +Z
  * hemisphere around the owner's centre, layer 1 the -Z one. The map's frame
  * is the world's (ViewMatrix and EnvMapMatrix are identity), so reflective
- * lookups only need the reflection vector. */
+ * lookups only need the reflection vector. Linear HDR (OB_VIEWS_ENV_FORMAT)
+ * with a full mip chain the renderer blits after the map renders.
+ *
+ * The projection is per vertex: a triangle's straight edges stay straight in
+ * the map while the true image of a long edge is curved, so a large
+ * polygon (a floor of one quad) is bent — a thin band, broken at the
+ * equator where the halves meet. Subdivided geometry (a plane of 64
+ * subdivisions), or the cube map (ob_view_cube.c), avoids it: see
+ * docs/limits.md. */
 struct ob_paraboloid_view {
     ob_view base;
     ob_views *ctx;
     ob_node *owner;
-    ob_param direction, env_map, env_matrix;
+    ob_param direction, env_map, env_matrix, env_info;
     /* Per item of this frame's draw list: bit L set when its bound reaches
      * layer L's hemisphere (filled in pre_render, read by the recording). */
     uint8_t *reach;
@@ -91,6 +99,10 @@ static void paraboloid_usage_params(ob_view *v, ob_renderer *r, ob_params *param
     ob_mat4_identity(identity);
     ob_params_set_texture(params, pv->env_map, v->color);
     ob_params_set_mat4(params, pv->env_matrix, identity);
+    /* Texcoords span [-1, 1] over the side: a direction turning by dθ near
+     * a half's centre moves dθ / 2 in the paraboloid, a quarter of the side. */
+    float info[4] = {0.0f, (float)(v->color_mips ? v->color_mips - 1 : 0), 0.25f * (float)v->width, 0.0f};
+    ob_params_set_vec4(params, pv->env_info, info);
 }
 
 static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
@@ -136,16 +148,19 @@ ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_
     pv->owner = owner;
     pv->base.no_frustum = true;
     pv->base.clear_depth = 0.0f;
-    static const float sky[4] = {0.35f, 0.45f, 0.6f, 1.0f};
-    memcpy(pv->base.clear_color, sky, sizeof sky);
+    /* The clear colour is the first camera's of each frame (queue_hook):
+     * the sky a reflection shows is the one around the object. */
+    pv->base.clear_color[3] = 1.0f;
+    pv->base.color_mips = ob_image_mip_levels_max(ctx->env_map_size, ctx->env_map_size);
     ob_param_registry *reg = ob_renderer_registry(ctx->r);
     pv->direction = ob_param_find(reg, "ParaboloidDirection");
     pv->env_map = ob_param_find(reg, "EnvMap");
     pv->env_matrix = ob_param_find(reg, "EnvMapMatrix");
+    pv->env_info = ob_param_find(reg, "EnvMapInfo");
     if (!pv->env_matrix.id) pv->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
     if (r == OB_OK)
         r = ob_views_make_target(ctx, &pv->base, ctx->env_map_size, ctx->env_map_size, 2,
-                                 OB_VIEWS_COLOR_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+                                 OB_VIEWS_ENV_FORMAT, OB_VIEWS_DEPTH_FORMAT);
     if (r != OB_OK) {
         ob_free(pv);
         pv = NULL;

@@ -38,7 +38,7 @@ static ob_result register_params(ob_param_registry *reg)
         "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "PointLight0Position",
         "PointLight1Position", "PointLight2Position", "PointLight3Position", "PointLight0Color",
         "PointLight1Color", "PointLight2Color", "PointLight3Color", "ParaboloidDirection",
-        "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
+        "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap", "EnvMapInfo",
     };
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
@@ -119,12 +119,12 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
 /* One image of a view's targets, named "<view>.<what>". */
 static ob_image make_image(ob_views *ctx, const ob_view *v, const char *what, uint32_t width,
                            uint32_t height, uint32_t layers, VkFormat format, uint32_t usage,
-                           uint32_t samples, ob_result *out_result)
+                           uint32_t samples, uint32_t mips, ob_result *out_result)
 {
     char name[64];
     snprintf(name, sizeof name, "%s.%s", v->name, what);
     ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = format,
-                       .usage = usage, .samples = samples, .name = name};
+                       .usage = usage, .samples = samples, .name = name, .mip_levels = mips};
     return ob_image_create(ctx->dev, &d, out_result);
 }
 
@@ -136,22 +136,31 @@ ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32
      * resolved into the single-sampled `color` consumers read. */
     uint32_t samples = layers == 1 && v->samples > 1 ? v->samples : 1;
     ob_image img[4] = {{0}};   /* color, depth, msaa_color, msaa_depth */
+    /* Mips (v->color_mips) only where the device blits the format linearly;
+     * otherwise one level, said once per target. */
+    uint32_t mips = OB_MIN(v->color_mips ? v->color_mips : 1, ob_image_mip_levels_max(width, height));
+    if (mips > 1 && color != VK_FORMAT_UNDEFINED && !ob_image_format_blits_linear(ctx->dev, color)) {
+        OB_LOG_W("views", "view '%s': format %d cannot be blitted linearly on '%s'; its colour "
+                 "target has no mips (rough reflections come out sharp)", v->name, (int)color,
+                 ob_device_name(ctx->dev));
+        mips = 1;
+    }
     if (color != VK_FORMAT_UNDEFINED) {
         img[0] = make_image(ctx, v, "color", width, height, layers, color,
                             OB_IMAGE_COLOR_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC |
-                                OB_IMAGE_TRANSFER_DST, 1, &r);
+                                OB_IMAGE_TRANSFER_DST, 1, mips, &r);
         if (r == OB_OK && samples > 1)
             img[2] = make_image(ctx, v, "color.msaa", width, height, 1, color,
-                                OB_IMAGE_COLOR_TARGET, samples, &r);
+                                OB_IMAGE_COLOR_TARGET, samples, 1, &r);
     }
     if (r == OB_OK && depth != VK_FORMAT_UNDEFINED) {
         if (samples > 1)
             img[3] = make_image(ctx, v, "depth.msaa", width, height, 1, depth,
-                                OB_IMAGE_DEPTH_TARGET, samples, &r);
+                                OB_IMAGE_DEPTH_TARGET, samples, 1, &r);
         else
             img[1] = make_image(ctx, v, "depth", width, height, layers, depth,
                                 OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
-                                1, &r);
+                                1, 1, &r);
     }
     if (r != OB_OK) {
         for (int i = 0; i < 4; i++) ob_image_destroy(ctx->dev, img[i]);
@@ -162,6 +171,7 @@ ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32
     v->msaa_color = img[2];
     v->msaa_depth = img[3];
     v->samples = samples;
+    v->color_mips = color != VK_FORMAT_UNDEFINED ? mips : v->color_mips;
     v->width = width;
     v->height = height;
     v->layer_count = layers;
@@ -277,33 +287,68 @@ static ob_result add_entry(ob_views_entry **list, uint32_t *count, uint32_t *cap
 /* The material library asks for the views an entity needs (its env map, its
  * simulation). Each is created on first need and pre-drawn with the current
  * view as its consumer. */
+static void env_destroy(ob_views *ctx, ob_view *view, void *object)
+{
+    if (view->type == OB_VIEW_CUBE)
+        ob_cube_view_destroy(ctx, object);
+    else
+        ob_paraboloid_view_destroy(ctx, object);
+}
+
+/* The env map of an entity: made on first need, of the context's kind. */
+static ob_views_entry *env_entry(ob_views *ctx, ob_renderer *r, ob_node *entity)
+{
+    uint32_t id = ob_node_id(entity);
+    ob_views_entry *e = find_entry(ctx->envs, ctx->env_count, id);
+    if (e) return e;
+    ob_result res;
+    ob_view *view = NULL;
+    void *object = NULL;
+    if (ctx->env_map_kind == OB_ENV_MAP_CUBE) {
+        ob_cube_view *cv = ob_cube_view_create(ctx, entity, &res);
+        if (cv) view = ob_cube_view_base(cv);
+        object = cv;
+    } else {
+        ob_paraboloid_view *pv = ob_paraboloid_view_create(ctx, entity, &res);
+        if (pv) view = ob_paraboloid_view_base(pv);
+        object = pv;
+    }
+    if (!view) {
+        OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
+                 ob_node_name(entity), id, ob_result_name(res));
+        ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+        return NULL;
+    }
+    if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap, (ob_views_entry){id, view, object}) != OB_OK) {
+        OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
+                 "skipped this frame", ob_node_name(entity), id);
+        ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
+        env_destroy(ctx, view, object);
+        return NULL;
+    }
+    return &ctx->envs[ctx->env_count - 1];
+}
+
+/* The material library asks for the views an entity needs (its env map, its
+ * simulation). Each is created on first need and pre-drawn with the current
+ * view as its consumer. */
 static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *requesting,
                        ob_view_type needed)
 {
     ob_views *ctx = user;
-    (void)requesting;
     uint32_t id = ob_node_id(entity);
-    if (needed == OB_VIEW_PARABOLOID) {
-        ob_views_entry *e = find_entry(ctx->envs, ctx->env_count, id);
-        if (!e) {
-            ob_result res;
-            ob_paraboloid_view *pv = ob_paraboloid_view_create(ctx, entity, &res);
-            if (!pv) {
-                OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
-                         ob_node_name(entity), id, ob_result_name(res));
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
-                return;
-            }
-            if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
-                          (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
-                OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
-                         "skipped this frame", ob_node_name(entity), id);
-                ob_renderer_note_skipped(r, ob_node_name(entity), OB_SKIP_ERROR);
-                ob_paraboloid_view_destroy(ctx, pv);
-                return;
-            }
-            e = &ctx->envs[ctx->env_count - 1];
+    if (needed == OB_VIEW_PARABOLOID || needed == OB_VIEW_CUBE) {
+        ob_views_entry *e = env_entry(ctx, r, entity);
+        if (!e) return;
+        /* The map shows the sky around its owner: the context's sky colour,
+         * else the clear colour of the first view that asks for it this
+         * frame (PreRender's order is fixed, so ST and MT agree). */
+        if (ctx->sky_color[3] > 0.0f) {
+            memcpy(e->view->clear_color, ctx->sky_color, 3 * sizeof(float));
+        } else if (requesting && e->view->queued_frame != ob_renderer_frame_serial(r)) {
+            memcpy(e->view->clear_color, requesting->clear_color, 3 * sizeof(float));
         }
+        e->view->clear_color[3] = 1.0f;
         ob_renderer_pre_render(r, e->view);
         /* Only a map that renders this frame is sampled: one left out (past
          * the recursion bound, say) was never written, so the entity is
@@ -441,6 +486,13 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ctx->effects = desc->effects;
     ctx->env_map_size = desc->env_map_size ? desc->env_map_size : 256;
     ctx->shadow_map_size = desc->shadow_map_size ? desc->shadow_map_size : 1024;
+    if ((unsigned)desc->env_map_kind >= OB_ENV_MAP_KIND_COUNT) {
+        OB_LOG_E("views", "env_map_kind %d is not a kind of environment map", (int)desc->env_map_kind);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail_destroy_views;
+    }
+    ctx->env_map_kind = desc->env_map_kind;
+    memcpy(ctx->sky_color, desc->sky_color, sizeof ctx->sky_color);
     static const float default_ambient[4] = {1.0f, 1.0f, 1.0f, 0.15f};
     memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
     ctx->dt = 1.0 / 60.0;
@@ -468,7 +520,7 @@ void ob_views_destroy(ob_views *ctx)
     for (uint32_t i = 0; i < ctx->shadow_count; i++)
         ob_shadow_view_destroy(ctx, ctx->shadows[i].owner_object);
     for (uint32_t i = 0; i < ctx->env_count; i++)
-        ob_paraboloid_view_destroy(ctx, ctx->envs[i].owner_object);
+        env_destroy(ctx, ctx->envs[i].view, ctx->envs[i].owner_object);
     ob_free(ctx->shadows);
     ob_free(ctx->envs);
     ob_free(ctx->systems);
@@ -488,6 +540,24 @@ void ob_views_set_time(ob_views *ctx, double time, double dt)
 }
 
 void ob_views_set_env_map_size(ob_views *ctx, uint32_t size) { ctx->env_map_size = size ? size : 256; }
+bool ob_views_set_env_map_kind(ob_views *ctx, ob_env_map_kind kind)
+{
+    if ((unsigned)kind >= OB_ENV_MAP_KIND_COUNT) {
+        OB_LOG_E("views", "env map kind %d is not a kind of environment map; kept %s", (int)kind,
+                 ctx->env_map_kind == OB_ENV_MAP_CUBE ? "cube" : "paraboloid");
+        return false;
+    }
+    ctx->env_map_kind = kind;
+    return true;
+}
+
+ob_env_map_kind ob_views_env_map_kind(const ob_views *ctx) { return ctx->env_map_kind; }
+
+void ob_views_set_sky_color(ob_views *ctx, const float rgba[4])
+{
+    memcpy(ctx->sky_color, rgba, sizeof ctx->sky_color);
+}
+
 void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
 {
     ctx->shadow_map_size = size ? size : 1024;

@@ -11,11 +11,12 @@
 
 typedef struct ob_shadow_view ob_shadow_view;
 typedef struct ob_paraboloid_view ob_paraboloid_view;
+typedef struct ob_cube_view ob_cube_view;
 
 typedef struct ob_views_entry {
     uint32_t node_id;
     ob_view *view;
-    void *owner_object;          /* the concrete view (shadow/paraboloid) or particle system */
+    void *owner_object;          /* the concrete view (shadow/paraboloid/cube) or particle system */
 } ob_views_entry;
 
 struct ob_views {
@@ -24,6 +25,8 @@ struct ob_views {
     ob_material_library *materials;
     ob_effect_context *effects;
     uint32_t env_map_size, shadow_map_size;
+    ob_env_map_kind env_map_kind;
+    float sky_color[4];          /* alpha 0: none, use the asking camera's clear colour */
     float ambient[4];
     double time, dt;
     ob_effect_counters counted;  /* effect counters already reported to the stats */
@@ -47,6 +50,10 @@ void ob_shadow_view_set_consumer(ob_shadow_view *v, ob_view *consumer);
 ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
 void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v);
 ob_view *ob_paraboloid_view_base(ob_paraboloid_view *v);
+
+ob_cube_view *ob_cube_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
+void ob_cube_view_destroy(ob_views *ctx, ob_cube_view *v);
+ob_view *ob_cube_view_base(ob_cube_view *v);
 
 /* Particle systems by emitter node: the perspective view queues the
  * simulation of every emitter it sees (ob_views_queue_simulations). */

@@ -168,13 +168,14 @@ void ob_scene_unload(ob_scene_loaded *l);
 
 /* The file's settings that shape a set-up, into *desc before ob_stack_create:
  * size, threads (renderer.threading and worker_count), env-map and
- * shadow-map sizes, clear colour and ambient. What the file does not give
+ * shadow-map sizes, env-map kind, clear colour, sky colour and ambient. What the file does not give
  * is left as it was. [any thread] */
 void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_desc *desc);
 
 /* The file's settings a live set-up can take: threading (from the next
- * frame) and env-map and shadow-map sizes (for views made afterwards, as
- * entities' maps are, on first need). [render thread, between frames] */
+ * frame), env-map and shadow-map sizes and the env-map kind (for views made
+ * afterwards, as entities' maps are, on first need) and the sky colour
+ * (from the next frame). [render thread, between frames] */
 void ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
                                   const ob_scene_file_settings *settings);
 
