@@ -31,6 +31,7 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
         .clear_color = {0.1f, 0.2f, 0.3f, 1.0f},
         .camera = {.fovy = 1.0f, .znear = 0.1f},
         .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size,
+        .env_map_kind = d.env_map_kind,
     }};
     ob_result r = ob_world_create(&s->world, &wd);
     if (r != OB_OK) ob_test_stack_stop(s);

@@ -9,7 +9,7 @@
  *
  * The scene (ob_test_stack_build_scene) is tiny but exercises every lazy
  * path of a first frame: a shadow-casting directional light and caster, a
- * reflective sphere (a paraboloid environment map), a particle system (a
+ * reflective sphere (a paraboloid or cube environment map), a particle system (a
  * compute simulation and a blended draw) and the composite to the final
  * target. Its image depends only on the frame index, never on earlier
  * frames: the particles live shorter than a frame, so every step respawns
@@ -31,6 +31,7 @@ typedef struct ob_test_stack_desc {
     uint32_t width, height;    /* 0 → 48 x 32 */
     uint32_t env_map_size;     /* 0 → 16 */
     uint32_t shadow_map_size;  /* 0 → 32 */
+    ob_env_map_kind env_map_kind;  /* 0 → paraboloid; the reflective sphere's map kind */
     const char *cache_dir;     /* NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack */
     /* The application's instance and device (ob_test_adopt.h) for walks
      * that start many stacks; NULL → the engine's own. */

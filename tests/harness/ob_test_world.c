@@ -27,6 +27,7 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     if (d.shadow_map_size) sd->shadow_map_size = d.shadow_map_size;
     if (d.clear_color[3] > 0.0f) memcpy(sd->clear_color, d.clear_color, sizeof sd->clear_color);
     sd->msaa = d.msaa;
+    sd->env_map_kind = d.env_map_kind;
     ob_world_create(w, &wd);
 }
 

@@ -27,6 +27,7 @@ typedef struct ob_test_world_desc {
     uint32_t chunk_draws;      /* renderer's draws per job; 0 → the renderer's default */
     uint32_t parallel_grain;   /* renderer's entities per parallel-loop index; 0 → default */
     uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
+    ob_env_map_kind env_map_kind;  /* 0 → paraboloid */
 } ob_test_world_desc;
 
 /* The world itself: its fields (w.r, w.lib, w.box, w.pixels, ...) are the
