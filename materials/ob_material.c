@@ -402,7 +402,7 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
         goto fail_log;
     }
     if (!all_finite(desc->diffuse, 4) || !all_finite(desc->specular, 4) ||
-        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity)) {
+        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity) || !isfinite(desc->roughness)) {
         OB_LOG_E("material", "material '%s': non-finite colour or reflectivity", name);
         r = OB_ERR_NON_FINITE;
         goto fail_log;
@@ -427,6 +427,8 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
                          : desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
                          : desc->reflectivity != 0.0f          ? desc->reflectivity
                                                                : 0.6f;
+    if (desc->kind == OB_MATERIAL_REFLECTIVE)   /* Reflectivity.y: lit.frag's blur */
+        m->reflectivity[1] = OB_MIN(OB_MAX(desc->roughness, 0.0f), 1.0f);
     m->casts_shadows = desc->casts_shadows;
     m->blended = desc->blended;
     if (desc->kind == OB_MATERIAL_PBR) {
@@ -511,7 +513,7 @@ ob_result ob_material_set_emissive(ob_material *m, const float rgb[4])
 }
 ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity)
 {
-    float v[4] = {reflectivity, 0, 0, 0};
+    float v[4] = {reflectivity, m ? m->reflectivity[1] : 0.0f, 0, 0};   /* roughness kept */
     return set_color(m, m ? m->reflectivity : NULL, v);
 }
 

@@ -7,8 +7,9 @@
 //               (shadow.glsl: compare sampler, 2x2 PCF).
 //   ENVMAP      reflective surfaces: the reflected view vector, rotated by
 //               EnvMapMatrix, samples "EnvMap" (envmap.glsl: dual paraboloid
-//               or cube, by EnvMapInfo) at level 0 (a mirror); mixed over the
-//               lit colour by Reflectivity.x.
+//               or cube, by EnvMapInfo) at the mip level of roughness
+//               Reflectivity.y (0: level 0, a mirror); mixed over the lit
+//               colour by Reflectivity.x.
 //   PARABOLOID  paired with paraboloid.vert: discards the other hemisphere.
 // Output is premultiplied alpha (the blend state is ONE, ONE_MINUS_SRC_ALPHA).
 #include "common.glsl"
@@ -58,7 +59,8 @@ void main()
                + ob_point_lights(vPosition, n, v, diffuse, SpecularColor);
 #if defined(ENVMAP)
     vec3 r = reflect(-v, n);
-    vec3 env = ob_env_sample(EnvMap, mat3(EnvMapMatrix) * r, 0.0);
+    float rough = clamp(Reflectivity.y, 0.0, 1.0);
+    vec3 env = ob_env_sample(EnvMap, mat3(EnvMapMatrix) * r, ob_env_lod(rough * rough));
     color = mix(color, env, clamp(Reflectivity.x, 0.0, 1.0));
 #endif
     float alpha = DiffuseColor.a;

@@ -242,7 +242,7 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
 static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
 {
     static const char *const keys[] = {"kind", "diffuse", "specular", "emissive", "reflectivity",
-                                       "casts_shadows", "blended", "priority"};
+                                       "roughness", "casts_shadows", "blended", "priority"};
     if (!ob_json_check_object(&c->rd, j, "a material object or the name of one", keys, OB_ARRAY_COUNT(keys)))
         return false;
     ob_material_desc *d = &m->desc;
@@ -285,11 +285,16 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
         ob_json_push_key(&c->rd, "reflectivity");
         return ob_json_fail(&c->rd, "only a \"reflective\" material has a reflectivity");
     }
+    if (ob_json_member(j, "roughness") && d->kind != OB_MATERIAL_REFLECTIVE) {
+        ob_json_push_key(&c->rd, "roughness");
+        return ob_json_fail(&c->rd, "only a \"reflective\" material has a roughness");
+    }
     memcpy(d->diffuse, diffuse, sizeof diffuse);
     memcpy(d->specular, specular, sizeof specular);
     memcpy(d->emissive, emissive, sizeof emissive);
     double prio = 0;
     if (!ob_json_opt_float(&c->rd, j, "reflectivity", OB_JSON_RANGE(0, 1), &d->reflectivity) ||
+        !ob_json_opt_float(&c->rd, j, "roughness", OB_JSON_RANGE(0, 1), &d->roughness) ||
         !ob_json_opt_bool(&c->rd, j, "casts_shadows", &d->casts_shadows) || !ob_json_opt_bool(&c->rd, j, "blended", &d->blended) ||
         !ob_json_opt_double(&c->rd, j, "priority", OB_JSON_INT(0, 1000000), &prio))
         return false;
