@@ -20,7 +20,7 @@ struct ob_cube_view {
     ob_view base;
     ob_views *ctx;
     ob_node *owner;
-    ob_param env_map, env_matrix, env_info;
+    ob_env_params env;
     float proj[16];
     /* Per item of this frame's draw list: bit F set when its bound reaches
      * face F's frustum (filled in post_cull, read by the recording). */
@@ -61,61 +61,36 @@ static void face_view(uint32_t face, float dest[16])
 
 /* An item reaches face F when its bound is not wholly outside one of the
  * four planes through the centre that bound the face (normals forward ±
- * right, forward ± up, unnormalised: the test scales the radius). Widened
- * as the paraboloid's, so no vertex can round across a plane. */
-static void cube_reach(ob_cube_view *cv)
+ * right, forward ± up, of length sqrt 2: the radius is scaled by it). */
+static uint8_t cube_faces(const double rel[3], double radius)
 {
-    ob_view *v = &cv->base;
-    cv->reach_valid = ob_array_reserve((void **)&cv->reach, &cv->reach_cap, v->item_count,
-                                       sizeof *cv->reach) == OB_OK;
-    if (!cv->reach_valid) {
-        OB_LOG_W("view", "view '%s': no memory for the per-face item masks; every item is drawn "
-                 "in every face this frame", v->name);
-        return;
-    }
-    for (uint32_t i = 0; i < v->item_count; i++) {
-        double c[3];
-        float radius;
-        ob_view_item_sphere(v, i, c, &radius);
-        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
-        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
-        double reach = ((double)radius + ((double)radius + dist) * 1e-5 + 1e-6) * sqrt(2.0);
-        uint8_t mask = 0;
-        for (uint32_t face = 0; face < 6; face++) {
-            const float *f = face_forward[face], *u = face_up[face];
-            float r[3];
-            cross3(f, u, r);
-            double df = 0, dr = 0, du = 0;
-            for (int k = 0; k < 3; k++) {
-                df += rel[k] * f[k];
-                dr += rel[k] * r[k];
-                du += rel[k] * u[k];
-            }
-            bool in = df - dr >= -reach && df + dr >= -reach && df - du >= -reach && df + du >= -reach;
-            if (in) mask |= (uint8_t)(1u << face);
+    uint8_t mask = 0;
+    double reach = radius * 1.4142135623730951;
+    for (uint32_t face = 0; face < 6; face++) {
+        const float *f = face_forward[face], *u = face_up[face];
+        float rt[3];
+        cross3(f, u, rt);
+        double df = 0, dr = 0, du = 0;
+        for (int k = 0; k < 3; k++) {
+            df += rel[k] * f[k];
+            dr += rel[k] * rt[k];
+            du += rel[k] * u[k];
         }
-        cv->reach[i] = mask;
+        if (df - dr >= -reach && df + dr >= -reach && df - du >= -reach && df + du >= -reach)
+            mask |= (uint8_t)(1u << face);
     }
+    return mask;
 }
 
 static bool cube_pre_cull(ob_view *v, ob_renderer *r)
 {
-    ob_cube_view *cv = (ob_cube_view *)v;
-    if (!ob_renderer_queue_view(r, v)) return false;
-    float radius;
-    ob_node_world_sphere(cv->owner, v->origin, &radius);
-    ob_mat4_identity(v->view_proj);
-    v->cull_exclude = cv->owner;
-    return true;
+    return ob_views_env_pre_cull(v, r, ((ob_cube_view *)v)->owner);
 }
 
 static void cube_post_cull(ob_view *v, ob_renderer *r)
 {
     ob_cube_view *cv = (ob_cube_view *)v;
-    cube_reach(cv);
-    ob_view_pre_render_items(v, r);
-    ob_views_queue_simulations(cv->ctx, r, v);
-    ob_material_library_prepare_view(cv->ctx->materials, r, v);
+    ob_views_env_post_cull(cv->ctx, v, r, cube_faces, &cv->reach, &cv->reach_cap, &cv->reach_valid);
 }
 
 static void cube_render_params(ob_view *v, ob_renderer *r, ob_params *params)
@@ -132,15 +107,9 @@ static void cube_usage_params(ob_view *v, ob_renderer *r, ob_params *params, con
     ob_cube_view *cv = (ob_cube_view *)v;
     (void)r;
     (void)consumer;
-    float identity[16];
-    ob_mat4_identity(identity);
-    ob_params_set_texture(params, cv->env_map, v->color);
-    ob_params_set_mat4(params, cv->env_matrix, identity);
     /* A face spans 90 degrees over its side: 2 / pi of it per radian at
      * the centre. */
-    float info[4] = {1.0f, (float)(v->color_mips ? v->color_mips - 1 : 0),
-                     (float)(2.0 / CUBE_PI) * (float)v->width, 0.0f};
-    ob_params_set_vec4(params, cv->env_info, info);
+    ob_views_env_usage(&cv->env, v, params, 1.0f, (float)(2.0 / CUBE_PI) * (float)v->width);
 }
 
 static void cube_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t layer,
@@ -151,16 +120,8 @@ static void cube_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uin
     face_view(layer, view);
     const ob_param_builtins *b = ob_param_registry_builtins(ob_renderer_registry(r));
     ob_params_set_mat4(ob_pipeline_manager_params(pm), b->view, view);
-    /* Runs of items this face draws are recorded together. */
-    uint32_t end = first + count < v->item_count ? first + count : v->item_count;
-    uint32_t run = first;
-    uint8_t bit = (uint8_t)(1u << layer);
-    for (uint32_t i = first; i < end && cv->reach_valid; i++) {
-        if (cv->reach[i] & bit) continue;
-        if (i > run) ob_view_record_items(v, r, pm, run, i - run);
-        run = i + 1;
-    }
-    if (end > run) ob_view_record_items(v, r, pm, run, end - run);
+    ob_views_record_masked(v, r, pm, first, count, cv->reach_valid ? cv->reach : NULL,
+                           (uint8_t)(1u << layer));
 }
 
 static const ob_view_vtbl cube_vtbl = {
@@ -180,24 +141,10 @@ ob_cube_view *ob_cube_view_create(ob_views *ctx, ob_node *owner, ob_result *out_
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto done;
     }
-    char name[48];
-    snprintf(name, sizeof name, "cubemap:%s", ob_node_name(owner));
-    ob_view_init(&cv->base, &cube_vtbl, OB_VIEW_CUBE, name);
     cv->ctx = ctx;
     cv->owner = owner;
-    cv->base.no_frustum = true;
-    cv->base.clear_depth = 0.0f;
-    cv->base.clear_color[3] = 1.0f;   /* the first camera's each frame (queue_hook) */
-    cv->base.color_mips = ob_image_mip_levels_max(ctx->env_map_size, ctx->env_map_size);
     ob_math_perspective_reverse_z((float)(CUBE_PI / 2.0), 1.0f, CUBE_NEAR, cv->proj);
-    ob_param_registry *reg = ob_renderer_registry(ctx->r);
-    cv->env_map = ob_param_find(reg, "EnvMap");
-    cv->env_matrix = ob_param_find(reg, "EnvMapMatrix");
-    cv->env_info = ob_param_find(reg, "EnvMapInfo");
-    if (!cv->env_matrix.id) cv->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
-    if (r == OB_OK)
-        r = ob_views_make_target(ctx, &cv->base, ctx->env_map_size, ctx->env_map_size, 6,
-                                 OB_VIEWS_ENV_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+    r = ob_views_env_view_init(ctx, &cv->base, &cube_vtbl, OB_VIEW_CUBE, "cubemap", owner, 6, &cv->env);
     if (r != OB_OK) {
         ob_free(cv);
         cv = NULL;

@@ -114,6 +114,86 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
     }
 }
 
+/* ------------------------------------------------------------ env maps */
+
+ob_result ob_views_env_view_init(ob_views *ctx, ob_view *v, const ob_view_vtbl *vtbl,
+                                 ob_view_type type, const char *prefix, const ob_node *owner,
+                                 uint32_t layers, ob_env_params *env)
+{
+    char name[48];
+    snprintf(name, sizeof name, "%s:%s", prefix, ob_node_name(owner));
+    ob_view_init(v, vtbl, type, name);
+    v->no_frustum = true;
+    v->clear_depth = 0.0f;
+    v->clear_color[3] = 1.0f;
+    v->color_mips = ob_image_mip_levels_max(ctx->env_map_size, ctx->env_map_size);
+    ob_param_registry *reg = ob_renderer_registry(ctx->r);
+    ob_result r = OB_OK;
+    env->env_map = ob_param_find(reg, "EnvMap");
+    env->env_info = ob_param_find(reg, "EnvMapInfo");
+    env->env_matrix = ob_param_find(reg, "EnvMapMatrix");
+    if (!env->env_matrix.id) env->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
+    if (r != OB_OK) return r;
+    return ob_views_make_target(ctx, v, ctx->env_map_size, ctx->env_map_size, layers,
+                                OB_VIEWS_ENV_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+}
+
+void ob_views_env_usage(const ob_env_params *p, const ob_view *v, ob_params *params, float kind,
+                        float texels_per_radian)
+{
+    float identity[16];
+    ob_mat4_identity(identity);
+    ob_params_set_texture(params, p->env_map, v->color);
+    ob_params_set_mat4(params, p->env_matrix, identity);
+    float info[4] = {kind, (float)(v->color_mips ? v->color_mips - 1 : 0), texels_per_radian, 0.0f};
+    ob_params_set_vec4(params, p->env_info, info);
+}
+
+bool ob_views_env_pre_cull(ob_view *v, ob_renderer *r, const ob_node *owner)
+{
+    if (!ob_renderer_queue_view(r, v)) return false;
+    float radius;
+    ob_node_world_sphere(owner, v->origin, &radius);
+    ob_mat4_identity(v->view_proj);
+    v->cull_exclude = owner;
+    return true;
+}
+
+void ob_views_env_post_cull(ob_views *ctx, ob_view *v, ob_renderer *r, ob_env_layer_mask_fn mask_of,
+                            uint8_t **masks, uint32_t *cap, bool *valid)
+{
+    *valid = ob_array_reserve((void **)masks, cap, v->item_count, sizeof **masks) == OB_OK;
+    if (!*valid)
+        OB_LOG_W("view", "view '%s': no memory for the per-layer item masks; every item is drawn "
+                 "in every layer this frame", v->name);
+    for (uint32_t i = 0; *valid && i < v->item_count; i++) {
+        double c[3];
+        float radius;
+        ob_view_item_sphere(v, i, c, &radius);
+        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
+        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+        (*masks)[i] = mask_of(rel, (double)radius + ((double)radius + dist) * 1e-5 + 1e-6);
+    }
+    ob_view_pre_render_items(v, r);
+    /* A particle system the map sees must step before the map draws it and
+     * hand it its parameters (it becomes a dependency), as for a camera. */
+    ob_views_queue_simulations(ctx, r, v);
+    ob_material_library_prepare_view(ctx->materials, r, v);
+}
+
+void ob_views_record_masked(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t first,
+                            uint32_t count, const uint8_t *mask, uint8_t bit)
+{
+    uint32_t end = first + count < v->item_count ? first + count : v->item_count;
+    uint32_t run = first;
+    for (uint32_t i = first; i < end && mask; i++) {
+        if (mask[i] & bit) continue;
+        if (i > run) ob_view_record_items(v, r, pm, run, i - run);
+        run = i + 1;
+    }
+    if (end > run) ob_view_record_items(v, r, pm, run, end - run);
+}
+
 /* ------------------------------------------------------------ targets */
 
 /* One image of a view's targets, named "<view>.<what>". */
