@@ -75,12 +75,13 @@ void ob_views_set_time(ob_views *ctx, double time, double dt);
 void ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
 void ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
 /* Env map kind for maps created afterwards (an entity keeps the map it has);
- * an unknown kind is refused: logged, false, the old kind kept. */
+ * an unknown kind is refused: logged, false, the old kind kept. [render
+ * thread, between frames] */
 bool ob_views_set_env_map_kind(ob_views *ctx, ob_env_map_kind kind);
 ob_env_map_kind ob_views_env_map_kind(const ob_views *ctx);
 /* What env maps clear to from the next frame on (ob_views_desc.sky_color:
  * alpha 0 → the first asking camera's clear colour). Linear, unclamped: a
- * value above 1 is an HDR sky. */
+ * value above 1 is an HDR sky. [render thread, between frames] */
 void ob_views_set_sky_color(ob_views *ctx, const float rgba[4]);
 
 /* ---------------------------------------------------------- perspective */
