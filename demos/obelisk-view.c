@@ -389,6 +389,8 @@ static void apply_settings(ob_demo_options *o, const ob_scene_file_settings *s)
     if (s->has_clear_color) memcpy(o->clear_color, s->clear_color, sizeof o->clear_color);
     if (s->has_ambient) memcpy(o->ambient, s->ambient, sizeof o->ambient);
     if (s->exposure > 0.0f && !o->exposure_given) o->exposure = s->exposure;
+    if (s->has_env_map_kind && !o->env_map_given) o->env_map_kind = s->env_map_kind;
+    if (s->has_sky_color) memcpy(o->sky_color, s->sky_color, sizeof o->sky_color);
 }
 
 int main(int argc, char **argv)

@@ -608,7 +608,7 @@ static void clear_if_undefined(ob_renderer *r, VkCommandBuffer cmd, ob_image img
     VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
                             .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &b};
     vkCmdPipelineBarrier2(cmd, &dep);
-    VkImageSubresourceRange range = {info.aspect, 0, 1, 0, info.layers};
+    VkImageSubresourceRange range = {info.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, info.layers};
     if (info.aspect & VK_IMAGE_ASPECT_DEPTH_BIT) {
         VkClearDepthStencilValue z = {0.0f, 0};
         vkCmdClearDepthStencilImage(cmd, ob_image_vk(r->dev, img),
@@ -693,11 +693,13 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
-/* The attachment view of img for one layer of v. */
+/* The attachment view of img for one layer of v: level 0 of that layer
+ * (the whole view of a single-layer image without mips). */
 static VkImageView attachment_view(ob_renderer *r, const ob_view *v, ob_image img, uint32_t layer)
 {
+    (void)v;
     if (!img.id) return VK_NULL_HANDLE;
-    return v->layer_count > 1 ? ob_image_layer_view(r->dev, img, layer) : ob_image_view(r->dev, img);
+    return ob_image_layer_view(r->dev, img, layer);
 }
 
 /* A multisampled view (one layer) draws into msaa_color / msaa_depth, which
@@ -914,6 +916,12 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
                 vs->chunks++;
             }
             if (v->layer_count > 0) vkCmdEndRendering(cmd);
+        }
+        /* Levels 1.. of a target with mips (env maps sampled by roughness),
+         * made before any consumer's barrier moves it to sampling. */
+        if (v->layer_count > 0 && v->color_mips > 1 && v->color.id) {
+            ob_renderer_note_image_state(r, v->color);
+            ob_image_record_mips(r->dev, cmd, v->color);
         }
         if (!multi) {
             ob_pipeline_manager_stats s = ob_pipeline_manager_stats_take(r->immediate);

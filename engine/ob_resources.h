@@ -88,7 +88,9 @@ typedef struct ob_image_desc {
      * are made from it on the device (a chain of linear blits; TRANSFER_SRC
      * is implied): the format must support linear blit filtering
      * (OB_ERR_UNSUPPORTED otherwise) unless data_mips is set. Sampled views
-     * cover every level; targets and read-back use level 0. */
+     * cover every level; targets and read-back use level 0 (a colour target
+     * may have mips: ob_image_record_mips fills them; a depth target may
+     * not). */
     uint32_t mip_levels;
     /* data holds every level, level 0 first, each tightly packed (mips the
      * caller made, e.g. on the CPU where the format cannot be blitted). */
@@ -104,8 +106,9 @@ bool ob_image_format_blits_linear(const ob_device *dev, VkFormat format);
 void ob_image_destroy(ob_device *dev, ob_image img);      /* deferred */
 bool ob_image_is_valid(const ob_device *dev, ob_image img);
 VkImage ob_image_vk(const ob_device *dev, ob_image img);
-/* The view over all layers (2D or 2D array), and a view of a single layer
- * (for rendering into one paraboloid half). */
+/* The view over all layers and levels (2D or 2D array), and a view of a
+ * single layer at level 0 (for rendering into one paraboloid half or cube
+ * face, or into a single-layer target with mips). */
 VkImageView ob_image_view(const ob_device *dev, ob_image img);
 VkImageView ob_image_layer_view(const ob_device *dev, ob_image img, uint32_t layer);
 typedef struct ob_image_info {
@@ -141,6 +144,16 @@ bool ob_image_transition(ob_device *dev, ob_image img, const ob_image_state *nex
  * back when recorded barriers were never submitted (a failed frame).
  * OB_ERR_INVALID_HANDLE / OB_ERR_INVALID_ARGUMENT, logged. [render thread] */
 ob_result ob_image_set_state(ob_device *dev, ob_image img, const ob_image_state *state);
+
+/* Records, into cmd, the mip chain of img made from its level 0 (linear
+ * blits, each level a box filter of the one above; every layer): for a
+ * colour target with mips after it was rendered. Transitions from the
+ * tracked state and leaves every level in TRANSFER_SRC_OPTIMAL, tracked,
+ * so the next transition (to sampling) waits for the blits. false, nothing
+ * recorded, for an invalid handle or a single level. The format must blit
+ * with linear filtering (ob_image_format_blits_linear). [render thread,
+ * recording the primary] */
+bool ob_image_record_mips(ob_device *dev, VkCommandBuffer cmd, ob_image img);
 
 /* Reads the image (layer 0) back as tightly packed RGBA8 (colour formats
  * R8G8B8A8/B8G8R8A8 UNORM/SRGB and R8G8B8A8_UINT, swizzled to RGBA, bytes as

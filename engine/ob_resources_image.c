@@ -182,10 +182,13 @@ static ob_result image_desc_check(const ob_image_desc *desc, const char *name, u
             return OB_ERR_INVALID_ARGUMENT;
         }
     }
+    /* A colour target may have mips (rendered into level 0 through its
+     * layer views, the rest made by ob_image_record_mips); a depth target
+     * may not. */
     if (desc->mip_levels > ob_image_mip_levels_max(desc->width, desc->height) ||
-        (desc->mip_levels > 1 && (desc->usage & (OB_IMAGE_COLOR_TARGET | OB_IMAGE_DEPTH_TARGET)))) {
+        (desc->mip_levels > 1 && (desc->usage & OB_IMAGE_DEPTH_TARGET))) {
         OB_LOG_E("resources", "image '%s': %u mip levels for %ux%u%s", name, desc->mip_levels, desc->width,
-                 desc->height, desc->mip_levels > 1 ? " (too many, or on a render target)" : "");
+                 desc->height, desc->mip_levels > 1 ? " (too many, or on a depth target)" : "");
         return OB_ERR_INVALID_ARGUMENT;
     }
     if (!desc->data) return OB_OK;
@@ -238,14 +241,14 @@ static VkImageAspectFlags view_aspect(const ob_image_rec *rec)
 }
 
 static ob_result image_view_create(ob_device *dev, ob_image_rec *rec, VkImageViewType type, uint32_t first_layer,
-                                   uint32_t layer_count, VkImageView *out_view)
+                                   uint32_t layer_count, uint32_t levels, VkImageView *out_view)
 {
     VkImageViewCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
         .image = rec->image,
         .viewType = type,
         .format = rec->info.format,
-        .subresourceRange = {view_aspect(rec), 0, rec->info.mip_levels, first_layer, layer_count},
+        .subresourceRange = {view_aspect(rec), 0, levels, first_layer, layer_count},
     };
     VkResult vr = OB_VK_CHECK_CREATE(vkCreateImageView(ob_device_vk(dev), &info, NULL, out_view));
     if (vr < 0) {
@@ -265,12 +268,15 @@ static ob_result image_views_create(ob_device *dev, ob_image_rec *rec)
 {
     uint32_t layers = rec->info.layers;
     ob_result r = image_view_create(dev, rec, layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D, 0,
-                                    layers, &rec->view);
-    if (r != OB_OK || layers == 1) return r;
+                                    layers, rec->info.mip_levels, &rec->view);
+    /* Layer views are attachments: level 0 only. A single-layer target with
+     * mips needs one too, since its whole view covers every level. */
+    bool mipped_target = rec->info.mip_levels > 1 && (rec->info.usage & OB_IMAGE_COLOR_TARGET);
+    if (r != OB_OK || (layers == 1 && !mipped_target)) return r;
     rec->layer_views = ob_calloc(layers, sizeof *rec->layer_views);
     if (!rec->layer_views) return OB_ERR_OUT_OF_HOST_MEMORY;
     for (uint32_t i = 0; i < layers && r == OB_OK; i++)
-        r = image_view_create(dev, rec, VK_IMAGE_VIEW_TYPE_2D, i, 1, &rec->layer_views[i]);
+        r = image_view_create(dev, rec, VK_IMAGE_VIEW_TYPE_2D, i, 1, 1, &rec->layer_views[i]);
     return r;
 }
 
@@ -307,7 +313,7 @@ static ob_result image_upload(ob_device *dev, ob_image_rec *rec, const void *dat
             .imageExtent = {rec->info.width, rec->info.height, 1},
         };
         vkCmdCopyBufferToImage(cmd, staging.buffer, rec->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        if (rec->info.mip_levels > 1) ob_res_image_blit_mips(cmd, rec);
+        if (rec->info.mip_levels > 1) ob_res_image_blit_mips(cmd, rec, VK_PIPELINE_STAGE_2_COPY_BIT);
     }
     /* Any shader stage may sample it next; ALL_COMMANDS keeps that true for
      * compute and vertex fetches as well as fragment shaders. */

@@ -106,10 +106,12 @@ bool ob_res_image_transition(ob_image_rec *rec, const ob_image_state *next, VkIm
  * this device; else logs naming the image and returns OB_ERR_UNSUPPORTED. */
 ob_result ob_res_mips_blit_check(ob_device *dev, const char *name, VkFormat format);
 /* Records the chain of linear blits level i-1 → i for every level of rec,
- * whose level 0 has just been written by a copy and whose levels are all in
- * TRANSFER_DST_OPTIMAL (made wait for ALL_TRANSFER). Leaves every level in
+ * whose level 0 has just been written (by a transfer in stage
+ * level0_written_by: the upload's copy, or the transition into
+ * TRANSFER_DST, waited for in BLIT, of ob_image_record_mips) and whose
+ * levels are all in TRANSFER_DST_OPTIMAL (made wait for ALL_TRANSFER, or BLIT). Leaves every level in
  * TRANSFER_SRC_OPTIMAL and rec's tracked state saying so. */
-void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec);
+void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec, VkPipelineStageFlags2 level0_written_by);
 /* Records the copy of every level from a staging buffer that holds them
  * tightly packed, level 0 first (all in TRANSFER_DST_OPTIMAL). */
 void ob_res_image_copy_levels(VkCommandBuffer cmd, VkBuffer staging, const ob_image_rec *rec, uint32_t block_bytes,

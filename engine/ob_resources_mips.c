@@ -65,7 +65,7 @@ static VkImageMemoryBarrier2 level_to_src(const ob_image_rec *rec, uint32_t leve
     };
 }
 
-void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec)
+void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec, VkPipelineStageFlags2 level0_written_by)
 {
     const uint32_t levels = rec->info.mip_levels;
     VkImageMemoryBarrier2 barrier;
@@ -75,7 +75,7 @@ void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec)
         .pImageMemoryBarriers = &barrier,
     };
     for (uint32_t i = 1; i < levels; i++) {
-        barrier = level_to_src(rec, i - 1, i == 1 ? VK_PIPELINE_STAGE_2_COPY_BIT : VK_PIPELINE_STAGE_2_BLIT_BIT);
+        barrier = level_to_src(rec, i - 1, i == 1 ? level0_written_by : VK_PIPELINE_STAGE_2_BLIT_BIT);
         vkCmdPipelineBarrier2(cmd, &dep);
         int32_t sw = (int32_t)OB_MAX(rec->info.width >> (i - 1), 1u);
         int32_t sh = (int32_t)OB_MAX(rec->info.height >> (i - 1), 1u);
@@ -100,12 +100,30 @@ void ob_res_image_blit_mips(VkCommandBuffer cmd, ob_image_rec *rec)
         };
         vkCmdBlitImage2(cmd, &blit);
     }
-    barrier = level_to_src(rec, levels - 1, levels == 1 ? VK_PIPELINE_STAGE_2_COPY_BIT : VK_PIPELINE_STAGE_2_BLIT_BIT);
+    barrier = level_to_src(rec, levels - 1, levels == 1 ? level0_written_by : VK_PIPELINE_STAGE_2_BLIT_BIT);
     vkCmdPipelineBarrier2(cmd, &dep);
     /* Reads by the blits are what the next layout change must wait for; the
      * writes were made available by the barriers above. */
     rec->state = (ob_image_state){VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_BLIT_BIT,
                                   VK_ACCESS_2_TRANSFER_READ_BIT};
+}
+
+bool ob_image_record_mips(ob_device *dev, VkCommandBuffer cmd, ob_image img)
+{
+    ob_image_rec *rec = ob_res_image_get(dev, img, "ob_image_record_mips");
+    if (!rec || rec->info.mip_levels < 2) return false;
+    /* Every level to TRANSFER_DST, level 0's contents kept (its last writer,
+     * the rendering, is waited for); the blits' barriers chain from BLIT. */
+    ob_image_state to_dst = {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_BLIT_BIT,
+                             VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    VkImageMemoryBarrier2 barrier;
+    if (ob_res_image_transition(rec, &to_dst, &barrier)) {
+        VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                                .imageMemoryBarrierCount = 1, .pImageMemoryBarriers = &barrier};
+        vkCmdPipelineBarrier2(cmd, &dep);
+    }
+    ob_res_image_blit_mips(cmd, rec, VK_PIPELINE_STAGE_2_BLIT_BIT);
+    return true;
 }
 
 void ob_res_image_copy_levels(VkCommandBuffer cmd, VkBuffer staging, const ob_image_rec *rec, uint32_t block_bytes,

@@ -16,7 +16,7 @@
 const char *ob_view_type_name(ob_view_type t)
 {
     static const char *const names[OB_VIEW_TYPE_COUNT] = {
-        "perspective", "shadow", "paraboloid", "simulation", "overlay", "composite",
+        "perspective", "shadow", "paraboloid", "simulation", "overlay", "composite", "cube",
     };
     return (unsigned)t < OB_VIEW_TYPE_COUNT ? names[t] : "unknown";
 }

@@ -36,6 +36,7 @@ typedef enum ob_view_type {
     OB_VIEW_SIMULATION,
     OB_VIEW_OVERLAY,
     OB_VIEW_COMPOSITE,
+    OB_VIEW_CUBE,              /* cube environment map: six 90° faces (layers) */
     OB_VIEW_TYPE_COUNT
 } ob_view_type;
 
@@ -46,7 +47,7 @@ const char *ob_view_type_name(ob_view_type t);
  * OB_MAX_FRAME_VIEWS (checked there) and an edge is never dropped. */
 #define OB_VIEW_MAX_DEPS 128
 #define OB_VIEW_MAX_INPUTS 8
-#define OB_VIEW_MAX_LAYERS 2
+#define OB_VIEW_MAX_LAYERS 6
 
 typedef struct ob_view ob_view;
 
@@ -108,9 +109,15 @@ struct ob_view {
     uint32_t id;                      /* stable id: order ties, hashes */
 
     /* Targets. A graphics view renders layer_count passes (2 for the dual
-     * paraboloid), each into layer i of color/depth (either may be zero). */
+     * paraboloid, 6 for a cube map), each into layer i of color/depth
+     * (either may be zero). */
     ob_image color, depth;
     uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
+    /* Mip levels wanted for `color` (0 or 1: none). With more, the target
+     * is made with them and, once the view has rendered, the renderer fills
+     * levels 1.. from level 0 (a box-filtered blit chain,
+     * ob_image_record_mips): environment maps sampled by roughness. */
+    uint32_t color_mips;
     uint32_t width, height;
     /* Multisampling. With samples > 1 (one layer only) the view draws into
      * msaa_color / msaa_depth and each rendering scope ends by resolving

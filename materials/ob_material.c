@@ -253,6 +253,14 @@ static ob_result create_samplers(ob_material_library *lib)
             .compare_op = VK_COMPARE_OP_GREATER_OR_EQUAL,   /* reversed-Z: nearer is greater */
             .name = specs[i].param,
         };
+        if (i == SAMPLER_ENV) {
+            /* Env maps have mips, sampled by roughness (envmap.glsl). */
+            sd.detailed = true;
+            sd.mag_filter = sd.min_filter = VK_FILTER_LINEAR;
+            sd.mipmap_mode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+            sd.address_u = sd.address_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+            sd.max_lod = VK_LOD_CLAMP_NONE;
+        }
         lib->samplers[i] = ob_sampler_create(lib->dev, &sd, &r);
         if (!lib->samplers[i].id) {
             OB_LOG_E("material", "default sampler '%s' not created: %s", specs[i].param,
@@ -370,11 +378,13 @@ static void set_render_flags(ob_material *m)
     case OB_MATERIAL_REFLECTIVE:
         m->render[OB_VIEW_PERSPECTIVE] = true;
         m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_CUBE] = true;
         m->render[OB_VIEW_SHADOW] = m->casts_shadows;
         break;
     case OB_MATERIAL_PBR:
         m->render[OB_VIEW_PERSPECTIVE] = true;
         m->render[OB_VIEW_PARABOLOID] = true;
+        m->render[OB_VIEW_CUBE] = true;
         m->render[OB_VIEW_SHADOW] = m->casts_shadows;
         break;
     case OB_MATERIAL_UNLIT:
@@ -400,7 +410,7 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
         goto fail_log;
     }
     if (!all_finite(desc->diffuse, 4) || !all_finite(desc->specular, 4) ||
-        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity)) {
+        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity) || !isfinite(desc->roughness)) {
         OB_LOG_E("material", "material '%s': non-finite colour or reflectivity", name);
         r = OB_ERR_NON_FINITE;
         goto fail_log;
@@ -425,6 +435,8 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
                          : desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
                          : desc->reflectivity != 0.0f          ? desc->reflectivity
                                                                : 0.6f;
+    if (desc->kind == OB_MATERIAL_REFLECTIVE)   /* Reflectivity.y: lit.frag's blur */
+        m->reflectivity[1] = OB_MIN(OB_MAX(desc->roughness, 0.0f), 1.0f);
     m->casts_shadows = desc->casts_shadows;
     m->blended = desc->blended;
     if (desc->kind == OB_MATERIAL_PBR) {
@@ -509,7 +521,7 @@ ob_result ob_material_set_emissive(ob_material *m, const float rgb[4])
 }
 ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity)
 {
-    float v[4] = {reflectivity, 0, 0, 0};
+    float v[4] = {reflectivity, m ? m->reflectivity[1] : 0.0f, 0, 0};   /* roughness kept */
     return set_color(m, m ? m->reflectivity : NULL, v);
 }
 
@@ -524,7 +536,9 @@ bool ob_material_view_depends_on(const ob_view *v, ob_view_type type)
 
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity)
 {
-    return r && entity ? ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID) : NULL;
+    if (!r || !entity) return NULL;
+    ob_view *env = ob_renderer_attached_view(r, entity, OB_VIEW_PARABOLOID);
+    return env ? env : ob_renderer_attached_view(r, entity, OB_VIEW_CUBE);
 }
 
 /* The effect a material wants in view v; false when it is not drawn there. */
@@ -559,6 +573,12 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
         return true;
     case OB_VIEW_PARABOLOID:
         out->kind = OB_STD_PARABOLOID;
+        out->variant = blended | instanced;
+        return true;
+    case OB_VIEW_CUBE:
+        /* A cube face is a plain 90-degree camera: no shadows, and no
+         * reflections (as in a paraboloid map) — it depends on no other map. */
+        out->kind = m->kind == OB_MATERIAL_UNLIT ? OB_STD_UNLIT : OB_STD_LIT;
         out->variant = blended | instanced;
         return true;
     case OB_VIEW_OVERLAY:

@@ -163,6 +163,10 @@ typedef struct ob_material_desc {
      * for REFLECTIVE (ignored otherwise). */
     float diffuse[4], specular[4], emissive[4];
     float reflectivity;
+    /* REFLECTIVE only: how rough the mirror is, 0 (sharp, default) to 1; the
+     * environment map is sampled at a coarser mip level (blurred) the
+     * rougher it is, as a PBR material's roughness does. Clamped to [0, 1]. */
+    float roughness;
     bool casts_shadows;
     bool blended;              /* sorted back to front, drawn with the BLENDED variant */
     uint32_t priority;         /* orders materials within a sort class */

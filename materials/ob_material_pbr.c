@@ -295,6 +295,11 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
         *out_key = key;
         return true;
     }
+    case OB_VIEW_CUBE:
+        /* A cube face draws like a camera without shadows or reflections. */
+        *out_slot = OB_PBR_PASS_MAIN;
+        *out_key = f | inst;
+        return true;
     case OB_VIEW_PARABOLOID:
         *out_slot = OB_PBR_PASS_PARABOLOID;
         *out_key = OB_PBR_P_PARABOLOID | inst | (f & ~OB_PBR_F_DOUBLE_SIDED);
@@ -353,6 +358,14 @@ ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *
     ob_params_set_vec4(params, p->factors, m->pbr.block[1]);
     ob_params_set_vec4(params, p->emissive, m->pbr.block[2]);
     ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
+    /* The rest of the shared PerMaterial block (pbr.frag declares it through
+     * common.glsl but reads only Reflectivity) gets a defined value too: its
+     * packed bytes, and so the command hashes, must not carry the last lit
+     * material this slot applied, which differs between ST and MT. */
+    static const float unused[4] = {0, 0, 0, 0};
+    ob_params_set_vec4(params, lib->diffuse, unused);
+    ob_params_set_vec4(params, lib->specular, unused);
+    ob_params_set_vec4(params, lib->emissive, unused);
     const ob_material_texture *slots[OB_PBR_TEX_COUNT] = {
         &m->pbr.desc.base_color_texture, &m->pbr.desc.metallic_roughness_texture, &m->pbr.desc.normal_texture,
         &m->pbr.desc.occlusion_texture, &m->pbr.desc.emissive_texture};

@@ -7,12 +7,21 @@
 /* Dual-paraboloid environment map of one entity: layer 0 holds the +Z
  * hemisphere around the owner's centre, layer 1 the -Z one. The map's frame
  * is the world's (ViewMatrix and EnvMapMatrix are identity), so reflective
- * lookups only need the reflection vector. */
+ * lookups only need the reflection vector. Linear HDR (OB_VIEWS_ENV_FORMAT)
+ * with a full mip chain the renderer blits after the map renders.
+ *
+ * The projection is per vertex: a triangle's straight edges stay straight in
+ * the map while the true image of a long edge is curved, so a large
+ * polygon (a floor of one quad) is bent — a thin band, broken at the
+ * equator where the halves meet. Subdivided geometry (a plane of 64
+ * subdivisions), or the cube map (ob_view_cube.c), avoids it: see
+ * docs/limits.md. */
 struct ob_paraboloid_view {
     ob_view base;
     ob_views *ctx;
     ob_node *owner;
-    ob_param direction, env_map, env_matrix;
+    ob_param direction;
+    ob_env_params env;
     /* Per item of this frame's draw list: bit L set when its bound reaches
      * layer L's hemisphere (filled in pre_render, read by the recording). */
     uint8_t *reach;
@@ -26,50 +35,21 @@ struct ob_paraboloid_view {
  * shaders discard every fragment of the other one. An item whose bound lies
  * wholly in the other hemisphere therefore leaves no pixel in that layer:
  * not drawing it there changes nothing but the cost (about half the items
- * of a map whose owner stands among them). The bound is widened by far more
- * than the float rounding of a vertex relative to the owner (about 1e-7 of
- * its distance), so that no vertex can round across the plane. */
-static void paraboloid_reach(ob_paraboloid_view *pv)
+ * of a map whose owner stands among them). */
+static uint8_t paraboloid_layers(const double rel[3], double radius)
 {
-    ob_view *v = &pv->base;
-    pv->reach_valid = ob_array_reserve((void **)&pv->reach, &pv->reach_cap, v->item_count,
-                                       sizeof *pv->reach) == OB_OK;
-    if (!pv->reach_valid) {
-        OB_LOG_W("view", "view '%s': no memory for the per-layer item masks; every item is drawn "
-                 "in both layers this frame", v->name);
-        return;
-    }
-    for (uint32_t i = 0; i < v->item_count; i++) {
-        double c[3];
-        float radius;
-        ob_view_item_sphere(v, i, c, &radius);
-        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
-        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
-        double reach = (double)radius + ((double)radius + dist) * 1e-5 + 1e-6;
-        pv->reach[i] = (uint8_t)((rel[2] + reach >= 0.0 ? 1u : 0u) | (-rel[2] + reach >= 0.0 ? 2u : 0u));
-    }
+    return (uint8_t)((rel[2] + radius >= 0.0 ? 1u : 0u) | (-rel[2] + radius >= 0.0 ? 2u : 0u));
 }
 
 static bool paraboloid_pre_cull(ob_view *v, ob_renderer *r)
 {
-    ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
-    if (!ob_renderer_queue_view(r, v)) return false;
-    float radius;
-    ob_node_world_sphere(pv->owner, v->origin, &radius);
-    ob_mat4_identity(v->view_proj);
-    v->cull_exclude = pv->owner;
-    return true;
+    return ob_views_env_pre_cull(v, r, ((ob_paraboloid_view *)v)->owner);
 }
 
 static void paraboloid_post_cull(ob_view *v, ob_renderer *r)
 {
     ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
-    paraboloid_reach(pv);
-    ob_view_pre_render_items(v, r);
-    /* A particle system the map sees must step before the map draws it and
-     * hand it its parameters (it becomes a dependency), as for a camera. */
-    ob_views_queue_simulations(pv->ctx, r, v);
-    ob_material_library_prepare_view(pv->ctx->materials, r, v);
+    ob_views_env_post_cull(pv->ctx, v, r, paraboloid_layers, &pv->reach, &pv->reach_cap, &pv->reach_valid);
 }
 
 static void paraboloid_render_params(ob_view *v, ob_renderer *r, ob_params *params)
@@ -87,10 +67,9 @@ static void paraboloid_usage_params(ob_view *v, ob_renderer *r, ob_params *param
     ob_paraboloid_view *pv = (ob_paraboloid_view *)v;
     (void)r;
     (void)consumer;
-    float identity[16];
-    ob_mat4_identity(identity);
-    ob_params_set_texture(params, pv->env_map, v->color);
-    ob_params_set_mat4(params, pv->env_matrix, identity);
+    /* Texcoords span [-1, 1] over the side: a direction turning by dθ near
+     * a half's centre moves dθ / 2 in the paraboloid, a quarter of the side. */
+    ob_views_env_usage(&pv->env, v, params, 0.0f, 0.25f * (float)v->width);
 }
 
 static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
@@ -100,16 +79,8 @@ static void paraboloid_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *p
     float side = layer == 0 ? 1.0f : -1.0f;
     float dir[4] = {side, PARABOLOID_NEAR, 0.0f, 0.0f};
     ob_params_set_vec4(ob_pipeline_manager_params(pm), pv->direction, dir);
-    /* Runs of items this layer draws are recorded together. */
-    uint32_t end = first + count < v->item_count ? first + count : v->item_count;
-    uint32_t run = first;
-    uint8_t bit = (uint8_t)(1u << layer);
-    for (uint32_t i = first; i < end && pv->reach_valid; i++) {
-        if (pv->reach[i] & bit) continue;
-        if (i > run) ob_view_record_items(v, r, pm, run, i - run);
-        run = i + 1;
-    }
-    if (end > run) ob_view_record_items(v, r, pm, run, end - run);
+    ob_views_record_masked(v, r, pm, first, count, pv->reach_valid ? pv->reach : NULL,
+                           (uint8_t)(1u << layer));
 }
 
 static const ob_view_vtbl paraboloid_vtbl = {
@@ -129,23 +100,11 @@ ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto done;
     }
-    char name[48];
-    snprintf(name, sizeof name, "envmap:%s", ob_node_name(owner));
-    ob_view_init(&pv->base, &paraboloid_vtbl, OB_VIEW_PARABOLOID, name);
     pv->ctx = ctx;
     pv->owner = owner;
-    pv->base.no_frustum = true;
-    pv->base.clear_depth = 0.0f;
-    static const float sky[4] = {0.35f, 0.45f, 0.6f, 1.0f};
-    memcpy(pv->base.clear_color, sky, sizeof sky);
-    ob_param_registry *reg = ob_renderer_registry(ctx->r);
-    pv->direction = ob_param_find(reg, "ParaboloidDirection");
-    pv->env_map = ob_param_find(reg, "EnvMap");
-    pv->env_matrix = ob_param_find(reg, "EnvMapMatrix");
-    if (!pv->env_matrix.id) pv->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
-    if (r == OB_OK)
-        r = ob_views_make_target(ctx, &pv->base, ctx->env_map_size, ctx->env_map_size, 2,
-                                 OB_VIEWS_COLOR_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+    pv->direction = ob_param_find(ob_renderer_registry(ctx->r), "ParaboloidDirection");
+    r = ob_views_env_view_init(ctx, &pv->base, &paraboloid_vtbl, OB_VIEW_PARABOLOID, "envmap", owner,
+                               2, &pv->env);
     if (r != OB_OK) {
         ob_free(pv);
         pv = NULL;

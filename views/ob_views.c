@@ -28,6 +28,7 @@ static ob_result register_params(ob_param_registry *reg)
     static const char *const vec4s[] = {
         "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "LightGrid",
         "ParaboloidDirection", "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
+        "EnvMapInfo",
     };
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
@@ -90,17 +91,97 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
     ob_views_set_light_params(ctx, v, params, view, proj);
 }
 
+/* ------------------------------------------------------------ env maps */
+
+ob_result ob_views_env_view_init(ob_views *ctx, ob_view *v, const ob_view_vtbl *vtbl,
+                                 ob_view_type type, const char *prefix, const ob_node *owner,
+                                 uint32_t layers, ob_env_params *env)
+{
+    char name[48];
+    snprintf(name, sizeof name, "%s:%s", prefix, ob_node_name(owner));
+    ob_view_init(v, vtbl, type, name);
+    v->no_frustum = true;
+    v->clear_depth = 0.0f;
+    v->clear_color[3] = 1.0f;
+    v->color_mips = ob_image_mip_levels_max(ctx->env_map_size, ctx->env_map_size);
+    ob_param_registry *reg = ob_renderer_registry(ctx->r);
+    ob_result r = OB_OK;
+    env->env_map = ob_param_find(reg, "EnvMap");
+    env->env_info = ob_param_find(reg, "EnvMapInfo");
+    env->env_matrix = ob_param_find(reg, "EnvMapMatrix");
+    if (!env->env_matrix.id) env->env_matrix = ob_param_register(reg, "EnvMapMatrix", OB_PARAM_MAT4, 1, &r);
+    if (r != OB_OK) return r;
+    return ob_views_make_target(ctx, v, ctx->env_map_size, ctx->env_map_size, layers,
+                                OB_VIEWS_ENV_FORMAT, OB_VIEWS_DEPTH_FORMAT);
+}
+
+void ob_views_env_usage(const ob_env_params *p, const ob_view *v, ob_params *params, float kind,
+                        float texels_per_radian)
+{
+    float identity[16];
+    ob_mat4_identity(identity);
+    ob_params_set_texture(params, p->env_map, v->color);
+    ob_params_set_mat4(params, p->env_matrix, identity);
+    float info[4] = {kind, (float)(v->color_mips ? v->color_mips - 1 : 0), texels_per_radian, 0.0f};
+    ob_params_set_vec4(params, p->env_info, info);
+}
+
+bool ob_views_env_pre_cull(ob_view *v, ob_renderer *r, const ob_node *owner)
+{
+    if (!ob_renderer_queue_view(r, v)) return false;
+    float radius;
+    ob_node_world_sphere(owner, v->origin, &radius);
+    ob_mat4_identity(v->view_proj);
+    v->cull_exclude = owner;
+    return true;
+}
+
+void ob_views_env_post_cull(ob_views *ctx, ob_view *v, ob_renderer *r, ob_env_layer_mask_fn mask_of,
+                            uint8_t **masks, uint32_t *cap, bool *valid)
+{
+    *valid = ob_array_reserve((void **)masks, cap, v->item_count, sizeof **masks) == OB_OK;
+    if (!*valid)
+        OB_LOG_W("view", "view '%s': no memory for the per-layer item masks; every item is drawn "
+                 "in every layer this frame", v->name);
+    for (uint32_t i = 0; *valid && i < v->item_count; i++) {
+        double c[3];
+        float radius;
+        ob_view_item_sphere(v, i, c, &radius);
+        double rel[3] = {c[0] - v->origin[0], c[1] - v->origin[1], c[2] - v->origin[2]};
+        double dist = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+        (*masks)[i] = mask_of(rel, (double)radius + ((double)radius + dist) * 1e-5 + 1e-6);
+    }
+    ob_view_pre_render_items(v, r);
+    /* A particle system the map sees must step before the map draws it and
+     * hand it its parameters (it becomes a dependency), as for a camera. */
+    ob_views_queue_simulations(ctx, r, v);
+    ob_material_library_prepare_view(ctx->materials, r, v);
+}
+
+void ob_views_record_masked(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t first,
+                            uint32_t count, const uint8_t *mask, uint8_t bit)
+{
+    uint32_t end = first + count < v->item_count ? first + count : v->item_count;
+    uint32_t run = first;
+    for (uint32_t i = first; i < end && mask; i++) {
+        if (mask[i] & bit) continue;
+        if (i > run) ob_view_record_items(v, r, pm, run, i - run);
+        run = i + 1;
+    }
+    if (end > run) ob_view_record_items(v, r, pm, run, end - run);
+}
+
 /* ------------------------------------------------------------ targets */
 
 /* One image of a view's targets, named "<view>.<what>". */
 static ob_image make_image(ob_views *ctx, const ob_view *v, const char *what, uint32_t width,
                            uint32_t height, uint32_t layers, VkFormat format, uint32_t usage,
-                           uint32_t samples, ob_result *out_result)
+                           uint32_t samples, uint32_t mips, ob_result *out_result)
 {
     char name[64];
     snprintf(name, sizeof name, "%s.%s", v->name, what);
     ob_image_desc d = {.width = width, .height = height, .layers = layers, .format = format,
-                       .usage = usage, .samples = samples, .name = name};
+                       .usage = usage, .samples = samples, .name = name, .mip_levels = mips};
     return ob_image_create(ctx->dev, &d, out_result);
 }
 
@@ -112,22 +193,31 @@ ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32
      * resolved into the single-sampled `color` consumers read. */
     uint32_t samples = layers == 1 && v->samples > 1 ? v->samples : 1;
     ob_image img[4] = {{0}};   /* color, depth, msaa_color, msaa_depth */
+    /* Mips (v->color_mips) only where the device blits the format linearly;
+     * otherwise one level, said once per target. */
+    uint32_t mips = OB_MIN(v->color_mips ? v->color_mips : 1, ob_image_mip_levels_max(width, height));
+    if (mips > 1 && color != VK_FORMAT_UNDEFINED && !ob_image_format_blits_linear(ctx->dev, color)) {
+        OB_LOG_W("views", "view '%s': format %d cannot be blitted linearly on '%s'; its colour "
+                 "target has no mips (rough reflections come out sharp)", v->name, (int)color,
+                 ob_device_name(ctx->dev));
+        mips = 1;
+    }
     if (color != VK_FORMAT_UNDEFINED) {
         img[0] = make_image(ctx, v, "color", width, height, layers, color,
                             OB_IMAGE_COLOR_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_SRC |
-                                OB_IMAGE_TRANSFER_DST, 1, &r);
+                                OB_IMAGE_TRANSFER_DST, 1, mips, &r);
         if (r == OB_OK && samples > 1)
             img[2] = make_image(ctx, v, "color.msaa", width, height, 1, color,
-                                OB_IMAGE_COLOR_TARGET, samples, &r);
+                                OB_IMAGE_COLOR_TARGET, samples, 1, &r);
     }
     if (r == OB_OK && depth != VK_FORMAT_UNDEFINED) {
         if (samples > 1)
             img[3] = make_image(ctx, v, "depth.msaa", width, height, 1, depth,
-                                OB_IMAGE_DEPTH_TARGET, samples, &r);
+                                OB_IMAGE_DEPTH_TARGET, samples, 1, &r);
         else
             img[1] = make_image(ctx, v, "depth", width, height, layers, depth,
                                 OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
-                                1, &r);
+                                1, 1, &r);
     }
     if (r != OB_OK) {
         for (int i = 0; i < 4; i++) ob_image_destroy(ctx->dev, img[i]);
@@ -138,6 +228,7 @@ ob_result ob_views_make_target(ob_views *ctx, ob_view *v, uint32_t width, uint32
     v->msaa_color = img[2];
     v->msaa_depth = img[3];
     v->samples = samples;
+    v->color_mips = color != VK_FORMAT_UNDEFINED ? mips : v->color_mips;
     v->width = width;
     v->height = height;
     v->layer_count = layers;
@@ -269,33 +360,68 @@ static ob_result add_entry(ob_views_entry **list, uint32_t *count, uint32_t *cap
 /* The material library asks for the views an entity needs (its env map, its
  * simulation). Each is created on first need and pre-drawn with the current
  * view as its consumer. */
+static void env_destroy(ob_views *ctx, ob_view *view, void *object)
+{
+    if (view->type == OB_VIEW_CUBE)
+        ob_cube_view_destroy(ctx, object);
+    else
+        ob_paraboloid_view_destroy(ctx, object);
+}
+
+/* The env map of an entity: made on first need, of the context's kind. */
+static ob_views_entry *env_entry(ob_views *ctx, ob_renderer *r, ob_node *entity)
+{
+    uint32_t id = ob_node_id(entity);
+    ob_views_entry *e = find_entry(ctx->envs, ctx->env_count, id);
+    if (e) return e;
+    ob_result res;
+    ob_view *view = NULL;
+    void *object = NULL;
+    if (ctx->env_map_kind == OB_ENV_MAP_CUBE) {
+        ob_cube_view *cv = ob_cube_view_create(ctx, entity, &res);
+        if (cv) view = ob_cube_view_base(cv);
+        object = cv;
+    } else {
+        ob_paraboloid_view *pv = ob_paraboloid_view_create(ctx, entity, &res);
+        if (pv) view = ob_paraboloid_view_base(pv);
+        object = pv;
+    }
+    if (!view) {
+        OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
+                 ob_node_name(entity), id, ob_result_name(res));
+        ob_renderer_note_error(r, ob_node_name(entity), res);
+        return NULL;
+    }
+    if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap, (ob_views_entry){id, view, object}) != OB_OK) {
+        OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
+                 "skipped this frame", ob_node_name(entity), id);
+        ob_renderer_note_error(r, ob_node_name(entity), OB_ERR_OUT_OF_HOST_MEMORY);
+        env_destroy(ctx, view, object);
+        return NULL;
+    }
+    return &ctx->envs[ctx->env_count - 1];
+}
+
+/* The material library asks for the views an entity needs (its env map, its
+ * simulation). Each is created on first need and pre-drawn with the current
+ * view as its consumer. */
 static void queue_hook(void *user, ob_node *entity, ob_renderer *r, ob_view *requesting,
                        ob_view_type needed)
 {
     ob_views *ctx = user;
-    (void)requesting;
     uint32_t id = ob_node_id(entity);
-    if (needed == OB_VIEW_PARABOLOID) {
-        ob_views_entry *e = find_entry(ctx->envs, ctx->env_count, id);
-        if (!e) {
-            ob_result res;
-            ob_paraboloid_view *pv = ob_paraboloid_view_create(ctx, entity, &res);
-            if (!pv) {
-                OB_LOG_E("views", "entity '%s' (id %u): cannot create its environment map: %s",
-                         ob_node_name(entity), id, ob_result_name(res));
-                ob_renderer_note_error(r, ob_node_name(entity), res);
-                return;
-            }
-            if (add_entry(&ctx->envs, &ctx->env_count, &ctx->env_cap,
-                          (ob_views_entry){id, ob_paraboloid_view_base(pv), pv}) != OB_OK) {
-                OB_LOG_E("views", "entity '%s' (id %u): no memory to keep its environment map; "
-                         "skipped this frame", ob_node_name(entity), id);
-                ob_renderer_note_error(r, ob_node_name(entity), OB_ERR_OUT_OF_HOST_MEMORY);
-                ob_paraboloid_view_destroy(ctx, pv);
-                return;
-            }
-            e = &ctx->envs[ctx->env_count - 1];
+    if (needed == OB_VIEW_PARABOLOID || needed == OB_VIEW_CUBE) {
+        ob_views_entry *e = env_entry(ctx, r, entity);
+        if (!e) return;
+        /* The map shows the sky around its owner: the context's sky colour,
+         * else the clear colour of the first view that asks for it this
+         * frame (PreRender's order is fixed, so ST and MT agree). */
+        if (ctx->sky_color[3] > 0.0f) {
+            memcpy(e->view->clear_color, ctx->sky_color, 3 * sizeof(float));
+        } else if (requesting && e->view->queued_frame != ob_renderer_frame_serial(r)) {
+            memcpy(e->view->clear_color, requesting->clear_color, 3 * sizeof(float));
         }
+        e->view->clear_color[3] = 1.0f;
         ob_renderer_pre_render(r, e->view);
         /* Only a map that renders this frame is sampled: one left out (past
          * the recursion bound, say) was never written, so the entity is
@@ -438,6 +564,13 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     r = ob_views_set_env_map_size(ctx, desc->env_map_size);
     if (r == OB_OK) r = ob_views_set_shadow_map_size(ctx, desc->shadow_map_size);
     if (r != OB_OK) goto fail_destroy_views;
+    if ((unsigned)desc->env_map_kind >= OB_ENV_MAP_KIND_COUNT) {
+        OB_LOG_E("views", "env_map_kind %d is not a kind of environment map", (int)desc->env_map_kind);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto fail_destroy_views;
+    }
+    ctx->env_map_kind = desc->env_map_kind;
+    memcpy(ctx->sky_color, desc->sky_color, sizeof ctx->sky_color);
     static const float default_ambient[4] = {1.0f, 1.0f, 1.0f, 0.15f};
     memcpy(ctx->ambient, desc->ambient[3] > 0.0f ? desc->ambient : default_ambient, sizeof ctx->ambient);
     ctx->dt = 1.0 / 60.0;
@@ -465,7 +598,7 @@ void ob_views_destroy(ob_views *ctx)
     for (uint32_t i = 0; i < ctx->shadow_count; i++)
         ob_shadow_view_destroy(ctx, ctx->shadows[i].owner_object);
     for (uint32_t i = 0; i < ctx->env_count; i++)
-        ob_paraboloid_view_destroy(ctx, ctx->envs[i].owner_object);
+        env_destroy(ctx, ctx->envs[i].view, ctx->envs[i].owner_object);
     ob_free(ctx->shadows);
     ob_free(ctx->envs);
     ob_free(ctx->systems);
@@ -483,6 +616,24 @@ void ob_views_set_time(ob_views *ctx, double time, double dt)
 {
     ctx->time = time;
     ctx->dt = dt;
+}
+
+bool ob_views_set_env_map_kind(ob_views *ctx, ob_env_map_kind kind)
+{
+    if ((unsigned)kind >= OB_ENV_MAP_KIND_COUNT) {
+        OB_LOG_E("views", "env map kind %d is not a kind of environment map; kept %s", (int)kind,
+                 ctx->env_map_kind == OB_ENV_MAP_CUBE ? "cube" : "paraboloid");
+        return false;
+    }
+    ctx->env_map_kind = kind;
+    return true;
+}
+
+ob_env_map_kind ob_views_env_map_kind(const ob_views *ctx) { return ctx->env_map_kind; }
+
+void ob_views_set_sky_color(ob_views *ctx, const float rgba[4])
+{
+    memcpy(ctx->sky_color, rgba, sizeof ctx->sky_color);
 }
 
 /* Whether a map of size x size can be made on this device (logged when not). */

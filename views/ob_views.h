@@ -9,6 +9,11 @@
  *   paraboloid   dual-paraboloid environment map of one reflective entity
  *                (two layers; the owner is excluded); queued by the material
  *                of a reflective entity visible to the queuing view
+ *   cube         the same as a cube map (six 90-degree faces in six layers),
+ *                when the context's env map kind is OB_ENV_MAP_CUBE
+ *                Both are linear HDR with a mip chain sampled by roughness,
+ *                cleared to the clear colour of the first camera view that
+ *                queues them in the frame.
  *   simulation   compute only: a particle system in a storage buffer that the
  *                perspective view then draws
  *   overlay      text (stb_easy_font) drawn last over the final target
@@ -38,11 +43,25 @@
 
 typedef struct ob_views ob_views;
 
+/* How a reflective entity's environment map is made (docs/materials.md has
+ * the trade-off; obelisk-bench's quality section measures it). */
+typedef enum ob_env_map_kind {
+    OB_ENV_MAP_PARABOLOID = 0,   /* default: two renders per map, but a polygon's
+                                    straight edges are bent (subdivide large ones) */
+    OB_ENV_MAP_CUBE,             /* six renders per map, straight edges exact */
+    OB_ENV_MAP_KIND_COUNT
+} ob_env_map_kind;
+
 typedef struct ob_views_desc {
     ob_renderer *renderer;
     ob_material_library *materials;
     ob_effect_context *effects;
-    uint32_t env_map_size;       /* 0 → 256 (per paraboloid half) */
+    uint32_t env_map_size;       /* 0 → 256 (side of a paraboloid half or cube face) */
+    ob_env_map_kind env_map_kind;  /* 0 → OB_ENV_MAP_PARABOLOID */
+    float sky_color[4];          /* linear rgb what env maps clear to, alpha > 0 to
+                                    use it; alpha 0 → the clear colour of the first
+                                    camera view that asks for the map in the frame
+                                    (ob_stack passes its main view's clear colour) */
     uint32_t shadow_map_size;    /* 0 → 1024 */
     float ambient[4];            /* rgb, w = intensity; zero → (1,1,1,0.15) */
 } ob_views_desc;
@@ -64,6 +83,15 @@ ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
  * beyond its range), only slower; for measuring and checking the grid.
  * [render thread, between frames] */
 void ob_views_set_light_tiles(ob_views *ctx, bool on);
+/* Env map kind for maps created afterwards (an entity keeps the map it has);
+ * an unknown kind is refused: logged, false, the old kind kept. [render
+ * thread, between frames] */
+bool ob_views_set_env_map_kind(ob_views *ctx, ob_env_map_kind kind);
+ob_env_map_kind ob_views_env_map_kind(const ob_views *ctx);
+/* What env maps clear to from the next frame on (ob_views_desc.sky_color:
+ * alpha 0 → the first asking camera's clear colour). Linear, unclamped: a
+ * value above 1 is an HDR sky. [render thread, between frames] */
+void ob_views_set_sky_color(ob_views *ctx, const float rgba[4]);
 
 /* ---------------------------------------------------------- perspective */
 

@@ -11,11 +11,12 @@
 
 typedef struct ob_shadow_view ob_shadow_view;
 typedef struct ob_paraboloid_view ob_paraboloid_view;
+typedef struct ob_cube_view ob_cube_view;
 
 typedef struct ob_views_entry {
     uint32_t node_id;
     ob_view *view;
-    void *owner_object;          /* the concrete view (shadow/paraboloid) or particle system */
+    void *owner_object;          /* the concrete view (shadow/paraboloid/cube) or particle system */
 } ob_views_entry;
 
 struct ob_views {
@@ -24,6 +25,8 @@ struct ob_views {
     ob_material_library *materials;
     ob_effect_context *effects;
     uint32_t env_map_size, shadow_map_size;
+    ob_env_map_kind env_map_kind;
+    float sky_color[4];          /* alpha 0: none, use the asking camera's clear colour */
     float ambient[4];
     double time, dt;
     ob_effect_counters counted;  /* effect counters already reported to the stats */
@@ -60,6 +63,46 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
 /* Log each point or spot light over OB_MAX_LIGHTS once by name and note how
  * many are over in the frame's stats. [render thread, PreRender] */
 void ob_views_report_light_limit(ob_views *ctx, ob_renderer *r);
+/* What an environment map (paraboloid or cube) hands its consumers. */
+typedef struct ob_env_params {
+    ob_param env_map, env_matrix, env_info;
+} ob_env_params;
+/* The common set-up of an environment map view v of `owner`, named
+ * "<prefix>:<owner>": no frustum (everything around counts), reversed-Z
+ * clear, a full mip chain, HDR colour and depth of `layers` layers at the
+ * context's env_map_size, and its params in *env. The clear colour is set
+ * per frame (queue_hook). Failure: the registry's or the image's error, v's
+ * targets empty. [render thread] */
+ob_result ob_views_env_view_init(ob_views *ctx, ob_view *v, const ob_view_vtbl *vtbl,
+                                 ob_view_type type, const char *prefix, const ob_node *owner,
+                                 uint32_t layers, ob_env_params *env);
+/* EnvMap = v's colour, EnvMapMatrix = identity (maps are in the world's
+ * frame), EnvMapInfo = (kind, top mip level, texels_per_radian, 0): what
+ * materials/shaders/envmap.glsl reads. [recording thread: writes params] */
+void ob_views_env_usage(const ob_env_params *p, const ob_view *v, ob_params *params, float kind,
+                        float texels_per_radian);
+/* pre_cull of an environment map: queue v, centre it on its owner, which
+ * culling leaves out. [render thread] */
+bool ob_views_env_pre_cull(ob_view *v, ob_renderer *r, const ob_node *owner);
+/* Which layers an item reaches: a bit per layer, from the item's centre
+ * relative to the map's and its radius, already widened by far more than
+ * the float rounding of a vertex relative to the owner. */
+typedef uint8_t (*ob_env_layer_mask_fn)(const double rel[3], double radius);
+/* post_cull of an environment map: the per-item layer masks into *masks
+ * (grown as needed; *valid false when that fails: logged, every item drawn
+ * in every layer), then what a camera does after culling (the items' views,
+ * simulations, pipelines). [render thread] */
+void ob_views_env_post_cull(ob_views *ctx, ob_view *v, ob_renderer *r, ob_env_layer_mask_fn mask_of,
+                            uint8_t **masks, uint32_t *cap, bool *valid);
+/* Records items [first, first + count) of v whose mask[i] has `bit`, in
+ * runs (all of them when mask is NULL): the per-layer culling of the
+ * environment maps. [recording thread] */
+void ob_views_record_masked(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t first,
+                            uint32_t count, const uint8_t *mask, uint8_t bit);
+
+ob_cube_view *ob_cube_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
+void ob_cube_view_destroy(ob_views *ctx, ob_cube_view *v);
+ob_view *ob_cube_view_base(ob_cube_view *v);
 
 /* Particle systems by emitter node: the perspective view queues the
  * simulation of every emitter it sees (ob_views_queue_simulations). */

@@ -16,9 +16,12 @@
 
 /* The standard views' target formats. */
 #define OB_VIEWS_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
-/* Environment maps: they only feed shading (sampled by reflective
- * materials), so 8-bit linear is kept there; lit values above 1 clip. */
+/* 8-bit linear colour targets of views that need no range above 1. */
 #define OB_VIEWS_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
+/* Environment maps (paraboloid and cube): linear HDR like the camera views,
+ * so a lit value or a bright emitter above 1 is reflected as such (a
+ * reflection of the sun is not clipped to white before the tone map). */
+#define OB_VIEWS_ENV_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 /* Camera views render linear HDR colour; the composite tone maps it into an
  * sRGB target (what is read back, written as PNG and presented). */
 #define OB_VIEWS_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
@@ -42,7 +45,9 @@ void ob_views_queue_simulations(ob_views *ctx, ob_renderer *r, ob_view *consumer
 /* ---- targets ------------------------------------------------------------- */
 
 /* Make v's targets: a colour image of format `color` (colour target, sampled,
- * transfer source and destination) and a depth image of format `depth`
+ * transfer source and destination; with v->color_mips > 1 that many levels,
+ * at most a full chain, one where the format does not blit linearly (logged),
+ * v->color_mips then set to what was made) and a depth image of format `depth`
  * (depth target, sampled, transfer destination), width x height with
  * `layers` layers, named "<view>.color" / "<view>.depth"; either format may
  * be VK_FORMAT_UNDEFINED (none). With v->samples > 1 and one layer, also

@@ -29,7 +29,8 @@ static void usage(FILE *f, const char *prog, const char *extra, bool takes_input
             "  --stats-json FILE write one object of stats per frame (the last also holds the\n"
             "                    lean report, as \"lean\")\n"
             "  --seed S          scene seed\n"
-            "  --env-size N      environment map size (per paraboloid half; 8 to 4096)\n"
+            "  --env-size N      environment map size (paraboloid half or cube face; 8 to 4096)\n"
+            "  --env-map KIND    environment maps: paraboloid (default) or cube\n"
             "  --shadow-size N   shadow map size (16 to 8192)\n"
             "  --msaa N          samples per pixel of the main view: 1, 2, 4 or 8 (default 1;\n"
             "                    lowered to what the device offers, said in the log)\n"
@@ -85,7 +86,7 @@ static bool takes_value(const char *a)
                                              "--stats-json", "--seed", "--objects", "--env-size",
                                              "--malloc-threshold", "--window-resize", "--msaa",
                                              "--exposure", "--shadow-size", "--input",
-                                             "--screenshot-prefix"};
+                                             "--screenshot-prefix", "--env-map"};
     for (size_t i = 0; i < OB_ARRAY_COUNT(with_value); i++)
         if (!strcmp(a, with_value[i])) return true;
     return false;
@@ -183,6 +184,12 @@ bool ob_demo_options_parse(int argc, char **argv, const char *usage_extra, bool 
             ok = parse_u32(v, &o->env_size) && o->env_size >= OB_SETTING_ENV_MAP_MIN &&
                  o->env_size <= OB_SETTING_ENV_MAP_MAX;
             range = "an integer from 8 to 4096";
+            i++;
+        } else if (!strcmp(a, "--env-map")) {
+            ok = v && (!strcmp(v, "paraboloid") || !strcmp(v, "cube"));
+            if (ok) o->env_map_kind = !strcmp(v, "cube") ? OB_ENV_MAP_CUBE : OB_ENV_MAP_PARABOLOID;
+            o->env_map_given = ok;
+            range = "paraboloid or cube";
             i++;
         } else if (!strcmp(a, "--malloc-threshold")) {
             ok = parse_u32(v, &o->malloc_threshold_kib) && o->malloc_threshold_kib >= 1 &&
@@ -555,11 +562,13 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
         .width = o->width, .height = o->height,
         .camera = {.fovy = 1.0f, .znear = 0.05f},
         .env_map_size = o->env_size, .shadow_map_size = o->shadow_size,
+        .env_map_kind = o->env_map_kind,
         .overlay = o->overlay,
         .msaa = o->msaa,
         .exposure = o->exposure,
     };
     memcpy(sd.clear_color, o->clear_color, sizeof sd.clear_color);
+    memcpy(sd.sky_color, o->sky_color, sizeof sd.sky_color);
     memcpy(sd.ambient, o->ambient, sizeof sd.ambient);
     if ((r = ob_world_create(&d->world, &(ob_world_desc){.stack = sd})) != OB_OK) return r;
     if (o->no_instancing) ob_material_library_set_instancing(d->world.lib, false);

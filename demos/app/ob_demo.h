@@ -32,7 +32,9 @@ typedef struct ob_demo_options {
     const char *stats_json;   /* --stats-json stats.json */
     uint32_t seed;            /* --seed S */
     uint32_t objects;         /* --objects N (obelisk-mirror) */
-    uint32_t env_size;        /* --env-size (paraboloid map size) */
+    uint32_t env_size;        /* --env-size (paraboloid half or cube face size) */
+    ob_env_map_kind env_map_kind; /* --env-map paraboloid|cube */
+    bool env_map_given;
     uint32_t shadow_size;     /* --shadow-size */
     uint32_t msaa;            /* --msaa 1|2|4|8 (main view; 0 = not given → 1) */
     float exposure;           /* --exposure F (> 0; 0 = not given → the default) */
@@ -54,6 +56,7 @@ typedef struct ob_demo_options {
      * their own folder (ob_model_desc.allow_any_folder): trusted content. */
     bool allow_missing, allow_any_folder;
     float clear_color[4];     /* main view clear colour; all zero → dark blue-grey */
+    float sky_color[4];       /* what env maps clear to; all zero → clear_color */
     float ambient[4];         /* rgb, w = intensity; w = 0 → the views' default */
     /* --input SCRIPT (ob_input.h; "@FILE" reads it from FILE): events fed to
      * the same listener as the window's, before the update of their frame. */

@@ -14,6 +14,8 @@ const char *ob_bench_quality_kind_name(ob_bench_quality_kind k)
     case OB_BENCH_QUALITY_THREADING: return "threading";
     case OB_BENCH_QUALITY_MSAA_REFERENCE: return "msaa-reference";
     case OB_BENCH_QUALITY_MSAA: return "msaa";
+    case OB_BENCH_QUALITY_ENV_CUBE_REFERENCE: return "env-cube-reference";
+    case OB_BENCH_QUALITY_ENV_CUBE: return "env-cube";
     }
     return "unknown";
 }
@@ -96,6 +98,7 @@ typedef struct render_how {
     uint32_t scale;                /* size factor per axis: 0 or 1 → the desc's size */
     bool timed;                    /* timing rounds after the image */
     bool exact;                    /* draw nothing unless the view got msaa samples */
+    ob_env_map_kind env_kind;      /* environment maps: paraboloid (0) or cube */
 } render_how;
 
 static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t env, uint32_t shadow,
@@ -108,6 +111,7 @@ static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t en
     o.msaa = how.msaa;
     o.env_size = env;
     o.shadow_size = shadow;
+    o.env_map_kind = how.env_kind;
     o.threads = (int)desc->pool_workers;
     o.quiet = true;
     o.overlay = false;
@@ -152,9 +156,9 @@ static ob_result render_config_as(const ob_bench_quality_desc *desc, uint32_t en
         r = ob_bench_run_modes(&s, &rd, &out->timing);
     }
     if (r != OB_OK)
-        OB_LOG_E("bench", "mirror scene %ux%u with env map %u, shadow map %u, MSAA %ux, mode %s "
-                 "failed: %s", o.width, o.height, env, shadow, OB_MAX(how.msaa, 1u), mode->name,
-                 ob_result_name(r));
+        OB_LOG_E("bench", "mirror scene %ux%u with %s env map %u, shadow map %u, MSAA %ux, mode %s "
+                 "failed: %s", o.width, o.height, how.env_kind == OB_ENV_MAP_CUBE ? "cube" : "paraboloid",
+                 env, shadow, OB_MAX(how.msaa, 1u), mode->name, ob_result_name(r));
     if (d.world.r) ob_renderer_wait_idle(d.world.r);
     ob_bench_scene_release(&s);
     ob_demo_shutdown(&d);
@@ -239,7 +243,8 @@ ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quali
         return OB_ERR_INVALID_ARGUMENT;
     uint32_t env_ref = desc->env_sizes[desc->env_count - 1];
     uint32_t shadow_ref = desc->shadow_sizes[desc->shadow_count - 1];
-    uint32_t cap = 1 + desc->env_count + desc->shadow_count + desc->mode_count + (desc->msaa ? 5 : 0);
+    uint32_t cap = 1 + desc->env_count + desc->shadow_count + desc->mode_count + (desc->msaa ? 5 : 0) +
+                   (desc->env_cube ? desc->env_count : 0);
     ob_bench_quality_row *rows = ob_calloc(cap, sizeof *rows);
     if (!rows) return OB_ERR_OUT_OF_HOST_MEMORY;
     uint32_t n = 0;
@@ -264,6 +269,26 @@ ob_result ob_bench_quality_run(const ob_bench_quality_desc *desc, ob_bench_quali
                      &got, desc);
         ob_free(got.pixels);
     }
+    /* The cube series: its own reference (the two kinds differ at any
+     * size: the paraboloid bends what the cube draws straight), then each
+     * smaller size against it. */
+    rendering cube_ref = {0};
+    const render_how cube = {.timed = true, .env_kind = OB_ENV_MAP_CUBE};
+    if (desc->env_cube && r == OB_OK) {
+        r = render_config_as(desc, env_ref, shadow_ref, st, cube, &cube_ref);
+        if (r == OB_OK)
+            fill_row(&rows[n++], OB_BENCH_QUALITY_ENV_CUBE_REFERENCE, env_ref, shadow_ref, st, &ref,
+                     &cube_ref, desc);
+    }
+    for (uint32_t i = 0; desc->env_cube && i + 1 < desc->env_count && r == OB_OK; i++) {
+        rendering got = {0};
+        r = render_config_as(desc, desc->env_sizes[i], shadow_ref, st, cube, &got);
+        if (r == OB_OK)
+            fill_row(&rows[n++], OB_BENCH_QUALITY_ENV_CUBE, desc->env_sizes[i], shadow_ref, st,
+                     &cube_ref, &got, desc);
+        ob_free(got.pixels);
+    }
+    ob_free(cube_ref.pixels);
     for (uint32_t i = 0; i + 1 < desc->shadow_count && r == OB_OK; i++) {
         rendering got = {0};
         r = render_config(desc, env_ref, desc->shadow_sizes[i], st, &got);

@@ -9,6 +9,13 @@
  *   quality     each env-map size (shadow map at its highest) and each
  *               shadow-map size (env map at its highest), single-threaded:
  *               max abs difference and PSNR over RGB against the reference
+ *   env-cube-reference  (desc.env_cube) the reference with cube maps (six
+ *               faces of the same side instead of two paraboloid halves),
+ *               against the reference: how far the two kinds differ (the
+ *               paraboloid bends long straight edges, the cube does not)
+ *   env-cube    each smaller env-map size with cube maps against the cube
+ *               reference: the cube series' error next to its cost, as the
+ *               env-map rows are the paraboloid's
  *   threading   every other mode at the reference quality: its image must be
  *               byte-identical to the reference and the command hash of each
  *               of its frames equal to the reference's frame of the same index
@@ -41,6 +48,8 @@ typedef enum ob_bench_quality_kind {
     OB_BENCH_QUALITY_THREADING,
     OB_BENCH_QUALITY_MSAA_REFERENCE,
     OB_BENCH_QUALITY_MSAA,
+    OB_BENCH_QUALITY_ENV_CUBE_REFERENCE, /* cube maps at the reference size, against the reference */
+    OB_BENCH_QUALITY_ENV_CUBE,     /* smaller cube maps, against the cube reference */
 } ob_bench_quality_kind;
 
 typedef struct ob_bench_quality_desc {
@@ -55,6 +64,7 @@ typedef struct ob_bench_quality_desc {
     const ob_bench_mode *modes;    /* modes[0] is the reference mode (single-threaded) */
     uint32_t mode_count;
     bool msaa;                     /* also the MSAA series */
+    bool env_cube;                 /* also the env-map sizes as cube maps (the cube series) */
     uint32_t msaa_scale;           /* its reference's size factor per axis: 0 → 4; lowered so
                                       that neither side passes 4096 (at least 1) */
     ob_bench_tick_fn tick;

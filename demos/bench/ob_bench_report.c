@@ -151,13 +151,13 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
             rep->raw_instanced.ns_per_draw, rep->summary.engine_vs_raw_instanced_per_object.median,
             rep->summary.commands_per_object_raw_instanced);
     fprintf(f, "\nimage error against the reference (ST, highest quality), mirror scene %ux%u, "
-               "frame %u:\n  %-10s %5s %6s %-5s %8s %9s %9s %9s %9s %s\n",
+               "frame %u:\n  %-18s %5s %6s %-5s %8s %9s %9s %9s %9s %s\n",
             rep->image_width, rep->image_height, rep->image_frames, "kind", "env", "shadow",
             "mode", "max_abs", "psnr_dB", "frame_ms", "gpu_ms", "rec+asm", "hashes");
     for (uint32_t i = 0; i < rep->quality_count; i++) {
         const ob_bench_quality_row *q = &rep->quality[i];
         if (q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE || q->kind == OB_BENCH_QUALITY_MSAA) continue;
-        fprintf(f, "  %-10s %5u %6u %-5s %8u %9.2f %9.2f %9.2f %9.2f %s\n",
+        fprintf(f, "  %-18s %5u %6u %-5s %8u %9.2f %9.2f %9.2f %9.2f %s\n",
                 ob_bench_quality_kind_name(q->kind), q->env_size, q->shadow_size, q->mode.name,
                 q->max_abs_diff, q->psnr_db, q->frame_ms, q->gpu_ms, q->record_total_ms,
                 q->kind != OB_BENCH_QUALITY_THREADING ? "-"
@@ -349,6 +349,10 @@ static void json_quality(FILE *f, const ob_bench_quality_row *q)
             q->draws, q->hash_mismatches, q->msaa_samples, q->supersample);
     if (q->kind == OB_BENCH_QUALITY_MSAA || q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE)
         fprintf(f, ",\"against\":\"msaa-reference\"");
+    if (q->kind == OB_BENCH_QUALITY_ENV_CUBE)
+        fprintf(f, ",\"against\":\"env-cube-reference\"");
+    if (q->kind == OB_BENCH_QUALITY_ENV_CUBE_REFERENCE)
+        fprintf(f, ",\"env_map\":\"cube\",\"against\":\"reference\"");
     if (q->kind == OB_BENCH_QUALITY_MSAA_REFERENCE)
         fprintf(f, ",\"reference\":\"drawn at %ux the size per axis with %ux MSAA (the most the "
                    "device offers, up to 8x), box-downsampled %ux%u in linear light\"",
@@ -757,15 +761,17 @@ static ob_result error_chart(const ob_bench_report *rep, const char *dir)
     char dat[1024], gp[1024];
     FILE *f = open_chart_data(dir, "error", dat, gp);
     if (!f) return OB_ERR_IO;
-    fputs("# series(0 env, 1 shadow) size frame_ms psnr_db max_abs_diff\n", f);
+    fputs("# series(0 env, 1 shadow, 2 env as cube maps against the cube reference) size frame_ms psnr_db "
+          "max_abs_diff\n", f);
     double ref_ms = NAN;
-    for (int series = 0; series < 2; series++) {
+    static const ob_bench_quality_kind series_kind[3] = {OB_BENCH_QUALITY_ENV, OB_BENCH_QUALITY_SHADOW,
+                                                         OB_BENCH_QUALITY_ENV_CUBE};
+    for (int series = 0; series < 3; series++) {
         for (uint32_t i = 0; i < rep->quality_count; i++) {
             const ob_bench_quality_row *q = &rep->quality[i];
             if (q->kind == OB_BENCH_QUALITY_REFERENCE) ref_ms = q->frame_ms;
-            ob_bench_quality_kind want = series ? OB_BENCH_QUALITY_SHADOW : OB_BENCH_QUALITY_ENV;
-            if (q->kind != want || !isfinite(q->psnr_db)) continue;
-            fprintf(f, "%d %u %.4f %.4f %u\n", series, series ? q->shadow_size : q->env_size,
+            if (q->kind != series_kind[series] || !isfinite(q->psnr_db)) continue;
+            fprintf(f, "%d %u %.4f %.4f %u\n", series, series == 1 ? q->shadow_size : q->env_size,
                     q->frame_ms, q->psnr_db, q->max_abs_diff);
         }
         fputs("\n\n", f);
@@ -782,7 +788,9 @@ static ob_result error_chart(const ob_bench_report *rep, const char *dir)
     fprintf(f, "plot '%s' index 0 using 3:4 with linespoints pt 7 lw 2 title 'env-map size', "
                "'' index 0 using 3:4:(sprintf('%%d', $2)) with labels offset 1,1 notitle, "
                "'' index 1 using 3:4 with linespoints pt 5 lw 2 title 'shadow-map size', "
-               "'' index 1 using 3:4:(sprintf('%%d', $2)) with labels offset 1,-1 notitle\n", dat);
+               "'' index 1 using 3:4:(sprintf('%%d', $2)) with labels offset 1,-1 notitle, "
+               "'' index 2 using 3:4 with linespoints pt 9 lw 2 title 'env-map size, cube maps (against the cube reference)', "
+               "'' index 2 using 3:4:(sprintf('%%d', $2)) with labels offset 1,1 notitle\n", dat);
     res = close_out(f, gp);
     return res == OB_OK ? run_gnuplot(gp) : res;
 }

@@ -703,12 +703,13 @@ static int run(const bench_options *o)
         .rounds = o->quick ? 2 : 3, .flight = o->flight,
         .env_sizes = o->quick ? env_quick : env_full, .env_count = o->quick ? 2 : 4,
         .shadow_sizes = o->quick ? shadow_quick : shadow_full, .shadow_count = o->quick ? 2 : 4,
-        .modes = o->modes, .mode_count = o->mode_count, .msaa = true,
+        .modes = o->modes, .mode_count = o->mode_count, .msaa = true, .env_cube = true,
     };
     /* The MSAA series adds up to three sample counts (2x, 4x, 8x: what the
      * device offers; 1x is the reference's image) and its own reference,
      * which draws its image frames only. */
-    uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3;
+    uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3 +
+                               (qd.env_cube ? qd.env_count : 0);
     uint64_t total = 0;
     if (o->perf) {
         /* scene200: three modes. */

@@ -35,7 +35,7 @@ layout(set = 0, binding = 1, std140) uniform PerMaterial {
     vec4 DiffuseColor;         // rgba (alpha used when blended)
     vec4 SpecularColor;        // rgb, w = Blinn-Phong power
     vec4 EmissiveColor;        // rgb added unlit
-    vec4 Reflectivity;         // x = mix factor of the environment map
+    vec4 Reflectivity;         // x = mix factor of the environment map, y = its roughness (reflective)
 };
 
 #if defined(INSTANCED)

@@ -6,18 +6,15 @@
 // Variants (each compiled only when a material needs it):
 //   SHADOWS     the directional light is shadowed by "ShadowMap"
 //               (shadow.glsl: compare sampler, 2x2 PCF).
-//   ENVMAP      reflective surfaces: the reflected view vector samples the
-//               dual-paraboloid "EnvMap" (2D array, layer 0 = +Z of the owner)
-//               rotated by EnvMapMatrix; mixed over the lit colour by
-//               Reflectivity.x.
+//   ENVMAP      reflective surfaces: the reflected view vector, rotated by
+//               EnvMapMatrix, samples "EnvMap" (envmap.glsl: dual paraboloid
+//               or cube, by EnvMapInfo) at the mip level of roughness
+//               Reflectivity.y (0: level 0, a mirror); mixed over the lit
+//               colour by Reflectivity.x.
 //   PARABOLOID  paired with paraboloid.vert: discards the other hemisphere.
 // Output is premultiplied alpha (the blend state is ONE, ONE_MINUS_SRC_ALPHA).
 #include "common.glsl"
 #include "lighting.glsl"
-#if defined(ENVMAP)
-#include "paraboloid.glsl"
-#endif
-
 layout(location = 0) in vec3 vPosition;
 layout(location = 1) in vec3 vNormal;
 layout(location = 2) in vec2 vUV;
@@ -34,8 +31,10 @@ layout(location = 0) out vec4 outColor;
 #if defined(ENVMAP)
 layout(set = 0, binding = 2, std140) uniform PerEnvMap {
     mat4 EnvMapMatrix;         // world -> env-map owner frame (rotation)
+    vec4 EnvMapInfo;           // x kind (0 paraboloid, 1 cube), y top level, z texels/radian
 };
 layout(set = 1, binding = 1) uniform sampler2DArray EnvMap;
+#include "envmap.glsl"
 #endif
 
 void main()
@@ -61,7 +60,8 @@ void main()
                + ob_local_lights(vPosition, n, v, diffuse, SpecularColor);
 #if defined(ENVMAP)
     vec3 r = reflect(-v, n);
-    vec3 env = texture(EnvMap, ob_paraboloid_lookup(mat3(EnvMapMatrix) * r)).rgb;
+    float rough = clamp(Reflectivity.y, 0.0, 1.0);
+    vec3 env = ob_env_sample(EnvMap, mat3(EnvMapMatrix) * r, ob_env_lod(rough * rough));
     color = mix(color, env, clamp(Reflectivity.x, 0.0, 1.0));
 #endif
     float alpha = DiffuseColor.a;

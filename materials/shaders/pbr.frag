@@ -5,19 +5,21 @@
 // Lighting model (docs/materials.md has the long form):
 //   colour = emissive
 //          + sum over lights of  pi * (f_diffuse + f_specular) * radiance * NdotL
-//          + ambient:  AmbientColor * occlusion * ((1 - F_a)(1 - metallic) base + F_a)
-//          + ENVMAP:   env(R) * F_a * occlusion * Reflectivity.x * (1 - roughness)^2
+//          + ambient:  AmbientColor * occlusion * ((1 - F_a)(1 - metallic) base + F_a * k)
+//          + ENVMAP:   env(R, lod(roughness)) * F_a * occlusion * Reflectivity.x
 //   with the BRDF of pbr.glsl (Cook-Torrance: GGX D, height-correlated Smith
 //   visibility, Schlick F with F0 = mix(0.04, base, metallic); Lambert
 //   diffuse) for the directional light (shadowed with SHADOWS) and the
 //   point and spot lights of lighting.glsl's tile grid; F_a is Schlick at n.v with roughness-limited
 //   reflectance (ob_fresnel_ambient).
-//   The environment map is one sharp dual-paraboloid image with no
-//   prefiltered mips, so it cannot show the blur of a rough surface: its
-//   mirror image is faded by (1 - roughness)^2 and the ambient term's
-//   specular part (F_a * AmbientColor) stands for the blurred rest. A
-//   smooth metal therefore mirrors its surroundings, a rough one shows a
-//   uniform sheen.
+//   The environment map (envmap.glsl: paraboloid or cube, linear HDR) has a
+//   box-filtered mip chain; it is sampled at the level whose texel spans
+//   the GGX lobe (alpha = roughness^2 radians, ob_env_lod), so a smooth
+//   metal mirrors its surroundings and a rough one reflects them blurred.
+//   This approximates a GGX prefilter (a box, not the lobe's shape). The
+//   ambient term's specular part (F_a * AmbientColor) stands for the
+//   environment where there is none: k = 1 - clamp(Reflectivity.x) with
+//   ENVMAP, 1 without.
 // Output: linear radiance (no gamma: the composite tone maps and encodes),
 // premultiplied alpha (the blend state is ONE, ONE_MINUS_SRC_ALPHA).
 //
@@ -40,9 +42,6 @@
 #include "common.glsl"
 #include "lighting.glsl"
 #include "pbr.glsl"
-#if defined(ENVMAP)
-#include "paraboloid.glsl"
-#endif
 #if defined(SHADOWS)
 #include "shadow.glsl"
 #endif
@@ -69,8 +68,10 @@ layout(location = 5) in float vHemisphere;
 #if defined(ENVMAP)
 layout(set = 0, binding = 2, std140) uniform PerEnvMap {
     mat4 EnvMapMatrix;         // world -> env-map owner frame (rotation)
+    vec4 EnvMapInfo;           // x kind (0 paraboloid, 1 cube), y top level, z texels/radian
 };
 layout(set = 1, binding = 1) uniform sampler2DArray EnvMap;
+#include "envmap.glsl"
 #endif
 #if defined(HAS_BASE_COLOR_TEXTURE)
 layout(set = 1, binding = 2) uniform sampler2D BaseColorTexture;
@@ -186,13 +187,14 @@ void main()
     }
     vec3 fa = ob_fresnel_ambient(s);
     vec3 ambient = AmbientColor.rgb * AmbientColor.w;
-    color += ambient * occlusion * ((1.0 - fa) * (1.0 - metallic) * base.rgb + fa);
+    float ambient_specular = 1.0;
 #if defined(ENVMAP)
+    ambient_specular = 1.0 - clamp(Reflectivity.x, 0.0, 1.0);
     vec3 r = reflect(-s.v, n);
-    vec3 env = texture(EnvMap, ob_paraboloid_lookup(mat3(EnvMapMatrix) * r)).rgb;
-    float sharp = (1.0 - roughness) * (1.0 - roughness);
-    color += env * fa * occlusion * sharp * max(Reflectivity.x, 0.0);
+    vec3 env = ob_env_sample(EnvMap, mat3(EnvMapMatrix) * r, ob_env_lod(s.a));
+    color += env * fa * occlusion * max(Reflectivity.x, 0.0);
 #endif
+    color += ambient * occlusion * ((1.0 - fa) * (1.0 - metallic) * base.rgb + fa * ambient_specular);
     outColor = vec4(color * base.a, base.a);
 #endif
 }

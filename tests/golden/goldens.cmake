@@ -16,6 +16,8 @@ ob_golden(mirror demos/scenes/mirror.json --frames 30)
 ob_golden(models demos/scenes/models.json --frames 3)
 # MSAA 4x resolve on the same scene (edges against the 1x golden above).
 ob_golden(primitives_msaa4 demos/scenes/primitives.json --frames 3 --msaa 4)
+ob_golden(reflections demos/scenes/reflections.json --frames 2)
+ob_golden(reflections_paraboloid demos/scenes/reflections.json --frames 2 --env-map paraboloid)
 # Real glTF models: a base-colour texture from a .glb, a node hierarchy of
 # many primitives, several materials with normal maps and alpha.
 ob_golden(boxtextured ${OB_GOLDEN_MODELS}/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb --frames 2)

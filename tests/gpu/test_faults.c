@@ -59,6 +59,7 @@ typedef struct reference {
      * driver does not survive an instance per point; test_device walks the
      * points of instance and device creation). */
     ob_test_vulkan tv;
+    ob_env_map_kind env_map_kind;  /* of the stacks walked against this reference */
 } reference;
 
 static ob_threading mode_of(bool multi) { return multi ? OB_THREADING_MULTI : OB_THREADING_SINGLE; }
@@ -118,7 +119,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
     ob_result r = OB_OK;
     if (ph == PHASE_START) {
         ob_fault_arm(kind, nth);
-        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
+        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles, .env_map_kind = ref->env_map_kind});
         ob_test_stack_stop(&s);
         o->hit = ob_fault_hit(kind);
         o->count = ob_fault_count(kind);
@@ -126,7 +127,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
         o->result = r;
         o->after_ok = true;
     } else {
-        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
+        r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles, .env_map_kind = ref->env_map_kind});
         if (r != OB_OK) fail_msg("%s: unarmed start-up failed: %s", phase_names[ph], ob_result_name(r));
         if (ph != PHASE_SCENE) {
             r = ob_test_stack_build_scene(&s);
@@ -164,7 +165,7 @@ static void run_phase(phase ph, bool multi, ob_fault_kind kind, uint64_t nth, co
 static void make_reference(reference *ref)
 {
     ob_test_stack s;
-    ob_result r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles});
+    ob_result r = ob_test_stack_start(&s, &(ob_test_stack_desc){.adopt = &ref->tv.handles, .env_map_kind = ref->env_map_kind});
     if (r == OB_OK) r = ob_test_stack_build_scene(&s);
     if (r != OB_OK) fail_msg("reference run: %s", ob_result_name(r));
     ref->width = s.width;
@@ -254,6 +255,22 @@ static void walk(phase ph, bool multi, ob_fault_kind kind, const reference *ref)
                            (unsigned long long)t.broken);
 }
 
+/* The walks of a first and a steady frame with cube environment maps (six
+ * layers, mips, a view of its own) against a reference made with them; the
+ * scene and start-up phases do not depend on the kind. */
+static void cube_walk(void **state, phase ph, bool multi, ob_fault_kind kind)
+{
+    reference cube = *(reference *)*state;
+    cube.env_map_kind = OB_ENV_MAP_CUBE;
+    make_reference(&cube);
+    walk(ph, multi, kind, &cube);
+    free_reference(&cube);
+}
+
+static void first_frame_cube_host(void **state) { cube_walk(state, PHASE_FIRST_FRAME, false, OB_FAULT_HOST_ALLOC); }
+static void first_frame_cube_vulkan(void **state) { cube_walk(state, PHASE_FIRST_FRAME, false, OB_FAULT_VK_OBJECT); }
+static void steady_frame_cube_mt_host(void **state) { cube_walk(state, PHASE_STEADY_FRAME, true, OB_FAULT_HOST_ALLOC); }
+
 static int setup(void **state)
 {
     reference *ref = calloc(1, sizeof *ref);
@@ -306,6 +323,9 @@ int main(void)
         cmocka_unit_test(steady_frame_vulkan),
         cmocka_unit_test(steady_frame_mt_host),
         cmocka_unit_test(steady_frame_mt_vulkan),
+        cmocka_unit_test(first_frame_cube_host),
+        cmocka_unit_test(first_frame_cube_vulkan),
+        cmocka_unit_test(steady_frame_cube_mt_host),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -127,14 +127,14 @@ static void test_render_flags_per_view_type(void **state)
         ob_material_kind kind;
         bool shadows;
         bool expect[OB_VIEW_TYPE_COUNT]; /* perspective, shadow, paraboloid, simulation,
-                                            overlay, composite */
+                                            overlay, composite, cube */
     } cases[] = {
-        {OB_MATERIAL_LIT, false, {true, false, true, false, false, false}},
-        {OB_MATERIAL_LIT, true, {true, true, true, false, false, false}},
-        {OB_MATERIAL_REFLECTIVE, false, {true, false, true, false, false, false}},
-        {OB_MATERIAL_REFLECTIVE, true, {true, true, true, false, false, false}},
-        {OB_MATERIAL_UNLIT, false, {true, false, false, false, true, false}},
-        {OB_MATERIAL_CUSTOM, true, {false, false, false, false, false, false}},
+        {OB_MATERIAL_LIT, false, {true, false, true, false, false, false, true}},
+        {OB_MATERIAL_LIT, true, {true, true, true, false, false, false, true}},
+        {OB_MATERIAL_REFLECTIVE, false, {true, false, true, false, false, false, true}},
+        {OB_MATERIAL_REFLECTIVE, true, {true, true, true, false, false, false, true}},
+        {OB_MATERIAL_UNLIT, false, {true, false, false, false, true, false, false}},
+        {OB_MATERIAL_CUSTOM, true, {false, false, false, false, false, false, false}},
     };
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(cases); i++) {
         ob_material *m = make_material(lib, cases[i].kind, cases[i].shadows, false, 0);

@@ -33,6 +33,7 @@ ob_result ob_test_stack_start(ob_test_stack *s, const ob_test_stack_desc *desc)
         .camera = {.fovy = 1.0f, .znear = 0.1f},
         .env_map_size = s->env_map_size, .shadow_map_size = s->shadow_map_size,
         .msaa = d.msaa,
+        .env_map_kind = d.env_map_kind,
     }};
     if (d.clear_color[3] > 0.0f) memcpy(wd.stack.clear_color, d.clear_color, sizeof d.clear_color);
     ob_result r = ob_world_create(&s->world, &wd);

@@ -9,7 +9,7 @@
  *
  * The scene (ob_test_stack_build_scene) is tiny but exercises every lazy
  * path of a first frame: a shadow-casting directional light and caster, a
- * reflective sphere (a paraboloid environment map), a particle system (a
+ * reflective sphere (a paraboloid or cube environment map), a particle system (a
  * compute simulation and a blended draw) and the composite to the final
  * target. Its image depends only on the frame index, never on earlier
  * frames: the particles live shorter than a frame, so every step respawns
@@ -28,7 +28,8 @@
 /* The test world's settings, with smaller defaults: workers 0 → 2, size
  * 0 → 48 x 32, env_map_size 0 → 16, shadow_map_size 0 → 32; cache_dir
  * NULL → $OB_CACHE_DIR/stack, else /tmp/obelisk-test-stack. clear_color,
- * chunk_draws, parallel_grain and msaa are the world's defaults. */
+ * chunk_draws, parallel_grain, msaa and env_map_kind (the reflective
+ * sphere's map) are the world's defaults. */
 typedef ob_test_world_desc ob_test_stack_desc;
 
 typedef struct ob_test_stack {

@@ -29,6 +29,7 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     sd->msaa = d.msaa;
     sd->cache_dir = d.cache_dir;
     sd->renderer.device.adopt = d.adopt;
+    sd->env_map_kind = d.env_map_kind;
     ob_world_create(w, &wd);
 }
 

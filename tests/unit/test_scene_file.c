@@ -32,7 +32,7 @@ static const char full_scene[] =
     "  \"description\": \"everything\",\n"
     "  \"settings\": { \"size\": [320, 200], \"env_map_size\": 64, \"shadow_map_size\": 512,\n"
     "                \"threads\": \"auto\", \"clear_color\": [0.1, 0.2, 0.3], \"ambient\": [1, 1, 1, 0],\n"
-    "                \"exposure\": 1.5 },\n"
+    "                \"exposure\": 1.5, \"env_map\": \"cube\", \"sky_color\": [2, 1, 0.5, 0.25] },\n"
     "  \"camera\": { \"position\": [1, 2, 3], \"target\": [1, 2, 0], \"fov_degrees\": 40, \"near\": 0.5 },\n"
     "  \"lights\": [\n"
     "    { \"type\": \"directional\", \"position\": [0, 10, 0], \"target\": [0, 0, 0], \"shadows\": true },\n"
@@ -40,7 +40,7 @@ static const char full_scene[] =
     "      \"intensity\": 2, \"range\": 5 }\n"
     "  ],\n"
     "  \"materials\": {\n"
-    "    \"mirror\": { \"kind\": \"reflective\", \"reflectivity\": 0 },\n"
+    "    \"mirror\": { \"kind\": \"reflective\", \"reflectivity\": 0, \"roughness\": 0.25 },\n"
     "    \"glass\": { \"diffuse\": [0.5, 0.6, 0.7, 0.25], \"blended\": true, \"casts_shadows\": false,\n"
     "               \"specular\": [0, 0, 0], \"emissive\": [0.1, 0, 0], \"priority\": 3 }\n"
     "  },\n"
@@ -92,6 +92,11 @@ static void full_file_parses_to_its_description(void **state)
     assert_true(s->has_ambient);              /* intensity 0 means no ambient light */
     assert_near(s->ambient[0], 0.0, 0);
     assert_near(s->ambient[3], 1.0, 0);
+    assert_true(s->has_env_map_kind);
+    assert_int_equal(s->env_map_kind, OB_ENV_MAP_CUBE);
+    assert_true(s->has_sky_color);            /* sRGB-decoded, may exceed 1; alpha ignored */
+    assert_near(s->sky_color[0], pow((2.0 + 0.055) / 1.055, 2.4), 1e-5);
+    assert_near(s->sky_color[3], 1.0, 0);
 
     assert_true(sf.camera.present);
     assert_near(sf.camera.position[2], 3.0, 0);
@@ -117,6 +122,7 @@ static void full_file_parses_to_its_description(void **state)
     assert_string_equal(mirror->name, "mirror");
     assert_int_equal(mirror->desc.kind, OB_MATERIAL_REFLECTIVE);
     assert_near(mirror->desc.reflectivity, 0.0, 0);   /* explicit 0 stays 0 */
+    assert_near(mirror->desc.roughness, 0.25, 0);
     assert_true(mirror->desc.casts_shadows);
     assert_near(mirror->desc.diffuse[3], 1.0, 0);
     assert_near(mirror->desc.specular[3], 32.0, 0);
@@ -210,6 +216,8 @@ static void minimal_file_gets_documented_defaults(void **state)
     assert_false(sf.camera.present);   /* the viewer frames the scene */
     assert_false(sf.has_lights);       /* the viewer adds a sun */
     assert_false(sf.settings.has_size);
+    assert_false(sf.settings.has_env_map_kind);   /* the views' default: paraboloid */
+    assert_false(sf.settings.has_sky_color);      /* the clear colour */
     assert_int_equal(sf.entity_count, 0);
     assert_null(sf.description);
     ob_scene_file_release(&sf);
@@ -429,6 +437,14 @@ static const bad_case bad_cases[] = {
      "only a spot light has cone angles"},
     {"{\"materials\": {\"m\": {\"reflectivity\": 0.5}}, " E "[]}", "materials.m.reflectivity",
      "only a \"reflective\" material has a reflectivity"},
+    {"{\"materials\": {\"m\": {\"roughness\": 0.5}}, " E "[]}", "materials.m.roughness",
+     "only a \"reflective\" material has a roughness"},
+    {"{\"materials\": {\"m\": {\"kind\": \"reflective\", \"roughness\": 2}}, " E "[]}",
+     "materials.m.roughness", "expected a number from 0 to 1"},
+    {"{\"settings\": {\"env_map\": \"sphere\"}, " E "[]}", "settings.env_map",
+     "expected \"paraboloid\" or \"cube\""},
+    {"{\"settings\": {\"env_map\": 1}, " E "[]}", "settings.env_map",
+     "expected \"paraboloid\" or \"cube\", got a number"},
     {"{" E "[{\"controllers\": [{\"rotate\": {}, \"orbit\": {}}]}]}", "entities[0].controllers[0]",
      "expected exactly one of rotate or orbit"},
     {"{" E "[{\"controllers\": [{\"orbit\": {\"radius\": -1}}]}]}", "entities[0].controllers[0].orbit.radius",

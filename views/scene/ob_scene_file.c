@@ -68,7 +68,7 @@ static bool opt_srgb_color(sf_ctx *c, const cJSON *j, const char *key, float w, 
 static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
 {
     static const char *const keys[] = {"size", "env_map_size", "shadow_map_size", "threads",
-                                       "clear_color", "ambient", "exposure"};
+                                       "clear_color", "ambient", "exposure", "env_map", "sky_color"};
     if (!ob_json_check_object(&c->rd, j, "an object", keys, OB_ARRAY_COUNT(keys))) return false;
     const cJSON *size = ob_json_member(j, "size");
     if (size) {
@@ -109,6 +109,22 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
     if (ob_json_member(j, "clear_color")) {
         s->has_clear_color = true;
         if (!opt_srgb_color(c, j, "clear_color", 1.0f, s->clear_color)) return false;
+    }
+    const cJSON *env = ob_json_member(j, "env_map");
+    if (env) {
+        size_t mark = ob_json_push_key(&c->rd, "env_map");
+        bool cube = cJSON_IsString(env) && strcmp(env->valuestring, "cube") == 0;
+        if (!cube && !(cJSON_IsString(env) && strcmp(env->valuestring, "paraboloid") == 0))
+            return ob_json_fail(&c->rd, "expected \"paraboloid\" or \"cube\", got %s",
+                                cJSON_IsString(env) ? "another string" : ob_json_type_name(env));
+        s->has_env_map_kind = true;
+        s->env_map_kind = cube ? OB_ENV_MAP_CUBE : OB_ENV_MAP_PARABOLOID;
+        ob_json_pop(&c->rd, mark);
+    }
+    if (ob_json_member(j, "sky_color")) {
+        s->has_sky_color = true;
+        if (!opt_srgb_color(c, j, "sky_color", 1.0f, s->sky_color)) return false;
+        s->sky_color[3] = 1.0f;
     }
     if (ob_json_member(j, "ambient")) {
         s->has_ambient = true;
@@ -254,7 +270,7 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
 static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
 {
     static const char *const keys[] = {"kind", "diffuse", "specular", "emissive", "reflectivity",
-                                       "casts_shadows", "blended", "priority"};
+                                       "roughness", "casts_shadows", "blended", "priority"};
     if (!ob_json_check_object(&c->rd, j, "a material object or the name of one", keys, OB_ARRAY_COUNT(keys)))
         return false;
     ob_material_desc *d = &m->desc;
@@ -297,11 +313,16 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
         ob_json_push_key(&c->rd, "reflectivity");
         return ob_json_fail(&c->rd, "only a \"reflective\" material has a reflectivity");
     }
+    if (ob_json_member(j, "roughness") && d->kind != OB_MATERIAL_REFLECTIVE) {
+        ob_json_push_key(&c->rd, "roughness");
+        return ob_json_fail(&c->rd, "only a \"reflective\" material has a roughness");
+    }
     memcpy(d->diffuse, diffuse, sizeof diffuse);
     memcpy(d->specular, specular, sizeof specular);
     memcpy(d->emissive, emissive, sizeof emissive);
     double prio = 0;
     if (!ob_json_opt_float(&c->rd, j, "reflectivity", OB_JSON_RANGE(0, 1), &d->reflectivity) ||
+        !ob_json_opt_float(&c->rd, j, "roughness", OB_JSON_RANGE(0, 1), &d->roughness) ||
         !ob_json_opt_bool(&c->rd, j, "casts_shadows", &d->casts_shadows) || !ob_json_opt_bool(&c->rd, j, "blended", &d->blended) ||
         !ob_json_opt_double(&c->rd, j, "priority", OB_JSON_INT(0, 1000000), &prio))
         return false;

@@ -82,6 +82,10 @@ typedef struct ob_scene_file_settings {
     bool has_ambient;
     float ambient[4];             /* rgb, w = intensity > 0 (0 0 0 1 for "none") */
     float exposure;               /* the composite's exposure; 0 = not given, else > 0 */
+    bool has_env_map_kind;
+    ob_env_map_kind env_map_kind; /* "env_map": "paraboloid" or "cube" */
+    bool has_sky_color;
+    float sky_color[4];           /* what env maps clear to (linear; alpha 1) */
 } ob_scene_file_settings;
 
 /* "camera": without one the program frames the whole scene (ob_scene_load

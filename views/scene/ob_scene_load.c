@@ -571,6 +571,8 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *s, ob_stack_desc *de
     if (s->has_clear_color) memcpy(desc->clear_color, s->clear_color, sizeof desc->clear_color);
     if (s->has_ambient) memcpy(desc->ambient, s->ambient, sizeof desc->ambient);
     if (s->exposure > 0.0f) desc->exposure = s->exposure;
+    if (s->has_env_map_kind) desc->env_map_kind = s->env_map_kind;
+    if (s->has_sky_color) memcpy(desc->sky_color, s->sky_color, sizeof desc->sky_color);
 }
 
 ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
@@ -591,5 +593,9 @@ ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
     if (views && s->shadow_map_size &&
         (res = ob_views_set_shadow_map_size(views, s->shadow_map_size)) != OB_OK && first == OB_OK)
         first = res;
+    if (views && s->has_env_map_kind && !ob_views_set_env_map_kind(views, s->env_map_kind) &&
+        first == OB_OK)
+        first = OB_ERR_INVALID_ARGUMENT;
+    if (views && s->has_sky_color) ob_views_set_sky_color(views, s->sky_color);
     return first;
 }

@@ -168,13 +168,14 @@ void ob_scene_unload(ob_scene_loaded *l);
 
 /* The file's settings that shape a set-up, into *desc before ob_stack_create:
  * size, threads (renderer.threading and worker_count), env-map and
- * shadow-map sizes, clear colour and ambient. What the file does not give
+ * shadow-map sizes, env-map kind, clear colour, sky colour and ambient. What the file does not give
  * is left as it was. [any thread] */
 void ob_scene_load_stack_desc(const ob_scene_file_settings *settings, ob_stack_desc *desc);
 
 /* The file's settings a live set-up can take: threading (from the next
- * frame) and env-map and shadow-map sizes (for views made afterwards, as
- * entities' maps are, on first need). Failure: the first setting refused
+ * frame), env-map and shadow-map sizes and the env-map kind (for views made
+ * afterwards, as entities' maps are, on first need) and the sky colour
+ * (from the next frame). Failure: the first setting refused
  * (OB_ERR_OUT_OF_RANGE for a map size the device cannot make, logged); the
  * others are still applied. [render thread, between frames] */
 ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,

@@ -24,6 +24,7 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
                         .effects = s->effects, .env_map_size = d.env_map_size,
                         .shadow_map_size = d.shadow_map_size};
     memcpy(vd.ambient, d.ambient, sizeof vd.ambient);
+    vd.env_map_kind = d.env_map_kind;
     if (!(s->views = ob_views_create(&vd, &r))) goto fail_destroy_stack;
 
     if (!(s->scene = ob_scene_create(&r))) goto fail_destroy_stack;
@@ -39,6 +40,13 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     if (memcmp(d.clear_color, no_color, sizeof no_color) != 0)
         memcpy(pd.clear_color, d.clear_color, sizeof pd.clear_color);
     if (!(s->main = ob_perspective_view_create(s->views, &pd, &r))) goto fail_destroy_stack;
+    /* Reflections show the scene's sky: the main view's clear colour unless
+     * the description names another. */
+    float sky[4];
+    memcpy(sky, memcmp(d.sky_color, no_color, sizeof no_color) != 0 ? d.sky_color : pd.clear_color,
+           sizeof sky);
+    sky[3] = 1.0f;
+    ob_views_set_sky_color(s->views, sky);
     s->composite = ob_composite_view_create(s->views, ob_perspective_view_base(s->main), &r);
     if (!s->composite) goto fail_destroy_stack;
     if (d.exposure != 0.0f && !ob_composite_view_set_exposure(s->composite, d.exposure)) {

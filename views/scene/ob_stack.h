@@ -40,6 +40,8 @@ typedef struct ob_stack_desc {
     float clear_color[4];        /* linear; all zero → opaque OB_STACK_CLEAR_R/G/B */
     ob_camera_desc camera;       /* zero → ob_node_set_camera's defaults */
     uint32_t env_map_size;       /* 0 → the views' default (256) */
+    ob_env_map_kind env_map_kind;  /* 0 → OB_ENV_MAP_PARABOLOID */
+    float sky_color[4];          /* linear; what env maps clear to; all zero → clear_color */
     uint32_t shadow_map_size;    /* 0 → the views' default (1024) */
     float ambient[4];            /* rgb, w = intensity; zero → the views' default */
     bool overlay;                /* also an overlay view, drawn last over the composite */
