@@ -28,12 +28,15 @@
 #define GLTF_MAX_NAMES 32u
 #define GLTF_NAME_MAX 96u
 
-/* Extensions the engine honours when a file requires them. None yet: the
- * ones assimp 5.2 reads (texture transform, the KHR_materials_* family,
- * specular-glossiness, unlit) are not carried into ob_model_material, and
- * quantized or Draco-compressed geometry is not decoded. Add a name here
- * only together with the code that honours it. */
-static const char *const supported_required[] = {NULL};
+/* Extensions the engine honours when a file requires them:
+ * KHR_texture_transform (offset, rotation and scale per texture, which
+ * assimp 5.2 reads; its texCoord override assimp drops, so such a texture
+ * keeps the textureInfo's set — docs/limits.md) and KHR_materials_clearcoat.
+ * The rest of the KHR_materials_* family, specular-glossiness and unlit are
+ * not carried into ob_model_material, and quantized or Draco-compressed
+ * geometry is not decoded. Add a name here only together with the code
+ * that honours it. */
+static const char *const supported_required[] = {"KHR_texture_transform", "KHR_materials_clearcoat", NULL};
 
 #define GLTF_NONE UINT32_MAX
 
@@ -787,15 +790,15 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
         ob_free(lists);
         return OB_OK;
     }
-    /* Optional ones: everything used that is not required (and supported). */
+    /* Optional ones ignored: everything used that is neither required nor supported. */
     bool optional[GLTF_MAX_NAMES] = {false};
     uint32_t optional_count = 0;
     for (uint32_t i = 0; i < used->count; i++) {
         bool req = false;
         for (uint32_t k = 0; k < required->count && !req; k++)
             req = strcmp(required->names[k], used->names[i]) == 0;
-        optional[i] = !req;
-        optional_count += !req;
+        optional[i] = !req && !is_supported(used->names[i]);
+        optional_count += optional[i];
     }
     if (optional_count || used->dropped) {
         join_names(used, optional, text_names, sizeof text_names);
