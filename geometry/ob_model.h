@@ -124,10 +124,12 @@ typedef struct ob_model_image {
  * directly (assimp's glTF keys: base colour, metallic and roughness factors,
  * emissive, alphaMode, alphaCutoff, doubleSided, the five textures with
  * normal scale and occlusion strength, KHR_texture_transform per texture
- * and KHR_materials_clearcoat). What of a file is still not carried
- * (KHR_texture_transform's texCoord override, which assimp 5.2 does not
- * read; the other KHR_materials_* extensions) is logged once per material
- * by name. Other formats are mapped:
+ * and KHR_materials_clearcoat). What of a file is still not carried is
+ * logged once per material by name: KHR_texture_transform's texCoord
+ * override, which assimp 5.2 does not read (a warning from the glTF scan;
+ * the texture keeps the textureInfo's set), and the other material
+ * extensions assimp reads (sheen, transmission, volume, specular,
+ * specular-glossiness, unlit: an info line). Other formats are mapped:
  * - OBJ .mtl: Kd → base colour rgb, d (or 1 − Tr) → base colour alpha and
  *   BLEND when < 1, map_Kd → base colour texture, Ke → emissive, metallic 0
  *   (Pm when given), roughness from the Phong exponent Ns as

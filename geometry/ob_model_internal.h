@@ -117,6 +117,9 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
  *   and every node's "skin" are renamed in a copy of the file (io->patched,
  *   served to assimp instead of the file), so assimp never sees a skin;
  *   one info line says so;
+ * - materials (ob_model_open only): a KHR_texture_transform texCoord
+ *   override, which assimp drops, is warned about once per material,
+ *   naming it, the texture and the set;
  * - point and line primitives (mode 0-3), which Obelisk drops after the
  *   import: their "indices" are hidden the same way (assimp 5.2 crashes on
  *   a LINE_LOOP index past the vertex count).

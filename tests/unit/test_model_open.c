@@ -662,6 +662,49 @@ static void texture_transform_as_authored(void **state)
     cJSON_Delete(doc);
 }
 
+/* KHR_texture_transform's texCoord override is what assimp 5.2 drops: the
+ * glTF scan names the material, the texture and the set it asked for, once
+ * per material, and the model still opens. */
+static void texcoord_override_is_named(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ob_test_model_open_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[96];
+    snprintf(path, sizeof path, "%s/override.gltf", dir);
+    static const char text[] =
+        "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],"
+        " \"nodes\": [{\"name\": \"tri\", \"mesh\": 0}],"
+        " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 1}]}],"
+        " \"materials\": [{\"name\": \"plain\"}, {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0,"
+        " \"extensions\": {\"KHR_texture_transform\": {\"offset\": [0.5, 0], \"texCoord\": 1}}}},"
+        " \"occlusionTexture\": {\"index\": 0, \"extensions\": {\"KHR_texture_transform\": {\"texCoord\": 1}}},"
+        " \"name\": \"shifted\"}],"
+        " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"absent.png\"}],"
+        " \"buffers\": [{\"byteLength\": 42, \"uri\": \"data:application/octet-stream;base64,"
+        "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA\"}],"
+        " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
+        " {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}],"
+        " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\","
+        " \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3,"
+        " \"type\": \"SCALAR\"}], \"extensionsUsed\": [\"KHR_texture_transform\"],"
+        " \"extensionsRequired\": [\"KHR_texture_transform\"]}";
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(text, 1, sizeof text - 1, f), sizeof text - 1);
+    fclose(f);
+    ob_test_log_clear();
+    ob_model *m = open_ok(path, true);   /* required, and honoured */
+    assert_true(ob_test_log_has("material 1 'shifted' baseColorTexture", "texCoord override",
+                                "TEXCOORD_1", NULL));
+    assert_false(ob_test_log_has("occlusionTexture", "texCoord override", NULL));   /* once per material */
+    assert_false(ob_test_log_has("'plain'", NULL));
+    assert_false(ob_test_log_has("optional glTF extension", NULL));
+    ob_model_close(m);
+    remove(path);
+    rmdir(dir);
+}
+
 /* KHR_materials_clearcoat: factors and the three textures, per material of
  * ClearCoatTest, against the JSON. */
 static void clearcoat_as_authored(void **state)
@@ -851,6 +894,7 @@ int main(void)
         cmocka_unit_test(clear_coat_normal_maps_get_tangents),
         cmocka_unit_test(texture_transform_as_authored),
         cmocka_unit_test(clearcoat_as_authored),
+        cmocka_unit_test(texcoord_override_is_named),
         cmocka_unit_test(second_uv_set_is_read),
         cmocka_unit_test(obj_and_ply_from_the_package),
         cmocka_unit_test(raw_embedded_texture_becomes_png),
