@@ -37,16 +37,18 @@ const ob_vertex_layout *ob_vertex_layout_standard(void) { return &standard_layou
 
 _Static_assert(sizeof(ob_vertex_extended) == 52, "the extended vertex is 52 bytes, unpadded");
 
+/* The extended vertex's attributes, shared by both extended layouts. */
+#define EXTENDED_ATTRIBUTES                                                                    \
+    {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},       \
+    {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},           \
+    {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},               \
+    {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},              \
+    {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"}
+
 static const ob_vertex_layout extended_layout = {
     .stride = sizeof(ob_vertex_extended),
     .attribute_count = 5,
-    .attributes = {
-        {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},
-        {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},
-        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},
-        {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},
-        {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"},
-    },
+    .attributes = {EXTENDED_ATTRIBUTES},
 };
 
 const ob_vertex_layout *ob_vertex_layout_extended(void) { return &extended_layout; }
@@ -56,14 +58,8 @@ _Static_assert(sizeof(ob_vertex_extended_uv1) == 60, "the extended vertex with T
 static const ob_vertex_layout extended_uv1_layout = {
     .stride = sizeof(ob_vertex_extended_uv1),
     .attribute_count = 6,
-    .attributes = {
-        {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},
-        {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},
-        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},
-        {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},
-        {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"},
-        {5, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended_uv1, uv1), "TEXCOORD1"},
-    },
+    .attributes = {EXTENDED_ATTRIBUTES,
+                   {5, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended_uv1, uv1), "TEXCOORD1"}},
 };
 
 const ob_vertex_layout *ob_vertex_layout_extended_uv1(void) { return &extended_uv1_layout; }

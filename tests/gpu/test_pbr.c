@@ -128,6 +128,32 @@ static void lit_side_is_brighter(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* The brightest pixel of the ball of ball_under_sun (its luminance; where
+ * it is into *out_x, *out_y). */
+static float brightest(const ob_test_world *w, uint32_t *out_x, uint32_t *out_y)
+{
+    float best = -1.0f;
+    *out_x = *out_y = 0;
+    for (uint32_t y = 30; y < 90; y++)
+        for (uint32_t x = 50; x < 110; x++) {
+            float l = luminance(ob_world_pixel(w, x, y));
+            if (l > best) best = l, *out_x = x, *out_y = y;
+        }
+    return best;
+}
+
+/* Where a mirror-like lobe of ball_under_sun's ball peaks for a sun at
+ * (5, 5, 5): the half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a
+ * sphere of radius ~23 pixels at (80, 60): about 9 pixels right and up. */
+static void mirror_point(float *out_x, float *out_y)
+{
+    float h[3] = {0.57735f, 0.57735f, 1.57735f};
+    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
+    *out_x = 80.0f + radius_px * h[0] / hl;
+    *out_y = 60.0f - radius_px * h[1] / hl;
+}
+
 /* A smooth white metal lit from the upper right: the brightest pixel of the
  * sphere sits where the normal is the half vector between the light and the
  * eye (up and to the right of the centre), and it is much brighter than the
@@ -140,19 +166,9 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     p.roughness = 0.05f;
     ob_test_world w;
     ball_under_sun(&w, "chrome", &p, 3.0f, 5, 5, 5, __func__);
-    uint32_t bx = 0, by = 0;
-    float best = -1.0f;
-    for (uint32_t y = 30; y < 90; y++)
-        for (uint32_t x = 50; x < 110; x++) {
-            float l = luminance(ob_world_pixel(&w, x, y));
-            if (l > best) best = l, bx = x, by = y;
-        }
-    /* The half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a sphere of
-     * radius ~23 pixels at (80, 60): about 9 pixels right and up. */
-    float h[3] = {0.57735f, 0.57735f, 1.57735f};
-    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
-    float ex = 80.0f + radius_px * h[0] / hl, ey = 60.0f - radius_px * h[1] / hl;
+    uint32_t bx, by;
+    float best = brightest(&w, &bx, &by), ex, ey;
+    mirror_point(&ex, &ey);
     if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
         fail_msg("highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
     float opposite = luminance(ob_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
@@ -161,22 +177,28 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     ob_test_world_destroy(&w);
 }
 
-/* A 2x1 PNG: left texel transparent, right opaque white. */
-static const ob_texture *half_transparent(ob_texture_cache *cache)
+/* A w x h RGBA8 image as a PNG texture, sampled NEAREST and CLAMP. */
+static const ob_texture *nearest_texture(ob_texture_cache *cache, const uint8_t *px, int w, int h, const char *what)
 {
-    static const uint8_t px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
     int size;
-    uint8_t *png = stbi_write_png_to_mem(px, 8, 2, 1, 4, &size);
+    uint8_t *png = stbi_write_png_to_mem(px, w * 4, w, h, 4, &size);
     assert_non_null(png);
     ob_result r;
     const ob_texture *t = ob_texture_cache_load(cache, &(ob_texture_desc){
-        .data = png, .size = (size_t)size, .srgb = true, .context = "test: half transparent",
+        .data = png, .size = (size_t)size, .srgb = true, .context = what,
         .sampling = {.mag = OB_TEXTURE_FILTER_NEAREST, .min = OB_TEXTURE_FILTER_NEAREST,
                      .mip = OB_TEXTURE_FILTER_NEAREST, .wrap_u = OB_TEXTURE_WRAP_CLAMP,
                      .wrap_v = OB_TEXTURE_WRAP_CLAMP}}, &r);
     ob_free(png);
     assert_non_null(t);
     return t;
+}
+
+/* A 2x1 PNG: left texel transparent, right opaque white. */
+static const ob_texture *half_transparent(ob_texture_cache *cache)
+{
+    static const uint8_t px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
+    return nearest_texture(cache, px, 2, 1, "test: half transparent");
 }
 
 /* A 160x120 world with a texture cache and a shadow-casting "leaf":
@@ -583,18 +605,7 @@ static void texture_maps_change_the_shading(void **state)
 static const ob_texture *quadrants(ob_texture_cache *cache)
 {
     static const uint8_t px[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
-    int size;
-    uint8_t *png = stbi_write_png_to_mem(px, 8, 2, 2, 4, &size);
-    assert_non_null(png);
-    ob_result r;
-    const ob_texture *t = ob_texture_cache_load(cache, &(ob_texture_desc){
-        .data = png, .size = (size_t)size, .srgb = true, .context = "test: quadrants",
-        .sampling = {.mag = OB_TEXTURE_FILTER_NEAREST, .min = OB_TEXTURE_FILTER_NEAREST,
-                     .mip = OB_TEXTURE_FILTER_NEAREST, .wrap_u = OB_TEXTURE_WRAP_CLAMP,
-                     .wrap_v = OB_TEXTURE_WRAP_CLAMP}}, &r);
-    ob_free(png);
-    assert_non_null(t);
-    return t;
+    return nearest_texture(cache, px, 2, 2, "test: quadrants");
 }
 
 enum { Q_RED, Q_GREEN, Q_BLUE, Q_WHITE };
@@ -718,29 +729,19 @@ static void clearcoat_adds_a_highlight_layer(void **state)
     p.base_color[0] = 0.5f, p.base_color[1] = 0.02f, p.base_color[2] = 0.01f;
     p.metallic = 0.0f;
     p.roughness = 0.8f;
-    float best[2] = {-1.0f, -1.0f};
+    float best[2];
     uint32_t bx = 0, by = 0;
     for (int coated = 0; coated < 2; coated++) {
         p.clearcoat = coated ? 1.0f : 0.0f;
         p.clearcoat_roughness = 0.05f;
         ob_test_world w;
         ball_under_sun(&w, coated ? "coated" : "base", &p, 3.0f, 5, 5, 5, coated ? "clearcoat" : "clearcoat_base");
-        for (uint32_t y = 30; y < 90; y++)
-            for (uint32_t x = 50; x < 110; x++) {
-                float l = luminance(ob_world_pixel(&w, x, y));
-                if (l > best[coated]) {
-                    best[coated] = l;
-                    if (coated) bx = x, by = y;
-                }
-            }
+        best[coated] = brightest(&w, &bx, &by);
         ob_test_world_destroy(&w);
     }
     if (!(best[1] > best[0] + 60.0f)) fail_msg("coated highlight %.0f, uncoated %.0f", best[1], best[0]);
-    /* The coat's half vector, as in smooth_metal_highlight_at_mirror_direction. */
-    float h[3] = {0.57735f, 0.57735f, 1.57735f};
-    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
-    float ex = 80.0f + radius_px * h[0] / hl, ey = 60.0f - radius_px * h[1] / hl;
+    float ex, ey;   /* the coat's lobe peaks where a mirror's would */
+    mirror_point(&ex, &ey);
     if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
         fail_msg("coat highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
 
