@@ -74,7 +74,7 @@ typedef struct ob_material_pbr_state {
     ob_material_pbr desc;
     uint32_t features;             /* OB_PBR_F_* bits the material uses */
     float block[4][4];             /* PbrBaseColor, PbrFactors, PbrEmissive, PbrClearcoat */
-    float uv[4 * OB_PBR_UV_MATRICES][4];   /* PbrUvTransforms as vec4 rows (OB_PBR_UV_MATRICES) */
+    float uv[16u * OB_PBR_UV_MATRICES];   /* PbrUvTransforms: 8 floats (two vec4 rows) per slot */
     _Atomic(ob_effect *) effects[OB_PBR_PASS_COUNT];
 } ob_material_pbr_state;
 

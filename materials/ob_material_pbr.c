@@ -310,7 +310,7 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc)
     /* Unused rows stay the identity on set 0. */
     memset(s->uv, 0, sizeof s->uv);
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
-        float *row = &s->uv[0][0] + 8u * i;
+        float *row = s->uv + 8u * i;
         row[0] = 1.0f;
         row[5] = 1.0f;
     }
@@ -318,7 +318,7 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc)
         if (!slots[i]->texture) continue;
         if (i >= OB_PBR_TEX_CC && !coat) continue;   /* no layer, nothing to texture */
         s->features |= texture_bits[i];
-        float *row = &s->uv[0][0] + 8u * i;   /* two vec4: (a, b, tx, set), (c, d, ty, 0) */
+        float *row = s->uv + 8u * i;   /* two vec4: (a, b, tx, set), (c, d, ty, 0) */
         if (slots[i]->has_transform) {
             if (!finite_n(slots[i]->transform, 6)) {
                 OB_LOG_E("material", "material '%s': %s has a non-finite uv transform", m->name, texture_names[i]);
@@ -439,7 +439,7 @@ ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *
     /* Only variants that declare them read these: others set nothing new. */
     if (m->pbr.features & OB_PBR_F_CLEARCOAT) ob_params_set_vec4(params, p->clearcoat, m->pbr.block[3]);
     if (m->pbr.features & (OB_PBR_F_UV_TRANSFORM | OB_PBR_F_TEXCOORD1))
-        ob_params_set_mat4_array(params, p->uv_transforms, &m->pbr.uv[0][0], OB_PBR_UV_MATRICES);
+        ob_params_set_mat4_array(params, p->uv_transforms, m->pbr.uv, OB_PBR_UV_MATRICES);
     const ob_material_texture *slots[OB_PBR_TEX_COUNT];
     texture_slots(&m->pbr.desc, slots);
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
