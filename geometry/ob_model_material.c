@@ -51,6 +51,7 @@ typedef struct material_ctx {
     int32_t *embedded_image;   /* per scene texture: its image index, -1 not yet */
     char *dir;                 /* the model's folder, with a trailing '/', or "" */
     bool flip_uv;              /* the meshes' uv convention (ob_model_desc.flip_uv) */
+    bool gltf;                 /* the material being read is glTF's (its uv transforms are) */
 } material_ctx;
 
 typedef struct slot_info {
@@ -409,7 +410,9 @@ static ob_result read_texture_n(material_ctx *c, const struct aiMaterial *m, enu
     }
     float t[5];
     unsigned count = 5;
-    if (aiGetMaterialFloatArray(m, AI_MATKEY_UVTRANSFORM(type, slot), t, &count) == AI_SUCCESS && count == 5 &&
+    /* Other importers fill the key in their own conventions: only glTF's is inverted. */
+    if (c->gltf &&
+        aiGetMaterialFloatArray(m, AI_MATKEY_UVTRANSFORM(type, slot), t, &count) == AI_SUCCESS && count == 5 &&
         !uv_transform_from_assimp(t, c->flip_uv, &tex->transform))
         OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s: KHR_texture_transform is not finite; "
                  "not applied", c->chk->path, si->material_index, si->material, si->slot);
@@ -580,6 +583,7 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
 
     struct aiString mode;
     const bool gltf = aiGetMaterialString(m, AI_MATKEY_GLTF_ALPHAMODE, &mode) == AI_SUCCESS;
+    c->gltf = gltf;
     struct aiColor4D col;
     if (aiGetMaterialColor(m, AI_MATKEY_BASE_COLOR, &col) == AI_SUCCESS ||
         aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &col) == AI_SUCCESS) {
