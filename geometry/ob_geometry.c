@@ -18,6 +18,7 @@ struct ob_geometry {
     ob_bounds bounds;
     uint32_t id;
     bool extended;
+    bool uv1;                 /* extended with TEXCOORD1 */
     char *name;
 };
 
@@ -36,29 +37,48 @@ const ob_vertex_layout *ob_vertex_layout_standard(void) { return &standard_layou
 
 _Static_assert(sizeof(ob_vertex_extended) == 52, "the extended vertex is 52 bytes, unpadded");
 
+/* The extended vertex's attributes, shared by both extended layouts. */
+#define EXTENDED_ATTRIBUTES                                                                    \
+    {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},       \
+    {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},           \
+    {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},               \
+    {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},              \
+    {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"}
+
 static const ob_vertex_layout extended_layout = {
     .stride = sizeof(ob_vertex_extended),
     .attribute_count = 5,
-    .attributes = {
-        {0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, position), "POSITION"},
-        {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(ob_vertex_extended, normal), "NORMAL"},
-        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended, uv), "TEXCOORD0"},
-        {3, VK_FORMAT_R8G8B8A8_UNORM, offsetof(ob_vertex_extended, color), "COLOR0"},
-        {4, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(ob_vertex_extended, tangent), "TANGENT"},
-    },
+    .attributes = {EXTENDED_ATTRIBUTES},
 };
 
 const ob_vertex_layout *ob_vertex_layout_extended(void) { return &extended_layout; }
 
-/* The mesh interleaved in the extended layout, defaults where an optional
- * array is missing. NULL when out of memory. */
-static ob_vertex_extended *interleave_extended(const ob_mesh *mesh)
+_Static_assert(sizeof(ob_vertex_extended_uv1) == 60, "the extended vertex with TEXCOORD1 is 60 bytes");
+
+static const ob_vertex_layout extended_uv1_layout = {
+    .stride = sizeof(ob_vertex_extended_uv1),
+    .attribute_count = 6,
+    .attributes = {EXTENDED_ATTRIBUTES,
+                   {5, VK_FORMAT_R32G32_SFLOAT, offsetof(ob_vertex_extended_uv1, uv1), "TEXCOORD1"}},
+};
+
+const ob_vertex_layout *ob_vertex_layout_extended_uv1(void) { return &extended_uv1_layout; }
+
+/* The mesh interleaved in the extended layout (with uv1: the TEXCOORD1 one,
+ * stride 60), defaults where an optional array is missing (uv1: the first
+ * set). NULL when out of memory. */
+static void *interleave_extended(const ob_mesh *mesh, bool uv1)
 {
-    ob_vertex_extended *out = ob_malloc((size_t)mesh->vertex_count * sizeof *out);
+    const size_t stride = uv1 ? sizeof(ob_vertex_extended_uv1) : sizeof(ob_vertex_extended);
+    uint8_t *out = ob_malloc((size_t)mesh->vertex_count * stride);
     if (!out) return NULL;
     for (uint32_t i = 0; i < mesh->vertex_count; i++) {
-        ob_vertex_extended *e = &out[i];
+        ob_vertex_extended *e = (ob_vertex_extended *)(void *)(out + i * stride);
         const ob_vertex *v = &mesh->vertices[i];
+        if (uv1) {
+            ob_vertex_extended_uv1 *x = (ob_vertex_extended_uv1 *)(void *)e;
+            memcpy(x->uv1, mesh->uv1 ? mesh->uv1[i] : v->uv, sizeof x->uv1);
+        }
         memcpy(e->position, v->position, sizeof e->position);
         memcpy(e->normal, v->normal, sizeof e->normal);
         memcpy(e->uv, v->uv, sizeof e->uv);
@@ -195,13 +215,14 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
     g->index_count = mesh->index_count;
     g->instance_count = 1;
     g->topology = topology;
-    g->extended = desc->extended || mesh->tangents || mesh->colors;
+    g->uv1 = desc->texcoord1 || mesh->uv1;
+    g->extended = desc->extended || mesh->tangents || mesh->colors || g->uv1;
 
-    ob_vertex_extended *interleaved = NULL;
+    void *interleaved = NULL;
     const void *vertex_bytes = mesh->vertices;
     size_t vertex_size = (size_t)mesh->vertex_count * sizeof(ob_vertex);
     if (g->extended) {
-        interleaved = interleave_extended(mesh);
+        interleaved = interleave_extended(mesh, g->uv1);
         if (!interleaved) {
             OB_LOG_E(OB_GEOMETRY_LOG, "%s: out of host memory interleaving %u extended vertices",
                      name, mesh->vertex_count);
@@ -209,7 +230,8 @@ ob_geometry *ob_geometry_create(ob_device *dev, const ob_geometry_desc *desc, ob
             goto fail_free_geometry;
         }
         vertex_bytes = interleaved;
-        vertex_size = (size_t)mesh->vertex_count * sizeof(ob_vertex_extended);
+        vertex_size = (size_t)mesh->vertex_count *
+                      (g->uv1 ? sizeof(ob_vertex_extended_uv1) : sizeof(ob_vertex_extended));
     }
     g->id = desc->id ? desc->id : derive_id(name, mesh, vertex_bytes, vertex_size);
 
@@ -263,7 +285,7 @@ uint32_t ob_geometry_instance_count(const ob_geometry *g) { return g ? g->instan
 const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g)
 {
     if (!g) return NULL;
-    return g->extended ? &extended_layout : &standard_layout;
+    return g->uv1 ? &extended_uv1_layout : g->extended ? &extended_layout : &standard_layout;
 }
 
 VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g)

@@ -57,6 +57,17 @@ typedef struct ob_vertex_extended {
  * stride 52. A static constant, never NULL. [any thread] */
 const ob_vertex_layout *ob_vertex_layout_extended(void);
 
+/* The extended vertex followed by a second uv set (60 bytes): meshes with
+ * TEXCOORD_1 (ob_mesh.uv1) drawn by materials that read it. */
+typedef struct ob_vertex_extended_uv1 {
+    ob_vertex_extended base;
+    float uv1[2];
+} ob_vertex_extended_uv1;
+
+/* ob_vertex_layout_extended() plus location 5 TEXCOORD1 (R32G32_SFLOAT,
+ * 52); stride 60. A static constant, never NULL. [any thread] */
+const ob_vertex_layout *ob_vertex_layout_extended_uv1(void);
+
 typedef struct ob_geometry ob_geometry;
 
 typedef struct ob_geometry_desc {
@@ -82,6 +93,11 @@ typedef struct ob_geometry_desc {
      * draw such a mesh with a standard-layout effect, pass a copy of the
      * ob_mesh with those two pointers set to NULL. */
     bool extended;
+    /* Upload in the extended layout with TEXCOORD1 (ob_vertex_extended_uv1):
+     * a mesh without uv1 repeats its uv there. A mesh with uv1 is uploaded
+     * so even without this flag; to draw it with a layout without TEXCOORD1,
+     * pass a copy of the ob_mesh with uv1 set to NULL. */
+    bool texcoord1;
 } ob_geometry_desc;
 
 /* Validates the mesh for the topology first (ob_mesh_validate_primitives:
@@ -108,7 +124,7 @@ ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UIN
 uint32_t ob_geometry_index_count(const ob_geometry *g);
 uint32_t ob_geometry_vertex_count(const ob_geometry *g);
 uint32_t ob_geometry_instance_count(const ob_geometry *g);  /* 1 for meshes */
-const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);  /* standard or extended */
+const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);  /* standard, extended or extended_uv1 */
 VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g);
 const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
 uint32_t ob_geometry_id(const ob_geometry *g);              /* never 0 for a live geometry */

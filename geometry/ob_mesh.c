@@ -25,6 +25,7 @@ void ob_mesh_release(ob_mesh *mesh)
     ob_free(mesh->indices);
     ob_free(mesh->tangents);
     ob_free(mesh->colors);
+    ob_free(mesh->uv1);
     memset(mesh, 0, sizeof *mesh);
 }
 
@@ -149,6 +150,7 @@ ob_result ob_mesh_validate_primitives(const ob_mesh *mesh, const char *name,
         check_attribute(&s, v, "position", vx->position, 3);
         check_attribute(&s, v, "normal", vx->normal, 3);
         check_attribute(&s, v, "uv", vx->uv, 2);
+        if (mesh->uv1) check_attribute(&s, v, "uv1", mesh->uv1[v], 2);
         if (mesh->tangents && !vec_finite(mesh->tangents[v], 4))
             problem(&s, OB_ERR_NON_FINITE, "vertex %u tangent is not finite (%g, %g, %g, %g)", v,
                     (double)mesh->tangents[v][0], (double)mesh->tangents[v][1],

@@ -48,6 +48,10 @@ typedef struct ob_mesh {
      * uploaded in the extended layout (ob_vertex_layout_extended). */
     float (*tangents)[4];   /* xyz unit tangent, w = ±1 bitangent sign (glTF convention) */
     uint8_t (*colors)[4];   /* vertex colour COLOR_0, linear, RGBA8 */
+    /* The second uv set (TEXCOORD_1), same convention as uv. A mesh with it
+     * is uploaded in the extended layout with TEXCOORD1
+     * (ob_vertex_layout_extended_uv1). */
+    float (*uv1)[2];
     uint32_t *indices;      /* triangle list: index_count / 3 triangles */
     uint32_t index_count;
     ob_bounds bounds;       /* valid after a generator, ob_model_load_mesh or ob_mesh_compute_bounds */
@@ -66,7 +70,7 @@ ob_result ob_mesh_compute_bounds(ob_mesh *mesh);
 
 /* Checks a mesh before it is used or uploaded: non-empty, index_count a
  * multiple of 3, every index < vertex_count, every position, normal and uv
- * finite, and every tangent (when present) finite. Logs each problem (the first few, then a count) prefixed with
+ * finite, and every tangent and second uv (when present) finite. Logs each problem (the first few, then a count) prefixed with
  * `name` (NULL → "mesh"), e.g. "crate: index 1234 = 99999 out of range
  * (8 vertices)". Returns the first problem found: OB_ERR_INVALID_ARGUMENT
  * (NULL, empty, missing arrays, count not a multiple of 3),

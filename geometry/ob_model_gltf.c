@@ -28,13 +28,17 @@
 #define GLTF_MAX_NAMES 32u
 #define GLTF_NAME_MAX 96u
 
-/* Extensions the engine honours when a file requires them: lights
- * (ob_model_open.c reads assimp's aiLight into ob_model_light). The others
- * assimp 5.2 reads (texture transform, the KHR_materials_* family,
- * specular-glossiness, unlit) are not carried into ob_model_material, and
+/* Extensions the engine honours when a file requires them:
+ * KHR_lights_punctual (ob_model_open.c reads assimp's aiLight into
+ * ob_model_light), KHR_texture_transform (offset, rotation and scale per
+ * texture, which assimp 5.2 reads; its texCoord override assimp drops, so
+ * such a texture keeps the textureInfo's set — docs/limits.md) and
+ * KHR_materials_clearcoat. The rest of the KHR_materials_* family,
+ * specular-glossiness and unlit are not carried into ob_model_material, and
  * quantized or Draco-compressed geometry is not decoded. Add a name here
  * only together with the code that honours it. */
-static const char *const supported_required[] = {"KHR_lights_punctual", NULL};
+static const char *const supported_required[] = {"KHR_lights_punctual", "KHR_texture_transform",
+                                                 "KHR_materials_clearcoat", NULL};
 
 #define GLTF_NONE UINT32_MAX
 
@@ -60,6 +64,10 @@ typedef struct scan {
     struct gltf_accessor *accessors;
     uint32_t view_count, view_cap, accessor_count, accessor_cap;
     bool out_of_memory;
+    /* What the loader does not carry of the materials, said once per
+     * material (only when log_materials: ob_model_open). */
+    const char *path;
+    bool log_materials;
 } scan;
 
 static bool hide_key(scan *s, const char *quote)
@@ -510,6 +518,99 @@ static bool scan_node(scan *s)
     return scan_object(s, false, node_field, NULL);
 }
 
+/* ------------------------------------------------------ material notes
+ * assimp 5.2 reads KHR_texture_transform's offset, rotation and scale but
+ * not its texCoord override, so such a texture is sampled with the
+ * textureInfo's set: each material with one gets a warning naming it, the
+ * texture and the set it asked for. */
+#define GLTF_MATERIAL_DEPTH 8u
+
+typedef struct material_note {
+    char name[GLTF_NAME_MAX];
+    char slot[32];          /* the textureInfo being walked ("baseColorTexture") */
+    char override_slot[32]; /* the first with a texCoord override */
+    uint32_t override_set;
+    bool found;
+    uint32_t depth;
+} material_note;
+
+static bool walk_value(scan *s, material_note *n);
+
+static bool transform_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)quote;
+    material_note *n = user;
+    bool ok = true;
+    uint32_t set = 0;
+    if (strcmp(key, "texCoord") != 0 || n->found) return skip_value(s);
+    if (!read_uint(s, &set, &ok)) return false;
+    if (ok) {
+        n->found = true;
+        n->override_set = set;
+        snprintf(n->override_slot, sizeof n->override_slot, "%s", n->slot);
+    }
+    return true;
+}
+
+static bool walk_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)quote;
+    material_note *n = user;
+    if (strcmp(key, "KHR_texture_transform") == 0) return scan_object(s, false, transform_field, n);
+    size_t len = strlen(key);
+    if (len >= 7 && strcmp(key + len - 7, "Texture") == 0) snprintf(n->slot, sizeof n->slot, "%s", key);
+    return walk_value(s, n);
+}
+
+/* Any value inside a material, objects walked for the notes above (to a
+ * bounded depth; deeper values are only skipped). */
+static bool walk_value(scan *s, material_note *n)
+{
+    skip_ws(s);
+    if (s->p >= s->end || *s->p != '{' || n->depth >= GLTF_MATERIAL_DEPTH) return skip_value(s);
+    n->depth++;
+    bool ok = scan_object(s, true, walk_field, n);
+    n->depth--;
+    return ok;
+}
+
+static bool material_field(scan *s, const char *key, const char *quote, void *user)
+{
+    (void)quote;
+    material_note *n = user;
+    if (strcmp(key, "name") == 0) {
+        skip_ws(s);
+        if (s->p < s->end && *s->p == '"') return read_string(s, n->name, sizeof n->name);
+        return skip_value(s);
+    }
+    snprintf(n->slot, sizeof n->slot, "%s", key);
+    return walk_value(s, n);
+}
+
+static bool scan_materials(scan *s)
+{
+    skip_ws(s);
+    if (!s->log_materials || s->p >= s->end || *s->p != '[') return skip_value(s);
+    s->p++;
+    skip_ws(s);
+    if (s->p < s->end && *s->p == ']') {
+        s->p++;
+        return true;
+    }
+    for (uint32_t index = 0;; index++) {
+        material_note n = {.depth = 0};
+        snprintf(n.name, sizeof n.name, "material %u", index);
+        if (!scan_object(s, true, material_field, &n)) return false;
+        if (n.found)
+            OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s: KHR_texture_transform's texCoord override "
+                     "(TEXCOORD_%u) is not supported (assimp 5.2 drops it); the texture reads the "
+                     "textureInfo's set", s->path, index, n.name, n.override_slot, n.override_set);
+        bool done;
+        if (!after_item(s, ']', &done)) return false;
+        if (done) return true;
+    }
+}
+
 /* The top-level object: extensionsRequired and extensionsUsed into the
  * lists, skins and the nodes' skin references to hide, every other member
  * skipped. */
@@ -527,6 +628,7 @@ static bool top_field(scan *s, const char *key, const char *quote, void *user)
     if (strcmp(key, "bufferViews") == 0) return scan_objects(s, grow_views, view_member);
     if (strcmp(key, "accessors") == 0) return scan_objects(s, grow_accessors, accessor_member);
     if (strcmp(key, "meshes") == 0) return scan_objects(s, grow_nothing, mesh_member);
+    if (strcmp(key, "materials") == 0) return scan_materials(s);
     return skip_value(s);
 }
 
@@ -740,7 +842,7 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
     }
     name_list *required = &lists[0], *used = &lists[1];
     io->gltf = true;
-    scan s = {.p = text, .begin = text, .end = text + size};
+    scan s = {.p = text, .begin = text, .end = text + size, .path = path, .log_materials = refuse_required};
     bool scanned = scan_top(&s, required, used);
     ob_free(text);
     if (s.out_of_memory) {
@@ -788,7 +890,7 @@ ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_
         ob_free(lists);
         return OB_OK;
     }
-    /* Optional ones: everything used that is not required (and supported). */
+    /* Optional ones ignored: everything used that is neither required nor supported. */
     bool optional[GLTF_MAX_NAMES] = {false};
     uint32_t optional_count = 0;
     for (uint32_t i = 0; i < used->count; i++) {

@@ -117,6 +117,9 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
  *   and every node's "skin" are renamed in a copy of the file (io->patched,
  *   served to assimp instead of the file), so assimp never sees a skin;
  *   one info line says so;
+ * - materials (ob_model_open only): a KHR_texture_transform texCoord
+ *   override, which assimp drops, is warned about once per material,
+ *   naming it, the texture and the set;
  * - point and line primitives (mode 0-3), which Obelisk drops after the
  *   import: their "indices" are hidden the same way (assimp 5.2 crashes on
  *   a LINE_LOOP index past the vertex count).
@@ -126,11 +129,13 @@ ob_result ob_model_import(ob_model_check *c, const ob_model_desc *desc, bool ref
 ob_result ob_model_gltf_precheck(const char *path, ob_model_io *io, bool refuse_required);
 
 /* model->materials (at least one: a file without materials gets one
- * default) and model->images from the scene (ob_model_material.c). On
+ * default) and model->images from the scene (ob_model_material.c);
+ * flip_uv says the meshes' uv convention, for KHR_texture_transform. On
  * failure (logged) what was read so far stays in model, counted, for
  * ob_model_close to free. [any thread] */
 struct ob_model;
-ob_result ob_model_read_materials(ob_model_check *c, const struct aiScene *s, struct ob_model *model);
+ob_result ob_model_read_materials(ob_model_check *c, const struct aiScene *s, bool flip_uv,
+                                  struct ob_model *model);
 
 /* Checks a file that assimp would read as a PLY (a .ply extension, or
  * content starting with "ply") before assimp reads it: the first line must

@@ -50,6 +50,8 @@ typedef struct material_ctx {
     uint32_t image_cap;
     int32_t *embedded_image;   /* per scene texture: its image index, -1 not yet */
     char *dir;                 /* the model's folder, with a trailing '/', or "" */
+    bool flip_uv;              /* the meshes' uv convention (ob_model_desc.flip_uv) */
+    bool gltf;                 /* the material being read is glTF's (its uv transforms are) */
 } material_ctx;
 
 typedef struct slot_info {
@@ -345,29 +347,88 @@ static ob_result resolve_image(material_ctx *c, const slot_info *si, const char 
     return external_image(c, si, ref, out);
 }
 
-/* Reads texture slot 0 of `type` into *tex (image -1 when absent or its
- * file is missing). */
-static ob_result read_texture(material_ctx *c, const struct aiMaterial *m, enum aiTextureType type,
-                              const slot_info *si, ob_model_texture *tex)
+/* KHR_texture_transform back from assimp's aiUVTransform. assimp 5.2
+ * (glTF2Importer's SetMaterialTextureProperty) stores scale as is, the
+ * rotation negated and a translation re-expressed for its own convention
+ * (rotation about the image centre, v mirrored):
+ *   tx = sx/2 (1 − cos r + sin r) + offset.x
+ *   ty = sy/2 (sin r + cos r − 1) + 1 − sy − offset.y
+ * which this inverts exactly (checked against TextureTransformTest's
+ * values); with aiProcess_FlipUVs, ty and the rotation arrive negated. Then the glTF map uv' = T R S uv, in the file's uv, and the same
+ * map for the meshes' uv: with flip_uv they are the file's; without, v is
+ * mirrored (v_mesh = 1 − v_file), so the map is conjugated by that mirror. */
+static bool uv_transform_from_assimp(const float t[5], bool flip_uv, ob_model_uv_transform *out)
+{
+    /* aiProcess_FlipUVs (flip_uv) negates the stored translation.y and
+     * rotation: undone first. */
+    const double flip = flip_uv ? -1.0 : 1.0;
+    const double tx = t[0], ty = flip * t[1], sx = t[2], sy = t[3], r = -flip * t[4];
+    const double c = cos(r), s = sin(r);
+    const double ox = tx - 0.5 * sx * (1.0 - c + s);
+    const double oy = -(ty - 0.5 * sy * (s + c - 1.0) - 1.0 + sy);
+    if (!isfinite(ox) || !isfinite(oy) || !isfinite(sx) || !isfinite(sy) || !isfinite(r)) return false;
+    /* Near-identity values are what assimp's arithmetic leaves of none. */
+    const double eps = 1e-6;
+    out->present = fabs(ox) > eps || fabs(oy) > eps || fabs(r) > eps || fabs(sx - 1.0) > eps ||
+                   fabs(sy - 1.0) > eps;
+    out->offset[0] = fabs(ox) > eps ? (float)ox : 0.0f;
+    out->offset[1] = fabs(oy) > eps ? (float)oy : 0.0f;
+    out->rotation = fabs(r) > eps ? (float)r : 0.0f;
+    out->scale[0] = (float)sx;
+    out->scale[1] = (float)sy;
+    /* File uv: u' = c sx u + s sy v + ox, v' = −s sx u + c sy v + oy. */
+    double m[6] = {c * sx, s * sy, ox, -s * sx, c * sy, oy};
+    if (!flip_uv) {
+        /* v_file = 1 − v: u' = m0 u − m1 v + (m1 + m2), v' = 1 − v'_file. */
+        const double k[6] = {m[0], -m[1], m[1] + m[2], -m[3], m[4], 1.0 - m[4] - m[5]};
+        memcpy(m, k, sizeof m);
+    }
+    for (int i = 0; i < 6; i++) out->uv[i] = (float)m[i];
+    if (!out->present) {
+        const float id[6] = {1, 0, 0, 0, 1, 0};
+        memcpy(out->uv, id, sizeof id);
+    }
+    return true;
+}
+
+/* Reads texture slot `slot` of `type` into *tex (image -1 when absent or
+ * its file is missing). */
+static ob_result read_texture_n(material_ctx *c, const struct aiMaterial *m, enum aiTextureType type,
+                                unsigned slot, const slot_info *si, ob_model_texture *tex)
 {
     struct aiString ref;
-    if (!texture_ref(m, type, &ref)) return OB_OK;
+    if (aiGetMaterialString(m, AI_MATKEY_TEXTURE(type, slot), &ref) != AI_SUCCESS || !ref.length)
+        return OB_OK;
     ob_result r = resolve_image(c, si, ref.data, &tex->image);
     if (r != OB_OK || tex->image < 0) return r;
     int v;
-    if (get_int(m, AI_MATKEY_UVWSRC(type, 0), &v) && v > 0) {
+    if (get_int(m, AI_MATKEY_UVWSRC(type, slot), &v) && v > 0) {
         tex->uv_set = (uint32_t)v;
-        OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s uses TEXCOORD_%d; only TEXCOORD_0 is "
-                 "loaded, so it will be sampled with that", c->chk->path, si->material_index,
-                 si->material, si->slot, v);
+        if (v > 1)
+            OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s uses TEXCOORD_%d; only TEXCOORD_0 and "
+                     "TEXCOORD_1 are loaded", c->chk->path, si->material_index, si->material, si->slot, v);
     }
-    if (get_int(m, AI_MATKEY_GLTF_MAPPINGFILTER_MAG(type, 0), &v) && v > 0)
+    float t[5];
+    unsigned count = 5;
+    /* Other importers fill the key in their own conventions: only glTF's is inverted. */
+    if (c->gltf &&
+        aiGetMaterialFloatArray(m, AI_MATKEY_UVTRANSFORM(type, slot), t, &count) == AI_SUCCESS && count == 5 &&
+        !uv_transform_from_assimp(t, c->flip_uv, &tex->transform))
+        OB_LOG_W(OB_MODEL_LOG, "%s: material %u '%s' %s: KHR_texture_transform is not finite; "
+                 "not applied", c->chk->path, si->material_index, si->material, si->slot);
+    if (get_int(m, AI_MATKEY_GLTF_MAPPINGFILTER_MAG(type, slot), &v) && v > 0)
         tex->sampler.mag_filter = (uint32_t)v;
-    if (get_int(m, AI_MATKEY_GLTF_MAPPINGFILTER_MIN(type, 0), &v) && v > 0)
+    if (get_int(m, AI_MATKEY_GLTF_MAPPINGFILTER_MIN(type, slot), &v) && v > 0)
         tex->sampler.min_filter = (uint32_t)v;
-    if (get_int(m, AI_MATKEY_MAPPINGMODE_U(type, 0), &v)) tex->sampler.wrap_s = wrap_code(v);
-    if (get_int(m, AI_MATKEY_MAPPINGMODE_V(type, 0), &v)) tex->sampler.wrap_t = wrap_code(v);
+    if (get_int(m, AI_MATKEY_MAPPINGMODE_U(type, slot), &v)) tex->sampler.wrap_s = wrap_code(v);
+    if (get_int(m, AI_MATKEY_MAPPINGMODE_V(type, slot), &v)) tex->sampler.wrap_t = wrap_code(v);
     return OB_OK;
+}
+
+static ob_result read_texture(material_ctx *c, const struct aiMaterial *m, enum aiTextureType type,
+                              const slot_info *si, ob_model_texture *tex)
+{
+    return read_texture_n(c, m, type, 0, si, tex);
 }
 
 /* The first of `types` that the material names a texture for. */
@@ -442,13 +503,15 @@ static float clamp01(float v) { return v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v; }
 
 static void defaults(ob_model_material *out)
 {
-    const ob_model_texture none = {.image = -1};
+    const ob_model_texture none = {.image = -1, .transform = {.scale = {1, 1}, .uv = {1, 0, 0, 0, 1, 0}}};
     *out = (ob_model_material){
         .base_color = {1, 1, 1, 1}, .metallic = 0.0f, .roughness = 1.0f,
         .normal_scale = 1.0f, .occlusion_strength = 1.0f,
         .base_color_texture = none, .metallic_roughness_texture = none,
         .normal_texture = none, .occlusion_texture = none, .emissive_texture = none,
         .alpha_mode = OB_MODEL_ALPHA_OPAQUE, .alpha_cutoff = 0.5f,
+        .clearcoat_normal_scale = 1.0f, .clearcoat_texture = none,
+        .clearcoat_roughness_texture = none, .clearcoat_normal_texture = none,
     };
 }
 
@@ -457,6 +520,53 @@ static bool all_finite(const float *v, int n)
     for (int i = 0; i < n; i++)
         if (!isfinite(v[i])) return false;
     return true;
+}
+
+/* KHR_materials_clearcoat: assimp's factor and roughness keys and its
+ * CLEARCOAT texture slots 0 (intensity), 1 (roughness), 2 (normal). */
+static ob_result read_clearcoat(material_ctx *c, const struct aiMaterial *m, slot_info *si,
+                                ob_model_material *out)
+{
+    float f;
+    if (!get_float(m, AI_MATKEY_CLEARCOAT_FACTOR, &f)) return OB_OK;
+    out->clearcoat = f;
+    if (get_float(m, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, &f)) out->clearcoat_roughness = f;
+    si->slot = "clearcoatTexture";
+    ob_result r = read_texture_n(c, m, aiTextureType_CLEARCOAT, 0, si, &out->clearcoat_texture);
+    si->slot = "clearcoatRoughnessTexture";
+    if (r == OB_OK) r = read_texture_n(c, m, aiTextureType_CLEARCOAT, 1, si, &out->clearcoat_roughness_texture);
+    si->slot = "clearcoatNormalTexture";
+    if (r == OB_OK) r = read_texture_n(c, m, aiTextureType_CLEARCOAT, 2, si, &out->clearcoat_normal_texture);
+    if (r == OB_OK && out->clearcoat_normal_texture.image >= 0 &&
+        get_float(m, AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_CLEARCOAT, 2), &f))
+        out->clearcoat_normal_scale = f;
+    return r;
+}
+
+/* One line per material naming what assimp read of it that the material
+ * does not carry (glTF material extensions past clearcoat). */
+static void log_unsupported(material_ctx *c, const struct aiMaterial *m, uint32_t index, const char *name)
+{
+    static const struct { const char *key; const char *what; } keys[] = {
+        {"$clr.sheen.factor", "KHR_materials_sheen"},
+        {"$mat.transmission.factor", "KHR_materials_transmission"},
+        {"$mat.volume.thicknessFactor", "KHR_materials_volume"},
+        {"$mat.specularFactor", "KHR_materials_specular"},
+        {"$mat.glossinessFactor", "KHR_materials_pbrSpecularGlossiness"},
+    };
+    char list[256] = "";
+    size_t n = 0;
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(keys); i++) {
+        const struct aiMaterialProperty *prop;
+        if (aiGetMaterialProperty(m, keys[i].key, 0, 0, &prop) != AI_SUCCESS || n >= sizeof list) continue;
+        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", n ? ", " : "", keys[i].what);
+    }
+    int shading;
+    if (get_int(m, AI_MATKEY_SHADING_MODEL, &shading) && shading == aiShadingMode_Unlit && n < sizeof list)
+        n += (size_t)snprintf(list + n, sizeof list - n, "%sKHR_materials_unlit", n ? ", " : "");
+    if (n)
+        OB_LOG_I(OB_MODEL_LOG, "%s: material %u '%s' uses %s, which the engine does not support; "
+                 "drawn without", c->chk->path, index, name, list);
 }
 
 static ob_result read_material(material_ctx *c, uint32_t index, const struct aiMaterial *m,
@@ -473,6 +583,7 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
 
     struct aiString mode;
     const bool gltf = aiGetMaterialString(m, AI_MATKEY_GLTF_ALPHAMODE, &mode) == AI_SUCCESS;
+    c->gltf = gltf;
     struct aiColor4D col;
     if (aiGetMaterialColor(m, AI_MATKEY_BASE_COLOR, &col) == AI_SUCCESS ||
         aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &col) == AI_SUCCESS) {
@@ -542,13 +653,18 @@ static ob_result read_material(material_ctx *c, uint32_t index, const struct aiM
     si.slot = "emissiveTexture";
     const enum aiTextureType emissive_types[] = {aiTextureType_EMISSIVE, aiTextureType_EMISSION_COLOR};
     if (r == OB_OK) r = read_first_texture(c, m, emissive_types, 2, &si, &out->emissive_texture);
+    if (r == OB_OK && gltf) r = read_clearcoat(c, m, &si, out);
     if (r != OB_OK) return r;
-    if (!isfinite(out->normal_scale) || !isfinite(out->occlusion_strength)) {
-        ob_model_bad(c->chk, "material %u '%s': normal scale or occlusion strength is not finite",
-                     index, out->name);
+    if (gltf) log_unsupported(c, m, index, out->name);
+    if (!isfinite(out->normal_scale) || !isfinite(out->occlusion_strength) || !isfinite(out->clearcoat) ||
+        !isfinite(out->clearcoat_roughness) || !isfinite(out->clearcoat_normal_scale)) {
+        ob_model_bad(c->chk, "material %u '%s': normal scale, occlusion strength or a clearcoat "
+                     "factor is not finite", index, out->name);
         return OB_ERR_BAD_MODEL;
     }
     out->occlusion_strength = clamp01(out->occlusion_strength);
+    out->clearcoat = clamp01(out->clearcoat);
+    out->clearcoat_roughness = clamp01(out->clearcoat_roughness);
     return OB_OK;
 }
 
@@ -559,9 +675,10 @@ static char *folder_of(const char *path)
     return dup_range(path, slash ? (size_t)(slash - path) + 1 : 0);
 }
 
-ob_result ob_model_read_materials(ob_model_check *chk, const struct aiScene *s, ob_model *model)
+ob_result ob_model_read_materials(ob_model_check *chk, const struct aiScene *s, bool flip_uv,
+                                  ob_model *model)
 {
-    material_ctx c = {.chk = chk, .scene = s, .model = model};
+    material_ctx c = {.chk = chk, .scene = s, .model = model, .flip_uv = flip_uv};
     if (s->mNumMaterials && !s->mMaterials) {
         ob_model_bad(chk, "%u materials but no material array", s->mNumMaterials);
         return OB_ERR_BAD_MODEL;

@@ -174,6 +174,14 @@ static ob_result build_primitive(open_ctx *c, uint32_t mi, const struct aiMesh *
             mesh->colors[v][3] = unorm8(col->a);
         }
     }
+    if (m->mTextureCoords[1]) {
+        mesh->uv1 = ob_malloc((size_t)mesh->vertex_count * sizeof *mesh->uv1);
+        if (!mesh->uv1) return out_of_memory(c, "the second uv set");
+        for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+            mesh->uv1[v][0] = m->mTextureCoords[1][v].x;
+            mesh->uv1[v][1] = m->mTextureCoords[1][v].y;
+        }
+    }
     /* Validation covers indices after post-processing and every attribute
      * (positions were checked raw; assimp's steps must not have broken
      * them either). */
@@ -184,7 +192,7 @@ static ob_result build_primitive(open_ctx *c, uint32_t mi, const struct aiMesh *
         return OB_ERR_BAD_MODEL;
     }
     const ob_model_material *mat = &model->materials[p->material];
-    if (mat->normal_texture.image < 0) return OB_OK;
+    if (mat->normal_texture.image < 0 && mat->clearcoat_normal_texture.image < 0) return OB_OK;
     /* Tangents only where a normal map needs them. */
     if (m->mTangents && m->mNormals) return file_tangents(c, mi, m, mesh);
     ob_result r = ob_mesh_generate_tangents(mesh, !c->flip_uv);
@@ -456,7 +464,7 @@ ob_result ob_model_open(const ob_model_desc *desc, ob_model **out_model)
         r = out_of_memory(&c, "the model");
         goto fail_close_model;
     }
-    r = ob_model_read_materials(&c.chk, scene, model);
+    r = ob_model_read_materials(&c.chk, scene, desc->flip_uv, model);
     if (r == OB_OK) r = build_primitives(&c);
     if (r == OB_OK) r = build_nodes(&c);
     if (r != OB_OK) goto fail_close_model;

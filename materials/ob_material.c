@@ -175,6 +175,19 @@ static const ob_effect_vertex_input builtin_extended_layout = {
                    {4, VK_FORMAT_R32G32B32A32_SFLOAT, 36}},
 };
 
+/* The extended layout plus TEXCOORD1 (geometry's ob_vertex_layout_extended_uv1):
+ * PBR variants whose textures read the second uv set. */
+static const ob_effect_vertex_input builtin_extended_uv1_layout = {
+    .stride = 60,
+    .attribute_count = 6,
+    .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, VK_FORMAT_R32G32_SFLOAT, 24},
+                   {3, VK_FORMAT_R8G8B8A8_UNORM, 32},
+                   {4, VK_FORMAT_R32G32B32A32_SFLOAT, 36},
+                   {5, VK_FORMAT_R32G32_SFLOAT, 52}},
+};
+
 static const ob_effect_vertex_input builtin_text_layout = {
     .stride = 16,
     .attribute_count = 2,
@@ -306,6 +319,7 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
     lib->standard_layout = d.standard_layout ? *d.standard_layout : builtin_standard_layout;
     lib->text_layout = d.text_layout ? *d.text_layout : builtin_text_layout;
     lib->extended_layout = d.extended_layout ? *d.extended_layout : builtin_extended_layout;
+    lib->extended_uv1_layout = builtin_extended_uv1_layout;
     lib->bias_constant = d.shadow_bias_constant != 0.0f ? d.shadow_bias_constant : -1.0f;
     lib->bias_slope = d.shadow_bias_slope != 0.0f ? d.shadow_bias_slope : -1.75f;
 

@@ -111,11 +111,20 @@ typedef enum ob_std_effect {
 typedef enum ob_alpha_mode { OB_ALPHA_OPAQUE = 0, OB_ALPHA_MASK, OB_ALPHA_BLEND } ob_alpha_mode;
 
 /* A texture slot of a PBR material: the texture (owned by its cache, which
- * must outlive the material) and the uv set it reads. Only TEXCOORD_0 exists
- * in the extended layout: uv_set 1 is drawn with set 0 and a warning. */
+ * must outlive the material), the uv set it reads (0 = TEXCOORD0, 1 =
+ * TEXCOORD1: the material then draws in the extended layout with TEXCOORD1,
+ * ob_vertex_layout_extended_uv1; sets past 1 are drawn with set 0 and a
+ * warning) and its uv transform (KHR_texture_transform): with
+ * has_transform, the texture is sampled at
+ *   (transform[0] u + transform[1] v + transform[2],
+ *    transform[3] u + transform[4] v + transform[5])
+ * of the mesh's uv (top-left origin). Either makes the variant carry the
+ * per-texture transforms (material parameters, not per draw). */
 typedef struct ob_material_texture {
     const ob_texture *texture;   /* NULL = none */
     uint32_t uv_set;
+    bool has_transform;
+    float transform[6];
 } ob_material_texture;
 
 /* glTF 2 metallic-roughness material. Textures: base colour and emissive
@@ -133,11 +142,21 @@ typedef struct ob_material_pbr {
     float alpha_cutoff;                /* MASK: alpha below it is cut out */
     bool double_sided;                 /* no culling; back faces lit with the normal flipped */
     bool vertex_colors;                /* multiply the base colour by COLOR0 */
+    /* KHR_materials_clearcoat: a clear dielectric layer (IOR 1.5) over the
+     * base, its own GGX lobe with clearcoat_roughness and its own normal
+     * (the clearcoat normal texture, else the geometric normal); the base is
+     * attenuated by 1 − clearcoat · F_c. clearcoat 0 = no layer (and no
+     * clearcoat code in the shader). Textures: intensity *= R, roughness
+     * *= G (UNORM), the coat's normal map (tangent space, xy *
+     * clearcoat_normal_scale). */
+    float clearcoat, clearcoat_roughness, clearcoat_normal_scale;
+    ob_material_texture clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
 } ob_material_pbr;
 
 /* glTF defaults: base (1,1,1,1), metallic 1, roughness 1, emissive 0,
  * normal_scale 1, occlusion_strength 1, OPAQUE, cutoff 0.5, single-sided,
- * no textures, no vertex colours. [any thread] */
+ * no textures, no vertex colours, no clearcoat (clearcoat_normal_scale 1).
+ * [any thread] */
 ob_material_pbr ob_material_pbr_defaults(void);
 
 typedef enum ob_std_variant {
@@ -271,6 +290,12 @@ ob_effect *ob_material_get_view_effect(ob_material *m, ob_renderer *r, const ob_
  * texture, ...") into out (cap bytes, NUL-terminated) for reports; returns
  * the number left out, 0 for a non-PBR material. [any thread] */
 uint32_t ob_material_pbr_left_out(const ob_material *m, char *out, size_t cap);
+
+/* True when m is a PBR material whose effects read TEXCOORD1, i.e. draw in
+ * the extended layout with TEXCOORD1 (a texture with uv_set 1): its
+ * geometry must be uploaded in that layout (ob_geometry_desc.texcoord1).
+ * [any thread] */
+bool ob_material_reads_texcoord1(const ob_material *m);
 
 /* The engine interface: renders, sort_info, pre_render, apply. Static data. */
 const ob_material_iface *ob_material_iface_get(void);

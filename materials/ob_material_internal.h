@@ -28,7 +28,11 @@ enum { SAMPLER_SHADOW, SAMPLER_ENV, SAMPLER_SOURCE, SAMPLER_COUNT };
 
 /* PBR texture slots, in ob_material_pbr's order. */
 enum { OB_PBR_TEX_BASE, OB_PBR_TEX_MR, OB_PBR_TEX_NORMAL, OB_PBR_TEX_OCCLUSION, OB_PBR_TEX_EMISSIVE,
-       OB_PBR_TEX_COUNT };
+       OB_PBR_TEX_CC, OB_PBR_TEX_CC_ROUGH, OB_PBR_TEX_CC_NORMAL, OB_PBR_TEX_COUNT };
+
+/* PbrUvTransforms: two vec4 per texture slot, (a, b, tx, uv set) and
+ * (c, d, ty, 0), packed as this many mat4 (pbr.frag indexes it as vec4s). */
+#define OB_PBR_UV_MATRICES ((2u * OB_PBR_TEX_COUNT + 3u) / 4u)
 
 /* One compiled PBR shader variant, shared by every material with its key. */
 typedef struct ob_pbr_variant {
@@ -38,7 +42,7 @@ typedef struct ob_pbr_variant {
 } ob_pbr_variant;
 
 typedef struct ob_pbr_params {
-    ob_param base_color, factors, emissive;
+    ob_param base_color, factors, emissive, clearcoat, uv_transforms;
     ob_param textures[OB_PBR_TEX_COUNT], samplers[OB_PBR_TEX_COUNT];
 } ob_pbr_params;
 
@@ -46,7 +50,7 @@ struct ob_material_library {
     ob_effect_context *ctx;
     ob_device *dev;
     ob_param_registry *reg;
-    ob_effect_vertex_input standard_layout, text_layout, extended_layout;
+    ob_effect_vertex_input standard_layout, text_layout, extended_layout, extended_uv1_layout;
     float bias_constant, bias_slope;
     bool instancing;               /* standard effects draw the INSTANCED variant */
     std_slot slots[OB_STD_EFFECT_COUNT][VARIANT_COUNT];
@@ -69,7 +73,8 @@ enum { OB_PBR_PASS_MAIN = 0, OB_PBR_PASS_PARABOLOID = 4, OB_PBR_PASS_DEPTH = 5, 
 typedef struct ob_material_pbr_state {
     ob_material_pbr desc;
     uint32_t features;             /* OB_PBR_F_* bits the material uses */
-    float block[3][4];             /* PbrBaseColor, PbrFactors, PbrEmissive */
+    float block[4][4];             /* PbrBaseColor, PbrFactors, PbrEmissive, PbrClearcoat */
+    float uv[16u * OB_PBR_UV_MATRICES];   /* PbrUvTransforms: 8 floats (two vec4 rows) per slot */
     _Atomic(ob_effect *) effects[OB_PBR_PASS_COUNT];
 } ob_material_pbr_state;
 
@@ -92,8 +97,8 @@ bool ob_material_view_depends_on(const ob_view *v, ob_view_type type);
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity);
 
 /* ob_material_pbr.c */
-/* Registers PbrBaseColor, PbrFactors, PbrEmissive and the five texture and
- * sampler parameters. */
+/* Registers PbrBaseColor, PbrFactors, PbrEmissive, PbrClearcoat,
+ * PbrUvTransforms and the eight texture and sampler parameters. */
 ob_result ob_pbr_register_params(ob_material_library *lib);
 /* Destroys the PBR variants and their table. */
 void ob_pbr_library_release(ob_material_library *lib);

@@ -24,12 +24,18 @@ enum {
     OB_PBR_F_VERTEX_COLOR = 1u << 6,
     OB_PBR_F_DOUBLE_SIDED = 1u << 7,
     OB_PBR_F_BLENDED = 1u << 8,
-    OB_PBR_FEATURES = (1u << 9) - 1u,
-    OB_PBR_P_SHADOWS = 1u << 9,
-    OB_PBR_P_ENVMAP = 1u << 10,
-    OB_PBR_P_PARABOLOID = 1u << 11,
-    OB_PBR_P_DEPTH = 1u << 12,
-    OB_PBR_P_INSTANCED = 1u << 13,  /* the per-draw block per instance */
+    OB_PBR_F_UV_TRANSFORM = 1u << 9,   /* a texture has a KHR_texture_transform */
+    OB_PBR_F_TEXCOORD1 = 1u << 10,     /* a texture reads TEXCOORD1 (the uv1 vertex layout) */
+    OB_PBR_F_CLEARCOAT = 1u << 11,
+    OB_PBR_F_CC_TEX = 1u << 12,
+    OB_PBR_F_CC_ROUGH_TEX = 1u << 13,
+    OB_PBR_F_CC_NORMAL_TEX = 1u << 14,
+    OB_PBR_FEATURES = (1u << 15) - 1u,
+    OB_PBR_P_SHADOWS = 1u << 15,
+    OB_PBR_P_ENVMAP = 1u << 16,
+    OB_PBR_P_PARABOLOID = 1u << 17,
+    OB_PBR_P_DEPTH = 1u << 18,
+    OB_PBR_P_INSTANCED = 1u << 19,  /* the per-draw block per instance */
 };
 
 /* Define, short name token, and what a report calls the feature. */
@@ -46,20 +52,41 @@ static const struct {
     {OB_PBR_F_VERTEX_COLOR, "VERTEX_COLOR", "vc", "vertex colours"},
     {OB_PBR_F_DOUBLE_SIDED, "DOUBLE_SIDED", "2s", "double-sided lighting"},
     {OB_PBR_F_BLENDED, "BLENDED", "blend", "alpha blending"},
+    {OB_PBR_F_UV_TRANSFORM, "HAS_UV_TRANSFORM", "uvx", "texture transforms"},
+    {OB_PBR_F_TEXCOORD1, "HAS_TEXCOORD1", "uv1", "second uv set"},
+    {OB_PBR_F_CLEARCOAT, "HAS_CLEARCOAT", "cc", "clearcoat"},
+    {OB_PBR_F_CC_TEX, "HAS_CLEARCOAT_TEXTURE", "cct", "clearcoat texture"},
+    {OB_PBR_F_CC_ROUGH_TEX, "HAS_CLEARCOAT_ROUGHNESS_TEXTURE", "ccr", "clearcoat roughness texture"},
+    {OB_PBR_F_CC_NORMAL_TEX, "HAS_CLEARCOAT_NORMAL_TEXTURE", "ccn", "clearcoat normal texture"},
     {OB_PBR_P_SHADOWS, "SHADOWS", "sh", NULL},
     {OB_PBR_P_ENVMAP, "ENVMAP", "env", NULL},
     {OB_PBR_P_PARABOLOID, "PARABOLOID", "para", NULL},
     {OB_PBR_P_DEPTH, "DEPTH_ONLY", "depth", NULL},
     {OB_PBR_P_INSTANCED, "INSTANCED", "inst", NULL},
 };
-#define PBR_MAX_DEFINES 14
+#define PBR_MAX_DEFINES 20
 
 static const char *const texture_names[OB_PBR_TEX_COUNT] = {
     "BaseColorTexture", "MetallicRoughnessTexture", "NormalTexture", "OcclusionTexture", "EmissiveTexture",
+    "ClearcoatTexture", "ClearcoatRoughnessTexture", "ClearcoatNormalTexture",
 };
 static const uint32_t texture_bits[OB_PBR_TEX_COUNT] = {
     OB_PBR_F_BASE, OB_PBR_F_MR, OB_PBR_F_NORMAL, OB_PBR_F_OCCLUSION, OB_PBR_F_EMISSIVE,
+    OB_PBR_F_CC_TEX, OB_PBR_F_CC_ROUGH_TEX, OB_PBR_F_CC_NORMAL_TEX,
 };
+
+/* The texture slots of a PBR description, in OB_PBR_TEX_* order. */
+static void texture_slots(const ob_material_pbr *p, const ob_material_texture *out[OB_PBR_TEX_COUNT])
+{
+    out[OB_PBR_TEX_BASE] = &p->base_color_texture;
+    out[OB_PBR_TEX_MR] = &p->metallic_roughness_texture;
+    out[OB_PBR_TEX_NORMAL] = &p->normal_texture;
+    out[OB_PBR_TEX_OCCLUSION] = &p->occlusion_texture;
+    out[OB_PBR_TEX_EMISSIVE] = &p->emissive_texture;
+    out[OB_PBR_TEX_CC] = &p->clearcoat_texture;
+    out[OB_PBR_TEX_CC_ROUGH] = &p->clearcoat_roughness_texture;
+    out[OB_PBR_TEX_CC_NORMAL] = &p->clearcoat_normal_texture;
+}
 
 ob_material_pbr ob_material_pbr_defaults(void)
 {
@@ -71,6 +98,7 @@ ob_material_pbr ob_material_pbr_defaults(void)
         .occlusion_strength = 1.0f,
         .alpha_mode = OB_ALPHA_OPAQUE,
         .alpha_cutoff = 0.5f,
+        .clearcoat_normal_scale = 1.0f,
     };
 }
 
@@ -84,9 +112,12 @@ ob_result ob_pbr_register_params(ob_material_library *lib)
         {&p->base_color, "PbrBaseColor", OB_PARAM_VEC4},
         {&p->factors, "PbrFactors", OB_PARAM_VEC4},
         {&p->emissive, "PbrEmissive", OB_PARAM_VEC4},
+        {&p->clearcoat, "PbrClearcoat", OB_PARAM_VEC4},
+        {&p->uv_transforms, "PbrUvTransforms", OB_PARAM_MAT4_ARRAY},
     };
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(list); i++) {
-        *list[i].out = ob_param_register(lib->reg, list[i].name, list[i].type, 1, &r);
+        const uint32_t count = list[i].type == OB_PARAM_MAT4_ARRAY ? OB_PBR_UV_MATRICES : 1u;
+        *list[i].out = ob_param_register(lib->reg, list[i].name, list[i].type, count, &r);
         if (!list[i].out->id) goto fail_log;
     }
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
@@ -132,7 +163,7 @@ static void variant_desc(const ob_material_library *lib, uint32_t key, ob_effect
     const bool blended = key & OB_PBR_F_BLENDED;
     uint32_t n = 0;
     *desc = (ob_effect_desc){
-        .layout = &lib->extended_layout,
+        .layout = (key & OB_PBR_F_TEXCOORD1) ? &lib->extended_uv1_layout : &lib->extended_layout,
         .depth_test = true,
         .depth_write = depth || !blended,
         .cull = (key & (OB_PBR_F_DOUBLE_SIDED | OB_PBR_P_PARABOLOID)) ? 0 : VK_CULL_MODE_BACK_BIT,
@@ -173,11 +204,30 @@ uint32_t ob_material_pbr_left_out(const ob_material *m, char *out, size_t cap)
     size_t n = 0;
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(pbr_bits); i++) {
         if (!pbr_bits[i].feature || (m->pbr.features & pbr_bits[i].bit)) continue;
+        /* Without a coat its textures are implied: "clearcoat" says it. */
+        if ((pbr_bits[i].bit & (OB_PBR_F_CC_TEX | OB_PBR_F_CC_ROUGH_TEX | OB_PBR_F_CC_NORMAL_TEX)) &&
+            !(m->pbr.features & OB_PBR_F_CLEARCOAT))
+            continue;
         if (out && n < cap)
             n += (size_t)snprintf(out + n, cap - n, "%s%s", count ? ", " : "", pbr_bits[i].feature);
         count++;
     }
+    /* What the material asked for and cannot have, with the reason. */
+    const ob_material_texture *slots[OB_PBR_TEX_COUNT];
+    texture_slots(&m->pbr.desc, slots);
+    for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
+        if (!slots[i]->texture || slots[i]->uv_set <= 1) continue;
+        if (out && n < cap)
+            n += (size_t)snprintf(out + n, cap - n, "%s%s uv set %u (only TEXCOORD_0 and _1 are drawn)",
+                                  count ? ", " : "", texture_names[i], slots[i]->uv_set);
+        count++;
+    }
     return count;
+}
+
+bool ob_material_reads_texcoord1(const ob_material *m)
+{
+    return m && m->kind == OB_MATERIAL_PBR && (m->pbr.features & OB_PBR_F_TEXCOORD1);
 }
 
 /* The library's variant for key, compiled on first request. */
@@ -246,18 +296,46 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc)
                  (int)p->alpha_mode);
         return OB_ERR_INVALID_ARGUMENT;
     }
+    if (!isfinite(p->clearcoat) || !isfinite(p->clearcoat_roughness) || !isfinite(p->clearcoat_normal_scale)) {
+        OB_LOG_E("material", "material '%s': non-finite clearcoat factor", m->name);
+        return OB_ERR_NON_FINITE;
+    }
     ob_material_pbr_state *s = &m->pbr;
     s->desc = *p;
-    const ob_material_texture *slots[OB_PBR_TEX_COUNT] = {&p->base_color_texture, &p->metallic_roughness_texture,
-                                                          &p->normal_texture, &p->occlusion_texture,
-                                                          &p->emissive_texture};
+    const ob_material_texture *slots[OB_PBR_TEX_COUNT];
+    texture_slots(p, slots);
     s->features = 0;
+    const bool coat = p->clearcoat > 0.0f;
+    if (coat) s->features |= OB_PBR_F_CLEARCOAT;
+    /* Unused rows stay the identity on set 0. */
+    memset(s->uv, 0, sizeof s->uv);
+    for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
+        float *row = s->uv + 8u * i;
+        row[0] = 1.0f;
+        row[5] = 1.0f;
+    }
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
         if (!slots[i]->texture) continue;
+        if (i >= OB_PBR_TEX_CC && !coat) continue;   /* no layer, nothing to texture */
         s->features |= texture_bits[i];
-        if (slots[i]->uv_set != 0)
-            OB_LOG_W("material", "material '%s': %s reads uv set %u; only set 0 (TEXCOORD_0) is drawn, so it "
-                                 "uses set 0", m->name, texture_names[i], slots[i]->uv_set);
+        float *row = s->uv + 8u * i;   /* two vec4: (a, b, tx, set), (c, d, ty, 0) */
+        if (slots[i]->has_transform) {
+            if (!finite_n(slots[i]->transform, 6)) {
+                OB_LOG_E("material", "material '%s': %s has a non-finite uv transform", m->name, texture_names[i]);
+                return OB_ERR_NON_FINITE;
+            }
+            const float *t = slots[i]->transform;
+            row[0] = t[0], row[1] = t[1], row[2] = t[2];
+            row[4] = t[3], row[5] = t[4], row[6] = t[5];
+            s->features |= OB_PBR_F_UV_TRANSFORM;
+        }
+        if (slots[i]->uv_set == 1) {
+            row[3] = 1.0f;
+            s->features |= OB_PBR_F_TEXCOORD1;
+        } else if (slots[i]->uv_set > 1) {
+            OB_LOG_W("material", "material '%s': %s reads uv set %u; only sets 0 and 1 (TEXCOORD_0, _1) are "
+                                 "drawn, so it uses set 0", m->name, texture_names[i], slots[i]->uv_set);
+        }
     }
     if (p->alpha_mode == OB_ALPHA_MASK) s->features |= OB_PBR_F_MASK;
     if (p->alpha_mode == OB_ALPHA_BLEND) s->features |= OB_PBR_F_BLENDED;
@@ -270,6 +348,10 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc)
     s->block[1][3] = p->occlusion_strength;
     memcpy(s->block[2], p->emissive, 3 * sizeof(float));
     s->block[2][3] = p->alpha_cutoff;
+    s->block[3][0] = p->clearcoat < 1.0f ? p->clearcoat : 1.0f;
+    s->block[3][1] = p->clearcoat_roughness < 0.0f ? 0.0f : p->clearcoat_roughness > 1.0f ? 1.0f : p->clearcoat_roughness;
+    s->block[3][2] = p->clearcoat_normal_scale;
+    s->block[3][3] = 0.0f;
     for (uint32_t i = 0; i < OB_PBR_PASS_COUNT; i++) atomic_init(&s->effects[i], NULL);
     return OB_OK;
 }
@@ -306,9 +388,12 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
         return true;
     case OB_VIEW_SHADOW:
         *out_slot = OB_PBR_PASS_DEPTH;
-        /* Only a cut-out changes what casts a shadow. */
-        *out_key = OB_PBR_P_DEPTH | inst | (f & OB_PBR_F_DOUBLE_SIDED) |
-                   ((f & OB_PBR_F_MASK) ? f & (OB_PBR_F_MASK | OB_PBR_F_BASE | OB_PBR_F_VERTEX_COLOR) : 0u);
+        /* Only a cut-out changes what casts a shadow; TEXCOORD1 changes the
+         * vertex layout every pass must read. */
+        *out_key = OB_PBR_P_DEPTH | inst | (f & (OB_PBR_F_DOUBLE_SIDED | OB_PBR_F_TEXCOORD1)) |
+                   ((f & OB_PBR_F_MASK) ? f & (OB_PBR_F_MASK | OB_PBR_F_BASE | OB_PBR_F_VERTEX_COLOR |
+                                               OB_PBR_F_UV_TRANSFORM)
+                                        : 0u);
         return true;
     default:
         return false;
@@ -366,11 +451,14 @@ ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *
     ob_params_set_vec4(params, lib->diffuse, unused);
     ob_params_set_vec4(params, lib->specular, unused);
     ob_params_set_vec4(params, lib->emissive, unused);
-    const ob_material_texture *slots[OB_PBR_TEX_COUNT] = {
-        &m->pbr.desc.base_color_texture, &m->pbr.desc.metallic_roughness_texture, &m->pbr.desc.normal_texture,
-        &m->pbr.desc.occlusion_texture, &m->pbr.desc.emissive_texture};
+    /* Only variants that declare these read them: others set nothing new. */
+    if (m->pbr.features & OB_PBR_F_CLEARCOAT) ob_params_set_vec4(params, p->clearcoat, m->pbr.block[3]);
+    if (m->pbr.features & (OB_PBR_F_UV_TRANSFORM | OB_PBR_F_TEXCOORD1))
+        ob_params_set_mat4_array(params, p->uv_transforms, m->pbr.uv, OB_PBR_UV_MATRICES);
+    const ob_material_texture *slots[OB_PBR_TEX_COUNT];
+    texture_slots(&m->pbr.desc, slots);
     for (uint32_t i = 0; i < OB_PBR_TEX_COUNT; i++) {
-        if (!slots[i]->texture) continue;
+        if (!(m->pbr.features & texture_bits[i])) continue;
         ob_params_set_texture(params, p->textures[i], ob_texture_image(slots[i]->texture));
         ob_params_set_sampler(params, p->samplers[i], ob_texture_sampler(slots[i]->texture));
     }

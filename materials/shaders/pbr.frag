@@ -39,6 +39,15 @@
 //   PARABOLOID                      drawn into an environment map (pbr.vert)
 //   DEPTH_ONLY                      shadow pass of an ALPHA_MASK material: the
 //                                   cut-out only, no colour
+//   HAS_UV_TRANSFORM                each texture sampled at its own 2x3 transform
+//                                   of the uv (KHR_texture_transform), rows of
+//                                   PbrUvTransforms (material parameters)
+//   HAS_TEXCOORD1                   textures whose row says set 1 read TEXCOORD1
+//   HAS_CLEARCOAT                   KHR_materials_clearcoat over the base (pbr.glsl):
+//                                   PbrClearcoat x intensity, y roughness, z normal scale
+//   HAS_CLEARCOAT_TEXTURE           intensity *= ClearcoatTexture.r
+//   HAS_CLEARCOAT_ROUGHNESS_TEXTURE coat roughness *= ClearcoatRoughnessTexture.g
+//   HAS_CLEARCOAT_NORMAL_TEXTURE    the coat's own tangent-space normal map
 #include "common.glsl"
 #include "lighting.glsl"
 #include "pbr.glsl"
@@ -50,6 +59,14 @@ layout(set = 0, binding = 3, std140) uniform PbrMaterial {
     vec4 PbrBaseColor;         // linear rgba factor
     vec4 PbrFactors;           // x metallic, y roughness, z normal scale, w occlusion strength
     vec4 PbrEmissive;          // rgb emissive factor, w alpha cutoff
+#if defined(HAS_CLEARCOAT)
+    vec4 PbrClearcoat;         // x intensity, y roughness, z normal scale
+#endif
+#if defined(HAS_UV_TRANSFORM) || defined(HAS_TEXCOORD1)
+    // Per texture slot (base, mr, normal, occlusion, emissive, cc, cc roughness,
+    // cc normal) two rows: (a, b, tx, uv set), (c, d, ty, 0); as vec4 k of mat4 k/4.
+    mat4 PbrUvTransforms[4];
+#endif
 };
 
 layout(location = 0) in vec3 vPosition;
@@ -58,11 +75,17 @@ layout(location = 2) in vec2 vUV;
 #if defined(VERTEX_COLOR)
 layout(location = 3) in vec4 vColor;
 #endif
-#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+#if (defined(HAS_NORMAL_TEXTURE) || defined(HAS_CLEARCOAT_NORMAL_TEXTURE)) && !defined(DEPTH_ONLY)
 layout(location = 4) in vec4 vTangent;
 #endif
 #if defined(PARABOLOID)
 layout(location = 5) in float vHemisphere;
+#endif
+#if defined(HAS_TEXCOORD1)
+layout(location = 6) in vec2 vUV1;
+#endif
+#if (defined(HAS_NORMAL_TEXTURE) || defined(HAS_CLEARCOAT_NORMAL_TEXTURE)) && !defined(DEPTH_ONLY)
+#define OB_TANGENT_FRAME
 #endif
 
 #if defined(ENVMAP)
@@ -89,14 +112,61 @@ layout(set = 1, binding = 5) uniform sampler2D OcclusionTexture;
 #if defined(HAS_EMISSIVE_TEXTURE)
 layout(set = 1, binding = 6) uniform sampler2D EmissiveTexture;
 #endif
+#if defined(HAS_CLEARCOAT_TEXTURE)
+layout(set = 1, binding = 7) uniform sampler2D ClearcoatTexture;
+#endif
+#if defined(HAS_CLEARCOAT_ROUGHNESS_TEXTURE)
+layout(set = 1, binding = 8) uniform sampler2D ClearcoatRoughnessTexture;
+#endif
+#if defined(HAS_CLEARCOAT_NORMAL_TEXTURE)
+layout(set = 1, binding = 9) uniform sampler2D ClearcoatNormalTexture;
+#endif
 layout(location = 0) out vec4 outColor;
+#endif
+
+// The uv texture slot i samples at (see PbrUvTransforms); plain vUV when
+// the variant has no transforms and no second set.
+#if defined(HAS_UV_TRANSFORM) || defined(HAS_TEXCOORD1)
+vec2 ob_texture_uv(int i)
+{
+    vec4 r0 = PbrUvTransforms[(2 * i) / 4][(2 * i) % 4];
+    vec4 r1 = PbrUvTransforms[(2 * i + 1) / 4][(2 * i + 1) % 4];
+#if defined(HAS_TEXCOORD1)
+    vec2 uv = r0.w > 0.5 ? vUV1 : vUV;
+#else
+    vec2 uv = vUV;
+#endif
+    return vec2(dot(r0.xy, uv) + r0.z, dot(r1.xy, uv) + r1.z);
+}
+#define OB_UV(i) ob_texture_uv(i)
+#else
+#define OB_UV(i) vUV
+#endif
+
+#if defined(OB_TANGENT_FRAME)
+// A tangent-space normal map (glTF: bitangent = cross(normal, tangent.xyz) *
+// tangent.w), the frame made orthogonal to the interpolated normal and
+// reversed with it on back faces; n when the map gives nothing usable.
+vec3 ob_mapped_normal(vec3 tn, float scale, vec3 n, bool back)
+{
+    vec3 front_n = back ? -n : n;
+    vec3 t = ob_safe_normalize(vTangent.xyz - front_n * dot(front_n, vTangent.xyz));
+    vec3 b = cross(front_n, t) * vTangent.w;
+    if (back) {
+        t = -t;
+        b = -b;
+    }
+    tn.xy *= scale;
+    vec3 mapped = ob_safe_normalize(mat3(t, b, n) * tn);
+    return dot(mapped, mapped) > 0.0 ? mapped : n;
+}
 #endif
 
 vec4 ob_base_color()
 {
     vec4 base = PbrBaseColor;
 #if defined(HAS_BASE_COLOR_TEXTURE)
-    base *= texture(BaseColorTexture, vUV);
+    base *= texture(BaseColorTexture, OB_UV(0));
 #endif
 #if defined(VERTEX_COLOR)
     base *= vColor;
@@ -123,25 +193,19 @@ void main()
     back = !gl_FrontFacing;
     if (back) n = -n;
 #endif
+#if defined(HAS_CLEARCOAT)
+    vec3 coat_n = n;   // the geometric normal unless the coat has its own map
+#if defined(HAS_CLEARCOAT_NORMAL_TEXTURE)
+    coat_n = ob_mapped_normal(texture(ClearcoatNormalTexture, OB_UV(7)).xyz * 2.0 - 1.0, PbrClearcoat.z, n, back);
+#endif
+#endif
 #if defined(HAS_NORMAL_TEXTURE)
-    // Tangent frame (glTF: bitangent = cross(normal, tangent.xyz) * tangent.w),
-    // made orthogonal to the interpolated normal; reversed with it on back faces.
-    vec3 front_n = back ? -n : n;
-    vec3 t = ob_safe_normalize(vTangent.xyz - front_n * dot(front_n, vTangent.xyz));
-    vec3 b = cross(front_n, t) * vTangent.w;
-    if (back) {
-        t = -t;
-        b = -b;
-    }
-    vec3 tn = texture(NormalTexture, vUV).xyz * 2.0 - 1.0;
-    tn.xy *= PbrFactors.z;
-    vec3 mapped = ob_safe_normalize(mat3(t, b, n) * tn);
-    if (dot(mapped, mapped) > 0.0) n = mapped;
+    n = ob_mapped_normal(texture(NormalTexture, OB_UV(2)).xyz * 2.0 - 1.0, PbrFactors.z, n, back);
 #endif
     float metallic = PbrFactors.x;
     float roughness = PbrFactors.y;
 #if defined(HAS_METALLIC_ROUGHNESS_TEXTURE)
-    vec4 mr = texture(MetallicRoughnessTexture, vUV);
+    vec4 mr = texture(MetallicRoughnessTexture, OB_UV(1));
     metallic *= mr.b;
     roughness *= mr.g;
 #endif
@@ -149,11 +213,11 @@ void main()
     roughness = clamp(roughness, 0.03, 1.0);
     float occlusion = 1.0;
 #if defined(HAS_OCCLUSION_TEXTURE)
-    occlusion = 1.0 + PbrFactors.w * (texture(OcclusionTexture, vUV).r - 1.0);
+    occlusion = 1.0 + PbrFactors.w * (texture(OcclusionTexture, OB_UV(3)).r - 1.0);
 #endif
     vec3 emissive = PbrEmissive.rgb;
 #if defined(HAS_EMISSIVE_TEXTURE)
-    emissive *= texture(EmissiveTexture, vUV).rgb;
+    emissive *= texture(EmissiveTexture, OB_UV(4)).rgb;
 #endif
 
     ob_surface s;
@@ -163,6 +227,19 @@ void main()
     s.metallic = metallic;
     s.a = roughness * roughness;
     s.f0 = mix(vec3(0.04), base.rgb, metallic);
+#if defined(HAS_CLEARCOAT)
+    s.cn = coat_n;
+    s.clearcoat = clamp(PbrClearcoat.x, 0.0, 1.0);
+    float coat_roughness = PbrClearcoat.y;
+#if defined(HAS_CLEARCOAT_TEXTURE)
+    s.clearcoat *= texture(ClearcoatTexture, OB_UV(5)).r;
+#endif
+#if defined(HAS_CLEARCOAT_ROUGHNESS_TEXTURE)
+    coat_roughness *= texture(ClearcoatRoughnessTexture, OB_UV(6)).g;
+#endif
+    coat_roughness = clamp(coat_roughness, 0.03, 1.0);
+    s.ca = coat_roughness * coat_roughness;
+#endif
 
     vec3 color = emissive;
     if (LightColor.w > 0.0) {
@@ -187,6 +264,9 @@ void main()
     }
     vec3 fa = ob_fresnel_ambient(s);
     vec3 ambient = AmbientColor.rgb * AmbientColor.w;
+#if defined(HAS_CLEARCOAT)
+    vec3 lit = color;   // emissive + lights (the lights already layered)
+#endif
     float ambient_specular = 1.0;
 #if defined(ENVMAP)
     ambient_specular = 1.0 - clamp(Reflectivity.x, 0.0, 1.0);
@@ -195,6 +275,20 @@ void main()
     color += env * fa * occlusion * max(Reflectivity.x, 0.0);
 #endif
     color += ambient * occlusion * ((1.0 - fa) * (1.0 - metallic) * base.rgb + fa * ambient_specular);
+#if defined(HAS_CLEARCOAT)
+    // The coat over the emissive, ambient and environment terms: the base's
+    // attenuated by 1 - clearcoat * F_c, the coat's own reflection added
+    // (blurred by the coat's roughness, as the base's is by its own).
+    float coat_f = ob_clearcoat_fresnel(s);
+    float keep = 1.0 - s.clearcoat * coat_f;
+    vec3 coat = ambient * occlusion * s.clearcoat * coat_f;
+#if defined(ENVMAP)
+    vec3 coat_r = reflect(-s.v, s.cn);
+    vec3 coat_env = ob_env_sample(EnvMap, mat3(EnvMapMatrix) * coat_r, ob_env_lod(s.ca));
+    coat += coat_env * s.clearcoat * coat_f * occlusion * max(Reflectivity.x, 0.0);
+#endif
+    color = (lit - emissive) + (emissive + color - lit) * keep + coat;
+#endif
     outColor = vec4(color * base.a, base.a);
 #endif
 }

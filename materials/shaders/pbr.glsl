@@ -50,14 +50,50 @@ struct ob_surface {
     float metallic;
     float a;            // GGX alpha = roughness^2 (roughness clamped to 0.03 to keep the peak finite)
     vec3 f0;
+#if defined(HAS_CLEARCOAT)
+    vec3 cn;            // the coat's unit normal (its normal map, else the geometric normal)
+    float clearcoat;    // layer intensity in [0, 1]
+    float ca;           // the coat's GGX alpha
+#endif
 };
+
+#if defined(HAS_CLEARCOAT)
+// KHR_materials_clearcoat: a dielectric layer (IOR 1.5, F0 = 0.04) with its
+// own GGX lobe over the base, which it attenuates by 1 - clearcoat * F_c,
+// F_c = Schlick at the coat normal and the view (the Khronos sample
+// viewer's layering).
+float ob_clearcoat_fresnel(ob_surface s)
+{
+    float ndotv = clamp(dot(s.cn, s.v), 0.0, 1.0);
+    return 0.04 + 0.96 * pow(1.0 - ndotv, 5.0);
+}
+
+vec3 ob_clearcoat_light(ob_surface s, vec3 l, vec3 radiance)
+{
+    float ndotl = dot(s.cn, l);
+    if (ndotl <= 0.0 || s.clearcoat <= 0.0) return vec3(0.0);
+    float ndotv = max(dot(s.cn, s.v), 1e-4);
+    vec3 h = ob_safe_normalize(l + s.v);
+    float ndoth = max(dot(s.cn, h), 0.0);
+    float vdoth = max(dot(s.v, h), 0.0);
+    vec3 f = ob_fresnel_schlick(vec3(0.04), vdoth);
+    vec3 spec = ob_ggx_d(ndoth, s.ca) * ob_smith_vis(ndotl, ndotv, s.ca) * f;
+    return OB_PI * s.clearcoat * spec * radiance * ndotl;
+}
+#endif
 
 // Contribution of one light of `radiance` arriving from unit direction l
 // (pi * f * radiance * NdotL: see the light units above).
+// With HAS_CLEARCOAT the coat is layered here, so every light gets it.
 vec3 ob_pbr_light(ob_surface s, vec3 l, vec3 radiance)
 {
     float ndotl = dot(s.n, l);
+#if defined(HAS_CLEARCOAT)
+    vec3 coat = ob_clearcoat_light(s, l, radiance);
+    if (ndotl <= 0.0) return coat;
+#else
     if (ndotl <= 0.0) return vec3(0.0);
+#endif
     float ndotv = max(dot(s.n, s.v), 1e-4);
     vec3 h = ob_safe_normalize(l + s.v);
     float ndoth = max(dot(s.n, h), 0.0);
@@ -65,7 +101,11 @@ vec3 ob_pbr_light(ob_surface s, vec3 l, vec3 radiance)
     vec3 f = ob_fresnel_schlick(s.f0, vdoth);
     vec3 spec = ob_ggx_d(ndoth, s.a) * ob_smith_vis(ndotl, ndotv, s.a) * f;
     vec3 diffuse = (1.0 - f) * (1.0 - s.metallic) * s.base / OB_PI;
+#if defined(HAS_CLEARCOAT)
+    return OB_PI * (diffuse + spec) * radiance * ndotl * (1.0 - s.clearcoat * ob_clearcoat_fresnel(s)) + coat;
+#else
     return OB_PI * (diffuse + spec) * radiance * ndotl;
+#endif
 }
 
 // Fresnel for the environment and ambient terms, where no single half

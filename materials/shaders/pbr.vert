@@ -8,7 +8,10 @@
 // Variants: VERTEX_COLOR (colour passed on), HAS_NORMAL_TEXTURE (tangent
 // passed on, in world space: it transforms with WorldMatrix, not the normal
 // matrix), PARABOLOID (dual-paraboloid projection as paraboloid.vert does),
-// DEPTH_ONLY (shadow pass of ALPHA_MASK materials: position and uv only).
+// DEPTH_ONLY (shadow pass of ALPHA_MASK materials: position and uv only),
+// HAS_TEXCOORD1 (the second uv set, location 5 of the extended layout with
+// TEXCOORD1, passed on), HAS_CLEARCOAT_NORMAL_TEXTURE (tangent passed on, as
+// for the normal texture).
 #define OB_VERTEX_STAGE
 #include "common.glsl"
 #if defined(PARABOLOID)
@@ -23,8 +26,13 @@ layout(location = 1) in vec3 inNormal;
 #if defined(VERTEX_COLOR)
 layout(location = 3) in vec4 inColor;
 #endif
-#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+#if (defined(HAS_NORMAL_TEXTURE) || defined(HAS_CLEARCOAT_NORMAL_TEXTURE)) && !defined(DEPTH_ONLY)
+#define OB_TANGENT_FRAME
 layout(location = 4) in vec4 inTangent;
+#endif
+#if defined(HAS_TEXCOORD1)
+layout(location = 5) in vec2 inUV1;
+layout(location = 6) out vec2 vUV1;
 #endif
 
 layout(location = 0) out vec3 vPosition;   // camera-relative world
@@ -33,7 +41,7 @@ layout(location = 2) out vec2 vUV;
 #if defined(VERTEX_COLOR)
 layout(location = 3) out vec4 vColor;
 #endif
-#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+#if defined(OB_TANGENT_FRAME)
 layout(location = 4) out vec4 vTangent;    // world xyz, w = bitangent sign
 #endif
 #if defined(PARABOLOID)
@@ -45,6 +53,9 @@ void main()
     vec4 world = WorldMatrix * vec4(inPosition, 1.0);
     vPosition = world.xyz;
     vUV = inUV;
+#if defined(HAS_TEXCOORD1)
+    vUV1 = inUV1;
+#endif
 #if defined(DEPTH_ONLY)
     vNormal = vec3(0.0);
 #else
@@ -53,7 +64,7 @@ void main()
 #if defined(VERTEX_COLOR)
     vColor = inColor;
 #endif
-#if defined(HAS_NORMAL_TEXTURE) && !defined(DEPTH_ONLY)
+#if defined(OB_TANGENT_FRAME)
     vTangent = vec4(ob_unit_normal(mat3(WorldMatrix) * inTangent.xyz),
                     (inTangent.w < 0.0 ? -1.0 : 1.0) * ob_mirror_sign(mat3(WorldMatrix)));
 #endif

@@ -95,6 +95,62 @@ static void box_uploads_with_counts_bounds_and_contents(void **state)
     ob_test_assert_no_validation(dev);
 }
 
+/* TEXCOORD_1: the extended layout plus location 5 at 52 (stride 60); a
+ * mesh with uv1 uploads so without a flag, one without it repeats its uv
+ * there when asked (a material reading set 1 on a mesh lacking it). */
+static void extended_uv1_layout_carries_the_second_set(void **state)
+{
+    (void)state;
+    const ob_vertex_layout *l = ob_vertex_layout_extended_uv1();
+    assert_int_equal(l->stride, 60);
+    assert_int_equal(l->attribute_count, 6);
+    for (uint32_t i = 0; i < 5; i++)
+        assert_memory_equal(&l->attributes[i], &ob_vertex_layout_extended()->attributes[i], sizeof l->attributes[i]);
+    assert_int_equal(l->attributes[5].location, 5);
+    assert_int_equal(l->attributes[5].offset, 52);
+    assert_int_equal(l->attributes[5].format, VK_FORMAT_R32G32_SFLOAT);
+    assert_string_equal(l->attributes[5].semantic, "TEXCOORD1");
+
+    const float h[3] = {1, 1, 1};
+    ob_mesh box;
+    assert_int_equal(ob_mesh_box(h, &box), OB_OK);
+    ob_result r;
+    ob_geometry *g = ob_geometry_create(dev, &(ob_geometry_desc){.mesh = &box, .name = "uv0 twice", .texcoord1 = true}, &r);
+    assert_int_equal(r, OB_OK);
+    assert_ptr_equal(ob_geometry_layout(g), l);
+    assert_int_equal(ob_buffer_size(dev, ob_geometry_vertex_buffer(g)), 24 * 60);
+    ob_vertex_extended_uv1 *x = read_back(ob_geometry_vertex_buffer(g), 24 * 60);
+    for (uint32_t i = 0; i < 24; i++) {
+        assert_memory_equal(x[i].base.uv, box.vertices[i].uv, sizeof x[i].base.uv);
+        assert_memory_equal(x[i].uv1, box.vertices[i].uv, sizeof x[i].uv1);
+    }
+    free(x);
+    ob_geometry_destroy(dev, g);
+
+    box.uv1 = ob_calloc(24, sizeof *box.uv1);
+    assert_non_null(box.uv1);
+    for (uint32_t i = 0; i < 24; i++) box.uv1[i][0] = 0.5f, box.uv1[i][1] = (float)i;
+    g = ob_geometry_create(dev, &(ob_geometry_desc){.mesh = &box, .name = "lightmapped"}, &r);
+    assert_int_equal(r, OB_OK);
+    assert_ptr_equal(ob_geometry_layout(g), l);
+    x = read_back(ob_geometry_vertex_buffer(g), 24 * 60);
+    for (uint32_t i = 0; i < 24; i++) {
+        assert_memory_equal(x[i].base.position, box.vertices[i].position, sizeof x[i].base.position);
+        assert_memory_equal(x[i].uv1, box.uv1[i], sizeof x[i].uv1);
+    }
+    free(x);
+    ob_geometry_destroy(dev, g);
+
+    /* A non-finite second uv is refused like any other attribute. */
+    box.uv1[5][1] = INFINITY;
+    ob_test_log_clear();
+    assert_null(ob_geometry_create(dev, &(ob_geometry_desc){.mesh = &box, .name = "lightmapped"}, &r));
+    assert_int_equal(r, OB_ERR_NON_FINITE);
+    assert_true(ob_test_log_has("lightmapped: vertex 5 uv1", NULL));
+    ob_mesh_release(&box);
+    ob_test_assert_no_validation(dev);
+}
+
 /* The extended layout: colours and tangents interleave after the standard
  * attributes; what a mesh lacks gets the documented defaults. */
 static void extended_layout_interleaves_colours_and_tangents(void **state)
@@ -292,6 +348,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(box_uploads_with_counts_bounds_and_contents),
         cmocka_unit_test(extended_layout_interleaves_colours_and_tangents),
+        cmocka_unit_test(extended_uv1_layout_carries_the_second_set),
         cmocka_unit_test(broken_mesh_uploads_nothing),
         cmocka_unit_test(line_list_topology_is_kept),
         cmocka_unit_test(failures_leave_no_resources),

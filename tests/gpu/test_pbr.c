@@ -128,6 +128,32 @@ static void lit_side_is_brighter(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* The brightest pixel of the ball of ball_under_sun (its luminance; where
+ * it is into *out_x, *out_y). */
+static float brightest(const ob_test_world *w, uint32_t *out_x, uint32_t *out_y)
+{
+    float best = -1.0f;
+    *out_x = *out_y = 0;
+    for (uint32_t y = 30; y < 90; y++)
+        for (uint32_t x = 50; x < 110; x++) {
+            float l = luminance(ob_world_pixel(w, x, y));
+            if (l > best) best = l, *out_x = x, *out_y = y;
+        }
+    return best;
+}
+
+/* Where a mirror-like lobe of ball_under_sun's ball peaks for a sun at
+ * (5, 5, 5): the half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a
+ * sphere of radius ~23 pixels at (80, 60): about 9 pixels right and up. */
+static void mirror_point(float *out_x, float *out_y)
+{
+    float h[3] = {0.57735f, 0.57735f, 1.57735f};
+    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
+    *out_x = 80.0f + radius_px * h[0] / hl;
+    *out_y = 60.0f - radius_px * h[1] / hl;
+}
+
 /* A smooth white metal lit from the upper right: the brightest pixel of the
  * sphere sits where the normal is the half vector between the light and the
  * eye (up and to the right of the centre), and it is much brighter than the
@@ -140,19 +166,9 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     p.roughness = 0.05f;
     ob_test_world w;
     ball_under_sun(&w, "chrome", &p, 3.0f, 5, 5, 5, __func__);
-    uint32_t bx = 0, by = 0;
-    float best = -1.0f;
-    for (uint32_t y = 30; y < 90; y++)
-        for (uint32_t x = 50; x < 110; x++) {
-            float l = luminance(ob_world_pixel(&w, x, y));
-            if (l > best) best = l, bx = x, by = y;
-        }
-    /* The half vector of l = (1,1,1)/sqrt3 and v = +Z, seen on a sphere of
-     * radius ~23 pixels at (80, 60): about 9 pixels right and up. */
-    float h[3] = {0.57735f, 0.57735f, 1.57735f};
-    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-    float radius_px = 0.5f / tanf(0.5f) / 2.5f * 60.0f;
-    float ex = 80.0f + radius_px * h[0] / hl, ey = 60.0f - radius_px * h[1] / hl;
+    uint32_t bx, by;
+    float best = brightest(&w, &bx, &by), ex, ey;
+    mirror_point(&ex, &ey);
     if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
         fail_msg("highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
     float opposite = luminance(ob_world_pixel(&w, (uint32_t)(160.0f - ex), (uint32_t)(120.0f - ey)));
@@ -161,22 +177,28 @@ static void smooth_metal_highlight_at_mirror_direction(void **state)
     ob_test_world_destroy(&w);
 }
 
-/* A 2x1 PNG: left texel transparent, right opaque white. */
-static const ob_texture *half_transparent(ob_texture_cache *cache)
+/* A w x h RGBA8 image as a PNG texture, sampled NEAREST and CLAMP. */
+static const ob_texture *nearest_texture(ob_texture_cache *cache, const uint8_t *px, int w, int h, const char *what)
 {
-    static const uint8_t px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
     int size;
-    uint8_t *png = stbi_write_png_to_mem(px, 8, 2, 1, 4, &size);
+    uint8_t *png = stbi_write_png_to_mem(px, w * 4, w, h, 4, &size);
     assert_non_null(png);
     ob_result r;
     const ob_texture *t = ob_texture_cache_load(cache, &(ob_texture_desc){
-        .data = png, .size = (size_t)size, .srgb = true, .context = "test: half transparent",
+        .data = png, .size = (size_t)size, .srgb = true, .context = what,
         .sampling = {.mag = OB_TEXTURE_FILTER_NEAREST, .min = OB_TEXTURE_FILTER_NEAREST,
                      .mip = OB_TEXTURE_FILTER_NEAREST, .wrap_u = OB_TEXTURE_WRAP_CLAMP,
                      .wrap_v = OB_TEXTURE_WRAP_CLAMP}}, &r);
     ob_free(png);
     assert_non_null(t);
     return t;
+}
+
+/* A 2x1 PNG: left texel transparent, right opaque white. */
+static const ob_texture *half_transparent(ob_texture_cache *cache)
+{
+    static const uint8_t px[8] = {255, 255, 255, 0, 255, 255, 255, 255};
+    return nearest_texture(cache, px, 2, 1, "test: half transparent");
 }
 
 /* A 160x120 world with a texture cache and a shadow-casting "leaf":
@@ -483,9 +505,13 @@ static void variants_only_use_what_the_material_uses(void **state)
     assert_string_equal(ob_effect_name(ob_material_get_view_effect(mp, w.r, a, main_view, false, &r)), "pbr:inst");
     assert_string_equal(ob_effect_name(ob_material_get_view_effect(mt, w.r, b, main_view, false, &r)), "pbr:base+inst");
     char left[256];
-    assert_int_equal(ob_material_pbr_left_out(mp, left, sizeof left), 9);
+    /* 9 texture/alpha/sidedness features plus texture transforms, the second
+     * uv set and clearcoat (its textures are implied without a coat). */
+    assert_int_equal(ob_material_pbr_left_out(mp, left, sizeof left), 12);
     assert_non_null(strstr(left, "normal texture"));
-    assert_int_equal(ob_material_pbr_left_out(mt, left, sizeof left), 8);
+    assert_non_null(strstr(left, "clearcoat"));
+    assert_null(strstr(left, "clearcoat texture"));
+    assert_int_equal(ob_material_pbr_left_out(mt, left, sizeof left), 11);
     assert_null(strstr(left, "base colour texture"));
     /* The same feature set in another material shares the variant. */
     ob_material *mp2 = pbr(&w, "plain too", &plain, false, 0);
@@ -570,6 +596,173 @@ static void texture_maps_change_the_shading(void **state)
     if (!(redness > 100.0f)) fail_msg("red emissive texture: red - green = %.0f", redness);
     float metal = quad_with_map(MAP_METALLIC_ROUGHNESS, true);
     if (!(metal < flat - 10.0f)) fail_msg("metal (no diffuse) %.0f, dielectric %.0f", metal, flat);
+}
+
+/* ------------------------------------------- glTF extensions (issue 28) */
+
+/* A 2x2 PNG, NEAREST and CLAMP: texel (0,0) red, (1,0) green, (0,1) blue,
+ * (1,1) white (uv (0,0) is the top-left texel). */
+static const ob_texture *quadrants(ob_texture_cache *cache)
+{
+    static const uint8_t px[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+    return nearest_texture(cache, px, 2, 2, "test: quadrants");
+}
+
+enum { Q_RED, Q_GREEN, Q_BLUE, Q_WHITE };
+
+/* Which quadrant colour a pixel shows. */
+static int quadrant_of(const uint8_t *p)
+{
+    if (p[0] > 100 && p[1] > 100 && p[2] > 100) return Q_WHITE;
+    return p[0] >= p[1] && p[0] >= p[2] ? Q_RED : p[1] >= p[2] ? Q_GREEN : Q_BLUE;
+}
+
+/* Four points around the middle of a card facing the camera, one in each
+ * quarter of its uv square. */
+static const uint32_t probe[4][2] = {{24, 18}, {40, 18}, {24, 30}, {40, 30}};
+
+/* The quadrant each probe shows on a card whose emissive texture (black
+ * base, so the emissive is what shows) is the quadrants image with
+ * `slot`'s uv set and transform; with second_set the card's uv are all
+ * (0,0) and, when the slot reads set 1, its uv1 are the plane's uv. */
+static void card_quadrants(const ob_material_texture *slot, bool second_set, int out[4], char *variant,
+                           size_t variant_size)
+{
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 64, .height = 48});
+    ob_result r;
+    ob_texture_cache *cache = ob_texture_cache_create(w.dev, &r);
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color[0] = p.base_color[1] = p.base_color[2] = 0.0f;
+    p.metallic = 0.0f;
+    p.emissive[0] = p.emissive[1] = p.emissive[2] = 1.0f;
+    p.emissive_texture = *slot;
+    p.emissive_texture.texture = quadrants(cache);
+    ob_mesh m;
+    assert_int_equal(ob_mesh_plane(2.0f, 2.0f, 1, &m), OB_OK);
+    if (second_set) {
+        /* Set 0 (0,0) everywhere: one texel. A material reading only set 0
+         * must draw a mesh without uv1 (the 52-byte layout), as
+         * ob_model_instance uploads it. */
+        if (slot->uv_set == 1) {
+            m.uv1 = ob_malloc((size_t)m.vertex_count * sizeof *m.uv1);
+            assert_non_null(m.uv1);
+        }
+        for (uint32_t i = 0; i < m.vertex_count; i++) {
+            if (m.uv1) memcpy(m.uv1[i], m.vertices[i].uv, sizeof m.uv1[i]);
+            m.vertices[i].uv[0] = m.vertices[i].uv[1] = 0.0f;
+        }
+    }
+    ob_material *mat = pbr(&w, "card", &p, false, 0);
+    ob_node *card = facing_quad(&w, "card", extended(&w, &m, "card quad", NULL), mat, 0, 0, 0, false);
+    ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_world_read(&w);
+    for (int k = 0; k < 4; k++) out[k] = quadrant_of(ob_world_pixel(&w, probe[k][0], probe[k][1]));
+    if (variant)
+        snprintf(variant, variant_size, "%s",
+                 ob_effect_name(ob_material_get_view_effect(mat, w.r, card, ob_perspective_view_base(w.main), false,
+                                                            &r)));
+    ob_texture_cache_destroy(cache);   /* before the device goes */
+    ob_test_world_destroy(&w);
+}
+
+/* KHR_texture_transform lands the texture where the spec says: an offset
+ * of half the image in u shows the right column everywhere (the rest is
+ * clamped), and a quarter turn (rotation pi/2, offset (0, 1): u' = v,
+ * v' = 1 - u) turns the image a quarter, each point showing the colour
+ * the spec's map names, wherever the plane's uv put each quadrant. */
+static void texture_transform_lands_where_expected(void **state)
+{
+    (void)state;
+    int plain[4], shifted[4], turned[4];
+    char variant[64];
+    card_quadrants(&(ob_material_texture){0}, false, plain, variant, sizeof variant);
+    assert_string_equal(variant, "pbr:emi+inst");
+    bool seen[4] = {false};
+    for (int k = 0; k < 4; k++) seen[plain[k]] = true;
+    assert_true(seen[Q_RED] && seen[Q_GREEN] && seen[Q_BLUE] && seen[Q_WHITE]);   /* one quadrant each */
+
+    card_quadrants(&(ob_material_texture){.has_transform = true, .transform = {1, 0, 0.5f, 0, 1, 0}}, false,
+                   shifted, variant, sizeof variant);
+    assert_string_equal(variant, "pbr:emi+uvx+inst");
+    /* u + 0.5: every point shows its row's right texel. */
+    static const int shift[4] = {[Q_RED] = Q_GREEN, [Q_GREEN] = Q_GREEN, [Q_BLUE] = Q_WHITE, [Q_WHITE] = Q_WHITE};
+    for (int k = 0; k < 4; k++)
+        if (shifted[k] != shift[plain[k]]) fail_msg("offset: probe %d shows %d, expected %d", k, shifted[k], shift[plain[k]]);
+
+    /* glTF: u' = cos r u + sin r v + ox, v' = -sin r u + cos r v + oy. */
+    card_quadrants(&(ob_material_texture){.has_transform = true, .transform = {0, 1, 0, -1, 0, 1}}, false, turned,
+                   NULL, 0);
+    /* A point in quadrant (cu, cv) samples texel (cv, 1 - cu). */
+    static const int turn[4] = {[Q_RED] = Q_BLUE, [Q_GREEN] = Q_RED, [Q_BLUE] = Q_WHITE, [Q_WHITE] = Q_GREEN};
+    for (int k = 0; k < 4; k++)
+        if (turned[k] != turn[plain[k]]) fail_msg("rotation: probe %d shows %d, expected %d", k, turned[k], turn[plain[k]]);
+}
+
+/* A texture reading TEXCOORD_1 samples the mesh's second uv set (here the
+ * plane's own uv, while set 0 is (0,0) everywhere), through the 60-byte
+ * layout, and shows all four quadrants where the plain card does; read
+ * with set 0 the card shows one texel. */
+static void texcoord1_is_used(void **state)
+{
+    (void)state;
+    int plain[4], set0[4], set1[4];
+    char variant[64];
+    card_quadrants(&(ob_material_texture){0}, false, plain, NULL, 0);
+    card_quadrants(&(ob_material_texture){.uv_set = 1}, true, set1, variant, sizeof variant);
+    assert_string_equal(variant, "pbr:emi+uv1+inst");
+    for (int k = 0; k < 4; k++) assert_int_equal(set1[k], plain[k]);
+    card_quadrants(&(ob_material_texture){0}, true, set0, variant, sizeof variant);
+    assert_string_equal(variant, "pbr:emi+inst");
+    for (int k = 1; k < 4; k++) assert_int_equal(set0[k], set0[0]);
+}
+
+/* KHR_materials_clearcoat adds a sharp highlight over a rough base: the
+ * coated ball's brightest pixel sits at the mirror direction and is much
+ * brighter than anything on the uncoated ball, whose rough lobe is broad;
+ * only the coated material compiles the clearcoat variant. */
+static void clearcoat_adds_a_highlight_layer(void **state)
+{
+    (void)state;
+    ob_material_pbr p = ob_material_pbr_defaults();
+    p.base_color[0] = 0.5f, p.base_color[1] = 0.02f, p.base_color[2] = 0.01f;
+    p.metallic = 0.0f;
+    p.roughness = 0.8f;
+    float best[2];
+    uint32_t bx = 0, by = 0;
+    for (int coated = 0; coated < 2; coated++) {
+        p.clearcoat = coated ? 1.0f : 0.0f;
+        p.clearcoat_roughness = 0.05f;
+        ob_test_world w;
+        ball_under_sun(&w, coated ? "coated" : "base", &p, 3.0f, 5, 5, 5, coated ? "clearcoat" : "clearcoat_base");
+        best[coated] = brightest(&w, &bx, &by);
+        ob_test_world_destroy(&w);
+    }
+    if (!(best[1] > best[0] + 60.0f)) fail_msg("coated highlight %.0f, uncoated %.0f", best[1], best[0]);
+    float ex, ey;   /* the coat's lobe peaks where a mirror's would */
+    mirror_point(&ex, &ey);
+    if (fabsf((float)bx - ex) > 4.0f || fabsf((float)by - ey) > 4.0f)
+        fail_msg("coat highlight at (%u, %u), expected near (%.1f, %.1f)", bx, by, ex, ey);
+
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.width = 64, .height = 48});
+    ob_result r;
+    p.clearcoat = 1.0f;
+    ob_material *coated = pbr(&w, "coated", &p, false, 0);
+    p.clearcoat = 0.0f;
+    ob_material *bare = pbr(&w, "bare", &p, false, 0);
+    ob_geometry *ball = ext_sphere(&w);
+    ob_node *a = ob_world_entity(&w, NULL, "a", ball, coated, -0.6, 0, 0);
+    ob_node *b = ob_world_entity(&w, NULL, "b", ball, bare, 0.6, 0, 0);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    ob_view *main_view = ob_perspective_view_base(w.main);
+    assert_string_equal(ob_effect_name(ob_material_get_view_effect(coated, w.r, a, main_view, false, &r)), "pbr:cc+inst");
+    assert_string_equal(ob_effect_name(ob_material_get_view_effect(bare, w.r, b, main_view, false, &r)), "pbr:inst");
+    char left[512];
+    ob_material_pbr_left_out(coated, left, sizeof left);
+    assert_non_null(strstr(left, "clearcoat normal texture"));
+    ob_test_world_destroy(&w);
 }
 
 /* ------------------------------------------------------------ faults */
@@ -825,6 +1018,9 @@ int main(void)
         cmocka_unit_test(shadow_map_feeds_pbr),
         cmocka_unit_test(environment_map_feeds_pbr),
         cmocka_unit_test(texture_maps_change_the_shading),
+        cmocka_unit_test(texture_transform_lands_where_expected),
+        cmocka_unit_test(texcoord1_is_used),
+        cmocka_unit_test(clearcoat_adds_a_highlight_layer),
         cmocka_unit_test(st_and_mt_are_byte_identical),
         cmocka_unit_test(variants_only_use_what_the_material_uses),
         cmocka_unit_test(defaults_and_bad_input),

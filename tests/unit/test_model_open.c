@@ -102,7 +102,8 @@ static void expect_well_formed(const ob_model *m)
         assert_int_equal(ob_mesh_validate(&p->mesh, p->name), OB_OK);
         const ob_model_material *mat = &m->materials[p->material];
         /* Tangents exactly where a normal map needs them; unit, w = ±1, ⟂ normal. */
-        assert_int_equal(p->mesh.tangents != NULL, mat->normal_texture.image >= 0);
+        assert_int_equal(p->mesh.tangents != NULL,
+                         mat->normal_texture.image >= 0 || mat->clearcoat_normal_texture.image >= 0);
         for (uint32_t v = 0; p->mesh.tangents && v < p->mesh.vertex_count; v++) {
             const float *t = p->mesh.tangents[v], *n = p->mesh.vertices[v].normal;
             float len = sqrtf(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
@@ -600,6 +601,177 @@ static void clear_coat_normal_maps_get_tangents(void **state)
     ob_model_close(m);
 }
 
+/* The JSON's KHR_texture_transform of a texture info (identity without). */
+static void json_transform(const cJSON *info, double offset[2], double *rotation, double scale[2])
+{
+    const cJSON *ext = cJSON_GetObjectItem(cJSON_GetObjectItem(info, "extensions"), "KHR_texture_transform");
+    const cJSON *o = cJSON_GetObjectItem(ext, "offset"), *sc = cJSON_GetObjectItem(ext, "scale");
+    offset[0] = o ? cJSON_GetArrayItem(o, 0)->valuedouble : 0.0;
+    offset[1] = o ? cJSON_GetArrayItem(o, 1)->valuedouble : 0.0;
+    scale[0] = sc ? cJSON_GetArrayItem(sc, 0)->valuedouble : 1.0;
+    scale[1] = sc ? cJSON_GetArrayItem(sc, 1)->valuedouble : 1.0;
+    *rotation = json_num(ext, "rotation", 0.0);
+}
+
+/* KHR_texture_transform comes through assimp's aiUVTransform as the file
+ * wrote it (offset, rotation, scale), and as the matrix that maps the
+ * meshes' uv: with flip_uv the glTF uv themselves, without it assimp's
+ * mirrored v. Every material of TextureTransformTest against its JSON. */
+static void texture_transform_as_authored(void **state)
+{
+    (void)state;
+    const char *path = MODELS "glTF2/textureTransform/TextureTransformTest.gltf";
+    if (!have_model(path)) return;
+    cJSON *doc = read_gltf_json(path);
+    for (int flip = 1; flip >= 0; flip--) {
+        ob_model *m = open_ok(path, flip != 0);
+        expect_well_formed(m);
+        uint32_t transformed = 0;
+        const cJSON *mat;
+        cJSON_ArrayForEach(mat, cJSON_GetObjectItem(doc, "materials")) {
+            const ob_model_material *ours = material_named(m, cJSON_GetObjectItem(mat, "name")->valuestring);
+            const cJSON *info = cJSON_GetObjectItem(cJSON_GetObjectItem(mat, "pbrMetallicRoughness"), "baseColorTexture");
+            double off[2], rot, sc[2];
+            json_transform(info, off, &rot, sc);
+            const ob_model_uv_transform *t = &ours->base_color_texture.transform;
+            bool identity = off[0] == 0 && off[1] == 0 && rot == 0 && sc[0] == 1 && sc[1] == 1;
+            assert_int_equal(t->present, !identity);
+            transformed += t->present;
+            assert_float_equal(t->offset[0], off[0], 1e-5);
+            assert_float_equal(t->offset[1], off[1], 1e-5);
+            assert_float_equal(t->rotation, rot, 1e-5);
+            assert_float_equal(t->scale[0], sc[0], 1e-5);
+            assert_float_equal(t->scale[1], sc[1], 1e-5);
+            /* The matrix at a few points against the spec's T·R·S in glTF uv. */
+            const double pts[3][2] = {{0, 0}, {1, 0}, {0.25, 0.75}};
+            for (int k = 0; k < 3; k++) {
+                double u = pts[k][0], v = pts[k][1];
+                double gv = flip ? v : 1.0 - v;   /* the file's v of this mesh uv */
+                double c = cos(rot), s = sin(rot);
+                double gu2 = c * sc[0] * u + s * sc[1] * gv + off[0];
+                double gv2 = -s * sc[0] * u + c * sc[1] * gv + off[1];
+                double want_v = flip ? gv2 : 1.0 - gv2;
+                assert_float_equal(t->uv[0] * u + t->uv[1] * v + t->uv[2], gu2, 1e-5);
+                assert_float_equal(t->uv[3] * u + t->uv[4] * v + t->uv[5], want_v, 1e-5);
+            }
+            assert_int_equal(ours->base_color_texture.uv_set, 0);
+        }
+        assert_int_equal(transformed, 6);
+        ob_model_close(m);
+    }
+    cJSON_Delete(doc);
+}
+
+/* KHR_texture_transform's texCoord override is what assimp 5.2 drops: the
+ * glTF scan names the material, the texture and the set it asked for, once
+ * per material, and the model still opens. */
+static void texcoord_override_is_named(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ob_test_model_open_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[96];
+    snprintf(path, sizeof path, "%s/override.gltf", dir);
+    static const char text[] =
+        "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],"
+        " \"nodes\": [{\"name\": \"tri\", \"mesh\": 0}],"
+        " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 1}]}],"
+        " \"materials\": [{\"name\": \"plain\"}, {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0,"
+        " \"extensions\": {\"KHR_texture_transform\": {\"offset\": [0.5, 0], \"texCoord\": 1}}}},"
+        " \"occlusionTexture\": {\"index\": 0, \"extensions\": {\"KHR_texture_transform\": {\"texCoord\": 1}}},"
+        " \"name\": \"shifted\"}],"
+        " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"absent.png\"}],"
+        " \"buffers\": [{\"byteLength\": 42, \"uri\": \"data:application/octet-stream;base64,"
+        "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA\"}],"
+        " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
+        " {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}],"
+        " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\","
+        " \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3,"
+        " \"type\": \"SCALAR\"}], \"extensionsUsed\": [\"KHR_texture_transform\"],"
+        " \"extensionsRequired\": [\"KHR_texture_transform\"]}";
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(text, 1, sizeof text - 1, f), sizeof text - 1);
+    fclose(f);
+    ob_test_log_clear();
+    ob_model *m = open_ok(path, true);   /* required, and honoured */
+    assert_true(ob_test_log_has("material 1 'shifted' baseColorTexture", "texCoord override",
+                                "TEXCOORD_1", NULL));
+    assert_false(ob_test_log_has("occlusionTexture", "texCoord override", NULL));   /* once per material */
+    assert_false(ob_test_log_has("'plain'", NULL));
+    assert_false(ob_test_log_has("optional glTF extension", NULL));
+    ob_model_close(m);
+    remove(path);
+    rmdir(dir);
+}
+
+/* KHR_materials_clearcoat: factors and the three textures, per material of
+ * ClearCoatTest, against the JSON. */
+static void clearcoat_as_authored(void **state)
+{
+    (void)state;
+    const char *path = MODELS "glTF2/ClearCoat-glTF/ClearCoatTest.gltf";
+    if (!have_model(path)) return;
+    ob_model *m = open_ok(path, true);
+    cJSON *doc = read_gltf_json(path);
+    uint32_t coated = 0;
+    const cJSON *mat;
+    cJSON_ArrayForEach(mat, cJSON_GetObjectItem(doc, "materials")) {
+        const ob_model_material *ours = material_named(m, cJSON_GetObjectItem(mat, "name")->valuestring);
+        const cJSON *cc = cJSON_GetObjectItem(cJSON_GetObjectItem(mat, "extensions"), "KHR_materials_clearcoat");
+        assert_float_equal(ours->clearcoat, json_num(cc, "clearcoatFactor", 0.0), 1e-6);
+        assert_float_equal(ours->clearcoat_roughness, json_num(cc, "clearcoatRoughnessFactor", 0.0), 1e-6);
+        assert_int_equal(ours->clearcoat_texture.image >= 0, cJSON_HasObjectItem(cc, "clearcoatTexture"));
+        assert_int_equal(ours->clearcoat_roughness_texture.image >= 0,
+                         cJSON_HasObjectItem(cc, "clearcoatRoughnessTexture"));
+        assert_int_equal(ours->clearcoat_normal_texture.image >= 0, cJSON_HasObjectItem(cc, "clearcoatNormalTexture"));
+        assert_float_equal(ours->clearcoat_normal_scale,
+                           json_num(cJSON_GetObjectItem(cc, "clearcoatNormalTexture"), "scale", 1.0), 1e-6);
+        coated += cc != NULL;
+    }
+    assert_int_equal(coated, 6);
+    /* The coat's textures name the files the JSON's images do. */
+    const ob_model_material *partial = material_named(m, "Partial_Coated");
+    assert_non_null(strstr(m->images[partial->clearcoat_texture.image].path, "PartialCoating.png"));
+    const ob_model_material *rough = material_named(m, "RoughVariations_Coated");
+    assert_non_null(strstr(m->images[rough->clearcoat_roughness_texture.image].path, "RoughnessStripes.png"));
+    const ob_model_material *wrap = material_named(m, "CoatNorm_Coated");
+    assert_non_null(strstr(m->images[wrap->clearcoat_normal_texture.image].path, "PlasticWrap_normals.jpg"));
+    cJSON_Delete(doc);
+    ob_model_close(m);
+}
+
+/* TEXCOORD_1: BoxTexcoords' second uv set reaches the mesh (flipped with
+ * the first), and a texture reading it keeps uv_set 1. */
+static void second_uv_set_is_read(void **state)
+{
+    (void)state;
+    const char *path = MODELS "glTF2/BoxTexcoords-glTF/boxTexcoords.gltf";
+    if (!have_model(path)) return;
+    ob_model *a = open_ok(path, true), *b = open_ok(path, false);
+    expect_well_formed(a);
+    uint32_t with_uv1 = 0;
+    for (uint32_t i = 0; i < a->primitive_count; i++) {
+        const ob_mesh *ma = &a->primitives[i].mesh, *mb = &b->primitives[i].mesh;
+        if (!ma->uv1) continue;
+        with_uv1++;
+        assert_non_null(mb->uv1);
+        for (uint32_t v = 0; v < ma->vertex_count; v++) {
+            assert_float_equal(ma->uv1[v][0], mb->uv1[v][0], 1e-6);
+            assert_float_equal(ma->uv1[v][1], 1.0f - mb->uv1[v][1], 1e-6);
+        }
+    }
+    assert_true(with_uv1 > 0);
+    uint32_t set1 = 0;
+    for (uint32_t i = 0; i < a->material_count; i++) {
+        const ob_model_texture *t = &a->materials[i].base_color_texture;
+        for (int s = 0; s < 5; s++, t++) set1 += t->image >= 0 && t->uv_set == 1;
+    }
+    assert_true(set1 > 0);
+    ob_model_close(a);
+    ob_model_close(b);
+}
+
 static void obj_and_ply_from_the_package(void **state)
 {
     (void)state;
@@ -753,6 +925,10 @@ int main(void)
         cmocka_unit_test(box_textured_embedded_and_external),
         cmocka_unit_test(engine_keeps_its_hierarchy),
         cmocka_unit_test(clear_coat_normal_maps_get_tangents),
+        cmocka_unit_test(texture_transform_as_authored),
+        cmocka_unit_test(clearcoat_as_authored),
+        cmocka_unit_test(texcoord_override_is_named),
+        cmocka_unit_test(second_uv_set_is_read),
         cmocka_unit_test(obj_and_ply_from_the_package),
         cmocka_unit_test(raw_embedded_texture_becomes_png),
         cmocka_unit_test(concurrent_opens_agree_with_serial_ones),

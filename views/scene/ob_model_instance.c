@@ -14,6 +14,7 @@
  * transform with a negative determinant.) The id range keeps room for
  * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE variants. */
 #define VARIANT_EXTENDED 1u
+#define VARIANT_TEXCOORD1 2u   /* with VARIANT_EXTENDED: the layout with TEXCOORD1 */
 #define VARIANT_COUNT OB_MODEL_ASSETS_IDS_PER_PRIMITIVE
 
 struct ob_model_assets {
@@ -25,7 +26,7 @@ struct ob_model_assets {
     char *name;
     uint32_t first_geometry_id;
     ob_material **materials;          /* per model material, NULL when no primitive uses it */
-    bool *material_extended;          /* per model material: its effects read the extended layout */
+    uint8_t *material_variant;        /* per model material: the VARIANT_* layout its effects read */
     ob_geometry *(*geometry)[VARIANT_COUNT];   /* per primitive */
     uint32_t geometry_count;
 };
@@ -46,7 +47,8 @@ static ob_material_texture model_texture(const ob_model_material_context *ctx,
                                          const ob_model_material *mm, const ob_model_texture *t,
                                          bool srgb, const char *slot)
 {
-    ob_material_texture out = {.uv_set = t->uv_set};
+    ob_material_texture out = {.uv_set = t->uv_set, .has_transform = t->transform.present};
+    memcpy(out.transform, t->transform.uv, sizeof out.transform);
     const ob_model *model = ctx->model;
     if (t->image < 0) return out;
     if ((uint32_t)t->image >= model->image_count) {
@@ -87,8 +89,9 @@ ob_material *ob_model_material_to_material(const ob_model_material_context *ctx,
     char name[256];
     snprintf(name, sizeof name, "%s/%s", ctx->model_name ? ctx->model_name : ctx->model->path, mm->name);
     /* glTF 2 metallic-roughness, as the file gives it: factors, the five
-     * texture slots (colour data sRGB, data maps UNORM), alpha mode and
-     * sidedness; vertex colours when a primitive of the material has them. */
+     * texture slots (colour data sRGB, data maps UNORM) with their uv sets
+     * and transforms, clearcoat, alpha mode and sidedness; vertex colours
+     * when a primitive of the material has them. */
     ob_material_pbr pbr = ob_material_pbr_defaults();
     memcpy(pbr.base_color, mm->base_color, sizeof pbr.base_color);
     memcpy(pbr.emissive, mm->emissive, sizeof pbr.emissive);
@@ -108,6 +111,16 @@ ob_material *ob_model_material_to_material(const ob_model_material_context *ctx,
     pbr.normal_texture = model_texture(ctx, mm, &mm->normal_texture, false, "normalTexture");
     pbr.occlusion_texture = model_texture(ctx, mm, &mm->occlusion_texture, false, "occlusionTexture");
     pbr.emissive_texture = model_texture(ctx, mm, &mm->emissive_texture, true, "emissiveTexture");
+    pbr.clearcoat = mm->clearcoat;
+    pbr.clearcoat_roughness = mm->clearcoat_roughness;
+    pbr.clearcoat_normal_scale = mm->clearcoat_normal_scale;
+    if (mm->clearcoat > 0.0f) {   /* the textures of an absent layer are not loaded */
+        pbr.clearcoat_texture = model_texture(ctx, mm, &mm->clearcoat_texture, false, "clearcoatTexture");
+        pbr.clearcoat_roughness_texture =
+            model_texture(ctx, mm, &mm->clearcoat_roughness_texture, false, "clearcoatRoughnessTexture");
+        pbr.clearcoat_normal_texture =
+            model_texture(ctx, mm, &mm->clearcoat_normal_texture, false, "clearcoatNormalTexture");
+    }
     ob_material_desc desc = {.name = name, .kind = OB_MATERIAL_PBR, .pbr = pbr,
                              .casts_shadows = pbr.alpha_mode != OB_ALPHA_BLEND};
     ob_result r;
@@ -154,9 +167,9 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
     a->first_geometry_id = desc->first_geometry_id;
     a->name = ob_strdup(desc->name ? desc->name : base_name(model->path));
     a->materials = ob_calloc(model->material_count, sizeof *a->materials);
-    a->material_extended = ob_calloc(model->material_count, sizeof *a->material_extended);
+    a->material_variant = ob_calloc(model->material_count, sizeof *a->material_variant);
     a->geometry = ob_calloc(model->primitive_count, sizeof *a->geometry);
-    if (!a->name || !a->materials || !a->material_extended || !a->geometry) {
+    if (!a->name || !a->materials || !a->material_variant || !a->geometry) {
         OB_LOG_E(LOG_MODULE, "%s: out of memory for the model's assets", model->path);
         r = OB_ERR_OUT_OF_HOST_MEMORY;
         goto fail_destroy_assets;
@@ -177,8 +190,11 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
         for (uint32_t p = 0; p < model->primitive_count && !used; p++)
             used = model->primitives[p].material == m;
         if (!used) continue;
-        a->materials[m] = ob_model_material_to_material(&ctx, m, &a->material_extended[m], &r);
+        bool extended;
+        a->materials[m] = ob_model_material_to_material(&ctx, m, &extended, &r);
         if (!a->materials[m]) goto fail_destroy_assets;
+        a->material_variant[m] = (uint8_t)((extended ? VARIANT_EXTENDED : 0u) |
+                                           (ob_material_reads_texcoord1(a->materials[m]) ? VARIANT_TEXCOORD1 : 0u));
     }
     if (out_result) *out_result = OB_OK;
     return a;
@@ -200,7 +216,7 @@ void ob_model_assets_destroy(ob_model_assets *a)
     ob_texture_cache_destroy(a->own_textures);   /* after the materials that use its textures */
     ob_free(a->geometry);
     ob_free(a->materials);
-    ob_free(a->material_extended);
+    ob_free(a->material_variant);
     ob_free(a->name);
     ob_model_close(a->model);
     ob_free(a);
@@ -221,9 +237,14 @@ static ob_geometry *variant(ob_model_assets *a, uint32_t p, uint32_t v, ob_resul
     const ob_model_primitive *prim = &a->model->primitives[p];
     ob_mesh mesh = prim->mesh;   /* shallow: the arrays stay the model's */
     if (!(v & VARIANT_EXTENDED)) mesh.tangents = NULL, mesh.colors = NULL;
+    if (!(v & VARIANT_TEXCOORD1)) mesh.uv1 = NULL;   /* only a material reading it gets TEXCOORD1 */
+    else if (!mesh.uv1)
+        OB_LOG_W(LOG_MODULE, "%s: primitive %u '%s' has no TEXCOORD_1 but its material reads it; "
+                 "TEXCOORD_0 stands in", a->model->path, p, prim->name);
     char name[160];
     snprintf(name, sizeof name, "%s/%s", a->name, prim->name);
     ob_geometry_desc gd = {.mesh = &mesh, .name = name, .extended = (v & VARIANT_EXTENDED) != 0,
+                           .texcoord1 = (v & VARIANT_TEXCOORD1) != 0,
                            .id = a->first_geometry_id ? a->first_geometry_id + p * VARIANT_COUNT + v : 0};
     ob_geometry *g = ob_geometry_create(ob_renderer_device(a->renderer), &gd, out_result);
     if (!g) {
@@ -339,7 +360,7 @@ ob_result ob_model_assets_instantiate(ob_model_assets *a, ob_scene *scene, ob_no
         for (uint32_t k = 0; k < mn->primitive_count && r == OB_OK; k++) {
             uint32_t p = mn->primitives[k];
             uint32_t mat = model->primitives[p].material;
-            uint32_t v = !override && a->material_extended[mat] ? VARIANT_EXTENDED : 0u;
+            uint32_t v = override ? 0u : a->material_variant[mat];
             ob_geometry *g = variant(a, p, v, &r);
             if (!g) break;
             ob_node *e = ob_node_create(scene, n, model->primitives[p].name, &r);

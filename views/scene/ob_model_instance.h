@@ -16,15 +16,18 @@
  * ob_model_material becomes an engine material: a PBR material
  * (materials/ob_material.h, docs/materials.md) with the file's factors, its
  * five texture slots loaded through a texture cache (base colour and
- * emissive as sRGB, the data maps as UNORM, samplers from the file), alpha
- * mode and cutoff, sidedness, and vertex colours when a primitive of the
+ * emissive as sRGB, the data maps as UNORM, samplers from the file) with
+ * their uv sets and KHR_texture_transform, clearcoat (its three textures
+ * loaded only when the material has a coat), alpha mode and cutoff, sidedness, and vertex colours when a primitive of the
  * material has them; casting shadows unless blended. A texture that does
  * not load is warned about (model, material, slot, file) and its slot left
  * empty: the material falls back to its factor and the rest renders. The
  * function also says whether the material's effects read the extended
  * vertex layout (PBR does); a primitive is uploaded in the layout its
  * material reads (the standard layout for an override of a standard kind,
- * its tangents and colours left out).
+ * its tangents and colours left out; TEXCOORD_1 only for a material that
+ * reads it, ob_material_reads_texcoord1, the first set standing in, with a
+ * warning, where a primitive of it has none).
  *
  * Mirroring: any world transform with a negative determinant, within the
  * model or above its root, is drawn with clockwise front faces and outward
@@ -83,8 +86,9 @@ typedef struct ob_model_assets_desc {
      * their own cache, destroyed with them. */
     ob_texture_cache *textures;
     const char *name;                /* for geometry, materials and logs; NULL → the model's file name */
-    /* Geometry ids for command hashes: primitive p's variant v (0..3; 0 and
-     * 1 are used, the standard and the extended layout) gets
+    /* Geometry ids for command hashes: primitive p's variant v (0..3: 0 the
+     * standard layout, 1 the extended one, 3 the extended one with
+     * TEXCOORD1 for a material reading the second uv set) gets
      * first_geometry_id + 4·p + v, so the model reserves
      * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE × primitive_count ids whatever is
      * uploaded; 0 → each derived from its contents. */
