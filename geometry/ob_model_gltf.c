@@ -203,16 +203,29 @@ static bool after_item(scan *s, char close, bool *done)
     return false;
 }
 
-static bool read_name_array(scan *s, name_list *l)
+/* The opening of an array (after white space): ARRAY_ITEMS when elements
+ * follow, ARRAY_DONE when it was empty (consumed) or, with skip_other, when
+ * the value there is no array (skipped), ARRAY_BAD on malformed input. */
+typedef enum { ARRAY_BAD, ARRAY_DONE, ARRAY_ITEMS } array_open;
+
+static array_open open_array(scan *s, bool skip_other)
 {
     skip_ws(s);
-    if (s->p >= s->end || *s->p != '[') return false;
+    if (s->p >= s->end || *s->p != '[')
+        return skip_other && skip_value(s) ? ARRAY_DONE : ARRAY_BAD;
     s->p++;
     skip_ws(s);
     if (s->p < s->end && *s->p == ']') {
         s->p++;
-        return true;
+        return ARRAY_DONE;
     }
+    return ARRAY_ITEMS;
+}
+
+static bool read_name_array(scan *s, name_list *l)
+{
+    array_open a = open_array(s, false);
+    if (a != ARRAY_ITEMS) return a == ARRAY_DONE;
     for (;;) {
         skip_ws(s);
         char name[GLTF_NAME_MAX];
@@ -405,14 +418,8 @@ static bool indexed_field(scan *s, const char *key, const char *quote, void *use
  * grow(index) makes room first. */
 static bool scan_objects(scan *s, bool (*grow)(scan *, uint32_t), member_fn fn)
 {
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '[') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == ']') {
-        s->p++;
-        return true;
-    }
+    array_open a = open_array(s, true);
+    if (a != ARRAY_ITEMS) return a == ARRAY_DONE;
     for (uint32_t index = 0;; index++) {
         skip_ws(s);
         if (s->p >= s->end || *s->p != '{') return false;
@@ -477,14 +484,8 @@ static bool scan_primitive(scan *s)
 /* An array of values, each handed to fn (which must consume it). */
 static bool scan_array(scan *s, bool (*fn)(scan *))
 {
-    skip_ws(s);
-    if (s->p >= s->end || *s->p != '[') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == ']') {
-        s->p++;
-        return true;
-    }
+    array_open a = open_array(s, true);
+    if (a != ARRAY_ITEMS) return a == ARRAY_DONE;
     for (;;) {
         if (!fn(s)) return false;
         bool done;
@@ -589,14 +590,12 @@ static bool material_field(scan *s, const char *key, const char *quote, void *us
 
 static bool scan_materials(scan *s)
 {
-    skip_ws(s);
-    if (!s->log_materials || s->p >= s->end || *s->p != '[') return skip_value(s);
-    s->p++;
-    skip_ws(s);
-    if (s->p < s->end && *s->p == ']') {
-        s->p++;
-        return true;
+    if (!s->log_materials) {
+        skip_ws(s);
+        return skip_value(s);
     }
+    array_open a = open_array(s, true);
+    if (a != ARRAY_ITEMS) return a == ARRAY_DONE;
     for (uint32_t index = 0;; index++) {
         material_note n = {.depth = 0};
         snprintf(n.name, sizeof n.name, "material %u", index);

@@ -15,19 +15,8 @@
 # Skipped (prints SKIP) when the build has no window support or xvfb-run is
 # missing; ./setup.sh installs both (libglfw3-dev, xvfb, xauth).
 # Run by ctest: cmake -DBIN=... -DSRC=... -DOUT=... -DWINDOW=ON|OFF -DXVFB_RUN=path -P mirror_window.cmake
-foreach(var BIN OUT)
-  if(NOT DEFINED ${var})
-    message(FATAL_ERROR "mirror_window: -D${var}=... is required")
-  endif()
-endforeach()
-if(NOT WINDOW)
-  message("SKIP: this build has no window support (configure with GLFW: libglfw3-dev)")
-  return()
-endif()
-if(NOT XVFB_RUN)
-  message("SKIP: xvfb-run not found (Debian: xvfb xauth)")
-  return()
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/../tools/window_test.cmake)
+ob_window_test_begin(mirror_window BIN OUT)
 file(MAKE_DIRECTORY ${OUT})
 set(frames 6)
 set(common --objects 120 --size 320x240 --frames ${frames} --quiet)

@@ -10,19 +10,8 @@
 # Skipped (prints SKIP) without window support or xvfb-run (./setup.sh
 # installs libglfw3-dev, xvfb, xauth).
 # Run by ctest: cmake -DBIN=... -DSRC=... -DOUT=... -DWINDOW=ON|OFF -DXVFB_RUN=path -P view_window.cmake
-foreach(var BIN SRC OUT)
-  if(NOT DEFINED ${var})
-    message(FATAL_ERROR "view_window: -D${var}=... is required")
-  endif()
-endforeach()
-if(NOT WINDOW)
-  message("SKIP: this build has no window support (configure with GLFW: libglfw3-dev)")
-  return()
-endif()
-if(NOT XVFB_RUN)
-  message("SKIP: xvfb-run not found (Debian: xvfb xauth)")
-  return()
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/../tools/window_test.cmake)
+ob_window_test_begin(view_window BIN SRC OUT)
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 set(frames 6)
