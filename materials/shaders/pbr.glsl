@@ -12,11 +12,11 @@
 //
 // Light units: the engine's lights are given as radiance at normal
 // incidence (LightColor.rgb * w, a local light's colour * intensity times the
-// attenuation), and lit.frag shows a white surface under a unit light as
-// white (diffuse * NdotL, no 1/pi). pbr.frag keeps that: every BRDF term is
-// multiplied by pi (the usual "punctual light intensity" convention), so a
-// white dielectric at roughness 1 matches a lit material of the same colour
-// up to the Fresnel and specular terms.
+// attenuation), and a white Lambert surface facing a unit light shows
+// white (diffuse * NdotL, no 1/pi): every BRDF term is multiplied by pi
+// (the usual "punctual light intensity" convention), so a white dielectric
+// at roughness 1 shows its colour * NdotL up to the Fresnel and specular
+// terms. This is the one BRDF: LIT and REFLECTIVE materials draw with it too.
 #ifndef OB_PBR_GLSL
 #define OB_PBR_GLSL
 
