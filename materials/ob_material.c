@@ -799,8 +799,10 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
     if (m->kind == OB_MATERIAL_PBR && !m->custom[v->type])
         return ob_pbr_set_params(m, entity, r, params, v, variant & OB_VARIANT_ENVMAP);
     const ob_material_library *lib = m->lib;
-    if (m->kind == OB_MATERIAL_LIT || m->kind == OB_MATERIAL_REFLECTIVE) {
-        /* The mirror share is in the mapped F0: the map at full strength. */
+    if ((m->kind == OB_MATERIAL_LIT || m->kind == OB_MATERIAL_REFLECTIVE) && !m->custom[v->type]) {
+        /* The mirror share is in the mapped F0: the map at full strength.
+         * (An effect of the application's own gets the description as
+         * given, in PerMaterial, below.) */
         const float env[4] = {m->kind == OB_MATERIAL_REFLECTIVE ? 1.0f : 0.0f, 0, 0, 0};
         ob_pbr_set_factors(m, params, env);
     } else {
