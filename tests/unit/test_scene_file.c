@@ -236,7 +236,7 @@ static void minimal_file_gets_documented_defaults(void **state)
  * renderer, not the parser, applies OB_MAX_LIGHTS and names what is over). */
 /* Lit and reflective materials in the metallic-roughness model: metallic
  * (either) or roughness (lit) gives the factors directly; a lit material
- * without them carries the roughness its specular power maps to; a
+ * given only metallic keeps the roughness its specular power maps to; a
  * reflective one's roughness alone keeps the rest mapped. */
 static void metallic_and_roughness_keys(void **state)
 {
@@ -245,7 +245,7 @@ static void metallic_and_roughness_keys(void **state)
     ob_scene_file_error err;
     static const char text[] =
         "{\"materials\": {\"steel\": {\"metallic\": 1, \"roughness\": 0.3},"
-        " \"satin\": {\"roughness\": 0.6}, \"plain\": {\"specular\": [0.2, 0.2, 0.2, 14]},"
+        " \"satin\": {\"roughness\": 0.6}, \"plain\": {\"specular\": [0.2, 0.2, 0.2, 14], \"metallic\": 0.5},"
         " \"chrome\": {\"kind\": \"reflective\", \"roughness\": 0.1},"
         " \"brass\": {\"kind\": \"reflective\", \"metallic\": 0.8}}, \"entities\": []}";
     assert_int_equal(parse(text, &sf, &err), OB_OK);
@@ -259,8 +259,9 @@ static void metallic_and_roughness_keys(void **state)
     assert_true(satin->metallic_roughness);
     assert_near(satin->metallic, 0.0, 0);
     assert_near(satin->roughness, 0.6, 1e-7);
-    assert_false(plain->metallic_roughness);
+    assert_true(plain->metallic_roughness);   /* its roughness: what power 14 maps to */
     assert_near(plain->roughness, pow(2.0 / 16.0, 0.25), 1e-6);
+    assert_near(plain->metallic, 0.5, 0);
     assert_false(chrome->metallic_roughness);
     assert_near(chrome->roughness, 0.1, 1e-7);
     assert_true(brass->metallic_roughness);

@@ -319,13 +319,6 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
         ob_json_push_key(&c->rd, factors[i]);
         return ob_json_fail(&c->rd, "an \"unlit\" material has no %s (it is not lit)", factors[i]);
     }
-    /* metallic (lit or reflective) or roughness (lit) describes the surface
-     * in the metallic-roughness model directly; a reflective material's
-     * roughness alone keeps the rest mapped from its other keys. */
-    const bool given_metallic = ob_json_member(j, "metallic") != NULL;
-    d->metallic_roughness = given_metallic || (d->kind == OB_MATERIAL_LIT && ob_json_member(j, "roughness"));
-    if (d->kind == OB_MATERIAL_LIT && !ob_json_member(j, "roughness"))   /* what the power gives */
-        d->roughness = powf(2.0f / (specular[3] + 2.0f), 0.25f);
     memcpy(d->diffuse, diffuse, sizeof diffuse);
     memcpy(d->specular, specular, sizeof specular);
     memcpy(d->emissive, emissive, sizeof emissive);
@@ -337,6 +330,13 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
         !ob_json_opt_double(&c->rd, j, "priority", OB_JSON_INT(0, 1000000), &prio))
         return false;
     d->priority = (uint32_t)prio;
+    /* metallic (lit or reflective) or roughness (lit) describes the surface
+     * in the metallic-roughness model directly; a lit one given only its
+     * metallic keeps the roughness its specular power maps to, and a
+     * reflective one's roughness alone keeps the rest mapped. */
+    const bool metallic = ob_json_member(j, "metallic") != NULL, roughness = ob_json_member(j, "roughness") != NULL;
+    if (d->kind == OB_MATERIAL_LIT && metallic && !roughness) d->roughness = ob_material_desc_to_pbr(d).pbr.roughness;
+    d->metallic_roughness = metallic || (d->kind == OB_MATERIAL_LIT && roughness);
     return true;
 }
 
