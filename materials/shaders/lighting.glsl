@@ -10,6 +10,10 @@
 // and instancing run lights a point with the same lights in the same order.
 // Views that are not perspective (paraboloid) set LightGrid.w = 0: tile 0
 // then holds every light.
+//
+// LOCAL_SHADOWS (variants of views that sample a point or spot light's
+// shadow map this frame): ob_local_light multiplies in the light's shadow
+// (shadow_local.glsl), so every lighting model's loop gets it unchanged.
 #ifndef OB_LIGHTING_GLSL
 #define OB_LIGHTING_GLSL
 
@@ -34,7 +38,11 @@ layout(set = 0, binding = 4, std140) uniform PerViewLights {
                                            // colour rgb, intensity | axis xyz (where it shines),
                                            // cos outer (< -1: a point light) | cos inner
     uvec4 LightTiles[2 * OB_LIGHT_TILES];  // 8 words a tile: bit i = light i may reach it
-};
+};                                         // (row 3: .y first shadow layer, -1 none)
+
+#if defined(LOCAL_SHADOWS)
+#include "shadow_local.glsl"
+#endif
 
 // The tile gl_FragCoord falls in (fragment stage only).
 uint ob_light_tile()
@@ -60,6 +68,11 @@ void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
     vec3 to_light = position.xyz - p;
     l = ob_safe_normalize(to_light);
     float att = ob_point_attenuation(length(to_light), position.w);
+#if defined(LOCAL_SHADOWS)
+    int first_layer = int(LightTable[4u * i + 3u].y);
+    if (first_layer >= 0 && att > 0.0)
+        att *= ob_local_shadow(first_layer, axis.w < -1.0, position.xyz, p);
+#endif
     if (axis.w >= -1.0) {
         // Spot: full inside the inner cone, smoothstep down to zero at the
         // outer one (the divisor is kept positive for inner == outer).
