@@ -37,29 +37,13 @@ static void add_floor(ob_test_world *w, bool pbr)
                         ob_world_material(w, "floor", OB_MATERIAL_LIT, 0.8f, 0.8f, 0.8f, false), 0, 0, 0);
         return;
     }
-    ob_mesh mesh;
-    assert_int_equal(ob_mesh_plane(20.0f, 20.0f, 2, &mesh), OB_OK);
-    mesh.colors = ob_calloc(mesh.vertex_count, sizeof *mesh.colors);
-    assert_non_null(mesh.colors);
-    memset(mesh.colors, 255, mesh.vertex_count * sizeof *mesh.colors);
-    ob_geometry *plane = ob_world_geometry(w, &mesh, "pbr plane");
-    ob_mesh_release(&mesh);
+    ob_geometry *plane = ob_test_world_pbr_plane(w, 2);
     ob_material_desc md = {.name = "pbr floor", .kind = OB_MATERIAL_PBR, .pbr = ob_material_pbr_defaults()};
     md.pbr.metallic = 0.0f;
     md.pbr.roughness = 1.0f;
     ob_world_entity(w, NULL, "floor", plane, ob_world_material_desc(w, &md), 0, 0, 0);
 }
 
-static ob_node *add_light(ob_test_world *w, const char *name, const ob_light_desc *d, double x,
-                          double y, double z)
-{
-    ob_result r;
-    ob_node *n = ob_node_create(w->scene, NULL, name, &r);
-    assert_non_null(n);
-    assert_int_equal(ob_node_set_light(n, d), OB_OK);
-    ob_node_set_position(n, (const double[3]){x, y, z});
-    return n;
-}
 
 static ob_node *box(ob_test_world *w, const char *name, double x, double y, double z, float size)
 {
@@ -109,7 +93,7 @@ static void spot_shadow_darkens_the_floor_behind_a_caster(bool pbr)
     box(&w, "caster", 1.0, 1.5, 0.0, 0.6f);
     ob_light_desc d = {.type = OB_LIGHT_SPOT, .intensity = 10.0f, .range = 12.0f,
                        .inner_angle = 0.6f, .outer_angle = 0.8f, .casts_shadows = true};
-    ob_node *spot = add_light(&w, "torch", &d, 0, 4, 0);
+    ob_node *spot = ob_test_world_light(&w, "torch", &d, 0, 4, 0);
     assert_int_equal(ob_node_look_at(spot, (const double[3]){0, 0, 0}, (const double[3]){0, 0, -1}),
                      OB_OK);
     for (int pass = 0; pass < 2; pass++) {
@@ -162,7 +146,7 @@ static void point_light_shadows_every_side(void **state)
     }
     ob_light_desc d = {.type = OB_LIGHT_POINT, .intensity = 8.0f, .range = 12.0f,
                        .casts_shadows = true};
-    add_light(&w, "bulb", &d, 0, 1.2, 0);
+    ob_test_world_light(&w, "bulb", &d, 0, 1.2, 0);
     ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     assert_non_null(ob_world_view_stats(st, "shadow:bulb"));
@@ -195,10 +179,10 @@ static void light_out_of_view_queues_no_shadow_view(void **state)
                           .outer_angle = 0.5f, .casts_shadows = true};
     ob_light_desc point = {.type = OB_LIGHT_POINT, .intensity = 5.0f, .range = 3.0f,
                            .casts_shadows = true};
-    add_light(&w, "far-spot", &spot, 60, 1, 0);
+    ob_test_world_light(&w, "far-spot", &spot, 60, 1, 0);
     /* A point light beside a caster, but its range ends before the floor
      * the camera sees: the plane is 20 wide, the light 40 off. */
-    add_light(&w, "far-bulb", &point, 0, 1, 40);
+    ob_test_world_light(&w, "far-bulb", &point, 0, 1, 40);
     box(&w, "far-caster", 0.0, 0.5, 39.0, 1.0f);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
     assert_null(ob_world_view_stats(st, "shadow:far-spot"));
@@ -227,7 +211,7 @@ static void lights_past_the_shadow_layers_are_reported_once(void **state)
     for (int i = 0; i < 3; i++) {
         char name[16];
         snprintf(name, sizeof name, "bulb%d", i);
-        add_light(&w, name, &d, -2.0 + 2.0 * i, 2.5, 1.0);
+        ob_test_world_light(&w, name, &d, -2.0 + 2.0 * i, 2.5, 1.0);
     }
     ob_test_log_clear();
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
