@@ -35,7 +35,8 @@
 typedef struct ob_local_shadow_view {
     ob_view base;
     ob_views *ctx;
-    ob_node *light;
+    ob_node *light;           /* this frame's node of light_id */
+    uint32_t light_id;        /* nodes are matched by id: a pointer may be reused */
     bool point;
     bool warned_over_limit;   /* logged once by name, not every frame */
     float view[16], proj[16]; /* spot: the light's view; point: face 0's (others per layer) */
@@ -48,6 +49,7 @@ typedef struct ob_local_shadow_view {
 
 struct ob_local_shadows {
     ob_image maps;            /* OB_MAX_LOCAL_SHADOW_LAYERS layers of depth */
+    uint32_t size;            /* its side: half the shadow-map size when made, at least 64 */
     ob_sampler sampler;       /* compare, as the directional map's */
     ob_param maps_param, matrices_param;
     ob_local_shadow_view **views;
@@ -176,8 +178,8 @@ static ob_result state_create(ob_views *ctx)
     ob_local_shadows *s = ob_calloc(1, sizeof *s);
     if (!s) return OB_ERR_OUT_OF_HOST_MEMORY;
     ob_result r = OB_OK;
-    uint32_t size = ctx->shadow_map_size / 2 >= 64 ? ctx->shadow_map_size / 2 : 64;
-    ob_image_desc d = {.width = size, .height = size, .layers = OB_MAX_LOCAL_SHADOW_LAYERS,
+    s->size = ctx->shadow_map_size / 2 >= 64 ? ctx->shadow_map_size / 2 : 64;
+    ob_image_desc d = {.width = s->size, .height = s->size, .layers = OB_MAX_LOCAL_SHADOW_LAYERS,
                        .format = OB_VIEWS_DEPTH_FORMAT,
                        .usage = OB_IMAGE_DEPTH_TARGET | OB_IMAGE_SAMPLED | OB_IMAGE_TRANSFER_DST,
                        .name = "shadow:local.depth"};
@@ -227,9 +229,18 @@ void ob_views_local_shadows_destroy(ob_views *ctx)
 
 static ob_local_shadow_view *find_view(const ob_local_shadows *s, const ob_node *light)
 {
+    uint32_t id = ob_node_id(light);
     for (uint32_t i = 0; s && i < s->count; i++)
-        if (s->views[i]->light == light) return s->views[i];
+        if (s->views[i]->light_id == id) return s->views[i];
     return NULL;
+}
+
+/* The light as it is now (a spot may have become a point light). */
+static void view_follow(ob_local_shadow_view *sv, ob_node *light)
+{
+    sv->light = light;
+    sv->point = ob_node_get_light(light)->type == OB_LIGHT_POINT;
+    sv->base.layer_count = sv->point ? 6 : 1;
 }
 
 /* The light's view, made on first need (logged and noted on failure). */
@@ -239,7 +250,10 @@ static ob_local_shadow_view *view_for(ob_views *ctx, ob_renderer *r, ob_node *li
     if (!ctx->local_shadows) res = state_create(ctx);
     ob_local_shadows *s = ctx->local_shadows;
     ob_local_shadow_view *sv = find_view(s, light);
-    if (sv) return sv;
+    if (sv) {
+        view_follow(sv, light);
+        return sv;
+    }
     if (res == OB_OK) res = ob_array_reserve((void **)&s->views, &s->cap, s->count + 1, sizeof *s->views);
     if (res == OB_OK && !(sv = ob_calloc(1, sizeof *sv))) res = OB_ERR_OUT_OF_HOST_MEMORY;
     if (res != OB_OK) {
@@ -250,13 +264,12 @@ static ob_local_shadow_view *view_for(ob_views *ctx, ob_renderer *r, ob_node *li
     }
     ob_view_init(&sv->base, &local_shadow_vtbl, OB_VIEW_SHADOW, name);
     sv->ctx = ctx;
-    sv->light = light;
-    sv->point = ob_node_get_light(light)->type == OB_LIGHT_POINT;
+    sv->light_id = ob_node_id(light);
+    view_follow(sv, light);
     sv->base.local_shadow = true;
     sv->base.clear_depth = 0.0f;
     sv->base.depth = s->maps;
-    sv->base.width = sv->base.height = ctx->shadow_map_size / 2 >= 64 ? ctx->shadow_map_size / 2 : 64;
-    sv->base.layer_count = sv->point ? 6 : 1;
+    sv->base.width = sv->base.height = s->size;
     s->views[s->count++] = sv;
     return sv;
 }

@@ -6,8 +6,9 @@
  *   lights alike; the same through the PBR shader.
  * - A shadowed point light among four boxes: behind each box (four cube
  *   faces) the floor is darker than beside it.
- * - A shadowed light whose range reaches nothing the camera sees queues no
- *   shadow view (noted as not needed) and its scene draws as without it.
+ * - A shadowed light whose range (or spot cone) reaches nothing the camera
+ *   sees queues no shadow view (noted as not needed) and its scene draws as
+ *   without it.
  * - Shadowed lights past OB_MAX_LOCAL_SHADOW_LAYERS light unshadowed,
  *   logged once by name and noted over the limit every frame.
  *
@@ -184,11 +185,19 @@ static void light_out_of_view_queues_no_shadow_view(void **state)
      * the camera sees: the plane is 20 wide, the light 40 off. */
     ob_test_world_light(&w, "far-bulb", &point, 0, 1, 40);
     box(&w, "far-caster", 0.0, 0.5, 39.0, 1.0f);
+    /* Above the floor's bound (a sphere of radius 14), in range of it, but
+     * its cone points up: the cone, not the range sphere, decides. */
+    ob_light_desc upward = spot;
+    upward.range = 20.0f;
+    ob_node *up = ob_test_world_light(&w, "up-spot", &upward, 0, 16, 0);
+    assert_int_equal(ob_node_look_at(up, (const double[3]){0, 30, 0}, (const double[3]){0, 0, -1}),
+                     OB_OK);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
     assert_null(ob_world_view_stats(st, "shadow:far-spot"));
     assert_null(ob_world_view_stats(st, "shadow:far-bulb"));
     assert_int_equal(ob_world_skip_reason(st, "shadow:far-spot"), OB_SKIP_NOT_NEEDED);
     assert_int_equal(ob_world_skip_reason(st, "shadow:far-bulb"), OB_SKIP_NOT_NEEDED);
+    assert_int_equal(ob_world_skip_reason(st, "shadow:up-spot"), OB_SKIP_NOT_NEEDED);
     assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 0);
     uint8_t *with = ob_world_snapshot(&w);
     assert_int_equal(ob_rgba_diff_count(without, with, w.width * w.height, 0), 0);
