@@ -241,10 +241,15 @@ static void spot_and_many_point_lights_parse(void **state)
     ob_scene_file_error err;
     static const char text[] =
         "{\"lights\": [{\"name\": \"torch\", \"type\": \"spot\", \"position\": [0, 4, 0],"
-        " \"target\": [0, 0, 0], \"range\": 9, \"inner_angle\": 15, \"outer_angle\": 30},"
-        " {\"type\": \"spot\"}], \"entities\": []}";
+        " \"target\": [0, 0, 0], \"range\": 9, \"inner_angle\": 15, \"outer_angle\": 30,"
+        " \"shadows\": true},"
+        " {\"type\": \"spot\"}, {\"type\": \"point\", \"shadows\": true}], \"entities\": []}";
     assert_int_equal(parse(text, &sf, &err), OB_OK);
-    assert_int_equal(sf.light_count, 2);
+    assert_int_equal(sf.light_count, 3);
+    /* Shadows on spot and point lights (issue 28); off by default. */
+    assert_true(sf.lights[0].desc.casts_shadows);
+    assert_false(sf.lights[1].desc.casts_shadows);
+    assert_true(sf.lights[2].desc.casts_shadows);
     const ob_scene_file_light *l = &sf.lights[0];
     assert_int_equal(l->desc.type, OB_LIGHT_SPOT);
     assert_string_equal(l->name, "torch");
