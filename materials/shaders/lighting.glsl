@@ -68,11 +68,6 @@ void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
     vec3 to_light = position.xyz - p;
     l = ob_safe_normalize(to_light);
     float att = ob_point_attenuation(length(to_light), position.w);
-#if defined(LOCAL_SHADOWS)
-    int first_layer = int(LightTable[4u * i + 3u].y);
-    if (first_layer >= 0 && att > 0.0)
-        att *= ob_local_shadow(first_layer, axis.w < -1.0, position.xyz, p);
-#endif
     if (axis.w >= -1.0) {
         // Spot: full inside the inner cone, smoothstep down to zero at the
         // outer one (the divisor is kept positive for inner == outer).
@@ -80,6 +75,13 @@ void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
         float t = clamp((dot(-l, axis.xyz) - axis.w) / max(cos_inner - axis.w, 1e-4), 0.0, 1.0);
         att *= t * t * (3.0 - 2.0 * t);
     }
+#if defined(LOCAL_SHADOWS)
+    // Last: the map is read only where the light reaches (inside the cone
+    // and the range), the rest of the floor pays nothing for it.
+    int first_layer = int(LightTable[4u * i + 3u].y);
+    if (first_layer >= 0 && att > 0.0)
+        att *= ob_local_shadow(first_layer, axis.w < -1.0, position.xyz, p);
+#endif
     radiance = color.rgb * color.w * att;
 }
 
