@@ -106,6 +106,7 @@ static void local_post_cull(ob_view *v, ob_renderer *r)
     float right[3], up[3], fwd[3];
     ob_node_world_axes(sv->light, right, up, fwd);
     float cos_outer = cosf(l->outer_angle);
+    bool any = !sv->reach_valid;
     for (uint32_t i = 0; sv->reach_valid && i < v->item_count; i++) {
         double c[3];
         float radius;
@@ -120,7 +121,11 @@ static void local_post_cull(ob_view *v, ob_renderer *r)
             sv->reach[i] = ob_views_cube_faces(rel, reach);
         else
             sv->reach[i] = ob_views_spot_reaches(fwd, cos_outer, l->range, rel, reach) ? 1u : 0u;
+        any = any || sv->reach[i];
     }
+    /* No caster within the cone and range: nothing to record, which the
+     * renderer reports (OB_SKIP_EMPTY) and the layers are only cleared. */
+    if (!any) v->item_count = 0;
     ob_material_library_prepare_view(sv->ctx->materials, r, v);
 }
 

@@ -9,6 +9,8 @@
  * - A shadowed light whose range (or spot cone) reaches nothing the camera
  *   sees queues no shadow view (noted as not needed) and its scene draws as
  *   without it.
+ * - A shadow view with no caster in its cone records nothing (reported
+ *   empty) and changes no pixel.
  * - Shadowed lights past OB_MAX_LOCAL_SHADOW_LAYERS light unshadowed,
  *   logged once by name and noted over the limit every frame.
  *
@@ -206,6 +208,38 @@ static void light_out_of_view_queues_no_shadow_view(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A spot over a floor that casts nothing, with a small box inside its
+ * square frustum but outside its round cone (a corner): the box reaches
+ * no layer, so the view records nothing and says so, and the lit floor is
+ * as without shadows. */
+static void no_caster_in_reach_records_nothing(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    setup(&w);
+    add_floor(&w, false);
+    box(&w, "corner", 2.1, 0.1, 2.1, 0.2f);
+    ob_light_desc d = {.type = OB_LIGHT_SPOT, .intensity = 10.0f, .range = 12.0f,
+                       .outer_angle = 0.5f, .casts_shadows = true};
+    ob_node *spot = ob_test_world_light(&w, "torch", &d, 0, 4, 0);
+    assert_int_equal(ob_node_look_at(spot, (const double[3]){0, 0, 0}, (const double[3]){0, 0, -1}),
+                     OB_OK);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    const ob_view_stats *vs = ob_world_view_stats(st, "shadow:torch");
+    assert_non_null(vs);
+    assert_int_equal(vs->draws, 0);
+    assert_int_equal(vs->skipped, OB_SKIP_EMPTY);
+    uint8_t *with = ob_world_snapshot(&w);
+    set_shadows(spot, false);
+    ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint8_t *without = ob_world_snapshot(&w);
+    assert_int_equal(ob_rgba_diff_count(without, with, w.width * w.height, 0), 0);
+    free(without);
+    free(with);
+    ob_test_world_destroy(&w);
+}
+
 /* Three point lights need 18 layers: the third lights unshadowed, named
  * once in the log and noted over the limit every frame. */
 static void lights_past_the_shadow_layers_are_reported_once(void **state)
@@ -244,6 +278,7 @@ int main(void)
         cmocka_unit_test(spot_light_shadows_pbr),
         cmocka_unit_test(point_light_shadows_every_side),
         cmocka_unit_test(light_out_of_view_queues_no_shadow_view),
+        cmocka_unit_test(no_caster_in_reach_records_nothing),
         cmocka_unit_test(lights_past_the_shadow_layers_are_reported_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
