@@ -348,9 +348,10 @@ typedef struct ob_light_desc {
      * the camera sees (only the first directional light is shaded). Spot:
      * one perspective map over the outer cone. Point: a cube map (six
      * 90-degree faces). A spot or point light's map is drawn only in frames
-     * where the light reaches an entity a camera sees, and takes layers of
-     * the one local shadow array (a spot 1, a point 6) in node-id order
-     * up to OB_MAX_LOCAL_SHADOW_LAYERS; a light past that lights unshadowed,
+     * where the light reaches an entity a camera sees, and then takes layers
+     * of the one local shadow array (a spot 1, a point 6; handed out each
+     * frame in the cameras' order, node-id order within a camera) up to
+     * OB_MAX_LOCAL_SHADOW_LAYERS; a light past that lights unshadowed,
      * logged once by name and listed each frame in ob_frame_stats.skipped
      * (OB_SKIP_OVER_LIMIT). */
     bool casts_shadows;
