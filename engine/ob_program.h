@@ -27,7 +27,9 @@
 #include "ob_reflect.h"
 
 #define OB_PROGRAM_MAX_UBOS 8
-#define OB_PROGRAM_MAX_RESOURCES 8
+/* The PBR kind with every texture (8), the shadow map, the env map and the
+ * local lights' shadow array: 11. */
+#define OB_PROGRAM_MAX_RESOURCES 12
 /* The largest push-constant block a program may declare: the pipeline
  * manager packs and compares push data in buffers of this size (lavapipe's
  * limit; Vulkan guarantees 128). A bigger block fails ob_program_create even

@@ -18,6 +18,7 @@ const char *ob_skip_reason_name(ob_skip_reason r)
     case OB_SKIP_NOT_NEEDED: return "not needed";
     case OB_SKIP_DUPLICATE: return "already queued";
     case OB_SKIP_ERROR: return "error";
+    case OB_SKIP_OVER_LIMIT: return "over the limit";
     }
     return "unknown";
 }

@@ -102,6 +102,8 @@ typedef enum ob_skip_reason {
     OB_SKIP_DUPLICATE,           /* already queued this frame (not reported by the renderer
                                     today: a second queueing only adds a dependency) */
     OB_SKIP_ERROR,               /* failed (see log) */
+    OB_SKIP_OVER_LIMIT,          /* over a documented limit (docs/limits.md), logged once
+                                    by name: a shadowed light past the shadow layers */
 } ob_skip_reason;
 const char *ob_skip_reason_name(ob_skip_reason r);
 

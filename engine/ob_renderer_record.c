@@ -697,9 +697,8 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
  * (the whole view of a single-layer image without mips). */
 static VkImageView attachment_view(ob_renderer *r, const ob_view *v, ob_image img, uint32_t layer)
 {
-    (void)v;
     if (!img.id) return VK_NULL_HANDLE;
-    return ob_image_layer_view(r->dev, img, layer);
+    return ob_image_layer_view(r->dev, img, v->first_layer + layer);
 }
 
 /* A multisampled view (one layer) draws into msaa_color / msaa_depth, which

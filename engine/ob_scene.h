@@ -344,7 +344,17 @@ typedef struct ob_light_desc {
     float intensity;      /* literal: 0 switches the light off (it lights nothing and
                              its shadow view is left out); set 1 for a plain light */
     float range;          /* point and spot lights; 0 → no cut-off */
-    bool casts_shadows;   /* directional lights only; ignored by point and spot */
+    /* Default false. Directional: an orthographic map fitted to the casters
+     * the camera sees (only the first directional light is shaded). Spot:
+     * one perspective map over the outer cone. Point: a cube map (six
+     * 90-degree faces). A spot or point light's map is drawn only in frames
+     * where the light reaches an entity a camera sees, and then takes layers
+     * of the one local shadow array (a spot 1, a point 6; handed out each
+     * frame in the cameras' order, node-id order within a camera) up to
+     * OB_MAX_LOCAL_SHADOW_LAYERS; a light past that lights unshadowed,
+     * logged once by name and listed each frame in ob_frame_stats.skipped
+     * (OB_SKIP_OVER_LIMIT). */
+    bool casts_shadows;
     /* Spot lights: half-angles of the cone from its axis, in radians. Full
      * intensity inside inner_angle, smoothly down to none at outer_angle;
      * 0 ≤ inner_angle ≤ outer_angle < pi/2. outer_angle 0 → pi/4 (glTF's
@@ -357,6 +367,9 @@ typedef struct ob_light_desc {
  * limit is logged once by name and counted in ob_frame_stats.lights_over_limit
  * every frame it is left out. */
 #define OB_MAX_LIGHTS 256u
+/* Layers of the local lights' shadow array (docs/limits.md): e.g. 16 spot
+ * lights, or 2 point lights and 4 spot lights, shadowed at once. */
+#define OB_MAX_LOCAL_SHADOW_LAYERS 16u
 
 /* Copies d with defaults filled in (NULL removes the light). Refuses unknown
  * types, negative or non-finite values, and spot angles outside

@@ -113,6 +113,14 @@ struct ob_view {
      * (either may be zero). */
     ob_image color, depth;
     uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
+    /* Layer i of the view is layer first_layer + i of color/depth: views
+     * that share one array target (the local lights' shadow maps), which
+     * their owner, not the view, creates and destroys. 0 otherwise. */
+    uint32_t first_layer;
+    /* A point or spot light's shadow view (type OB_VIEW_SHADOW): consumers
+     * sample it as the local lights' shadow array (materials' LOCAL_SHADOWS
+     * variants), not as the directional light's map (SHADOWS). */
+    bool local_shadow;
     /* Mip levels wanted for `color` (0 or 1: none). With more, the target
      * is made with them and, once the view has rendered, the renderer fills
      * levels 1.. from level 0 (a box-filtered blit chain,

@@ -331,7 +331,7 @@ static void place_light(open_ctx *c, const struct aiNode *n, uint32_t index)
     hit->placed = true;
     const struct aiLight *al = c->scene->mLights[hit->light];
     const char *name = c->model->nodes[index].name;
-    ob_light_desc d = {0};
+    ob_light_desc d = {0};   /* casts_shadows false: glTF says nothing of shadows */
     switch (al->mType) {
     case aiLightSource_DIRECTIONAL: d.type = OB_LIGHT_DIRECTIONAL; break;
     case aiLightSource_POINT: d.type = OB_LIGHT_POINT; break;

@@ -17,7 +17,7 @@ typedef struct effect_choice {
 
 static const uint32_t allowed_variants[OB_STD_EFFECT_COUNT] = {
     [OB_STD_LIT] = OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP | OB_VARIANT_BLENDED |
-                   OB_VARIANT_INSTANCED,
+                   OB_VARIANT_INSTANCED | OB_VARIANT_LOCAL_SHADOWS,
     [OB_STD_DEPTH] = OB_VARIANT_INSTANCED,
     [OB_STD_PARABOLOID] = OB_VARIANT_BLENDED | OB_VARIANT_INSTANCED,
     [OB_STD_UNLIT] = OB_VARIANT_BLENDED | OB_VARIANT_INSTANCED,
@@ -30,16 +30,21 @@ static const char *const std_names[OB_STD_EFFECT_COUNT] = {
 
 static void variant_name(ob_std_effect kind, uint32_t variant, char *out, size_t cap)
 {
-    snprintf(out, cap, "%s%s%s%s%s", std_names[kind],
+    snprintf(out, cap, "%s%s%s%s%s%s", std_names[kind],
              variant & OB_VARIANT_SHADOWS ? "+SHADOWS" : "",
+             variant & OB_VARIANT_LOCAL_SHADOWS ? "+LOCAL_SHADOWS" : "",
              variant & OB_VARIANT_ENVMAP ? "+ENVMAP" : "",
              variant & OB_VARIANT_BLENDED ? "+BLENDED" : "",
              variant & OB_VARIANT_INSTANCED ? "+INSTANCED" : "");
 }
 
+/* Defines a standard variant can have: LIT's INSTANCED, SHADOWS, ENVMAP,
+ * BLENDED and LOCAL_SHADOWS at most, with room to spare. */
+#define STD_MAX_DEFINES 8
+
 /* Fills desc (and its defines) for a standard variant. */
 static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_t variant,
-                     ob_effect_desc *desc, ob_shader_define defines[4])
+                     ob_effect_desc *desc, ob_shader_define defines[STD_MAX_DEFINES])
 {
     bool blended = variant & OB_VARIANT_BLENDED;
     uint32_t n = 0;
@@ -61,6 +66,8 @@ static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_
         if (variant & OB_VARIANT_SHADOWS) defines[n++] = (ob_shader_define){"SHADOWS", "1"};
         if (variant & OB_VARIANT_ENVMAP) defines[n++] = (ob_shader_define){"ENVMAP", "1"};
         if (blended) defines[n++] = (ob_shader_define){"BLENDED", "1"};
+        if (variant & OB_VARIANT_LOCAL_SHADOWS)
+            defines[n++] = (ob_shader_define){"LOCAL_SHADOWS", "1"};
         break;
     case OB_STD_DEPTH:
         desc->vertex = "depth.vert";
@@ -137,7 +144,7 @@ ob_effect *ob_material_library_effect(ob_material_library *lib, ob_std_effect ki
     if (!e && r == OB_OK) {
         char name[64];
         ob_effect_desc desc;
-        ob_shader_define defines[4];
+        ob_shader_define defines[STD_MAX_DEFINES];
         variant_name(kind, variant, name, sizeof name);
         std_desc(lib, kind, variant, &desc, defines);
         desc.name = name;
@@ -551,6 +558,16 @@ bool ob_material_view_depends_on(const ob_view *v, ob_view_type type)
     return false;
 }
 
+void ob_material_view_shadows(const ob_view *v, bool *out_directional, bool *out_local)
+{
+    *out_directional = *out_local = false;
+    for (uint32_t i = 0; i < v->dep_count; i++) {
+        if (!v->deps[i] || v->deps[i]->type != OB_VIEW_SHADOW) continue;
+        if (v->deps[i]->local_shadow) *out_local = true;
+        else *out_directional = true;
+    }
+}
+
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity)
 {
     if (!r || !entity) return NULL;
@@ -580,7 +597,10 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
         }
         out->kind = OB_STD_LIT;
         out->variant = blended | instanced;
-        if (ob_material_view_depends_on(v, OB_VIEW_SHADOW)) out->variant |= OB_VARIANT_SHADOWS;
+        bool directional, local;
+        ob_material_view_shadows(v, &directional, &local);
+        if (directional) out->variant |= OB_VARIANT_SHADOWS;
+        if (local) out->variant |= OB_VARIANT_LOCAL_SHADOWS;
         if (m->kind == OB_MATERIAL_REFLECTIVE && ob_material_attached_env_map(r, entity))
             out->variant |= OB_VARIANT_ENVMAP;
         return true;
@@ -611,10 +631,11 @@ static bool choose(const ob_material *m, const ob_renderer *r, const ob_node *en
 static ob_effect *find_with_fallback(const ob_material_library *lib, ob_std_effect kind,
                                      uint32_t *io_variant)
 {
-    static const uint32_t drop[] = {0u, OB_VARIANT_SHADOWS, OB_VARIANT_ENVMAP,
-                                    OB_VARIANT_SHADOWS | OB_VARIANT_ENVMAP};
+    /* Every subset of the three inputs, fewest dropped first. */
+    enum { S = OB_VARIANT_SHADOWS, E = OB_VARIANT_ENVMAP, L = OB_VARIANT_LOCAL_SHADOWS };
+    static const uint32_t drop[] = {0u, L, S, E, S | L, L | E, S | E, S | E | L};
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(drop); i++) {
-        if (i && !(*io_variant & drop[i])) continue;
+        if (i && (*io_variant & drop[i]) != drop[i]) continue;
         uint32_t variant = *io_variant & ~drop[i];
         ob_effect *e = ob_material_library_find_effect(lib, kind, variant);
         if (e) {

@@ -173,6 +173,7 @@ typedef enum ob_std_variant {
     OB_VARIANT_BLENDED = 1u << 2,  /* lit/paraboloid/unlit: alpha blended, no depth write */
     OB_VARIANT_INSTANCED = 1u << 3, /* lit/depth/paraboloid/unlit: the per-draw block per
                                        instance (ob_material_library_set_instancing) */
+    OB_VARIANT_LOCAL_SHADOWS = 1u << 4, /* lit: point and spot lights' shadow array */
 } ob_std_variant;
 
 /* A view type of a material: render flag and the base effect (NULL until the

@@ -17,7 +17,7 @@
 /* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
 #pragma GCC visibility push(hidden)
 
-#define VARIANT_COUNT 16u  /* every combination of the ob_std_variant bits */
+#define VARIANT_COUNT 32u  /* every combination of the ob_std_variant bits */
 
 typedef struct std_slot {
     _Atomic(ob_effect *) effect;   /* published once created; read while recording */
@@ -68,7 +68,9 @@ struct ob_material_library {
 
 /* Per-material effect slots of a PBR material: the main pass by its
  * +SHADOWS (1) and +ENVMAP (2) bits, then the paraboloid and shadow passes. */
-enum { OB_PBR_PASS_MAIN = 0, OB_PBR_PASS_PARABOLOID = 4, OB_PBR_PASS_DEPTH = 5, OB_PBR_PASS_COUNT = 6 };
+/* Main passes are OB_PBR_PASS_MAIN | OB_PBR_SLOT_* bits. */
+enum { OB_PBR_SLOT_SHADOWS = 1, OB_PBR_SLOT_ENVMAP = 2, OB_PBR_SLOT_LOCAL_SHADOWS = 4 };
+enum { OB_PBR_PASS_MAIN = 0, OB_PBR_PASS_PARABOLOID = 8, OB_PBR_PASS_DEPTH = 9, OB_PBR_PASS_COUNT = 10 };
 
 typedef struct ob_material_pbr_state {
     ob_material_pbr desc;
@@ -101,6 +103,9 @@ struct ob_material {
 
 /* ob_material.c helpers the PBR kind shares. */
 bool ob_material_view_depends_on(const ob_view *v, ob_view_type type);
+/* The shadow maps v samples this frame: *out_directional the directional
+ * light's (SHADOWS), *out_local point or spot lights' (LOCAL_SHADOWS). */
+void ob_material_view_shadows(const ob_view *v, bool *out_directional, bool *out_local);
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity);
 
 /* ob_material_lit.c */

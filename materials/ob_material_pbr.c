@@ -36,6 +36,7 @@ enum {
     OB_PBR_P_PARABOLOID = 1u << 17,
     OB_PBR_P_DEPTH = 1u << 18,
     OB_PBR_P_INSTANCED = 1u << 19,  /* the per-draw block per instance */
+    OB_PBR_P_LOCAL_SHADOWS = 1u << 20,
 };
 
 /* Define, short name token, and what a report calls the feature. */
@@ -63,8 +64,10 @@ static const struct {
     {OB_PBR_P_PARABOLOID, "PARABOLOID", "para", NULL},
     {OB_PBR_P_DEPTH, "DEPTH_ONLY", "depth", NULL},
     {OB_PBR_P_INSTANCED, "INSTANCED", "inst", NULL},
+    {OB_PBR_P_LOCAL_SHADOWS, "LOCAL_SHADOWS", "lsh", NULL},
 };
-#define PBR_MAX_DEFINES 20
+#define PBR_MAX_DEFINES 21
+_Static_assert(OB_ARRAY_COUNT(pbr_bits) <= PBR_MAX_DEFINES, "a define for every feature bit");
 
 static const char *const texture_names[OB_PBR_TEX_COUNT] = {
     "BaseColorTexture", "MetallicRoughnessTexture", "NormalTexture", "OcclusionTexture", "EmissiveTexture",
@@ -365,12 +368,18 @@ static bool pass_of(const ob_material *m, const ob_renderer *r, const ob_node *e
     switch (v->type) {
     case OB_VIEW_PERSPECTIVE: {
         uint32_t slot = OB_PBR_PASS_MAIN, key = f | inst;
-        if (ob_material_view_depends_on(v, OB_VIEW_SHADOW)) {
-            slot |= 1u;
+        bool directional, local;
+        ob_material_view_shadows(v, &directional, &local);
+        if (directional) {
+            slot |= OB_PBR_SLOT_SHADOWS;
             key |= OB_PBR_P_SHADOWS;
         }
+        if (local) {
+            slot |= OB_PBR_SLOT_LOCAL_SHADOWS;
+            key |= OB_PBR_P_LOCAL_SHADOWS;
+        }
         if (m->reflectivity[0] > 0.0f && ob_material_attached_env_map(r, entity)) {
-            slot |= 2u;
+            slot |= OB_PBR_SLOT_ENVMAP;
             key |= OB_PBR_P_ENVMAP;
         }
         *out_slot = slot;
@@ -418,16 +427,17 @@ ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
     if (!e) {
         /* The wanted one, else the closest existing one needing fewer inputs
          * (no shadow map, no env map), as the standard kinds fall back. */
-        static const uint32_t drop[] = {0u, 1u, 2u, 3u};
+        enum { S = OB_PBR_SLOT_SHADOWS, E = OB_PBR_SLOT_ENVMAP, L = OB_PBR_SLOT_LOCAL_SHADOWS };
+        static const uint32_t drop[] = {0u, L, S, E, S | L, L | E, S | E, S | E | L};
         for (uint32_t i = 0; i < OB_ARRAY_COUNT(drop) && !e; i++) {
-            if (i && (slot >= OB_PBR_PASS_PARABOLOID || !(slot & drop[i]))) continue;
+            if (i && (slot >= OB_PBR_PASS_PARABOLOID || (slot & drop[i]) != drop[i])) continue;
             uint32_t s = slot & ~drop[i];
             e = atomic_load_explicit(&m->pbr.effects[s], memory_order_acquire);
             if (e) slot = s;
         }
         if (!e && res == OB_OK) res = OB_ERR_NOT_FOUND;
     }
-    *out_env = e && slot < OB_PBR_PASS_PARABOLOID && (slot & 2u);
+    *out_env = e && slot < OB_PBR_PASS_PARABOLOID && (slot & OB_PBR_SLOT_ENVMAP);
     /* A fallback drawn in place of a variant that failed still reports the
      * failure, as the standard kinds do (resolve in ob_material.c). */
     if (out_result) *out_result = res;

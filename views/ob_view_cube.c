@@ -44,8 +44,7 @@ static void cross3(const float a[3], const float b[3], float dest[3])
     dest[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* World → face view (rows right, up, -forward; camera looks down -Z). */
-static void face_view(uint32_t face, float dest[16])
+void ob_views_cube_face_view(uint32_t face, float dest[16])
 {
     const float *f = face_forward[face], *u = face_up[face];
     float r[3];
@@ -62,7 +61,7 @@ static void face_view(uint32_t face, float dest[16])
 /* An item reaches face F when its bound is not wholly outside one of the
  * four planes through the centre that bound the face (normals forward ±
  * right, forward ± up, of length sqrt 2: the radius is scaled by it). */
-static uint8_t cube_faces(const double rel[3], double radius)
+uint8_t ob_views_cube_faces(const double rel[3], double radius)
 {
     uint8_t mask = 0;
     double reach = radius * 1.4142135623730951;
@@ -90,7 +89,7 @@ static bool cube_pre_cull(ob_view *v, ob_renderer *r)
 static void cube_post_cull(ob_view *v, ob_renderer *r)
 {
     ob_cube_view *cv = (ob_cube_view *)v;
-    ob_views_env_post_cull(cv->ctx, v, r, cube_faces, &cv->reach, &cv->reach_cap, &cv->reach_valid);
+    ob_views_env_post_cull(cv->ctx, v, r, ob_views_cube_faces, &cv->reach, &cv->reach_cap, &cv->reach_valid);
 }
 
 static void cube_render_params(ob_view *v, ob_renderer *r, ob_params *params)
@@ -98,7 +97,7 @@ static void cube_render_params(ob_view *v, ob_renderer *r, ob_params *params)
     ob_cube_view *cv = (ob_cube_view *)v;
     (void)r;
     float view[16];
-    face_view(0, view);
+    ob_views_cube_face_view(0, view);
     ob_views_set_common_params(cv->ctx, v, params, view, cv->proj);
 }
 
@@ -117,7 +116,7 @@ static void cube_record(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uin
 {
     ob_cube_view *cv = (ob_cube_view *)v;
     float view[16];
-    face_view(layer, view);
+    ob_views_cube_face_view(layer, view);
     const ob_param_builtins *b = ob_param_registry_builtins(ob_renderer_registry(r));
     ob_params_set_mat4(ob_pipeline_manager_params(pm), b->view, view);
     ob_views_record_masked(v, r, pm, first, count, cv->reach_valid ? cv->reach : NULL,

@@ -485,6 +485,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
         ob_shadow_view_set_consumer(e->owner_object, consumer);
         ob_renderer_pre_render(r, e->view);
     }
+    ob_views_queue_local_shadows(ctx, r, consumer);
 }
 
 ob_result ob_views_add_system(ob_views *ctx, ob_node *emitter, ob_view *sim, ob_particle_system *ps)
@@ -599,6 +600,7 @@ void ob_views_destroy(ob_views *ctx)
         ob_shadow_view_destroy(ctx, ctx->shadows[i].owner_object);
     for (uint32_t i = 0; i < ctx->env_count; i++)
         env_destroy(ctx, ctx->envs[i].view, ctx->envs[i].owner_object);
+    ob_views_local_shadows_destroy(ctx);
     ob_free(ctx->shadows);
     ob_free(ctx->envs);
     ob_free(ctx->systems);

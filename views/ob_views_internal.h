@@ -12,6 +12,7 @@
 typedef struct ob_shadow_view ob_shadow_view;
 typedef struct ob_paraboloid_view ob_paraboloid_view;
 typedef struct ob_cube_view ob_cube_view;
+typedef struct ob_local_shadows ob_local_shadows;
 
 typedef struct ob_views_entry {
     uint32_t node_id;
@@ -40,6 +41,7 @@ struct ob_views {
     uint32_t *over_limit;        /* ids of lights logged as over OB_MAX_LIGHTS, ascending */
     uint32_t over_limit_count, over_limit_cap;
     bool light_tiles_off;        /* ob_views_set_light_tiles(false): every light in tile 0 */
+    ob_local_shadows *local_shadows; /* point and spot lights' shadow views, made on first need */
 
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };
@@ -100,9 +102,36 @@ void ob_views_env_post_cull(ob_views *ctx, ob_view *v, ob_renderer *r, ob_env_la
 void ob_views_record_masked(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm, uint32_t first,
                             uint32_t count, const uint8_t *mask, uint8_t bit);
 
+/* The cube map faces (+X, -X, +Y, -Y, +Z, -Z; envmap.glsl's ob_cube_face
+ * and shadow_local.glsl agree): face's world → face view rotation, and the
+ * faces an item reaches (an ob_env_layer_mask_fn). [any thread] */
+void ob_views_cube_face_view(uint32_t face, float dest[16]);
+uint8_t ob_views_cube_faces(const double rel[3], double radius);
+
 ob_cube_view *ob_cube_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
 void ob_cube_view_destroy(ob_views *ctx, ob_cube_view *v);
 ob_view *ob_cube_view_base(ob_cube_view *v);
+
+/* Point and spot lights' shadows (ob_view_local_shadow.c). queue: for each
+ * shadow-casting local light that reaches an item `consumer` sees, its
+ * shadow view (made on first need) gets layers of the shared array and
+ * pre-renders; others are noted skipped. [render thread, PreRender] */
+void ob_views_queue_local_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer);
+/* The first shadow layer of `light` as v samples it (-1: v has no map of
+ * it this frame) and that light's layer matrices into mats (camera-relative
+ * world of v → the layer's clip space). [recording thread: reads views] */
+float ob_views_local_shadow_layer(const ob_views *ctx, const ob_view *v, const ob_node *light,
+                                  float mats[OB_MAX_LOCAL_SHADOW_LAYERS][16]);
+/* LocalShadowMatrices = mats, when a shader uses them. [recording thread] */
+void ob_views_set_local_shadow_matrices(const ob_views *ctx, ob_params *params,
+                                        const float mats[OB_MAX_LOCAL_SHADOW_LAYERS][16]);
+void ob_views_local_shadows_destroy(ob_views *ctx);
+/* Whether a spot light at the origin shining along unit `axis`, with
+ * cos(outer angle) and range (0: none), may reach the sphere (rel, radius):
+ * exact for the cone bounded by its range sphere, conservative never
+ * false for a sphere it lights. [any thread] */
+bool ob_views_spot_reaches(const float axis[3], float cos_outer, float range, const double rel[3],
+                           double radius);
 
 /* Particle systems by emitter node: the perspective view queues the
  * simulation of every emitter it sees (ob_views_queue_simulations). */

@@ -10,7 +10,13 @@
  * they are, and it needs no descriptor indexing: the block is one more
  * uniform block in set 0. Lights are indexed in node-id order; the shader
  * walks the mask bits in ascending order, so the sum is the same whatever
- * the tiling or the thread that records.
+ * the tiling or the thread that records. A spot light's tiles are those of
+ * the smallest sphere around its cone (bounded by its range), not of its
+ * range sphere.
+ *
+ * Shadowed lights: row 3's .y is the light's first layer in the local
+ * shadow array when the view samples its map this frame, else -1
+ * (ob_view_local_shadow.c); the block's matrices come with the table.
  */
 #include "ob_views_internal.h"
 
@@ -90,6 +96,38 @@ static bool sphere_tiles(const float view[16], const float proj[16], const float
     return true;
 }
 
+bool ob_views_spot_reaches(const float axis[3], float cos_outer, float range, const double rel[3],
+                           double radius)
+{
+    /* Signed distance from the centre to the cone's side (Wronski's test),
+     * then the range sphere and the plane through the apex (the cone is
+     * narrower than a half-space: outer angle < 90 degrees). */
+    double len2 = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
+    double along = rel[0] * axis[0] + rel[1] * axis[1] + rel[2] * axis[2];
+    if (range > 0.0f && sqrt(len2) - radius > (double)range) return false;
+    if (along < -radius) return false;
+    double c = cos_outer, s = sqrt(fmax(1.0 - c * c, 0.0));
+    double across = sqrt(fmax(len2 - along * along, 0.0));
+    return c * across - along * s <= radius;
+}
+
+/* The smallest sphere around a spot light's cone bounded by its range
+ * (apex, rim and cap): centred on the axis; the range sphere for a point
+ * light or an unbounded spot. */
+static void light_bound(const ob_light_desc *l, const float axis[3], const float pos[3],
+                        float out_center[3], float *out_radius)
+{
+    memcpy(out_center, pos, 3 * sizeof(float));
+    *out_radius = l->range;
+    if (l->type != OB_LIGHT_SPOT || !(l->range > 0.0f)) return;
+    float c = cosf(l->outer_angle), s = sinf(l->outer_angle);
+    /* Under 45 degrees the sphere through apex and rim holds the cap; wider,
+     * the one around the rim does. */
+    float along = c >= s ? l->range / (2.0f * c) : l->range * c;
+    *out_radius = c >= s ? along : l->range * s;
+    for (int k = 0; k < 3; k++) out_center[k] = pos[k] + axis[k] * along;
+}
+
 void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *params,
                                const float view[16], const float proj[16])
 {
@@ -111,6 +149,8 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
         b.grid[3] = 1.0f;
     }
 
+    float shadow_mats[OB_MAX_LOCAL_SHADOW_LAYERS][16];
+    for (uint32_t k = 0; k < OB_MAX_LOCAL_SHADOW_LAYERS; k++) ob_mat4_identity(shadow_mats[k]);
     uint32_t count = 0, used = 0;
     ob_scene *scene = ob_renderer_scene(ctx->r);
     ob_node *const *lights = scene ? ob_scene_lights(scene, &count) : NULL;
@@ -125,8 +165,8 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
         b.table[4 * used][3] = l->range;
         memcpy(b.table[4 * used + 1], l->color, sizeof l->color);
         b.table[4 * used + 1][3] = l->intensity;
+        float right[3], up[3], fwd[3] = {0, 0, 0};
         if (l->type == OB_LIGHT_SPOT) {
-            float right[3], up[3], fwd[3];
             ob_node_world_axes(lights[i], right, up, fwd);
             memcpy(b.table[4 * used + 2], fwd, sizeof fwd);
             b.table[4 * used + 2][3] = cosf(l->outer_angle);
@@ -134,12 +174,16 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
         } else {
             b.table[4 * used + 2][3] = -2.0f;   /* a point light: no cone */
         }
+        b.table[4 * used + 3][1] =
+            l->casts_shadows ? ob_views_local_shadow_layer(ctx, v, lights[i], shadow_mats) : -1.0f;
 
         uint32_t word = used / 32, bit = 1u << (used % 32);
         uint32_t r[4] = {0, 0, 0, 0};
         bool reaches = true;
+        float bc[3], bradius;
+        light_bound(l, fwd, c, bc, &bradius);
         if (tiled && l->range > 0.0f)
-            reaches = sphere_tiles(view, proj, c, l->range, v->width, v->height, r);
+            reaches = sphere_tiles(view, proj, bc, bradius, v->width, v->height, r);
         else if (tiled)
             r[1] = OB_LIGHT_TILES_X - 1, r[3] = OB_LIGHT_TILES_Y - 1;
         if (reaches)
@@ -151,6 +195,7 @@ void ob_views_set_light_params(ob_views *ctx, const ob_view *v, ob_params *param
     ob_params_set_vec4(params, grid, b.grid);
     ob_params_set_bytes(params, table, b.table, sizeof b.table);
     ob_params_set_bytes(params, tiles, b.tiles, sizeof b.tiles);
+    ob_views_set_local_shadow_matrices(ctx, params, (const float(*)[16])shadow_mats);
 }
 
 static int compare_ids(const void *a, const void *b)

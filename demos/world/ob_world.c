@@ -155,7 +155,7 @@ ob_node *ob_world_light(ob_world *w, ob_light_type type, bool shadows, float int
                         .casts_shadows = shadows};
     r = ob_node_set_light(n, &ld);
     ob_node_set_position(n, (const double[3]){x, y, z});
-    if (r == OB_OK && type == OB_LIGHT_DIRECTIONAL)
+    if (r == OB_OK && type != OB_LIGHT_POINT)
         r = ob_node_look_at(n, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0});
     if (r != OB_OK) fail(w, r, "light '%s'", name);
     return n;

@@ -96,8 +96,8 @@ ob_material *ob_world_material(ob_world *w, const char *name, ob_material_kind k
 /* An entity drawing g with m at (x, y, z) under parent (NULL → root). */
 ob_node *ob_world_entity(ob_world *w, ob_node *parent, const char *name, ob_geometry *g,
                          ob_material *m, double x, double y, double z);
-/* A white light at (x, y, z) named "sun" (directional, aimed at the origin)
- * or "lamp". */
+/* A white light at (x, y, z) named "sun" (directional) or "lamp" (point or
+ * spot); directional and spot lights aimed at the origin. */
 ob_node *ob_world_light(ob_world *w, ob_light_type type, bool shadows, float intensity, double x,
                         double y, double z);
 /* The camera at the eye, aimed at the target, up +Y. */

@@ -12,6 +12,10 @@
 // and instancing run lights a point with the same lights in the same order.
 // Views that are not perspective (paraboloid) set LightGrid.w = 0: tile 0
 // then holds every light.
+//
+// LOCAL_SHADOWS (variants of views that sample a point or spot light's
+// shadow map this frame): ob_local_light multiplies in the light's shadow
+// (shadow_local.glsl), so every lighting model's loop gets it unchanged.
 #ifndef OB_LIGHTING_GLSL
 #define OB_LIGHTING_GLSL
 
@@ -36,7 +40,11 @@ layout(set = 0, binding = 4, std140) uniform PerViewLights {
                                            // colour rgb, intensity | axis xyz (where it shines),
                                            // cos outer (< -1: a point light) | cos inner
     uvec4 LightTiles[2 * OB_LIGHT_TILES];  // 8 words a tile: bit i = light i may reach it
-};
+};                                         // (row 3: .y first shadow layer, -1 none)
+
+#if defined(LOCAL_SHADOWS)
+#include "shadow_local.glsl"
+#endif
 
 // The tile gl_FragCoord falls in (fragment stage only).
 uint ob_light_tile()
@@ -69,6 +77,13 @@ void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
         float t = clamp((dot(-l, axis.xyz) - axis.w) / max(cos_inner - axis.w, 1e-4), 0.0, 1.0);
         att *= t * t * (3.0 - 2.0 * t);
     }
+#if defined(LOCAL_SHADOWS)
+    // Last: the map is read only where the light reaches (inside the cone
+    // and the range), the rest of the floor pays nothing for it.
+    int first_layer = int(LightTable[4u * i + 3u].y);
+    if (first_layer >= 0 && att > 0.0)
+        att *= ob_local_shadow(first_layer, axis.w < -1.0, position.xyz, p);
+#endif
     radiance = color.rgb * color.w * att;
 }
 

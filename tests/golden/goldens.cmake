@@ -45,6 +45,8 @@ ob_golden(mtl_quad tests/data/models/mtl_quad.obj --frames 2)
 ob_golden(features tests/data/models/features.gltf --frames 2)
 ob_golden(colour_cube tests/golden/models/colour_cube.ply --frames 2)
 # Lights (issue 28): two spot lights, one soft-edged and one nearly hard,
-# and 64 coloured point lights, all through the screen-tile light grid.
+# both shadowed, and 64 coloured point lights, all through the screen-tile
+# light grid; a shadowed point light (cube map) among boxes.
 ob_golden(spot tests/golden/scenes/spot.json --frames 2)
+ob_golden(point_shadow tests/golden/scenes/point_shadow.json --frames 2)
 ob_golden(lights64 tests/golden/scenes/lights64.json --frames 2)

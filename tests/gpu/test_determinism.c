@@ -1,4 +1,5 @@
-/* Issue 5: determinism. One animated scene — a shadow-casting sun, three
+/* Issue 5: determinism. One animated scene — a shadow-casting sun, a
+ * shadowed point light (a cube map) and spot light (issue 28), three
  * mirror spheres with environment maps, a particle simulation and 500
  * moving entities — rendered for five frames single-threaded, with 1, 2, 3,
  * 4 and 8 workers, switching mode every frame, and in AUTO mode: every frame
@@ -47,8 +48,16 @@ static void build_scene(ob_test_world *w, ob_particle_system **out_ps)
 {
     ob_world_look(w, 0, 7, 14, 0, 0.5, 0);
     ob_world_light(w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 6, 12, 4);
-    ob_world_light(w, OB_LIGHT_POINT, false, 2.0f, -3, 2, 2);
+    ob_world_light(w, OB_LIGHT_POINT, true, 2.0f, -3, 2, 2);
     ob_result r;
+    ob_node *spot = ob_node_create(w->scene, NULL, "torch", &r);
+    assert_non_null(spot);
+    ob_light_desc sd = {.type = OB_LIGHT_SPOT, .intensity = 6.0f, .range = 14.0f,
+                        .outer_angle = 0.6f, .inner_angle = 0.4f, .casts_shadows = true};
+    assert_int_equal(ob_node_set_light(spot, &sd), OB_OK);
+    ob_node_set_position(spot, (const double[3]){2, 5, 3});
+    assert_int_equal(ob_node_look_at(spot, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0}),
+                     OB_OK);
     ob_material *palette[8];
     for (int i = 0; i < 6; i++)
         palette[i] = ob_world_material(w, "test", OB_MATERIAL_LIT, 0.2f + 0.13f * (float)i,
@@ -133,7 +142,10 @@ static void check_reference(const run_result *ref)
     for (int f = 0; f < FRAMES; f++) {
         const ob_frame_stats *st = &ref->stats[f];
         assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 3);
-        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        /* The sun's, the point light's cube and the spot's. */
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 3);
+        assert_non_null(ob_world_view_stats(st, "shadow:lamp"));
+        assert_true(ob_world_view_stats(st, "shadow:torch")->draws > 0);
         assert_int_equal(ob_world_count_views(st, OB_VIEW_SIMULATION), 1);
         assert_true(ob_world_view_stats(st, "main")->draws > 200);
         assert_int_equal(st->pm.skipped_draws, 0);

@@ -64,13 +64,7 @@ static ob_node *wall(ob_test_world *w, float r, float g, float b)
  * white here). */
 static ob_node *pbr_wall(ob_test_world *w, float r, float g, float b)
 {
-    ob_mesh mesh;
-    assert_int_equal(ob_mesh_plane(20.0f, 20.0f, 1, &mesh), OB_OK);
-    mesh.colors = ob_calloc(mesh.vertex_count, sizeof *mesh.colors);
-    assert_non_null(mesh.colors);
-    memset(mesh.colors, 255, mesh.vertex_count * sizeof *mesh.colors);
-    ob_geometry *plane = ob_world_geometry(w, &mesh, "pbr plane");
-    ob_mesh_release(&mesh);
+    ob_geometry *plane = ob_test_world_pbr_plane(w, 1);
     ob_material_desc md = {.name = "pbr wall", .kind = OB_MATERIAL_PBR, .pbr = ob_material_pbr_defaults()};
     md.pbr.base_color[0] = r, md.pbr.base_color[1] = g, md.pbr.base_color[2] = b;
     md.pbr.metallic = 0.0f;
@@ -86,16 +80,6 @@ static void setup(ob_test_world *w, uint32_t workers)
     ob_composite_view_set_exposure(w->composite, EXPOSURE);
 }
 
-static ob_node *add_light(ob_test_world *w, const char *name, const ob_light_desc *d, double x,
-                          double y, double z)
-{
-    ob_result r;
-    ob_node *n = ob_node_create(w->scene, NULL, name, &r);
-    assert_non_null(n);
-    assert_int_equal(ob_node_set_light(n, d), OB_OK);
-    ob_node_set_position(n, (const double[3]){x, y, z});
-    return n;
-}
 
 /* 256 coloured point lights of range 2.5 on a 16 x 16 grid 0.6 in front of
  * the wall, covering the camera's view. */
@@ -109,7 +93,7 @@ static void add_point_grid(ob_test_world *w, ob_node *out[LIGHTS], float intensi
                            .intensity = intensity, .range = 2.5f};
         char name[32];
         snprintf(name, sizeof name, "lamp %d", i);
-        out[i] = add_light(w, name, &d, -6.0 + 0.8 * gx, -4.5 + 0.6 * gy, 0.6);
+        out[i] = ob_test_world_light(w, name, &d, -6.0 + 0.8 * gx, -4.5 + 0.6 * gy, 0.6);
     }
 }
 
@@ -218,7 +202,7 @@ static void spot_light_lights_its_cone_with_a_soft_edge(void **state)
         wall(&w, 0.9f, 0.9f, 0.9f);
         ob_light_desc d = {.type = pass ? OB_LIGHT_POINT : OB_LIGHT_SPOT, .intensity = 12.0f,
                            .inner_angle = pass ? 0.0f : inner, .outer_angle = pass ? 0.0f : outer};
-        add_light(&w, "torch", &d, 0, 0, h);
+        ob_test_world_light(&w, "torch", &d, 0, 0, h);
         ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
         ob_world_read(&w);
         for (int k = 0; k < 3; k++) (pass ? point : spot)[k] = wall_pixel(&w, at[k], 0)[1];
@@ -245,7 +229,7 @@ static void lights_over_the_limit_are_reported_once_by_name(void **state)
     for (int i = 0; i < 3; i++) {
         char name[32];
         snprintf(name, sizeof name, "extra %d", i);
-        add_light(&w, name, &d, i, 0, 2);
+        ob_test_world_light(&w, name, &d, i, 0, 2);
     }
     ob_test_log_clear();
     assert_int_equal(ob_test_world_frame(&w, OB_THREADING_SINGLE, 0)->lights_over_limit, 3);
@@ -276,7 +260,7 @@ static void many_lights_same_in_every_threading_mode(void **state)
     set_intensity(lights[LIGHTS - 1], 0.0f);   /* room for the spot under the limit */
     ob_light_desc spot = {.type = OB_LIGHT_SPOT, .intensity = 6.0f, .range = 9.0f,
                           .inner_angle = 0.3f, .outer_angle = 0.5f};
-    add_light(&w, "torch", &spot, 1, 1, 5);
+    ob_test_world_light(&w, "torch", &spot, 1, 1, 5);
     ob_material *m = ob_world_material(&w, "ball", OB_MATERIAL_LIT, 0.6f, 0.6f, 0.6f, false);
     for (int i = 0; i < 120; i++)
         ob_world_entity(&w, NULL, "ball", w.box, m, -5.5 + 1.0 * (i % 12), -4 + 0.8 * (i / 12), 0.4);

@@ -105,6 +105,22 @@ ob_result ob_test_stack_build_scene(ob_test_stack *s)
     if ((r = ob_node_look_at(sun, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0})) != OB_OK)
         return r;
 
+    /* Shadowed local lights (issue 28): a spot's perspective map and a
+     * point light's cube, layers of the shared local shadow array. */
+    ob_node *spot = ob_node_create(st->scene, NULL, "torch", &r);
+    if (!spot) return r;
+    ob_light_desc sd = {.type = OB_LIGHT_SPOT, .intensity = 3.0f, .range = 8.0f,
+                        .inner_angle = 0.4f, .outer_angle = 0.7f, .casts_shadows = true};
+    if ((r = ob_node_set_light(spot, &sd)) != OB_OK) return r;
+    ob_node_set_position(spot, (const double[3]){-0.5, 2.5, 1.0});
+    if ((r = ob_node_look_at(spot, (const double[3]){0, 0, 0}, (const double[3]){0, 1, 0})) != OB_OK)
+        return r;
+    ob_node *bulb = ob_node_create(st->scene, NULL, "bulb", &r);
+    if (!bulb) return r;
+    ob_light_desc bd = {.type = OB_LIGHT_POINT, .intensity = 1.5f, .range = 5.0f, .casts_shadows = true};
+    if ((r = ob_node_set_light(bulb, &bd)) != OB_OK) return r;
+    ob_node_set_position(bulb, (const double[3]){0.0, 1.0, 0.8});
+
     ob_node *fountain = ob_node_create(st->scene, NULL, "fountain", &r);
     if (!fountain) return r;
     ob_node_set_position(fountain, (const double[3]){0.0, 1.2, 0.6});

@@ -9,7 +9,8 @@
  *
  * The scene (ob_test_stack_build_scene) is tiny but exercises every lazy
  * path of a first frame: a shadow-casting directional light and caster, a
- * reflective sphere (a paraboloid or cube environment map), a particle system (a
+ * shadowed spot light and point light (views into the shared local shadow
+ * array, the LOCAL_SHADOWS variants), a reflective sphere (a paraboloid or cube environment map), a particle system (a
  * compute simulation and a blended draw) and the composite to the final
  * target. Its image depends only on the frame index, never on earlier
  * frames: the particles live shorter than a frame, so every step respawns

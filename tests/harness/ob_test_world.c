@@ -59,3 +59,26 @@ const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mo
     ob_world_frame(w, mode, workers, extra, extra_count);
     return ob_world_stats(w);
 }
+
+ob_node *ob_test_world_light(ob_test_world *w, const char *name, const ob_light_desc *d, double x,
+                             double y, double z)
+{
+    ob_result r;
+    ob_node *n = ob_node_create(w->scene, NULL, name, &r);
+    assert_non_null(n);
+    assert_int_equal(ob_node_set_light(n, d), OB_OK);
+    ob_node_set_position(n, (const double[3]){x, y, z});
+    return n;
+}
+
+ob_geometry *ob_test_world_pbr_plane(ob_test_world *w, uint32_t subdivisions)
+{
+    ob_mesh mesh;
+    assert_int_equal(ob_mesh_plane(20.0f, 20.0f, subdivisions, &mesh), OB_OK);
+    mesh.colors = ob_calloc(mesh.vertex_count, sizeof *mesh.colors);
+    assert_non_null(mesh.colors);
+    memset(mesh.colors, 255, mesh.vertex_count * sizeof *mesh.colors);
+    ob_geometry *plane = ob_world_geometry(w, &mesh, "pbr plane");
+    ob_mesh_release(&mesh);
+    return plane;
+}

@@ -56,4 +56,11 @@ const ob_frame_stats *ob_test_world_frame_with(ob_test_world *w, ob_threading mo
                                                uint32_t workers, ob_view *const *extra,
                                                uint32_t extra_count);
 
+/* A light node `name` of d at (x, y, z) (fails the test when refused). */
+ob_node *ob_test_world_light(ob_test_world *w, const char *name, const ob_light_desc *d, double x,
+                             double y, double z);
+/* The 20 x 20 XZ plane in the extended vertex layout the PBR shaders read
+ * (white vertex colours), owned by the world. */
+ob_geometry *ob_test_world_pbr_plane(ob_test_world *w, uint32_t subdivisions);
+
 #endif

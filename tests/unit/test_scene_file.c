@@ -277,10 +277,15 @@ static void spot_and_many_point_lights_parse(void **state)
     ob_scene_file_error err;
     static const char text[] =
         "{\"lights\": [{\"name\": \"torch\", \"type\": \"spot\", \"position\": [0, 4, 0],"
-        " \"target\": [0, 0, 0], \"range\": 9, \"inner_angle\": 15, \"outer_angle\": 30},"
-        " {\"type\": \"spot\"}], \"entities\": []}";
+        " \"target\": [0, 0, 0], \"range\": 9, \"inner_angle\": 15, \"outer_angle\": 30,"
+        " \"shadows\": true},"
+        " {\"type\": \"spot\"}, {\"type\": \"point\", \"shadows\": true}], \"entities\": []}";
     assert_int_equal(parse(text, &sf, &err), OB_OK);
-    assert_int_equal(sf.light_count, 2);
+    assert_int_equal(sf.light_count, 3);
+    /* Shadows on spot and point lights (issue 28); off by default. */
+    assert_true(sf.lights[0].desc.casts_shadows);
+    assert_false(sf.lights[1].desc.casts_shadows);
+    assert_true(sf.lights[2].desc.casts_shadows);
     const ob_scene_file_light *l = &sf.lights[0];
     assert_int_equal(l->desc.type, OB_LIGHT_SPOT);
     assert_string_equal(l->name, "torch");
@@ -445,8 +450,6 @@ static const bad_case bad_cases[] = {
      "must differ from camera.position"},
     {"{\"camera\": {\"position\": [0, 5, 0], \"target\": [0, 0, 0]}, " E "[]}", "camera.up",
      "must not be parallel to the viewing direction"},
-    {"{\"lights\": [{\"type\": \"point\", \"shadows\": true}], " E "[]}", "lights[0].shadows",
-     "only directional lights cast shadows"},
     {"{\"lights\": [{\"type\": \"point\", \"direction\": [0, -1, 0]}], " E "[]}", "lights[0].direction",
      "only a directional or spot light has a direction"},
     {"{\"lights\": [{\"type\": \"directional\", \"range\": 3}], " E "[]}", "lights[0].range",
@@ -457,8 +460,6 @@ static const bad_case bad_cases[] = {
      "expected a non-zero vector"},
     {"{\"lights\": [{\"type\": \"directional\"}, {\"type\": \"directional\"}], " E "[]}", "lights[1]",
      "only one directional light is drawn"},
-    {"{\"lights\": [{\"type\": \"spot\", \"shadows\": true}], " E "[]}", "lights[0].shadows",
-     "only directional lights cast shadows"},
     {"{\"lights\": [{\"type\": \"spot\", \"inner_angle\": 30, \"outer_angle\": 20}], " E "[]}",
      "lights[0].inner_angle", "must not be larger than outer_angle (20 degrees), got 30"},
     {"{\"lights\": [{\"type\": \"spot\", \"outer_angle\": 90}], " E "[]}", "lights[0].outer_angle",

@@ -240,10 +240,6 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
         /* outer_angle 0 is a zero-width cone here, not the engine's default. */
         if (l->desc.outer_angle == 0.0f) l->desc.outer_angle = 1e-6f;
     }
-    if ((point || spot) && l->desc.casts_shadows) {
-        ob_json_push_key(&c->rd, "shadows");
-        return ob_json_fail(&c->rd, "only directional lights cast shadows");
-    }
     if (ob_json_member(j, "target") && ob_json_member(j, "direction")) {
         ob_json_push_key(&c->rd, "direction");
         return ob_json_fail(&c->rd, "give either target or direction, not both");
