@@ -113,6 +113,10 @@ struct ob_view {
      * (either may be zero). */
     ob_image color, depth;
     uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
+    /* Layer of color/depth that the view's layer 0 renders into: views that
+     * share one array target (a light's shadow cascades) each own a layer.
+     * The first view owns the images; the others only borrow them. */
+    uint32_t target_layer;
     /* Mip levels wanted for `color` (0 or 1: none). With more, the target
      * is made with them and, once the view has rendered, the renderer fills
      * levels 1.. from level 0 (a box-filtered blit chain,
