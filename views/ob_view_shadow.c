@@ -94,18 +94,19 @@ typedef struct camera_shape {
 
 static bool camera_shape_of(const float vp[16], camera_shape *out)
 {
-    float row[3][3];
-    float len[3];
+    /* In double: the rows hold 1 / znear (scale_clip_to_near), whose
+     * square leaves float's range in a scene of 1e-30 or 1e30. */
+    double row[3][3], len[3];
     for (int j = 0; j < 3; j++) {
         int rj = j == 2 ? 3 : j;   /* rows x, y and w */
         for (int k = 0; k < 3; k++) row[j][k] = vp[k * 4 + rj];
-        len[j] = sqrtf(row[j][0] * row[j][0] + row[j][1] * row[j][1] + row[j][2] * row[j][2]);
+        len[j] = ob_dvec3_length(row[j]);
     }
-    if (!(len[0] > 0.0f && len[1] > 0.0f && len[2] > 0.0f)) return false;
-    for (int k = 0; k < 3; k++) out->forward[k] = row[2][k] / len[2];
-    out->znear = vp[14] / len[2];
-    float tx = len[2] / len[0], ty = len[2] / len[1];
-    out->k2 = tx * tx + ty * ty;
+    if (!(len[0] > 0.0 && len[1] > 0.0 && len[2] > 0.0)) return false;
+    for (int k = 0; k < 3; k++) out->forward[k] = (float)(row[2][k] / len[2]);
+    out->znear = (float)(vp[14] / len[2]);
+    double tx = len[2] / len[0], ty = len[2] / len[1];
+    out->k2 = (float)(tx * tx + ty * ty);
     return out->znear > 0.0f && isfinite(out->znear) && isfinite(out->k2);
 }
 
@@ -120,36 +121,44 @@ static float split_distance(float znear, float zfar, float lambda, uint32_t i, u
 }
 
 /* The smallest sphere around the frustum slice [d0, d1] of a camera of
- * shape k2: its centre on the axis, at *out_z. */
+ * shape k2: its centre on the axis, at *out_z. In double: the squares of a
+ * 1e24-unit slice overflow float, those of a 1e-30 one underflow. */
 static float slice_sphere(float d0, float d1, float k2, float *out_z)
 {
-    float z = 0.5f * (d0 + d1) * (1.0f + k2);
-    if (z >= d1) {
+    double a = d0, b = d1, k = k2;
+    double z = 0.5 * (a + b) * (1.0 + k);
+    if (z >= b) {
         *out_z = d1;
-        return sqrtf(k2) * d1;
+        return (float)(sqrt(k) * b);
     }
-    *out_z = z;
-    return sqrtf((d1 - z) * (d1 - z) + k2 * d1 * d1);
+    *out_z = (float)z;
+    return (float)sqrt((b - z) * (b - z) + k * b * b);
 }
 
-static void fit_cascade(ob_shadow_cascade *sc, const double axes[9], const double centre[3],
-                        float radius, double caster_top, float caster_depth, uint32_t size)
+static void fit_cascade(ob_shadow_cascade *sc, const double axes[9], const double anchor[3],
+                        const double centre[3], float radius, double caster_top,
+                        float caster_depth, uint32_t size)
 {
     ob_view *v = &sc->base;
     /* One texel more than the sphere on every side: snapping moves the box
      * by less than a texel. */
     double half = (double)radius * size / (size - 2.0);
     double texel = 2.0 * half / size;
-    double light[3];
+    /* The texel grid is anchored at the light's node, not at the world's
+     * origin: it holds still while the camera moves, and moves with a
+     * scene moved as a whole (the same shadow at any coordinates). */
+    double light[3], base[3];
+    for (int k = 0; k < 3; k++) {
+        base[k] = ob_dvec3_dot(&axes[3 * k], anchor);
+        light[k] = floor((ob_dvec3_dot(&axes[3 * k], centre) - base[k]) / texel) * texel;
+    }
     for (int k = 0; k < 3; k++)
-        light[k] = floor(ob_dvec3_dot(&axes[3 * k], centre) / texel) * texel;
-    for (int k = 0; k < 3; k++)
-        v->origin[k] = axes[k] * light[0] + axes[3 + k] * light[1] + axes[6 + k] * light[2];
+        v->origin[k] = anchor[k] + axes[k] * light[0] + axes[3 + k] * light[1] + axes[6 + k] * light[2];
     ob_math_view_relative(axes, v->origin, v->origin, sc->view);
     /* Toward the light: past the highest caster the consumer sees by its
      * casters' depth (a caster out of view above them still fits), in
      * whole box sizes so the depth mapping holds still as well. */
-    double reach = fmax(half, caster_top - light[2] + caster_depth);
+    double reach = fmax(half, caster_top - base[2] - light[2] + caster_depth);
     reach = ceil(reach / (2.0 * half)) * 2.0 * half;
     ob_math_ortho_reverse_z((float)-half, (float)half, (float)-half, (float)half, (float)-reach,
                             (float)(half + texel), sc->proj);
@@ -171,11 +180,15 @@ static bool fit_cascades(ob_shadow_view *sv, ob_renderer *r, const ob_view *c)
     if (cr.casters == 0) return false;
 
     /* Default distance: the farthest point the camera sees, rounded up to a
-     * power of two so that turning the camera rarely changes it (a change
-     * resizes every cascade). */
+     * power of two times the near distance, so that turning the camera
+     * rarely changes it (a change resizes every cascade) and a scene scaled
+     * as a whole, near plane included, gets the same cascades. */
     float zfar = ctx->shadow_distance;
-    if (!(zfar > 0.0f)) zfar = exp2f(ceilf(log2f(fmaxf(cr.farthest, 2.0f * cam.znear))));
+    if (!(zfar > 0.0f))
+        zfar = cam.znear * exp2f(ceilf(log2f(fmaxf(cr.farthest / cam.znear, 2.0f))));
     zfar = fmaxf(zfar, 2.0f * cam.znear);
+    double anchor[3];
+    ob_node_world_position(sv->light, anchor);
     memcpy(sv->fit_origin, c->origin, sizeof sv->fit_origin);
     memcpy(sv->axis, cam.forward, sizeof sv->axis);
     double caster_top = cr.top + ob_dvec3_dot(&axes[6], c->origin);
@@ -190,7 +203,7 @@ static bool fit_cascades(ob_shadow_view *sv, ob_renderer *r, const ob_view *c)
         float radius = slice_sphere(from, end, cam.k2, &z);
         double centre[3];
         for (int k = 0; k < 3; k++) centre[k] = c->origin[k] + (double)cam.forward[k] * z;
-        fit_cascade(&sv->cascades[i], axes, centre, radius, caster_top, caster_depth,
+        fit_cascade(&sv->cascades[i], axes, anchor, centre, radius, caster_top, caster_depth,
                     sv->cascades[i].base.width);
         prev = start;
         start = end;

@@ -133,7 +133,7 @@ static void check_reference(const run_result *ref)
     for (int f = 0; f < FRAMES; f++) {
         const ob_frame_stats *st = &ref->stats[f];
         assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 3);
-        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), OB_SHADOW_DEFAULT_CASCADES);
         assert_int_equal(ob_world_count_views(st, OB_VIEW_SIMULATION), 1);
         assert_true(ob_world_view_stats(st, "main")->draws > 200);
         assert_int_equal(st->pm.skipped_draws, 0);
