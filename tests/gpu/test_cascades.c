@@ -11,6 +11,7 @@
  */
 #include "ob_test_world.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -241,11 +242,43 @@ static void shadow_holds_still_when_the_camera_moves(void **state)
     }
 }
 
+/* Out-of-range settings are refused and keep the old value; a new count
+ * applies from the next frame (the array map is made again). */
+static void cascade_settings_checked_and_applied(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_material *m = ob_world_material(&w, "m", OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true);
+    ob_material *floor_m = ob_world_material(&w, "floor", OB_MATERIAL_LIT, 0.7f, 0.7f, 0.7f, false);
+    ob_world_entity(&w, NULL, "floor", w.plane, floor_m, 0, -0.5, 0);
+    ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+    assert_int_equal(ob_views_set_shadow_cascades(w.views, OB_SHADOW_MAX_CASCADES + 1),
+                     OB_ERR_OUT_OF_RANGE);
+    assert_int_equal(ob_views_set_shadow_distance(w.views, -1.0f), OB_ERR_OUT_OF_RANGE);
+    assert_int_equal(ob_views_set_shadow_distance(w.views, INFINITY), OB_ERR_OUT_OF_RANGE);
+    assert_int_equal(ob_views_set_shadow_split_lambda(w.views, 1.5f), OB_ERR_OUT_OF_RANGE);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    assert_int_equal(ob_world_shadow_cascades(st, "sun", NULL), OB_SHADOW_DEFAULT_CASCADES);
+    static const uint32_t counts[] = {2, 1, 4, 3};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(counts); i++) {
+        assert_int_equal(ob_views_set_shadow_cascades(w.views, counts[i]), OB_OK);
+        st = ob_test_world_frame(&w, i % 2 ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+        assert_int_equal(ob_world_shadow_cascades(st, "sun", NULL), counts[i]);
+        char last[32];
+        snprintf(last, sizeof last, "shadow:sun:c%u", counts[i] - 1);
+        assert_non_null(ob_world_view_stats(st, last));
+    }
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(near_shadows_sharp_far_shadows_kept),
         cmocka_unit_test(shadow_holds_still_when_the_camera_moves),
+        cmocka_unit_test(cascade_settings_checked_and_applied),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
