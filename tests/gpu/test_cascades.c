@@ -242,6 +242,43 @@ static void shadow_holds_still_when_the_camera_moves(void **state)
     }
 }
 
+/* A caster the camera does not see (above it, toward the sun) still throws
+ * its shadow onto the floor the camera sees: the cascades reach toward the
+ * light past what the camera sees, and are culled on their own. */
+static void caster_out_of_view_still_casts(void **state)
+{
+    (void)state;
+    uint8_t *images[2];
+    uint32_t main_draws[2];
+    for (int run = 0; run < 2; run++) {
+        ob_test_world w;
+        ob_test_world_create(&w, NULL);
+        ob_material *m = ob_world_material(&w, "m", OB_MATERIAL_LIT, 0.8f, 0.3f, 0.2f, true);
+        ob_material *floor_m = ob_world_material(&w, "floor", OB_MATERIAL_LIT, 0.7f, 0.7f, 0.7f, false);
+        ob_world_entity(&w, NULL, "floor", w.plane, floor_m, 0, 0, 0);
+        ob_world_entity(&w, NULL, "seen", w.box, m, -1.5, 0.5, 0);
+        /* On the line from the origin toward the sun, 6 units up it: far
+         * above the camera's view (it looks down from (0, 2, 5)). */
+        ob_node *above = ob_world_entity(&w, NULL, "above", w.box, m, 1.36, 5.4, 2.0);
+        ob_node_set_hidden(above, run == 1);
+        ob_world_light(&w, OB_LIGHT_DIRECTIONAL, true, 1.0f, 2, 8, 3);
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        main_draws[run] = ob_world_view_stats(st, "main")->draws;
+        ob_world_read(&w);
+        images[run] = ob_world_copy(&w);
+        assert_non_null(images[run]);
+        ob_test_world_destroy(&w);
+    }
+    /* The camera draws the same entities either way... */
+    assert_int_equal(main_draws[0], main_draws[1]);
+    /* ...but the unseen box's shadow darkens the floor around the origin. */
+    uint32_t shadowed = ob_rgba_diff_count(images[1], images[0], 160 * 120, 12);
+    print_message("the unseen caster's shadow: %u pixels\n", shadowed);
+    assert_true(shadowed > 100);
+    free(images[0]);
+    free(images[1]);
+}
+
 /* Out-of-range settings are refused and keep the old value; a new count
  * applies from the next frame (the array map is made again). */
 static void cascade_settings_checked_and_applied(void **state)
@@ -278,6 +315,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(near_shadows_sharp_far_shadows_kept),
         cmocka_unit_test(shadow_holds_still_when_the_camera_moves),
+        cmocka_unit_test(caster_out_of_view_still_casts),
         cmocka_unit_test(cascade_settings_checked_and_applied),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
