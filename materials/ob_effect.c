@@ -266,7 +266,7 @@ static const char *base_name(const char *path)
     return s ? s + 1 : path;
 }
 
-/* "lit.vert+lit.frag SHADOWS=1": names a variant when the desc gives none. */
+/* "pbr.vert+pbr.frag SHADOWS=1": names a variant when the desc gives none. */
 static void default_name(const ob_effect_desc *desc, char *out, size_t cap)
 {
     size_t n = 0;

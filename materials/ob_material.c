@@ -53,10 +53,14 @@ static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_
     };
     switch (kind) {
     case OB_STD_LIT:
-        desc->vertex = "lit.vert";
-        desc->fragment = "lit.frag";
+        /* The metallic-roughness model with no texture: LIT and REFLECTIVE
+         * (ob_material_lit.c), in the standard layout (pbr.vert then reads
+         * only position, normal and uv). */
+        desc->vertex = "pbr.vert";
+        desc->fragment = "pbr.frag";
         if (variant & OB_VARIANT_SHADOWS) defines[n++] = (ob_shader_define){"SHADOWS", "1"};
         if (variant & OB_VARIANT_ENVMAP) defines[n++] = (ob_shader_define){"ENVMAP", "1"};
+        if (blended) defines[n++] = (ob_shader_define){"BLENDED", "1"};
         break;
     case OB_STD_DEPTH:
         desc->vertex = "depth.vert";
@@ -65,10 +69,11 @@ static void std_desc(const ob_material_library *lib, ob_std_effect kind, uint32_
         break;
     case OB_STD_PARABOLOID:
         /* The paraboloid mirrors the back hemisphere: winding means nothing. */
-        desc->vertex = "paraboloid.vert";
-        desc->fragment = "lit.frag";
+        desc->vertex = "pbr.vert";
+        desc->fragment = "pbr.frag";
         desc->cull = 0;
         defines[n++] = (ob_shader_define){"PARABOLOID", "1"};
+        if (blended) defines[n++] = (ob_shader_define){"BLENDED", "1"};
         break;
     case OB_STD_UNLIT:
         desc->vertex = "unlit.vert";
@@ -335,9 +340,8 @@ ob_material_library *ob_material_library_create(ob_effect_context *ctx,
      * made on first use, in a frame, where a missing file could only be
      * logged (issue 25.8). */
     static const char *const standard_shaders[] = {
-        "lit.vert", "lit.frag", "depth.vert", "paraboloid.vert", "unlit.vert", "unlit.frag",
-        "fullscreen.vert", "fullscreen.frag", "particles.comp", "particles.vert", "particles.frag",
-        "pbr.vert", "pbr.frag"};
+        "pbr.vert", "pbr.frag", "depth.vert", "unlit.vert", "unlit.frag", "fullscreen.vert",
+        "fullscreen.frag", "particles.comp", "particles.vert", "particles.frag"};
     r = ob_effect_context_check_shaders(ctx, "material library", standard_shaders,
                                         OB_ARRAY_COUNT(standard_shaders));
     if (r != OB_OK) goto fail_destroy_library;
@@ -382,8 +386,6 @@ ob_effect_context *ob_material_library_context(const ob_material_library *lib)
 }
 
 /* --------------------------------------------------------------- materials */
-
-static bool all_zero(const float v[4]) { return !v[0] && !v[1] && !v[2] && !v[3]; }
 
 static bool all_finite(const float *v, uint32_t n)
 {
@@ -432,7 +434,8 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
         goto fail_log;
     }
     if (!all_finite(desc->diffuse, 4) || !all_finite(desc->specular, 4) ||
-        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity) || !isfinite(desc->roughness)) {
+        !all_finite(desc->emissive, 4) || !isfinite(desc->reflectivity) || !isfinite(desc->roughness) ||
+        !isfinite(desc->metallic)) {
         OB_LOG_E("material", "material '%s': non-finite colour or reflectivity", name);
         r = OB_ERR_NON_FINITE;
         goto fail_log;
@@ -448,17 +451,16 @@ ob_material *ob_material_create(ob_material_library *lib, const ob_material_desc
     m->lib = lib;
     snprintf(m->name, sizeof m->name, "%s", name);
     m->kind = desc->kind;
-    static const float white[4] = {1, 1, 1, 1}, soft_highlight[4] = {0.25f, 0.25f, 0.25f, 32};
-    memcpy(m->diffuse, all_zero(desc->diffuse) ? white : desc->diffuse, sizeof m->diffuse);
-    memcpy(m->specular, all_zero(desc->specular) ? soft_highlight : desc->specular,
-           sizeof m->specular);
+    ob_lit_defaults(desc, m->diffuse, m->specular);
     memcpy(m->emissive, desc->emissive, sizeof m->emissive);
     m->reflectivity[0] = desc->kind == OB_MATERIAL_PBR         ? OB_MAX(desc->reflectivity, 0.0f)
                          : desc->kind != OB_MATERIAL_REFLECTIVE ? 0.0f
                          : desc->reflectivity != 0.0f          ? desc->reflectivity
                                                                : 0.6f;
-    if (desc->kind == OB_MATERIAL_REFLECTIVE)   /* Reflectivity.y: lit.frag's blur */
-        m->reflectivity[1] = OB_MIN(OB_MAX(desc->roughness, 0.0f), 1.0f);
+    m->metallic = desc->metallic;
+    m->roughness = desc->roughness;
+    m->metallic_roughness = desc->metallic_roughness;
+    ob_lit_refresh(m);
     m->casts_shadows = desc->casts_shadows;
     m->blended = desc->blended;
     if (desc->kind == OB_MATERIAL_PBR) {
@@ -526,6 +528,7 @@ static ob_result set_color(ob_material *m, float dest[4], const float v[4])
         return OB_ERR_NON_FINITE;
     }
     memcpy(dest, v, 4 * sizeof *v);
+    ob_lit_refresh(m);
     return OB_OK;
 }
 
@@ -543,7 +546,7 @@ ob_result ob_material_set_emissive(ob_material *m, const float rgb[4])
 }
 ob_result ob_material_set_reflectivity(ob_material *m, float reflectivity)
 {
-    float v[4] = {reflectivity, m ? m->reflectivity[1] : 0.0f, 0, 0};   /* roughness kept */
+    float v[4] = {reflectivity, 0, 0, 0};
     return set_color(m, m ? m->reflectivity : NULL, v);
 }
 
@@ -804,10 +807,18 @@ static ob_apply_result iface_apply(struct ob_material *m, ob_node *entity, ob_re
     if (m->kind == OB_MATERIAL_PBR && !m->custom[v->type])
         return ob_pbr_set_params(m, entity, r, params, v, variant & OB_VARIANT_ENVMAP);
     const ob_material_library *lib = m->lib;
-    ob_params_set_vec4(params, lib->diffuse, m->diffuse);
-    ob_params_set_vec4(params, lib->specular, m->specular);
-    ob_params_set_vec4(params, lib->emissive, m->emissive);
-    ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
+    if ((m->kind == OB_MATERIAL_LIT || m->kind == OB_MATERIAL_REFLECTIVE) && !m->custom[v->type]) {
+        /* The mirror share is in the mapped F0: the map at full strength.
+         * (An effect of the application's own gets the description as
+         * given, in PerMaterial, below.) */
+        const float env[4] = {m->kind == OB_MATERIAL_REFLECTIVE ? 1.0f : 0.0f, 0, 0, 0};
+        ob_pbr_set_factors(m, params, env);
+    } else {
+        ob_params_set_vec4(params, lib->diffuse, m->diffuse);
+        ob_params_set_vec4(params, lib->specular, m->specular);
+        ob_params_set_vec4(params, lib->emissive, m->emissive);
+        ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
+    }
     if (variant & OB_VARIANT_ENVMAP) {
         /* Each reflective entity samples its own map: bind it per draw. */
         ob_view *env = ob_material_attached_env_map(r, entity);

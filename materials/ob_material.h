@@ -2,16 +2,24 @@
  * (Hieroglyph 3's MaterialDX11 with Params[VT_NUM_VIEW_TYPES]).
  *
  * A material says, per view type, whether an entity using it is drawn there
- * and with which effect, plus its own parameters (DiffuseColor,
- * SpecularColor, EmissiveColor, Reflectivity), which it writes into the
- * recording manager's slot when applied. The engine reaches materials only
+ * and with which effect, plus its own parameters, which it writes into the
+ * recording manager's slot when applied.
+ *
+ * One lighting model: LIT, REFLECTIVE and PBR are all drawn by the glTF 2
+ * metallic-roughness model of pbr.frag (docs/materials.md). LIT and
+ * REFLECTIVE keep their Blinn-Phong-style description (diffuse, specular
+ * colour and power, emissive, reflectivity, roughness) and are mapped to
+ * that model's base colour, metallic and roughness (the PbrMaterial block;
+ * ob_material_desc_to_pbr says what a description becomes), or take
+ * metallic and roughness as given (metallic_roughness). UNLIT is not lit. The engine reaches materials only
  * through ob_material_iface (engine/ob_renderer.h), which
  * ob_material_iface_get() implements.
  *
  * Standard kinds and the effect used per view type:
- *   LIT         perspective: lit (+SHADOWS when the view depends on a shadow
- *               view this frame); shadow: depth-only when casts_shadows;
- *               paraboloid: paraboloid generation (lit shading).
+ *   LIT         perspective: lit (pbr.vert + pbr.frag with no texture, the
+ *               standard vertex layout; +SHADOWS when the view depends on a
+ *               shadow view this frame); shadow: depth-only when casts_shadows;
+ *               paraboloid: paraboloid generation (the same shading).
  *   REFLECTIVE  perspective: lit + ENVMAP (paraboloid lookup) when the entity
  *               has an environment-map view attached this frame
  *               (ob_renderer_attached_view), plain lit otherwise;
@@ -96,9 +104,9 @@ typedef enum ob_material_kind {
 
 /* Standard effects of the library; variants are flags. */
 typedef enum ob_std_effect {
-    OB_STD_LIT = 0,           /* lit.vert + lit.frag */
+    OB_STD_LIT = 0,           /* pbr.vert + pbr.frag, no texture, standard layout (LIT, REFLECTIVE) */
     OB_STD_DEPTH,             /* depth.vert, no fragment stage, depth bias */
-    OB_STD_PARABOLOID,        /* paraboloid.vert + lit.frag PARABOLOID, no culling */
+    OB_STD_PARABOLOID,        /* the same with PARABOLOID, no culling */
     OB_STD_UNLIT,             /* unlit.vert + unlit.frag, standard layout */
     OB_STD_OVERLAY,           /* unlit SCREEN_SPACE + VERTEX_COLOR, text layout, blended */
     OB_STD_FULLSCREEN,        /* fullscreen.vert + .frag, no vertex input, no depth */
@@ -178,14 +186,28 @@ typedef struct ob_material_desc {
     const char *name;          /* copied; NULL → "material" */
     ob_material_kind kind;
     /* Zero means default: diffuse (1,1,1,1); specular (0.25,0.25,0.25, power
-     * 32) — use {0,0,0,1} for no highlight; emissive none; reflectivity 0.6
-     * for REFLECTIVE (ignored otherwise). */
+     * 32) — {0,0,0,1} for the faintest highlight (a dielectric's); emissive
+     * none; reflectivity 0.6 for REFLECTIVE (ignored otherwise).
+     * LIT and REFLECTIVE are drawn by the metallic-roughness model: diffuse
+     * is the base colour (its alpha used only when blended); the specular
+     * power gives roughness (2 / (power + 2))^(1/4); the specular colour
+     * ks the reflectance F0 = 8 ks / (power + 2) (the highlight's peak kept),
+     * REFLECTIVE's reflectivity raises F0 to at least itself (the share it
+     * mirrors); an F0 over a dielectric's 0.04 becomes metallic, by the glTF
+     * specular-glossiness conversion. docs/materials.md has the table. */
     float diffuse[4], specular[4], emissive[4];
     float reflectivity;
-    /* REFLECTIVE only: how rough the mirror is, 0 (sharp, default) to 1; the
-     * environment map is sampled at a coarser mip level (blurred) the
-     * rougher it is, as a PBR material's roughness does. Clamped to [0, 1]. */
+    /* REFLECTIVE: its roughness in the model, 0 (a mirror, default) to 1:
+     * the environment map is sampled at a coarser mip level (blurred) and
+     * the highlights spread the rougher it is (the specular power then
+     * only sets F0). LIT: read only with metallic_roughness. Clamped to [0, 1]. */
     float roughness;
+    /* LIT and REFLECTIVE: take metallic (0..1) and roughness as given, base
+     * colour = diffuse, instead of deriving them from the specular colour,
+     * power and reflectivity (then unused); a REFLECTIVE material's
+     * environment map is then weighted by the model's Fresnel alone. */
+    float metallic;
+    bool metallic_roughness;
     bool casts_shadows;
     bool blended;              /* sorted back to front, drawn with the BLENDED variant */
     uint32_t priority;         /* orders materials within a sort class */
@@ -268,7 +290,15 @@ ob_material_view_params ob_material_get_view_params(const ob_material *m, ob_vie
  * `type`; NULL stops drawing there. The caller owns the effect and keeps it
  * alive as long as the material. [render thread, not while recording] */
 ob_result ob_material_set_view_effect(ob_material *m, ob_view_type type, ob_effect *effect);
-/* Parameters; non-finite values are refused (OB_ERR_NON_FINITE). [render thread] */
+/* What a LIT or REFLECTIVE description is in the metallic-roughness model:
+ * a PBR description (pbr: base colour, metallic, roughness, emissive, alpha
+ * mode from blended; reflectivity 1 for REFLECTIVE, 0 for LIT) that draws
+ * the same surface (in the extended vertex layout). Other kinds: *desc
+ * unchanged. NULL: a zeroed desc. [any thread] */
+ob_material_desc ob_material_desc_to_pbr(const ob_material_desc *desc);
+
+/* Parameters; non-finite values are refused (OB_ERR_NON_FINITE). A LIT or
+ * REFLECTIVE material maps them to its model factors again. [render thread] */
 ob_result ob_material_set_diffuse(ob_material *m, const float rgba[4]);
 ob_result ob_material_set_specular(ob_material *m, const float rgb_power[4]);
 ob_result ob_material_set_emissive(ob_material *m, const float rgb[4]);

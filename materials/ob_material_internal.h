@@ -82,19 +82,35 @@ struct ob_material {
     ob_material_library *lib;
     char name[48];
     ob_material_kind kind;
+    /* As given (desc, setters). LIT and REFLECTIVE draw with pbr.block,
+     * mapped from these by ob_lit_refresh; reflectivity.x: the REFLECTIVE
+     * mix, or PBR's environment scale. */
     float diffuse[4], specular[4], emissive[4], reflectivity[4];
+    float metallic, roughness;     /* LIT, REFLECTIVE: desc's (ob_lit_refresh reads them) */
+    bool metallic_roughness;
     bool casts_shadows, blended;
     uint32_t priority;
     uint32_t id;                   /* creation order in its library: groups draws */
     bool render[OB_VIEW_TYPE_COUNT];
     ob_effect *custom[OB_VIEW_TYPE_COUNT];
     atomic_bool warned;            /* a skipped draw is logged once */
-    ob_material_pbr_state pbr;     /* kind == OB_MATERIAL_PBR */
+    /* kind == OB_MATERIAL_PBR: all of it; LIT and REFLECTIVE: block[0..2]
+     * (their parameter set of the same model, ob_lit_refresh). */
+    ob_material_pbr_state pbr;
 };
 
 /* ob_material.c helpers the PBR kind shares. */
 bool ob_material_view_depends_on(const ob_view *v, ob_view_type type);
 ob_view *ob_material_attached_env_map(const ob_renderer *r, const ob_node *entity);
+
+/* ob_material_lit.c */
+/* desc's diffuse and specular with zero meaning default (white; 0.25 grey,
+ * power 32), as every kind but PBR keeps them. */
+void ob_lit_defaults(const ob_material_desc *desc, float diffuse[4], float specular[4]);
+/* Maps m's LIT or REFLECTIVE parameters (diffuse, specular, emissive,
+ * reflectivity, metallic/roughness) to the metallic-roughness factors in
+ * m->pbr.block[0..2]; after creation and after each setter. */
+void ob_lit_refresh(ob_material *m);
 
 /* ob_material_pbr.c */
 /* Registers PbrBaseColor, PbrFactors, PbrEmissive, PbrClearcoat,
@@ -109,6 +125,10 @@ ob_result ob_pbr_material_init(ob_material *m, const ob_material_desc *desc);
  * *out_env says whether it is the ENVMAP variant. */
 ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity, const ob_view *v, bool create,
                           bool *out_env, ob_result *out_result);
+/* The PbrMaterial factors of m->pbr.block[0..2] and Reflectivity = env
+ * (the environment term's scale), the rest of PerMaterial zeroed: what
+ * every metallic-roughness draw sets (PBR, LIT and REFLECTIVE). */
+void ob_pbr_set_factors(const ob_material *m, ob_params *params, const float env[4]);
 /* apply's PBR part, after the shared code set the pipeline: the material's
  * factors and textures, and with `env` the entity's environment map. */
 ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,

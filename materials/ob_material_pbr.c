@@ -434,23 +434,30 @@ ob_effect *ob_pbr_resolve(ob_material *m, ob_renderer *r, const ob_node *entity,
     return e;
 }
 
-ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,
-                                  const ob_view *v, bool env)
+void ob_pbr_set_factors(const ob_material *m, ob_params *params, const float env[4])
 {
     const ob_material_library *lib = m->lib;
     const ob_pbr_params *p = &lib->pbr;
     ob_params_set_vec4(params, p->base_color, m->pbr.block[0]);
     ob_params_set_vec4(params, p->factors, m->pbr.block[1]);
     ob_params_set_vec4(params, p->emissive, m->pbr.block[2]);
-    ob_params_set_vec4(params, lib->reflectivity, m->reflectivity);
+    ob_params_set_vec4(params, lib->reflectivity, env);
     /* The rest of the shared PerMaterial block (pbr.frag declares it through
      * common.glsl but reads only Reflectivity) gets a defined value too: its
-     * packed bytes, and so the command hashes, must not carry the last lit
+     * packed bytes, and so the command hashes, must not carry the last unlit
      * material this slot applied, which differs between ST and MT. */
     static const float unused[4] = {0, 0, 0, 0};
     ob_params_set_vec4(params, lib->diffuse, unused);
     ob_params_set_vec4(params, lib->specular, unused);
     ob_params_set_vec4(params, lib->emissive, unused);
+}
+
+ob_apply_result ob_pbr_set_params(ob_material *m, ob_node *entity, ob_renderer *r, ob_params *params,
+                                  const ob_view *v, bool env)
+{
+    const ob_material_library *lib = m->lib;
+    const ob_pbr_params *p = &lib->pbr;
+    ob_pbr_set_factors(m, params, m->reflectivity);
     /* Only variants that declare these read them: others set nothing new. */
     if (m->pbr.features & OB_PBR_F_CLEARCOAT) ob_params_set_vec4(params, p->clearcoat, m->pbr.block[3]);
     if (m->pbr.features & (OB_PBR_F_UV_TRANSFORM | OB_PBR_F_TEXCOORD1))

@@ -83,7 +83,7 @@ typedef struct ob_shader_desc {
 
 /* Immutable once returned; owned by its compiler until the compiler is destroyed. */
 typedef struct ob_shader {
-    const char *name;          /* path + defines sorted by name: "lit.frag [SHADOWS=1]" */
+    const char *name;          /* path + defines sorted by name: "pbr.frag [SHADOWS=1]" */
     ob_shader_stage stage;
     uint64_t hash;             /* preprocessed source + stage + defines + compiler version */
     const uint32_t *spirv;

@@ -59,7 +59,7 @@ uint32_t ob_shader_source_log(const ob_shader_source *src, const char *variant_n
                               const char *info_log);
 
 /* Validates and sorts the defines, then builds the variant name
- * ("lit.frag [A=1, B=2]") and the preamble ("#define A 1\n#define B 2\n").
+ * ("pbr.frag [A=1, B=2]") and the preamble ("#define A 1\n#define B 2\n").
  * Both are ob_malloc'ed. Failure: OB_ERR_INVALID_ARGUMENT (logged, naming
  * the define), OB_ERR_OUT_OF_HOST_MEMORY. */
 ob_result ob_shader_variant_describe(const ob_shader_desc *desc, char **out_name,

@@ -123,6 +123,22 @@ static void print_msaa(FILE *f, const ob_bench_report *rep)
     }
 }
 
+static void print_lights(FILE *f, const ob_bench_report *rep)
+{
+    if (!rep->lights_count) return;
+    fprintf(f, "\nlights at fixed coverage (a wall and 120 boxes, %ux%u, ST; each light's range "
+               "1.25 grid spacings), %s per frame over %u rounds of %u frames:\n"
+               "  %6s %7s %-6s %9s %9s %9s\n",
+            rep->lights_width, rep->lights_height,
+            rep->lights[0].cpu_measure ? "process CPU ms (CPU device)" : "GPU ms", rep->lights_rounds,
+            rep->lights_frames, "lights", "range", "tiles", "median", "p25", "p75");
+    for (uint32_t i = 0; i < rep->lights_count; i++) {
+        const ob_bench_lights_row *l = &rep->lights[i];
+        fprintf(f, "  %6u %7.3f %-6s %9.2f %9.2f %9.2f\n", l->lights, l->range,
+                l->tiles ? "grid" : "all", l->cost_ms.median, l->cost_ms.p25, l->cost_ms.p75);
+    }
+}
+
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
     fprintf(f, "sweep: medians (ms) over %u idle rounds of each mode's fastest of %u frames, "
@@ -165,6 +181,7 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                                                       : "equal");
     }
     print_msaa(f, rep);
+    print_lights(f, rep);
     const ob_bench_summary *s = &rep->summary;
     fprintf(f, "\nsummary (ratios: median of per-round ratios [p25, p75]):\n");
     print_spread(f, "mt_speedup_record_10k_8views", s->mt_speedup_record_10k_8views);
@@ -194,6 +211,10 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fprintf(f, "\n  %-30s %.3f (GPU ms, ST, 10k x 8 views: instanced %.1f, one draw per entity "
                "%.1f)", "gpu_time_instanced_vs_per_draw", s->gpu_time_instanced_vs_per_draw_10k_8views,
             s->gpu_ms_10k_8views, s->gpu_ms_10k_8views_per_draw);
+    fprintf(f, "\n  %-30s %.3f with the tile grid, %.3f with every light everywhere "
+               "(frame cost from 4 to 256 lights at fixed coverage; below 1: sub-linear)",
+            "lights_cost_exponent_4_to_256", s->lights_cost_exponent_4_to_256,
+            s->lights_cost_exponent_4_to_256_all);
     fprintf(f, "\n  %-30s %.3f (ST record per draw, 1 view; ratio of medians)\n"
                "  %-30s %.2f engine (estimate), %.2f raw\n  %-30s %.2f engine, %.2f raw\n",
             "per_object_growth_50k_vs_1k", s->per_object_growth_50k_vs_1k, "commands_per_object",
@@ -411,6 +432,8 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "gpu_ms_10k_8views_per_draw", s->gpu_ms_10k_8views_per_draw);
     json_field(f, "gpu_time_instanced_vs_per_draw_10k_8views",
                s->gpu_time_instanced_vs_per_draw_10k_8views);
+    json_field(f, "lights_cost_exponent_4_to_256", s->lights_cost_exponent_4_to_256);
+    json_field(f, "lights_cost_exponent_4_to_256_all", s->lights_cost_exponent_4_to_256_all);
     json_field(f, "teardown_ns_per_entity_batch", s->teardown_ns_per_entity_batch);
     json_field(f, "teardown_ns_per_entity_single", s->teardown_ns_per_entity_single);
     json_field(f, "commands_per_object_engine", s->commands_per_object_engine);
@@ -545,7 +568,17 @@ static void json_perf(FILE *f, const ob_bench_report *rep)
                 q->max_abs_diff, q->hash_mismatches,
                 q->max_abs_diff == 0 && q->hash_mismatches == 0 ? "true" : "false");
     }
-    fputs("],\n", f);
+    fprintf(f, "],\n\"lights\":{\"size\":[%u,%u],\"rounds\":%u,\"frames\":%u,\"rows\":[",
+            rep->lights_width, rep->lights_height, rep->lights_rounds, rep->lights_frames);
+    for (uint32_t i = 0; i < rep->lights_count; i++) {
+        const ob_bench_lights_row *l = &rep->lights[i];
+        fprintf(f, "%s\n  {\"lights\":%u,\"range\":%.4f,\"tiles\":%s,\"measure\":\"%s\",",
+                i ? "," : "", l->lights, l->range, l->tiles ? "true" : "false",
+                l->cpu_measure ? "process_cpu" : "gpu");
+        json_spread(f, "cost_ms", l->cost_ms);
+        fputs("\"unit\":\"ms\"}", f);
+    }
+    fputs("]},\n", f);
     json_summary(f, rep);
 }
 

@@ -13,6 +13,7 @@
 
 #include <stdio.h>
 
+#include "ob_bench_lights.h"
 #include "ob_bench_quality.h"
 #include "ob_bench_raw.h"
 #include "ob_bench_run.h"
@@ -74,6 +75,11 @@ typedef struct ob_bench_summary {
      * their ratio. */
     double gpu_ms_10k_8views, gpu_ms_10k_8views_per_draw;
     double gpu_time_instanced_vs_per_draw_10k_8views;
+    /* The lights section (ob_bench_lights.h): the exponent of the frame
+     * cost's growth from 4 to 256 point lights at fixed coverage, with the
+     * tile grid and with every light in every fragment (below 1:
+     * sub-linear). */
+    double lights_cost_exponent_4_to_256, lights_cost_exponent_4_to_256_all;
     /* vkCmd calls per visible object: the engine's estimated from the
      * pipeline manager's issued counters, the raw loop's counted; in the raw
      * configuration, ST */
@@ -116,6 +122,9 @@ typedef struct ob_bench_report {
     uint32_t quality_count;
     ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */
     ob_bench_sweep_entry per_draw_10k_8views;      /* ST, --no-instancing (mode_count 0: not run) */
+    ob_bench_lights_row *lights;                   /* the lights section's rows */
+    uint32_t lights_count;
+    uint32_t lights_width, lights_height, lights_frames, lights_rounds;
     ob_bench_summary summary;
 } ob_bench_report;
 

@@ -15,6 +15,9 @@
  *              highest-quality single-threaded image next to frame time; the
  *              threading modes must give that image byte for byte; MSAA
  *              sample counts against a supersampled antialiasing reference
+ *   lights     frame cost against point-light count at fixed coverage, with
+ *              the tile grid and with every light everywhere
+ *              (ob_bench_lights.h)
  *   teardown   destroying a scene graph of 100k entities, in one call and
  *              one entity at a time (no device)
  *   stability  numerical precision and extreme cases (ob_stability.h):
@@ -733,6 +736,14 @@ static int run(const bench_options *o)
     /* A stability case takes about as long as a dozen mirror-scene frames. */
     const uint64_t stability_unit = 12;
     if (o->stability) total += ob_stability_case_count() * stability_unit;
+    ob_bench_lights_desc ld = {.width = o->quick ? 320 : 640, .height = o->quick ? 240 : 480,
+                               .frames = o->quick ? 4 : 8, .rounds = 3,
+                               .tick = ob_bench_progress_tick};
+    rep.lights_width = ld.width;
+    rep.lights_height = ld.height;
+    rep.lights_frames = ld.frames;
+    rep.lights_rounds = ld.rounds;
+    if (o->perf) total += ob_bench_lights_frames(&ld);
     ob_bench_progress prog;
     ob_bench_progress_init(&prog, total, o->progress);
     qd.tick = ob_bench_progress_tick;
@@ -774,6 +785,11 @@ static int run(const bench_options *o)
         ob_bench_progress_label(&prog, "quality and threading check (mirror scene)");
         r = ob_bench_quality_run(&qd, &rep.quality, &rep.quality_count);
     }
+    if (r == OB_OK && o->perf) {
+        ob_bench_progress_label(&prog, "lights: 0 to 256 point lights, grid and every light");
+        ld.tick_user = &prog;
+        r = ob_bench_lights_run(&ld, &rep.lights, &rep.lights_count);
+    }
     ob_stability stab = {0};
     if (r == OB_OK && o->stability) {
         prog.unit = stability_unit;
@@ -798,6 +814,10 @@ static int run(const bench_options *o)
     } else {
         if (o->perf) {
             summarize(&rep);
+            rep.summary.lights_cost_exponent_4_to_256 =
+                ob_bench_lights_exponent(rep.lights, rep.lights_count, true);
+            rep.summary.lights_cost_exponent_4_to_256_all =
+                ob_bench_lights_exponent(rep.lights, rep.lights_count, false);
             rep.summary.teardown_ns_per_entity_batch = teardown_ns(true);
             rep.summary.teardown_ns_per_entity_single = teardown_ns(false);
         }
@@ -833,6 +853,7 @@ static int run(const bench_options *o)
     ob_stability_release(&stab);
     ob_free(rep.sweep);
     ob_free(rep.quality);
+    ob_free(rep.lights);
     return code;
 }
 

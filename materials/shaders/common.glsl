@@ -36,10 +36,10 @@ layout(set = 0, binding = 0, std140) uniform PerView {
 };
 
 layout(set = 0, binding = 1, std140) uniform PerMaterial {
-    vec4 DiffuseColor;         // rgba (alpha used when blended)
-    vec4 SpecularColor;        // rgb, w = Blinn-Phong power
-    vec4 EmissiveColor;        // rgb added unlit
-    vec4 Reflectivity;         // x = mix factor of the environment map, y = its roughness (reflective)
+    vec4 DiffuseColor;         // rgba (unlit.frag; alpha used when blended)
+    vec4 SpecularColor;        // unused by the standard shaders (LIT maps it to PbrMaterial)
+    vec4 EmissiveColor;        // unused by the standard shaders (LIT maps it to PbrMaterial)
+    vec4 Reflectivity;         // x = scale of pbr.frag's environment-map term
 };
 
 #if defined(INSTANCED)

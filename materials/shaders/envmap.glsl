@@ -1,5 +1,5 @@
-// envmap.glsl — sampling an entity's environment map (lit.frag and pbr.frag
-// with ENVMAP), whichever kind the views layer made for it:
+// envmap.glsl — sampling an entity's environment map (pbr.frag with
+// ENVMAP), whichever kind the views layer made for it:
 //   EnvMapInfo.x = 0  dual paraboloid: layer 0 the +Z hemisphere, layer 1 -Z
 //                     (paraboloid.glsl);
 //   EnvMapInfo.x = 1  cube map in a 2D array of six layers, faces +X, -X,

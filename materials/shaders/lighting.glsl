@@ -1,6 +1,8 @@
-// lighting.glsl — Blinn-Phong for one directional light and any number of
-// point and spot lights, in camera-relative world space (the eye is at the
-// origin).
+// lighting.glsl — the lights of the lit shaders (pbr.frag, which lights
+// every LIT, REFLECTIVE and PBR material with pbr.glsl's BRDF), in
+// camera-relative world space (the eye is at the origin): the point and spot
+// lights' table and tile grid, and what one of them sends to a point. The
+// directional light is common.glsl's LightDirection and LightColor.
 //
 // Point and spot lights: views/ob_views_lights.c fills PerViewLights per view
 // with the scene's first OB_MAX_LIGHTS lights (node-id order) and a 16 x 16
@@ -68,43 +70,6 @@ void ob_local_light(uint i, vec3 p, out vec3 l, out vec3 radiance)
         att *= t * t * (3.0 - 2.0 * t);
     }
     radiance = color.rgb * color.w * att;
-}
-
-vec3 ob_blinn_phong(vec3 n, vec3 v, vec3 l, vec3 radiance, vec3 diffuse, vec4 specular)
-{
-    float ndotl = max(dot(n, l), 0.0);
-    if (ndotl <= 0.0) return vec3(0.0);
-    vec3 h = ob_safe_normalize(l + v);
-    float spec = specular.w > 0.0 ? pow(max(dot(n, h), 0.0), specular.w) : 0.0;
-    return radiance * (diffuse * ndotl + specular.rgb * spec);
-}
-
-// Directional light contribution; `visibility` is the shadow term (1 = lit).
-vec3 ob_directional_light(vec3 n, vec3 v, vec3 diffuse, vec4 specular, float visibility)
-{
-    if (LightColor.w <= 0.0) return vec3(0.0);
-    vec3 l = ob_safe_normalize(LightDirection.xyz);
-    return visibility * ob_blinn_phong(n, v, l, LightColor.rgb * LightColor.w, diffuse, specular);
-}
-
-// Every point and spot light of the fragment's tile, summed in light order.
-vec3 ob_local_lights(vec3 p, vec3 n, vec3 v, vec3 diffuse, vec4 specular)
-{
-    vec3 sum = vec3(0.0);
-    uint tile = ob_light_tile();
-    // Only the words that can hold a light: walking all eight costs a
-    // scene of two lights three times its frame time on lavapipe.
-    for (uint w = 0u; w < uint(LightGrid.z); w++) {
-        uint bits = ob_light_word(tile, w);
-        while (bits != 0u) {
-            uint i = w * 32u + uint(findLSB(bits));
-            bits &= bits - 1u;
-            vec3 l, radiance;
-            ob_local_light(i, p, l, radiance);
-            sum += ob_blinn_phong(n, v, l, radiance, diffuse, specular);
-        }
-    }
-    return sum;
 }
 
 #endif

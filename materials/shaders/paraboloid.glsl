@@ -1,5 +1,5 @@
 // paraboloid.glsl — the dual-paraboloid mapping shared by the map generation
-// (paraboloid.vert) and the lookup (lit.frag with ENVMAP).
+// (pbr.vert with PARABOLOID) and the lookup (envmap.glsl, pbr.frag with ENVMAP).
 //
 // A direction d, expressed in the map's frame (the paraboloid view's
 // ViewMatrix, i.e. the owner's world->local rotation, also bound to lookups as

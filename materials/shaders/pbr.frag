@@ -1,6 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// pbr.frag — glTF 2 metallic-roughness material.
+// pbr.frag — glTF 2 metallic-roughness material: the one lighting model of
+// the LIT, REFLECTIVE (their parameter sets, ob_material_lit.c, with no
+// texture and the standard vertex layout) and PBR kinds.
 //
 // Lighting model (docs/materials.md has the long form):
 //   colour = emissive
@@ -35,7 +37,8 @@
 //   ALPHA_MASK                      discard below the cutoff, alpha 1
 //   BLENDED                         alpha blended (alpha mode BLEND)
 //   DOUBLE_SIDED                    back faces drawn with the normal flipped
-//   SHADOWS, ENVMAP                 as lit.frag
+//   SHADOWS                         the directional light shadowed (shadow.glsl)
+//   ENVMAP                          the entity's environment map (envmap.glsl)
 //   PARABOLOID                      drawn into an environment map (pbr.vert)
 //   DEPTH_ONLY                      shadow pass of an ALPHA_MASK material: the
 //                                   cut-out only, no colour

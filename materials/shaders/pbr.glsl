@@ -12,11 +12,11 @@
 //
 // Light units: the engine's lights are given as radiance at normal
 // incidence (LightColor.rgb * w, a local light's colour * intensity times the
-// attenuation), and lit.frag shows a white surface under a unit light as
-// white (diffuse * NdotL, no 1/pi). pbr.frag keeps that: every BRDF term is
-// multiplied by pi (the usual "punctual light intensity" convention), so a
-// white dielectric at roughness 1 matches a lit material of the same colour
-// up to the Fresnel and specular terms.
+// attenuation), and a white Lambert surface facing a unit light shows
+// white (diffuse * NdotL, no 1/pi): every BRDF term is multiplied by pi
+// (the usual "punctual light intensity" convention), so a white dielectric
+// at roughness 1 shows its colour * NdotL up to the Fresnel and specular
+// terms. This is the one BRDF: LIT and REFLECTIVE materials draw with it too.
 #ifndef OB_PBR_GLSL
 #define OB_PBR_GLSL
 
@@ -38,9 +38,17 @@ float ob_smith_vis(float ndotl, float ndotv, float a)
     return s > 0.0 ? 0.5 / s : 0.0;
 }
 
+// x^5 by multiplication: pow() is exp2(5 log2 x) on lavapipe, and every
+// lit fragment takes it once per light and once for the ambient term.
+float ob_pow5(float x)
+{
+    float x2 = x * x;
+    return x2 * x2 * x;
+}
+
 vec3 ob_fresnel_schlick(vec3 f0, float vdoth)
 {
-    return f0 + (1.0 - f0) * pow(clamp(1.0 - vdoth, 0.0, 1.0), 5.0);
+    return f0 + (1.0 - f0) * ob_pow5(clamp(1.0 - vdoth, 0.0, 1.0));
 }
 
 // Surface description at one fragment.
@@ -65,7 +73,7 @@ struct ob_surface {
 float ob_clearcoat_fresnel(ob_surface s)
 {
     float ndotv = clamp(dot(s.cn, s.v), 0.0, 1.0);
-    return 0.04 + 0.96 * pow(1.0 - ndotv, 5.0);
+    return 0.04 + 0.96 * ob_pow5(1.0 - ndotv);
 }
 
 vec3 ob_clearcoat_light(ob_surface s, vec3 l, vec3 radiance)
@@ -116,7 +124,7 @@ vec3 ob_fresnel_ambient(ob_surface s)
     float ndotv = max(dot(s.n, s.v), 0.0);
     float roughness = sqrt(s.a);
     vec3 fmax = max(vec3(1.0 - roughness), s.f0);
-    return s.f0 + (fmax - s.f0) * pow(1.0 - ndotv, 5.0);
+    return s.f0 + (fmax - s.f0) * ob_pow5(1.0 - ndotv);
 }
 
 #endif

@@ -1,13 +1,16 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // pbr.vert — vertex stage of the glTF metallic-roughness material (pbr.frag).
+// LIT and REFLECTIVE draw it in the standard layout (position, normal, uv;
+// stride 32): with no colour, tangent or TEXCOORD1 it reads nothing else.
 // Input: the extended vertex layout (position, normal, uv, colour RGBA8 at
 // location 3, tangent xyz + bitangent sign at location 4; stride 52); only
 // what the variant uses is declared, so unused attributes cost nothing.
 //
 // Variants: VERTEX_COLOR (colour passed on), HAS_NORMAL_TEXTURE (tangent
 // passed on, in world space: it transforms with WorldMatrix, not the normal
-// matrix), PARABOLOID (dual-paraboloid projection as paraboloid.vert does),
+// matrix), PARABOLOID (dual-paraboloid projection of paraboloid.glsl; the
+// fragment stage discards the other hemisphere),
 // DEPTH_ONLY (shadow pass of ALPHA_MASK materials: position and uv only),
 // HAS_TEXCOORD1 (the second uv set, location 5 of the extended layout with
 // TEXCOORD1, passed on), HAS_CLEARCOAT_NORMAL_TEXTURE (tangent passed on, as

@@ -117,9 +117,10 @@ static void test_standard_effects_build(void **state)
     ob_effect_local_size(sim, ls);
     assert_int_equal(ls[0], 64);
     assert_int_equal(ob_effect_program(sim)->bind_point, VK_PIPELINE_BIND_POINT_COMPUTE);
-    /* The lit program's uniform blocks: PerView, PerMaterial and
-     * PerViewLights (the point and spot lights) in set 0. */
-    assert_int_equal(ob_effect_program(ob_material_library_find_effect(lib, OB_STD_LIT, 0))->ubo_count, 3);
+    /* The lit program's uniform blocks: PerView, PerMaterial, PbrMaterial
+     * (the metallic-roughness factors LIT is mapped to) and PerViewLights
+     * (the point and spot lights) in set 0. */
+    assert_int_equal(ob_effect_program(ob_material_library_find_effect(lib, OB_STD_LIT, 0))->ubo_count, 4);
 
     ob_effect_counters c = ob_effect_context_counters(ctx);
     assert_int_equal(c.variants_compiled, OB_ARRAY_COUNT(cases));
@@ -159,7 +160,7 @@ static void test_pipeline_once_per_format_pair(void **state)
     ob_effect_context *ctx = make_context(f, "pairs");
     ob_result r;
     ob_effect *e = ob_effect_create(ctx, &(ob_effect_desc){
-        .name = "pairs", .vertex = "lit.vert", .fragment = "lit.frag", .layout = &standard_input,
+        .name = "pairs", .vertex = "pbr.vert", .fragment = "pbr.frag", .layout = &standard_input,
         .depth_test = true, .depth_write = true, .cull = VK_CULL_MODE_BACK_BIT}, &r);
     assert_non_null(e);
     assert_int_equal(ob_effect_pipeline_count(e), 0);   /* nothing until first use */
@@ -245,12 +246,12 @@ static void test_bad_desc_refused(void **state)
     fixture *f = *state;
     ob_effect_context *ctx = make_context(f, "bad");
     ob_result r;
-    /* lit.vert reads the normal (location 1): a position-only layout lacks it. */
+    /* pbr.vert reads the normal (location 1): a position-only layout lacks it. */
     ob_effect_vertex_input position_only = {
         .stride = 12, .attribute_count = 1, .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}}};
     ob_test_log_clear();
     assert_null(ob_effect_create(ctx, &(ob_effect_desc){
-        .name = "no-normal", .vertex = "lit.vert", .fragment = "lit.frag",
+        .name = "no-normal", .vertex = "pbr.vert", .fragment = "pbr.frag",
         .layout = &position_only}, &r));
     assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
     assert_true(ob_test_log_has("no-normal", "inNormal", "location 1", NULL));
@@ -258,7 +259,7 @@ static void test_bad_desc_refused(void **state)
     assert_null(ob_effect_create(ctx, &(ob_effect_desc){.name = "empty"}, &r));
     assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
     assert_null(ob_effect_create(ctx, &(ob_effect_desc){
-        .name = "mixed", .vertex = "lit.vert", .compute = "particles.comp"}, &r));
+        .name = "mixed", .vertex = "pbr.vert", .compute = "particles.comp"}, &r));
     assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
     /* depth.vert only reads the position, so the same layout is enough there. */
     ob_effect *depth = ob_effect_create(ctx, &(ob_effect_desc){
@@ -287,7 +288,7 @@ static uint32_t build_lit_pipeline(ob_effect_context *ctx)
 {
     ob_result r;
     ob_effect *e = ob_effect_create(ctx, &(ob_effect_desc){
-        .name = "cached", .vertex = "lit.vert", .fragment = "lit.frag", .layout = &standard_input,
+        .name = "cached", .vertex = "pbr.vert", .fragment = "pbr.frag", .layout = &standard_input,
         .depth_test = true, .depth_write = true}, &r);
     assert_non_null(e);
     assert_non_null(ob_effect_pipeline(e, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_D32_SFLOAT, NULL));
@@ -344,7 +345,7 @@ static void test_effect_creation_faults(void **state)
 {
     fixture *f = *state;
     ob_effect_context *ctx = make_context(f, "faults");
-    ob_effect_desc desc = {.name = "faulty", .vertex = "lit.vert", .fragment = "lit.frag",
+    ob_effect_desc desc = {.name = "faulty", .vertex = "pbr.vert", .fragment = "pbr.frag",
                            .layout = &standard_input, .depth_test = true};
     ob_result r;
     /* Warm the compiler's cache, so the walk covers the effect's own work. */

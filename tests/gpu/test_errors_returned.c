@@ -238,7 +238,7 @@ static void effect_allocation_failures_are_returned(void **state)
 {
     (void)state;
     ob_device *dev = ob_test_device_create();
-    ob_effect_desc d = {.name = "walked", .vertex = "lit.vert", .fragment = "lit.frag",
+    ob_effect_desc d = {.name = "walked", .vertex = "pbr.vert", .fragment = "pbr.frag",
                         .layout = ob_views_standard_input(), .depth_test = true,
                         .depth_write = true};
     uint64_t points = 0;
@@ -315,7 +315,7 @@ static void material_library_without_shaders_is_io(void **state)
     r = OB_OK;
     assert_null(ob_material_library_create(ctx, NULL, &r));
     assert_int_equal(r, OB_ERR_IO);
-    assert_logged("lit.vert", empty);
+    assert_logged("pbr.vert", empty);
     ob_effect_context_destroy(ctx);
     ob_test_assert_no_validation(ob_renderer_device(rd));
     ob_renderer_destroy(rd);
@@ -470,7 +470,7 @@ static void particle_shader_that_does_not_compile_fails_the_system(void **state)
 
 /* ------------------------------------------------------------------ frame */
 
-/* A material's effect is made in its first frame: a lit.frag that reads
+/* A material's effect is made in its first frame: a pbr.frag that reads
  * but does not compile gives that frame an error — returned by
  * ob_views_render and ob_stack_frame, counted in the stats, the material
  * named — and the frame still renders the rest. */
@@ -478,11 +478,11 @@ static void frame_with_a_material_that_does_not_compile_returns_it(void **state)
 {
     (void)state;
     char dir[300];
-    shader_folder("broken-lit", "lit.frag", dir, sizeof dir);
+    shader_folder("broken-lit", "pbr.frag", dir, sizeof dir);
     ob_stack_desc d = stack_desc(dir);
     ob_result r;
     ob_stack *s = ob_stack_create(&d, &r);
-    assert_non_null(s);   /* the library reads lit.frag; it is compiled on first use */
+    assert_non_null(s);   /* the library reads pbr.frag; it is compiled on first use */
     ob_mesh m = {0};
     assert_int_equal(ob_mesh_box((const float[3]){0.5f, 0.5f, 0.5f}, &m), OB_OK);
     ob_geometry *box = ob_stack_add_geometry(s, &m, "box", &r);
@@ -505,7 +505,7 @@ static void frame_with_a_material_that_does_not_compile_returns_it(void **state)
         named |= strcmp(st->skipped[i].name, "material:red") == 0 &&
                  st->skipped[i].reason == OB_SKIP_ERROR;
     assert_true(named);
-    assert_logged("lit.frag:3");
+    assert_logged("pbr.frag:3");
 
     /* Every later frame says so too (the failure is kept, not retried),
      * through the split frame as well. */

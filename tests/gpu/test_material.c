@@ -357,20 +357,26 @@ static void test_apply_and_prepare_view(void **state)
 
     mi->pre_render(red, NULL, NULL, &persp);
     assert_true(mi->apply(red, NULL, NULL, pm, &persp));
+    /* LIT draws with the metallic-roughness model: apply writes its mapped
+     * factors (ob_material_desc_to_pbr) into the PbrMaterial block. */
     ob_params *params = ob_pipeline_manager_params(pm);
+    const ob_param base_color = ob_param_find(f->reg, "PbrBaseColor");
     float got[4];
-    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "DiffuseColor"), got), OB_OK);
-    assert_true(got[0] == 1 && got[1] == 0 && got[2] == 0 && got[3] == 1);
-    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "EmissiveColor"), got), OB_OK);
+    assert_int_equal(ob_params_get_vec4(params, base_color, got), OB_OK);
+    const ob_material_pbr red_pbr = ob_material_desc_to_pbr(&(ob_material_desc){
+        .diffuse = {1, 0, 0, 1}, .emissive = {0.1f, 0, 0, 0}}).pbr;
+    for (int k = 0; k < 4; k++) assert_float_equal(got[k], red_pbr.base_color[k], 1e-6f);
+    assert_true(got[0] == 1 && got[1] < 0.01f && got[2] < 0.01f && got[3] == 1);
+    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "PbrEmissive"), got), OB_OK);
     assert_true(got[0] == 0.1f);
     assert_true(mi->apply(blue, NULL, NULL, pm, &persp));   /* same effect, other colours */
-    assert_int_equal(ob_params_get_vec4(params, ob_param_find(f->reg, "DiffuseColor"), got), OB_OK);
-    assert_true(got[2] == 1 && got[0] == 0);
+    assert_int_equal(ob_params_get_vec4(params, base_color, got), OB_OK);
+    assert_true(got[2] == 1 && got[0] < 0.01f);
     /* Only slot 1 was written: the immediate slot does not hold blue. */
     ob_params immediate;
     assert_int_equal(ob_params_manager(f->reg, 0, &immediate), OB_OK);
-    ob_params_get_vec4(&immediate, ob_param_find(f->reg, "DiffuseColor"), got);
-    assert_false(got[0] == 0 && got[1] == 0 && got[2] == 1);
+    ob_params_get_vec4(&immediate, base_color, got);
+    assert_false(got[2] == 1 && got[0] < 0.01f);
 
     /* A shadow view queued after the entities' PreRender: the camera now
      * wants lit+SHADOWS, which does not exist yet, so apply uses lit. */
@@ -685,9 +691,17 @@ static void test_reflective_uses_attached_env_map(void **state)
     assert_true(mi->apply(mirror, ball, rd, pm, &persp));
     assert_int_equal(env.calls, 1);
     assert_ptr_equal(env.consumer, &persp);
+    /* The REFLECTIVE default mix 0.6 is in the mapped F0 (mostly metal);
+     * the map's term is then weighted by the model's Fresnel alone. */
     float got[4];
-    ob_params_get_vec4(ob_pipeline_manager_params(pm), ob_param_find(ob_renderer_registry(rd), "Reflectivity"), got);
-    assert_true(got[0] == 0.6f);   /* the REFLECTIVE default */
+    ob_params *mp = ob_pipeline_manager_params(pm);
+    ob_params_get_vec4(mp, ob_param_find(ob_renderer_registry(rd), "Reflectivity"), got);
+    assert_true(got[0] == 1.0f);
+    ob_params_get_vec4(mp, ob_param_find(ob_renderer_registry(rd), "PbrFactors"), got);
+    const ob_material_pbr mapped =
+        ob_material_desc_to_pbr(&(ob_material_desc){.kind = OB_MATERIAL_REFLECTIVE}).pbr;
+    assert_float_equal(got[0], mapped.metallic, 1e-6f);
+    assert_true(got[0] > 0.5f && got[1] == 0.0f);   /* a mirror: roughness 0 */
 
     /* Another entity with the same reflective material has no map: plain lit. */
     assert_true(mi->apply(mirror, cube, rd, pm, &persp));

@@ -1005,11 +1005,54 @@ static void defaults_and_bad_input(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* One lighting model: a LIT or REFLECTIVE material draws as the PBR
+ * material ob_material_desc_to_pbr makes of it, byte for byte (the same
+ * shader and factors; only the vertex layout differs), under a sun and a
+ * point light: the highlight, the diffuse and the ambient of each. */
+static void lit_draws_as_its_pbr_twin(void **state)
+{
+    (void)state;
+    static const ob_material_desc descs[] = {
+        {.name = "plain", .kind = OB_MATERIAL_LIT, .diffuse = {0.8f, 0.3f, 0.2f, 1}},
+        {.name = "gold", .kind = OB_MATERIAL_LIT, .diffuse = {0.2f, 0.15f, 0.05f, 1},
+         .specular = {1.0f, 0.8f, 0.35f, 6}},
+        {.name = "given", .kind = OB_MATERIAL_LIT, .diffuse = {0.3f, 0.5f, 0.9f, 1}, .metallic = 0.4f,
+         .roughness = 0.35f, .metallic_roughness = true},
+        {.name = "mirror", .kind = OB_MATERIAL_REFLECTIVE, .diffuse = {0.9f, 0.9f, 0.95f, 1}, .roughness = 0.2f},
+    };
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(descs); i++) {
+        uint8_t *img[2];
+        for (int twin = 0; twin < 2; twin++) {
+            ob_test_world w;
+            ob_test_world_create(&w, &(ob_test_world_desc){.width = 160, .height = 120});
+            ob_mesh m;
+            assert_int_equal(ob_mesh_sphere(0.5f, 48, 32, &m), OB_OK);
+            ob_geometry *g = twin ? extended(&w, &m, "twin sphere", NULL) : ob_world_geometry(&w, &m, "sphere");
+            if (!twin) ob_mesh_release(&m);
+            ob_material_desc d = twin ? ob_material_desc_to_pbr(&descs[i]) : descs[i];
+            ob_world_entity(&w, NULL, "ball", g, ob_world_material_desc(&w, &d), 0, 0, 0);
+            ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 3, 4);
+            ob_world_light(&w, OB_LIGHT_POINT, false, 2.0f, -1.5, 0.5, 1.5);
+            ob_world_look(&w, 0, 0, 2.5, 0, 0, 0);
+            ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+            ob_world_read(&w);
+            img[twin] = ob_world_copy(&w);
+            assert_int_equal(w.err, OB_OK);
+            ob_test_world_destroy(&w);
+        }
+        uint32_t d = ob_test_image_max_diff(img[0], img[1], 160, 120);
+        if (d) fail_msg("material '%s': %u levels from its PBR twin", descs[i].name, d);
+        free(img[0]);
+        free(img[1]);
+    }
+}
+
 int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lit_side_is_brighter),
+        cmocka_unit_test(lit_draws_as_its_pbr_twin),
         cmocka_unit_test(smooth_metal_highlight_at_mirror_direction),
         cmocka_unit_test(alpha_mask_cuts_out),
         cmocka_unit_test(alpha_mask_cuts_the_shadow_too),

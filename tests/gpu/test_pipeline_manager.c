@@ -67,19 +67,23 @@ static ob_pipeline_manager_stats composite_only(ob_test_world *w, ob_threading m
 }
 
 /* Sizes of the lit effect's per-view blocks (PerView and PerViewLights,
- * packed once per view and slot) and its PerMaterial block. */
-static void lit_block_sizes(ob_test_world *w, uint32_t *per_view, uint32_t *per_material)
+ * packed once per view and slot) and its material blocks: PerMaterial
+ * (binding 1: only Reflectivity differs between LIT materials) and
+ * PbrMaterial (binding 3: the mapped factors); per_material is both. */
+static void lit_block_sizes(ob_test_world *w, uint32_t *per_view, uint32_t *per_material,
+                            uint32_t *pbr_material)
 {
     ob_effect *e = ob_material_library_find_effect(w->lib, OB_STD_LIT, 0);
     assert_non_null(e);
     const ob_program *p = ob_effect_program(e);
-    assert_int_equal(p->ubo_count, 3);
-    *per_view = *per_material = 0;
+    assert_int_equal(p->ubo_count, 4);
+    *per_view = *per_material = *pbr_material = 0;
     for (uint32_t i = 0; i < p->ubo_count; i++) {
         if (p->ubos[i].binding == 0 || p->ubos[i].binding == 4) *per_view += p->ubos[i].size;
-        if (p->ubos[i].binding == 1) *per_material = p->ubos[i].size;
+        if (p->ubos[i].binding == 1 || p->ubos[i].binding == 3) *per_material += p->ubos[i].size;
+        if (p->ubos[i].binding == 3) *pbr_material = p->ubos[i].size;
     }
-    assert_true(*per_view > 0 && *per_material > 0);
+    assert_true(*per_view > 0 && *pbr_material > 0 && *per_material > *pbr_material);
 }
 
 /* 100 entities sharing a material and a geometry: one pipeline, vertex,
@@ -97,8 +101,8 @@ static void shared_state_bound_once_single_threaded(void **state)
     ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    uint32_t per_view, per_material;
-    lit_block_sizes(&w, &per_view, &per_material);
+    uint32_t per_view, per_material, pbr_material;
+    lit_block_sizes(&w, &per_view, &per_material, &pbr_material);
     ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
     const ob_view_stats *main = ob_world_view_stats(st, "main");
     assert_int_equal(main->draws, 100);
@@ -113,10 +117,10 @@ static void shared_state_bound_once_single_threaded(void **state)
     assert_int_equal(s.index_binds_issued, 1);
     assert_int_equal(s.descriptor_binds_requested, 100);
     assert_int_equal(s.descriptor_binds_issued, 1);
-    /* PerView, PerViewLights and PerMaterial packed once, reused by the
-     * other 99 draws. */
-    assert_int_equal(s.blocks_packed, 3);
-    assert_int_equal(s.blocks_reused, 3 * 99);
+    /* PerView, PerViewLights, PerMaterial and PbrMaterial packed once,
+     * reused by the other 99 draws. */
+    assert_int_equal(s.blocks_packed, 4);
+    assert_int_equal(s.blocks_reused, 4 * 99);
     assert_int_equal(s.uniform_bytes, per_view + per_material);
     /* Every box has its own world matrix: push constants change per draw. */
     assert_int_equal(s.push_constant_requested, 100);
@@ -138,10 +142,10 @@ static void shared_state_bound_once_per_secondary(void **state)
     ob_pipeline_manager_stats base = composite_only(&w, OB_THREADING_MULTI, 4);
     ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.7f, 0.5f, 0.3f, false);
     add_grid(&w, 100, &m, 1);
-    uint32_t per_view, per_material;
+    uint32_t per_view, per_material, pbr_material;
     for (int frame = 0; frame < 3; frame++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 4);
-        if (frame == 0) lit_block_sizes(&w, &per_view, &per_material);
+        if (frame == 0) lit_block_sizes(&w, &per_view, &per_material, &pbr_material);
         ob_pipeline_manager_stats s = pm_minus(st->pm, &base);
         const ob_view_stats *main = ob_world_view_stats(st, "main");
         assert_int_equal(st->workers, 4);
@@ -159,8 +163,8 @@ static void shared_state_bound_once_per_secondary(void **state)
         assert_int_equal(s.descriptor_binds_requested, 100);
         assert_int_equal(s.descriptor_binds_issued, chunks);
         /* A worker keeps its packed blocks across the chunks it records. */
-        assert_true(s.blocks_packed >= 3 && s.blocks_packed <= 3 * chunks);
-        assert_int_equal(s.blocks_packed + s.blocks_reused, 300);
+        assert_true(s.blocks_packed >= 4 && s.blocks_packed <= 4 * chunks);
+        assert_int_equal(s.blocks_packed + s.blocks_reused, 400);
         assert_true(s.uniform_bytes <= (uint64_t)chunks * (per_view + per_material));
         assert_int_equal(s.skipped_draws, 0);
     }
@@ -175,7 +179,7 @@ static void uniforms_packed_only_after_a_change(void **state)
     (void)state;
     enum { SHARED_50, SHARED_100, SAME_VALUES, DISTINCT, CASES };
     ob_pipeline_manager_stats got[CASES];
-    uint32_t per_view = 0, per_material = 0;
+    uint32_t per_view = 0, per_material = 0, pbr_material = 0;
     for (int c = 0; c < CASES; c++) {
         ob_test_world w;
         ob_test_world_create(&w, NULL);
@@ -194,21 +198,22 @@ static void uniforms_packed_only_after_a_change(void **state)
         const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
         assert_int_equal(ob_world_view_stats(st, "main")->draws, count);
         got[c] = pm_minus(st->pm, &base);
-        if (c == 0) lit_block_sizes(&w, &per_view, &per_material);
+        if (c == 0) lit_block_sizes(&w, &per_view, &per_material, &pbr_material);
         /* The next frame packs again (new ring space) but no more than this one. */
         const ob_frame_stats *again = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
         assert_int_equal(pm_minus(again->pm, &base).blocks_packed, got[c].blocks_packed);
         ob_test_world_destroy(&w);
     }
-    assert_int_equal(got[SHARED_50].blocks_packed, 3);
-    assert_int_equal(got[SHARED_100].blocks_packed, 3);
+    assert_int_equal(got[SHARED_50].blocks_packed, 4);
+    assert_int_equal(got[SHARED_100].blocks_packed, 4);
     assert_int_equal(got[SHARED_50].uniform_bytes, got[SHARED_100].uniform_bytes);
-    assert_int_equal(got[SAME_VALUES].blocks_packed, 3);
+    assert_int_equal(got[SAME_VALUES].blocks_packed, 4);
     assert_int_equal(got[SAME_VALUES].uniform_bytes, per_view + per_material);
     assert_int_equal(got[SAME_VALUES].descriptor_binds_issued, 1);
-    assert_int_equal(got[DISTINCT].blocks_packed, 2 + 100);
-    assert_int_equal(got[DISTINCT].blocks_reused, 2 * 99);
-    assert_int_equal(got[DISTINCT].uniform_bytes, per_view + 100 * per_material);
+    /* A colour per material changes its PbrMaterial block only. */
+    assert_int_equal(got[DISTINCT].blocks_packed, 3 + 100);
+    assert_int_equal(got[DISTINCT].blocks_reused, 3 * 99);
+    assert_int_equal(got[DISTINCT].uniform_bytes, per_view + per_material + 99 * pbr_material);
     /* One effect for all of them: still one pipeline bind. */
     assert_int_equal(got[DISTINCT].pipeline_binds_issued, 1);
 }

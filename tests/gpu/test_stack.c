@@ -100,7 +100,7 @@ static void test_stack_without_shaders_fails_naming_one(void **state)
     rmdir(dir);
     assert_null(s);
     assert_int_equal(r, OB_ERR_IO);
-    if (!ob_test_log_has("lit.vert", "cannot be read", dir, NULL)) {
+    if (!ob_test_log_has("pbr.vert", "cannot be read", dir, NULL)) {
         ob_test_log_dump(OB_LOG_WARN, 20);
         fail_msg("no log line names the missing shader and its folder");
     }

@@ -33,7 +33,7 @@ uint32_t ob_test_log_count(ob_log_level min_level);
 void ob_test_log_dump(ob_log_level min_level, uint32_t max);
 /* Fails the test, showing what was captured, unless one captured line
  * (since the last clear) contains every given substring:
- * assert_logged("'box'", "lit.frag"). */
+ * assert_logged("'box'", "pbr.frag"). */
 #define assert_logged(...) ob_test_assert_logged(__FILE__, __LINE__, __VA_ARGS__, (const char *)NULL)
 void ob_test_assert_logged(const char *file, int line, const char *needle, ...);
 /* cmocka setup and teardown for a test that provokes errors on purpose:

@@ -26,7 +26,7 @@ foreach(f ${libdir}/libobelisk.a ${libdir}/libobelisk.so ${libdir}/pkgconfig/obe
           ${libdir}/cmake/Obelisk/ObeliskTargets.cmake
           ${libdir}/cmake/Obelisk/ObeliskStaticTargets.cmake
           include/obelisk/obelisk.h include/obelisk/ob_renderer.h include/obelisk/ob_stack.h
-          share/obelisk/shaders/lit.frag share/obelisk/shaders/common.glsl)
+          share/obelisk/shaders/pbr.frag share/obelisk/shaders/common.glsl)
   if(NOT EXISTS ${PREFIX}/${f})
     message(FATAL_ERROR "not installed: ${f}")
   endif()

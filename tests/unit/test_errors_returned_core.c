@@ -203,10 +203,10 @@ static void shader_missing_file_is_io(void **state)
     ob_shader_compiler_desc cd = {.shader_dir = MISSING, .no_disk_cache = true};
     ob_shader_compiler *c = ob_shader_compiler_create(&cd, &r);
     assert_non_null(c);
-    ob_shader_desc d = {.path = "lit.frag", .stage = OB_SHADER_FRAGMENT};
+    ob_shader_desc d = {.path = "pbr.frag", .stage = OB_SHADER_FRAGMENT};
     assert_null(ob_shader_get(c, &d, &r));
     assert_int_equal(r, OB_ERR_IO);
-    assert_logged("lit.frag", MISSING);
+    assert_logged("pbr.frag", MISSING);
     ob_shader_compiler_destroy(c);
 }
 

@@ -238,6 +238,42 @@ static void minimal_file_gets_documented_defaults(void **state)
 /* Spot lights: cone half-angles in degrees become radians in the light's
  * desc, aimed like a directional light; many point lights parse (the
  * renderer, not the parser, applies OB_MAX_LIGHTS and names what is over). */
+/* Lit and reflective materials in the metallic-roughness model: metallic
+ * (either) or roughness (lit) gives the factors directly; a lit material
+ * given only metallic keeps the roughness its specular power maps to; a
+ * reflective one's roughness alone keeps the rest mapped. */
+static void metallic_and_roughness_keys(void **state)
+{
+    (void)state;
+    ob_scene_file sf;
+    ob_scene_file_error err;
+    static const char text[] =
+        "{\"materials\": {\"steel\": {\"metallic\": 1, \"roughness\": 0.3},"
+        " \"satin\": {\"roughness\": 0.6}, \"plain\": {\"specular\": [0.2, 0.2, 0.2, 14], \"metallic\": 0.5},"
+        " \"chrome\": {\"kind\": \"reflective\", \"roughness\": 0.1},"
+        " \"brass\": {\"kind\": \"reflective\", \"metallic\": 0.8}}, \"entities\": []}";
+    assert_int_equal(parse(text, &sf, &err), OB_OK);
+    assert_int_equal(sf.material_count, 5);
+    const ob_material_desc *steel = &sf.materials[0].desc, *satin = &sf.materials[1].desc,
+                           *plain = &sf.materials[2].desc, *chrome = &sf.materials[3].desc,
+                           *brass = &sf.materials[4].desc;
+    assert_true(steel->metallic_roughness);
+    assert_near(steel->metallic, 1.0, 0);
+    assert_near(steel->roughness, 0.3, 1e-7);
+    assert_true(satin->metallic_roughness);
+    assert_near(satin->metallic, 0.0, 0);
+    assert_near(satin->roughness, 0.6, 1e-7);
+    assert_true(plain->metallic_roughness);   /* its roughness: what power 14 maps to */
+    assert_near(plain->roughness, pow(2.0 / 16.0, 0.25), 1e-6);
+    assert_near(plain->metallic, 0.5, 0);
+    assert_false(chrome->metallic_roughness);
+    assert_near(chrome->roughness, 0.1, 1e-7);
+    assert_true(brass->metallic_roughness);
+    assert_near(brass->metallic, 0.8, 1e-7);
+    assert_near(brass->roughness, 0.0, 0);
+    ob_scene_file_release(&sf);
+}
+
 static void spot_and_many_point_lights_parse(void **state)
 {
     (void)state;
@@ -445,8 +481,12 @@ static const bad_case bad_cases[] = {
      "only a spot light has cone angles"},
     {"{\"materials\": {\"m\": {\"reflectivity\": 0.5}}, " E "[]}", "materials.m.reflectivity",
      "only a \"reflective\" material has a reflectivity"},
-    {"{\"materials\": {\"m\": {\"roughness\": 0.5}}, " E "[]}", "materials.m.roughness",
-     "only a \"reflective\" material has a roughness"},
+    {"{\"materials\": {\"m\": {\"kind\": \"unlit\", \"roughness\": 0.5}}, " E "[]}", "materials.m.roughness",
+     "an \"unlit\" material has no roughness (it is not lit)"},
+    {"{\"materials\": {\"m\": {\"kind\": \"unlit\", \"metallic\": 1}}, " E "[]}", "materials.m.metallic",
+     "an \"unlit\" material has no metallic (it is not lit)"},
+    {"{\"materials\": {\"m\": {\"metallic\": -0.1}}, " E "[]}", "materials.m.metallic",
+     "expected a number from 0 to 1"},
     {"{\"materials\": {\"m\": {\"kind\": \"reflective\", \"roughness\": 2}}, " E "[]}",
      "materials.m.roughness", "expected a number from 0 to 1"},
     {"{\"settings\": {\"env_map\": \"sphere\"}, " E "[]}", "settings.env_map",
@@ -749,6 +789,7 @@ int main(void)
         cmocka_unit_test(full_file_parses_to_its_description),
         cmocka_unit_test(minimal_file_gets_documented_defaults),
         cmocka_unit_test(spot_and_many_point_lights_parse),
+        cmocka_unit_test(metallic_and_roughness_keys),
         cmocka_unit_test(every_malformed_case_names_its_path),
         cmocka_unit_test(syntax_errors_give_line_and_column),
         cmocka_unit_test(only_the_first_error_is_reported),

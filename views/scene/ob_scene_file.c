@@ -280,7 +280,7 @@ static bool parse_light(sf_ctx *c, const cJSON *j, uint32_t i, uint32_t *directi
 static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
 {
     static const char *const keys[] = {"kind", "diffuse", "specular", "emissive", "reflectivity",
-                                       "roughness", "casts_shadows", "blended", "priority"};
+                                       "roughness", "metallic", "casts_shadows", "blended", "priority"};
     if (!ob_json_check_object(&c->rd, j, "a material object or the name of one", keys, OB_ARRAY_COUNT(keys)))
         return false;
     ob_material_desc *d = &m->desc;
@@ -323,9 +323,11 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
         ob_json_push_key(&c->rd, "reflectivity");
         return ob_json_fail(&c->rd, "only a \"reflective\" material has a reflectivity");
     }
-    if (ob_json_member(j, "roughness") && d->kind != OB_MATERIAL_REFLECTIVE) {
-        ob_json_push_key(&c->rd, "roughness");
-        return ob_json_fail(&c->rd, "only a \"reflective\" material has a roughness");
+    static const char *const factors[] = {"roughness", "metallic"};
+    for (uint32_t i = 0; i < OB_ARRAY_COUNT(factors); i++) {
+        if (!ob_json_member(j, factors[i]) || d->kind != OB_MATERIAL_UNLIT) continue;
+        ob_json_push_key(&c->rd, factors[i]);
+        return ob_json_fail(&c->rd, "an \"unlit\" material has no %s (it is not lit)", factors[i]);
     }
     memcpy(d->diffuse, diffuse, sizeof diffuse);
     memcpy(d->specular, specular, sizeof specular);
@@ -333,10 +335,18 @@ static bool parse_material(sf_ctx *c, const cJSON *j, ob_scene_file_material *m)
     double prio = 0;
     if (!ob_json_opt_float(&c->rd, j, "reflectivity", OB_JSON_RANGE(0, 1), &d->reflectivity) ||
         !ob_json_opt_float(&c->rd, j, "roughness", OB_JSON_RANGE(0, 1), &d->roughness) ||
+        !ob_json_opt_float(&c->rd, j, "metallic", OB_JSON_RANGE(0, 1), &d->metallic) ||
         !ob_json_opt_bool(&c->rd, j, "casts_shadows", &d->casts_shadows) || !ob_json_opt_bool(&c->rd, j, "blended", &d->blended) ||
         !ob_json_opt_double(&c->rd, j, "priority", OB_JSON_INT(0, 1000000), &prio))
         return false;
     d->priority = (uint32_t)prio;
+    /* metallic (lit or reflective) or roughness (lit) describes the surface
+     * in the metallic-roughness model directly; a lit one given only its
+     * metallic keeps the roughness its specular power maps to, and a
+     * reflective one's roughness alone keeps the rest mapped. */
+    const bool metallic = ob_json_member(j, "metallic") != NULL, roughness = ob_json_member(j, "roughness") != NULL;
+    if (d->kind == OB_MATERIAL_LIT && metallic && !roughness) d->roughness = ob_material_desc_to_pbr(d).pbr.roughness;
+    d->metallic_roughness = metallic || (d->kind == OB_MATERIAL_LIT && roughness);
     return true;
 }
 
