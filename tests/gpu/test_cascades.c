@@ -101,10 +101,10 @@ static void near_shadows_sharp_far_shadows_kept(void **state)
     assert_int_equal(one.cascades_ran, 1);
     int full = full_shadow(&lit, &four);
     assert_true(full > 40);
-    /* Rows near the horizon hold the floor 40..200 units away; the bottom
+    /* Rows 92..106, just under the horizon, hold the far floor; the bottom
      * third the first few units. */
-    shadow_count far4 = count_shadow(&lit, &four, 96, 104, full);
-    shadow_count far1 = count_shadow(&lit, &one, 96, 104, full);
+    shadow_count far4 = count_shadow(&lit, &four, 92, 106, full);
+    shadow_count far1 = count_shadow(&lit, &one, 92, 106, full);
     shadow_count near4 = count_shadow(&lit, &four, 2 * H / 3, H, full);
     shadow_count near1 = count_shadow(&lit, &one, 2 * H / 3, H, full);
     print_message("far: 4 cascades %u umbra + %u penumbra, 1 cascade %u + %u; near: 4 cascades "
@@ -112,8 +112,9 @@ static void near_shadows_sharp_far_shadows_kept(void **state)
                   far4.penumbra, far1.umbra, far1.penumbra, near4.umbra, near4.penumbra,
                   near1.umbra, near1.penumbra, full);
     /* Far posts still throw shadows (thin lines: a post there is under a
-     * pixel wide). */
-    assert_true(far4.umbra + far4.penumbra >= 20);
+     * pixel wide; 30 pixels here), more than one map keeps (8). */
+    assert_true(far4.umbra + far4.penumbra >= 15);
+    assert_true(far4.umbra + far4.penumbra > 2 * (far1.umbra + far1.penumbra));
     /* Near the camera, four cascades draw the posts' shadows dark with
      * sharp edges; one map over 200 units has texels wider than a post
      * (0.8 units at 512 texels) and loses most of them. */
