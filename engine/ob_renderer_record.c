@@ -694,7 +694,8 @@ static void view_barriers(ob_renderer *r, VkCommandBuffer cmd, ob_view *v)
 }
 
 /* The attachment view of img for one layer of v: level 0 of that layer
- * (the whole view of a single-layer image without mips). */
+ * (the whole view of a single-layer image without mips), offset by the
+ * view's first_layer where views share an array target. */
 static VkImageView attachment_view(ob_renderer *r, const ob_view *v, ob_image img, uint32_t layer)
 {
     if (!img.id) return VK_NULL_HANDLE;

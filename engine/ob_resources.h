@@ -73,6 +73,8 @@ typedef enum ob_image_usage {
 typedef struct ob_image_desc {
     uint32_t width, height;  /* 0 is an error */
     uint32_t layers;         /* 0 → 1; >1 makes a 2D array (paraboloid maps use 2) */
+    bool array;              /* sampled as a 2D array even with one layer (a shader's
+                                sampler2DArray: shadow cascades, however many) */
     VkFormat format;         /* must support the usage on this device, else OB_ERR_UNSUPPORTED */
     uint32_t usage;          /* ob_image_usage bits */
     uint32_t samples;        /* 0 or 1 → single-sampled; 2, 4, 8...: a multisampled

@@ -267,12 +267,13 @@ static ob_result image_view_create(ob_device *dev, ob_image_rec *rec, VkImageVie
 static ob_result image_views_create(ob_device *dev, ob_image_rec *rec)
 {
     uint32_t layers = rec->info.layers;
-    ob_result r = image_view_create(dev, rec, layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D, 0,
+    bool array = layers > 1 || rec->array;
+    ob_result r = image_view_create(dev, rec, array ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D, 0,
                                     layers, rec->info.mip_levels, &rec->view);
     /* Layer views are attachments: level 0 only. A single-layer target with
      * mips needs one too, since its whole view covers every level. */
     bool mipped_target = rec->info.mip_levels > 1 && (rec->info.usage & OB_IMAGE_COLOR_TARGET);
-    if (r != OB_OK || (layers == 1 && !mipped_target)) return r;
+    if (r != OB_OK || (layers == 1 && !mipped_target && !rec->array)) return r;
     rec->layer_views = ob_calloc(layers, sizeof *rec->layer_views);
     if (!rec->layer_views) return OB_ERR_OUT_OF_HOST_MEMORY;
     for (uint32_t i = 0; i < layers && r == OB_OK; i++)
@@ -366,6 +367,7 @@ ob_image ob_image_create(ob_device *dev, const ob_image_desc *desc, ob_result *o
     rec->info = (ob_image_info){desc->width, desc->height, layers, desc->format, desc->usage,
                                 format_aspect(desc->format), levels, desc->samples > 1 ? desc->samples : 1};
     rec->state = (ob_image_state){VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+    rec->array = desc->array;
     rec->name = ob_strdup(name);
     if (!rec->name) {
         r = OB_ERR_OUT_OF_HOST_MEMORY;

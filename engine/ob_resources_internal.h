@@ -31,6 +31,7 @@ typedef struct ob_image_rec {
     VkDeviceMemory memory;
     VkImageView view;          /* all layers: 2D or 2D array */
     VkImageView *layer_views;  /* one 2D view per layer when layers > 1 */
+    bool array;                /* `view` is a 2D array even with one layer */
     uint64_t mem_size;
     ob_image_info info;
     ob_image_state state;

@@ -114,8 +114,10 @@ struct ob_view {
     ob_image color, depth;
     uint32_t layer_count;             /* 0 → compute view (no rendering scope) */
     /* Layer i of the view is layer first_layer + i of color/depth: views
-     * that share one array target (the local lights' shadow maps), which
-     * their owner, not the view, creates and destroys. 0 otherwise. */
+     * that share one array target (a light's shadow cascades, the local
+     * lights' shadow maps) each own their layers. The images are created
+     * and destroyed by their owner (the first cascade, the local shadow
+     * set), not by every view. 0 otherwise. */
     uint32_t first_layer;
     /* A point or spot light's shadow view (type OB_VIEW_SHADOW): consumers
      * sample it as the local lights' shadow array (materials' LOCAL_SHADOWS

@@ -230,7 +230,8 @@ static ob_result register_standard_params(ob_material_library *lib)
         {"LightColor", OB_PARAM_VEC4},          {"LightGrid", OB_PARAM_VEC4},
         {"ParaboloidDirection", OB_PARAM_VEC4},
         {"SimStep", OB_PARAM_VEC4},             {"SimEmitter", OB_PARAM_VEC4},
-        {"SimForce", OB_PARAM_VEC4},            {"ShadowMatrix", OB_PARAM_MAT4},
+        {"SimForce", OB_PARAM_VEC4},            {"ShadowSplits", OB_PARAM_VEC4},
+        {"ShadowCascades", OB_PARAM_VEC4},      {"ShadowAxis", OB_PARAM_VEC4},
         {"EnvMapMatrix", OB_PARAM_MAT4},        {"ShadowMap", OB_PARAM_TEXTURE},
         {"EnvMap", OB_PARAM_TEXTURE},           {"SourceImage", OB_PARAM_TEXTURE},
         {"Particles", OB_PARAM_STORAGE_BUFFER},
@@ -238,6 +239,13 @@ static ob_result register_standard_params(ob_material_library *lib)
     ob_result r = OB_OK;
     for (uint32_t i = 0; i < OB_ARRAY_COUNT(params); i++)
         if (!register_param(lib->reg, params[i].name, params[i].type, &r).id) return r;
+    /* The shadow cascades' matrices (OB_SHADOW_MAX_CASCADES in views/ob_views.h,
+     * the array in materials/shaders/common.glsl). */
+    if (!ob_param_register(lib->reg, "ShadowMatrices", OB_PARAM_MAT4_ARRAY, 4, &r).id) {
+        OB_LOG_E("material", "parameter 'ShadowMatrices' (mat4[4]) not registered: %s",
+                 ob_result_text(r));
+        return r;
+    }
     static const struct {
         const char *name;
         uint32_t bytes;

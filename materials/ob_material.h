@@ -54,8 +54,8 @@
  * parameters and gives "ShadowMapSampler" (depth compare GREATER_OR_EQUAL,
  * linear, clamp), "EnvMapSampler" and "SourceImageSampler" (linear, clamp) a
  * default in every slot. Views provide the rest: per-view matrices and
- * lights (materials/shaders/common.glsl), "ShadowMap" + "ShadowMatrix" from
- * shadow views, "EnvMap" + "EnvMapMatrix" (world → owner-frame rotation, the
+ * lights (materials/shaders/common.glsl), "ShadowMap" + "ShadowMatrices",
+ * "ShadowSplits", "ShadowCascades", "ShadowAxis" from the shadow cascades, "EnvMap" + "EnvMapMatrix" (world → owner-frame rotation, the
  * env-map view's ViewMatrix) + "ParaboloidDirection" from env-map views.
  *
  * Lifecycle: library_create → material_create* → frames → library_destroy

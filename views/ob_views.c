@@ -8,7 +8,7 @@
 
 typedef struct view_params {
     ob_param screen, ambient, light_dir, light_color;
-    ob_param shadow_matrix, paraboloid;
+    ob_param shadow_matrices, shadow_splits, shadow_cascades, shadow_axis, paraboloid;
 } view_params;
 
 static view_params params_of(ob_param_registry *reg)
@@ -18,7 +18,10 @@ static view_params params_of(ob_param_registry *reg)
     p.ambient = ob_param_find(reg, "AmbientColor");
     p.light_dir = ob_param_find(reg, "LightDirection");
     p.light_color = ob_param_find(reg, "LightColor");
-    p.shadow_matrix = ob_param_find(reg, "ShadowMatrix");
+    p.shadow_matrices = ob_param_find(reg, "ShadowMatrices");
+    p.shadow_splits = ob_param_find(reg, "ShadowSplits");
+    p.shadow_cascades = ob_param_find(reg, "ShadowCascades");
+    p.shadow_axis = ob_param_find(reg, "ShadowAxis");
     p.paraboloid = ob_param_find(reg, "ParaboloidDirection");
     return p;
 }
@@ -28,14 +31,15 @@ static ob_result register_params(ob_param_registry *reg)
     static const char *const vec4s[] = {
         "ScreenSize", "AmbientColor", "LightDirection", "LightColor", "LightGrid",
         "ParaboloidDirection", "SimStep", "SimEmitter", "SimForce", "DiffuseColor", "ToneMap",
-        "EnvMapInfo",
+        "EnvMapInfo", "ShadowSplits", "ShadowCascades", "ShadowAxis",
     };
     ob_result r = OB_OK;
     for (size_t i = 0; i < OB_ARRAY_COUNT(vec4s) && r == OB_OK; i++)
         ob_param_register(reg, vec4s[i], OB_PARAM_VEC4, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "LightTable", OB_PARAM_BYTES, OB_LIGHT_TABLE_BYTES, &r);
     if (r == OB_OK) ob_param_register(reg, "LightTiles", OB_PARAM_BYTES, OB_LIGHT_TILES_BYTES, &r);
-    if (r == OB_OK) ob_param_register(reg, "ShadowMatrix", OB_PARAM_MAT4, 1, &r);
+    if (r == OB_OK)
+        ob_param_register(reg, "ShadowMatrices", OB_PARAM_MAT4_ARRAY, OB_SHADOW_MAX_CASCADES, &r);
     if (r == OB_OK) ob_param_register(reg, "ShadowMap", OB_PARAM_TEXTURE, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "EnvMap", OB_PARAM_TEXTURE, 1, &r);
     if (r == OB_OK) ob_param_register(reg, "SourceImage", OB_PARAM_TEXTURE, 1, &r);
@@ -59,10 +63,14 @@ void ob_views_set_common_params(ob_views *ctx, const ob_view *v, ob_params *para
      * them afterwards), so a slot never carries another view's leftovers:
      * the packed bytes, and so the command hashes, do not depend on which
      * views a worker happened to record before. */
-    float identity[16];
-    ob_mat4_identity(identity);
-    ob_params_set_mat4(params, p.shadow_matrix, identity);
-    ob_params_set_vec4(params, p.paraboloid, (const float[4]){0, 0, 0, 0});
+    float identity[OB_SHADOW_MAX_CASCADES][16];
+    for (uint32_t i = 0; i < OB_SHADOW_MAX_CASCADES; i++) ob_mat4_identity(identity[i]);
+    ob_params_set_mat4_array(params, p.shadow_matrices, &identity[0][0], OB_SHADOW_MAX_CASCADES);
+    static const float zero4[4] = {0, 0, 0, 0};
+    ob_params_set_vec4(params, p.shadow_splits, zero4);
+    ob_params_set_vec4(params, p.shadow_cascades, zero4);
+    ob_params_set_vec4(params, p.shadow_axis, zero4);
+    ob_params_set_vec4(params, p.paraboloid, zero4);
 
     /* Lights, relative to the view's origin like everything else. */
     float zero[4] = {0, 0, 0, 0};
@@ -473,7 +481,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
                 continue;
             }
             if (add_entry(&ctx->shadows, &ctx->shadow_count, &ctx->shadow_cap,
-                          (ob_views_entry){id, ob_shadow_view_base(sv), sv}) != OB_OK) {
+                          (ob_views_entry){id, NULL, sv}) != OB_OK) {
                 OB_LOG_E("views", "light '%s': no memory to keep its shadow map; skipped this frame",
                          ob_node_name(lights[i]));
                 ob_renderer_note_error(r, name, OB_ERR_OUT_OF_HOST_MEMORY);
@@ -482,8 +490,7 @@ void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer)
             }
             e = &ctx->shadows[ctx->shadow_count - 1];
         }
-        ob_shadow_view_set_consumer(e->owner_object, consumer);
-        ob_renderer_pre_render(r, e->view);
+        ob_shadow_view_pre_render(e->owner_object, r, consumer);
     }
     ob_views_queue_local_shadows(ctx, r, consumer);
 }
@@ -564,6 +571,9 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     ctx->effects = desc->effects;
     r = ob_views_set_env_map_size(ctx, desc->env_map_size);
     if (r == OB_OK) r = ob_views_set_shadow_map_size(ctx, desc->shadow_map_size);
+    if (r == OB_OK) r = ob_views_set_shadow_cascades(ctx, desc->shadow_cascades);
+    if (r == OB_OK) r = ob_views_set_shadow_distance(ctx, desc->shadow_distance);
+    if (r == OB_OK) r = ob_views_set_shadow_split_lambda(ctx, desc->shadow_split_lambda);
     if (r != OB_OK) goto fail_destroy_views;
     if ((unsigned)desc->env_map_kind >= OB_ENV_MAP_KIND_COUNT) {
         OB_LOG_E("views", "env_map_kind %d is not a kind of environment map", (int)desc->env_map_kind);
@@ -661,6 +671,39 @@ ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size)
     ob_result r = check_map_size(ctx, "shadow map", size);
     if (r == OB_OK) ctx->shadow_map_size = size ? size : 1024;
     return r;
+}
+
+ob_result ob_views_set_shadow_cascades(ob_views *ctx, uint32_t count)
+{
+    if (count > OB_SHADOW_MAX_CASCADES) {
+        OB_LOG_E("views", "%u shadow cascades refused: 1..%u (0: the default, %u)", count,
+                 OB_SHADOW_MAX_CASCADES, OB_SHADOW_DEFAULT_CASCADES);
+        return OB_ERR_OUT_OF_RANGE;
+    }
+    ctx->shadow_cascades = count ? count : OB_SHADOW_DEFAULT_CASCADES;
+    return OB_OK;
+}
+
+ob_result ob_views_set_shadow_distance(ob_views *ctx, float distance)
+{
+    if (!(distance >= 0.0f) || !isfinite(distance)) {
+        OB_LOG_E("views", "shadow distance %g refused: a finite distance > 0 (0: from the scene)",
+                 (double)distance);
+        return OB_ERR_OUT_OF_RANGE;
+    }
+    ctx->shadow_distance = distance;
+    return OB_OK;
+}
+
+ob_result ob_views_set_shadow_split_lambda(ob_views *ctx, float lambda)
+{
+    if (!(lambda >= 0.0f && lambda <= 1.0f)) {
+        OB_LOG_E("views", "shadow split lambda %g refused: (0, 1] (0: the default, %g)",
+                 (double)lambda, (double)OB_SHADOW_DEFAULT_SPLIT_LAMBDA);
+        return OB_ERR_OUT_OF_RANGE;
+    }
+    ctx->shadow_split_lambda = lambda > 0.0f ? lambda : OB_SHADOW_DEFAULT_SPLIT_LAMBDA;
+    return OB_OK;
 }
 
 ob_result ob_views_render(ob_views *ctx, ob_view *final_view)

@@ -4,8 +4,11 @@
  *   perspective  a camera's linear HDR colour + depth (optionally
  *                multisampled and resolved); queues the shadow views of the
  *                lights that cast shadows onto what it sees
- *   shadow       a directional light's depth, fitted to the casters the
- *                consumer sees; left out with no caster or zero intensity
+ *   shadow       a directional light's cascaded shadow maps: one view per
+ *                cascade ("shadow:<light>:c<i>"), each fitted to a slice of
+ *                the consumer camera's frustum, all in the layers of one
+ *                array depth image; left out with no caster in view or
+ *                zero intensity
  *   paraboloid   dual-paraboloid environment map of one reflective entity
  *                (two layers; the owner is excluded); queued by the material
  *                of a reflective entity visible to the queuing view
@@ -62,9 +65,20 @@ typedef struct ob_views_desc {
                                     use it; alpha 0 → the clear colour of the first
                                     camera view that asks for the map in the frame
                                     (ob_stack passes its main view's clear colour) */
-    uint32_t shadow_map_size;    /* 0 → 1024 */
+    uint32_t shadow_map_size;    /* 0 → 1024 (side of each cascade) */
+    uint32_t shadow_cascades;    /* 0 → OB_SHADOW_DEFAULT_CASCADES; 1..OB_SHADOW_MAX_CASCADES */
+    float shadow_distance;       /* how far from the camera shadows reach; 0 → the farthest
+                                    point the camera sees, rounded up to a power of two */
+    float shadow_split_lambda;   /* 0 → OB_SHADOW_DEFAULT_SPLIT_LAMBDA; (0, 1]: the share of
+                                    logarithmic splits against uniform ones */
     float ambient[4];            /* rgb, w = intensity; zero → (1,1,1,0.15) */
 } ob_views_desc;
+
+/* Cascaded shadow maps of the shaded directional light (docs/architecture.md,
+ * "Shadows"): at most this many cascades per light and camera. */
+#define OB_SHADOW_MAX_CASCADES 4
+#define OB_SHADOW_DEFAULT_CASCADES 4
+#define OB_SHADOW_DEFAULT_SPLIT_LAMBDA 0.75f
 
 ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result);
 void ob_views_destroy(ob_views *ctx);
@@ -77,6 +91,14 @@ void ob_views_set_time(ob_views *ctx, double time, double dt);
  * made. ob_views_create refuses such a desc size the same way. */
 ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size);
 ob_result ob_views_set_shadow_map_size(ob_views *ctx, uint32_t size);
+/* Cascades of a directional light's shadow from the next frame (0 → the
+ * default, 4); over OB_SHADOW_MAX_CASCADES is refused (OB_ERR_OUT_OF_RANGE,
+ * logged; the count stays). The shadow distance (0 → from the scene;
+ * negative or not finite refused) and the split lambda (0 → the default;
+ * outside [0, 1] refused) the same way. [render thread, between frames] */
+ob_result ob_views_set_shadow_cascades(ob_views *ctx, uint32_t count);
+ob_result ob_views_set_shadow_distance(ob_views *ctx, float distance);
+ob_result ob_views_set_shadow_split_lambda(ob_views *ctx, float lambda);
 /* Screen-tile culling of point and spot lights (docs/architecture.md,
  * "Many lights"), on by default. Off, every fragment of a camera view loops
  * over all the scene's lights: the same pixels (a light adds exactly zero

@@ -26,6 +26,9 @@ struct ob_views {
     ob_material_library *materials;
     ob_effect_context *effects;
     uint32_t env_map_size, shadow_map_size;
+    uint32_t shadow_cascades;    /* 1..OB_SHADOW_MAX_CASCADES */
+    float shadow_distance;       /* 0: from what the camera sees */
+    float shadow_split_lambda;   /* (0, 1] */
     ob_env_map_kind env_map_kind;
     float sky_color[4];          /* alpha 0: none, use the asking camera's clear colour */
     float ambient[4];
@@ -46,11 +49,19 @@ struct ob_views {
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
 };
 
+/* The cascades of one directional light (ob_view_shadow.c): views named
+ * "shadow:<light>:c<i>", one layer each of one array depth image of the
+ * context's cascade count at its shadow map size. Failure: the image's
+ * error, NULL. [render thread] */
 ob_shadow_view *ob_shadow_view_create(ob_views *ctx, ob_node *light, ob_result *out_result);
 void ob_shadow_view_destroy(ob_views *ctx, ob_shadow_view *v);
-ob_view *ob_shadow_view_base(ob_shadow_view *v);
-/* Set the consumer whose visible casters the next pre_render fits. */
-void ob_shadow_view_set_consumer(ob_shadow_view *v, ob_view *consumer);
+/* "shadow:<light>": the name the set is left out under as a whole. */
+const char *ob_shadow_view_name(const ob_shadow_view *v);
+/* Fits the cascades to `consumer` (unless an earlier consumer of this frame
+ * did) and pre-renders each, so the consumer depends on them; left out
+ * (OB_SKIP_NO_CASTERS) when the consumer sees no caster. [render thread,
+ * PreRender] */
+void ob_shadow_view_pre_render(ob_shadow_view *v, ob_renderer *r, ob_view *consumer);
 
 ob_paraboloid_view *ob_paraboloid_view_create(ob_views *ctx, ob_node *owner, ob_result *out_result);
 void ob_paraboloid_view_destroy(ob_views *ctx, ob_paraboloid_view *v);

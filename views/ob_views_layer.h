@@ -29,11 +29,12 @@
 
 /* ---- PreRender ----------------------------------------------------------- */
 
-/* Pre-render the shadow view of every directional light that casts shadows
- * (made on first need, one per light, owned by ctx), fitted to the casters
- * `consumer` sees: call it after ob_view_cull of the consumer. The consumer
- * then depends on them and samples the map through their set_usage_params
- * (ShadowMap, ShadowMatrix). A light of zero intensity is left out
+/* Pre-render the shadow cascades of the shaded directional light when it
+ * casts shadows (made on first need, owned by ctx), fitted to `consumer`'s
+ * camera and the casters it sees: call it after ob_view_cull of the
+ * consumer. The consumer then depends on them and samples the maps through
+ * their set_usage_params (ShadowMap, ShadowMatrices, ShadowSplits,
+ * ShadowCascades, ShadowAxis). A light of zero intensity is left out
  * (OB_SKIP_NOT_NEEDED); a shadow view that cannot be made is logged and left
  * out (OB_SKIP_ERROR) and the rest goes on. [render thread, PreRender] */
 void ob_views_queue_shadows(ob_views *ctx, ob_renderer *r, ob_view *consumer);
@@ -85,7 +86,8 @@ bool ob_views_bind_effect(ob_views *ctx, ob_effect *e, const ob_view *v, ob_pipe
  * ob_views_create, the scene's first directional light relative to
  * v->origin, the PerViewLights block (up to OB_MAX_LIGHTS point and spot
  * lights and, for a perspective view, the screen tiles each may reach:
- * docs/architecture.md, "Many lights"), and defaults for ShadowMatrix (identity) and
+ * docs/architecture.md, "Many lights"), and defaults for the shadow
+ * cascades' parameters (identity matrices, no cascade) and
  * ParaboloidDirection (zero) that dependencies override. Call it from
  * set_render_params with the slot given. Cannot fail. [recording thread:
  * writes only `params`] */

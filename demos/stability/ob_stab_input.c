@@ -95,7 +95,7 @@ ob_result ob_stab_zero_scale(ob_stab_ctx *c)
                         ob_rgba_diff_count(without, with, N, 0), "pixels", 0, black == 0,
                         ob_stab_take_ms(c), "max abs diff %u; NaN-black pixels %u; main drew %u "
                         "items, shadow view %s", ob_rgba_max_diff(without, with, N), black,
-                        main ? main->draws : 0, ob_world_view_stats(st, "shadow:sun") ? "ran" : "did not run");
+                        main ? main->draws : 0, ob_world_shadow_cascades(st, "sun", NULL) ? "ran" : "did not run");
     ob_free(without);
     ob_free(with);
     return finish(c, &w, r);
@@ -243,7 +243,7 @@ ob_result ob_stab_empty_scene(ob_stab_ctx *c)
         main_skip = main ? main->skipped : OB_SKIP_ERROR;
         shadow_skip = ob_world_skip_reason(st, "shadow:sun");
         ok &= main_skip == OB_SKIP_EMPTY && shadow_skip == OB_SKIP_NO_CASTERS &&
-              !ob_world_view_stats(st, "shadow:sun");
+              ob_world_shadow_cascades(st, "sun", NULL) == 0;
         if (img) worst = OB_MAX(worst, not_clear(&w, img));
         ob_free(img);
     }
@@ -268,7 +268,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
     ob_stab_hide(lamp, true);
     const ob_frame_stats *st;
     uint8_t *off = ob_stab_render(&w, &st);
-    bool absent = !ob_world_view_stats(st, "shadow:sun");
+    bool absent = ob_world_shadow_cascades(st, "sun", NULL) == 0;
     if (lamp) ob_node_destroy(lamp);
     ob_stab_hide(b.sun, false);
     ob_result set = OB_OK;
@@ -278,7 +278,7 @@ ob_result ob_stab_light_off(ob_stab_ctx *c)
         set = ob_node_set_light(b.sun, &dark);
     }
     uint8_t *zero = ob_stab_render(&w, &st);
-    absent &= !ob_world_view_stats(st, "shadow:sun");
+    absent &= ob_world_shadow_cascades(st, "sun", NULL) == 0;
     ob_skip_reason skip = ob_world_skip_reason(st, "shadow:sun");
     if (b.sun) ob_node_destroy(b.sun);
     uint8_t *none = ob_stab_render(&w, NULL);
@@ -388,7 +388,7 @@ ob_result ob_stab_non_finite_light_camera(ob_stab_ctx *c)
     ob_stab_position(b.sun, 3, INFINITY, 4);
     const ob_frame_stats *st;
     uint8_t *img_sun = ob_stab_render(&w, &st);
-    bool shadow_absent = !ob_world_view_stats(st, "shadow:sun");
+    bool shadow_absent = ob_world_shadow_cascades(st, "sun", NULL) == 0;
     ob_stab_hide(b.sun, true);
     uint8_t *no_sun = ob_stab_render(&w, NULL);
     ob_stab_hide(b.sun, false);

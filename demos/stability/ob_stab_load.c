@@ -337,7 +337,7 @@ ob_result ob_stab_no_casters(ob_stab_ctx *c)
     ob_node *sun = ob_world_light(&w.world, OB_LIGHT_DIRECTIONAL, true, 1.0f, 3, 8, 4);
     const ob_frame_stats *st = ob_stab_frame(&w, OB_THREADING_SINGLE);
     ob_skip_reason skipped = ob_world_skip_reason(st, "shadow:sun");
-    bool absent = !ob_world_view_stats(st, "shadow:sun");
+    bool absent = ob_world_shadow_cascades(st, "sun", NULL) == 0;
     uint8_t *without = ob_stab_snapshot(&w);
     ob_result set = OB_OK;
     if (sun) {

@@ -238,9 +238,8 @@ static ob_result render_offset(ob_stab_ctx *c, const double o[3], offset_image *
     build_offset_scene(&w, o);
     ob_stab_frame(&w, OB_THREADING_SINGLE);
     const ob_frame_stats *st = ob_stab_frame(&w, OB_THREADING_MULTI);
-    const ob_view_stats *shadow = ob_world_view_stats(st, "shadow:sun");
+    ob_world_shadow_cascades(st, "sun", &out->shadow_draws);
     const ob_view_stats *env = ob_world_view_stats(st, "envmap:mirror");
-    out->shadow_draws = shadow ? shadow->draws : 0;
     out->env_draws = env ? env->draws : 0;
     out->env_items = env ? env->items : 0;
     out->pixels = ob_stab_snapshot(&w);
@@ -437,7 +436,7 @@ static ob_result render_scaled(ob_stab_ctx *c, double s, uint8_t **out_img, bool
     ob_world_look(&w.world, 0.3 * s, 2.2 * s, 4.1 * s, 0, 0.4 * s, 0);
     const ob_frame_stats *st;
     *out_img = ob_stab_render(&w, &st);
-    *out_shadow = ob_world_view_stats(st, "shadow:sun") != NULL;
+    *out_shadow = ob_world_shadow_cascades(st, "sun", NULL) > 0;
     ob_stab_frame(&w, OB_THREADING_SINGLE);   /* timed: the first frame makes pipelines */
     ob_result r = w.world.err;
     ob_stab_world_destroy(&w);

@@ -251,6 +251,20 @@ const ob_view_stats *ob_world_view_stats(const ob_frame_stats *st, const char *n
     return i < 0 ? NULL : &st->views[i];
 }
 
+uint32_t ob_world_shadow_cascades(const ob_frame_stats *st, const char *light, uint32_t *out_draws)
+{
+    char prefix[64];
+    int n = snprintf(prefix, sizeof prefix, "shadow:%s:c", light);
+    uint32_t count = 0, draws = 0;
+    for (uint32_t i = 0; st && n > 0 && i < st->view_count; i++) {
+        if (strncmp(st->views[i].name, prefix, (size_t)n) != 0) continue;
+        count++;
+        draws += st->views[i].draws;
+    }
+    if (out_draws) *out_draws = draws;
+    return count;
+}
+
 int ob_world_view_index(const ob_frame_stats *st, const char *name)
 {
     for (uint32_t i = 0; st && i < st->view_count; i++)

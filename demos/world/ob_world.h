@@ -135,6 +135,9 @@ const ob_view_stats *ob_world_view_stats(const ob_frame_stats *st, const char *n
 int ob_world_view_index(const ob_frame_stats *st, const char *name);
 /* The skip reason recorded for name, OB_SKIP_NONE if none. */
 ob_skip_reason ob_world_skip_reason(const ob_frame_stats *st, const char *name);
+/* The cascades of a directional light's shadow ("shadow:<light>:c<i>")
+ * that ran: how many, and their draws summed into *out_draws (may be NULL). */
+uint32_t ob_world_shadow_cascades(const ob_frame_stats *st, const char *light, uint32_t *out_draws);
 /* Views of a type that ran; skip entries with a reason. */
 uint32_t ob_world_count_views(const ob_frame_stats *st, ob_view_type type);
 uint32_t ob_world_count_skipped(const ob_frame_stats *st, ob_skip_reason reason);

@@ -22,13 +22,17 @@ layout(set = 0, binding = 0, std140) uniform PerView {
     mat4 ViewMatrix;           // rotation only
     mat4 ProjMatrix;           // reversed-Z, infinite far plane
     mat4 ViewProjMatrix;       // ProjMatrix * ViewMatrix
-    mat4 ShadowMatrix;         // camera-relative world -> shadow clip space
+    mat4 ShadowMatrices[4];    // camera-relative world -> clip space of shadow cascade i
     vec4 CameraPosition;       // always 0 (camera-relative); kept for shaders
     vec4 ScreenSize;           // width, height, 1/width, 1/height in pixels
     vec4 AmbientColor;         // rgb, w = intensity
     vec4 LightDirection;       // xyz toward the light (need not be unit length)
     vec4 LightColor;           // rgb, w = intensity (0 = no directional light)
     vec4 ParaboloidDirection;  // x: +1 front layer (0), -1 back layer (1); y: near distance
+    vec4 ShadowSplits;         // far distance of cascade i's slice along ShadowAxis
+    vec4 ShadowCascades;       // x: cascade count (0: none), y: blend band (part of a slice)
+    vec4 ShadowAxis;           // xyz: forward of the camera the cascades were fitted for;
+                               // distance of p = dot(p, xyz) + w
 };
 
 layout(set = 0, binding = 1, std140) uniform PerMaterial {

@@ -50,3 +50,7 @@ ob_golden(colour_cube tests/golden/models/colour_cube.ply --frames 2)
 ob_golden(spot tests/golden/scenes/spot.json --frames 2)
 ob_golden(point_shadow tests/golden/scenes/point_shadow.json --frames 2)
 ob_golden(lights64 tests/golden/scenes/lights64.json --frames 2)
+# Cascaded shadow maps (issue 28): a 200-unit floor with a post and a block
+# every 10 units and a low camera looking along it: sharp shadows at the
+# camera's feet, still there 150 units away, no seam between cascades.
+ob_golden(cascades tests/golden/scenes/cascades.json --frames 2 --size 320x200)

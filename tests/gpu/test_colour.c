@@ -336,7 +336,7 @@ static void msaa_4x_same_in_st_and_mt(void **state)
         for (int f = 0; f < 3; f++)
             st = ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
         assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 2);
-        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), OB_SHADOW_DEFAULT_CASCADES);
         assert_int_equal(ob_perspective_view_samples(w.main), 4);
         hash[mode] = st->frame_hash;
         img[mode] = ob_world_snapshot(&w);

@@ -5,6 +5,9 @@
  * 4 and 8 workers, switching mode every frame, and in AUTO mode: every frame
  * has the same pixels (byte for byte) and the same command hash per view.
  *
+ * The sun's shadow is cascaded (issue 28): its four cascade views are
+ * compared like every other view.
+ *
  * Each run builds the scene afresh (controllers and the particle buffer
  * carry state from frame to frame). The renderer always has 8 workers;
  * ob_renderer_set_threading picks how many record. Views are cut into
@@ -142,10 +145,21 @@ static void check_reference(const run_result *ref)
     for (int f = 0; f < FRAMES; f++) {
         const ob_frame_stats *st = &ref->stats[f];
         assert_int_equal(ob_world_count_views(st, OB_VIEW_PARABOLOID), 3);
-        /* The sun's, the point light's cube and the spot's. */
-        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 3);
+        /* The sun's shadow is four cascade views, several of them drawing
+         * (their hashes and the pixels they shade are compared below), plus
+         * the point light's cube and the spot's. */
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), OB_SHADOW_DEFAULT_CASCADES + 2);
         assert_non_null(ob_world_view_stats(st, "shadow:lamp"));
         assert_true(ob_world_view_stats(st, "shadow:torch")->draws > 0);
+        uint32_t drawing = 0;
+        for (uint32_t c = 0; c < OB_SHADOW_DEFAULT_CASCADES; c++) {
+            char name[32];
+            snprintf(name, sizeof name, "shadow:sun:c%u", c);
+            const ob_view_stats *vs = ob_world_view_stats(st, name);
+            assert_non_null(vs);
+            drawing += vs->draws > 0;
+        }
+        assert_true(drawing >= 2);
         assert_int_equal(ob_world_count_views(st, OB_VIEW_SIMULATION), 1);
         assert_true(ob_world_view_stats(st, "main")->draws > 200);
         assert_int_equal(st->pm.skipped_draws, 0);

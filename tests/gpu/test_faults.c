@@ -179,6 +179,12 @@ static void make_reference(reference *ref)
     if (r == OB_OK) r = frames(&s, OB_THREADING_SINGLE, CHECK_FRAME_STEADY + 1);
     if (r == OB_OK) r = ob_test_stack_read(&s, ref->steady);
     if (r != OB_OK) fail_msg("reference frames: %s", ob_result_name(r));
+    /* The walks cover the sun's shadow cascades (the creation of their
+     * array map and each cascade view's PreRender and recording). */
+    uint32_t shadow_draws = 0;
+    assert_int_equal(ob_world_shadow_cascades(ob_renderer_last_stats(s.world.r), "sun",
+                                              &shadow_draws), OB_SHADOW_DEFAULT_CASCADES);
+    assert_true(shadow_draws > 0);
     ob_test_stack_stop(&s);
     assert_false(ob_test_log_has("[vk-validation]", NULL));
     /* The scene really draws something besides the clear colour. */

@@ -734,7 +734,9 @@ static void test_library_registers_standard_interface(void **state)
     } expect[] = {
         {"DiffuseColor", OB_PARAM_VEC4},  {"Reflectivity", OB_PARAM_VEC4},
         {"LightTable", OB_PARAM_BYTES}, {"ParaboloidDirection", OB_PARAM_VEC4},
-        {"ShadowMatrix", OB_PARAM_MAT4},  {"EnvMapMatrix", OB_PARAM_MAT4},
+        {"ShadowMatrices", OB_PARAM_MAT4_ARRAY}, {"ShadowSplits", OB_PARAM_VEC4},
+        {"ShadowCascades", OB_PARAM_VEC4}, {"ShadowAxis", OB_PARAM_VEC4},
+        {"EnvMapMatrix", OB_PARAM_MAT4},
         {"ShadowMap", OB_PARAM_TEXTURE},  {"EnvMapSampler", OB_PARAM_SAMPLER},
         {"Particles", OB_PARAM_STORAGE_BUFFER}, {"SimStep", OB_PARAM_VEC4},
     };

@@ -131,18 +131,20 @@ static void dependencies_run_before_consumers(void **state)
     for (int f = 0; f < 4; f++) {
         const ob_frame_stats *st = ob_test_world_frame(&w, f % 2 ? OB_THREADING_MULTI
                                                                  : OB_THREADING_SINGLE, 0);
-        assert_int_equal(st->view_count, 5);
+        /* The sun's shadow is OB_SHADOW_DEFAULT_CASCADES views. */
+        const int c = OB_SHADOW_DEFAULT_CASCADES;
+        assert_int_equal(st->view_count, 4 + c);
         assert_each_view_once(st);
-        int shadow = ob_world_view_index(st, "shadow:sun");
+        int shadow = ob_world_view_index(st, "shadow:sun:c3");
         int env = ob_world_view_index(st, "envmap:mirror");
         int sim = ob_world_view_index(st, "sparks");
         int at_main = ob_world_view_index(st, "main");
         int at_composite = ob_world_view_index(st, "composite");
         assert_true(shadow >= 0 && env >= 0 && sim >= 0);
         assert_true(shadow < at_main && env < at_main && sim < at_main);
-        assert_int_equal(at_main, 3);
-        assert_int_equal(at_composite, 4);
-        assert_int_equal(main->dep_count, 3);
+        assert_int_equal(at_main, 2 + c);
+        assert_int_equal(at_composite, 3 + c);
+        assert_int_equal(main->dep_count, 2 + (uint32_t)c);
         assert_deps_first(st, main);
         assert_deps_first(st, composite);
         ob_view *env_view = ob_renderer_attached_view(w.r, mirror, OB_VIEW_PARABOLOID);
@@ -277,7 +279,8 @@ static void second_camera_leaves_the_main_cameras_shadow(void **state)
             assert_int_equal(ob_renderer_end_frame(w.r), OB_OK);
             assert_int_equal(ob_renderer_wait_idle(w.r), OB_OK);
         }
-        assert_int_equal(ob_world_count_views(ob_renderer_last_stats(w.r), OB_VIEW_SHADOW), run != 3);
+        assert_int_equal(ob_world_count_views(ob_renderer_last_stats(w.r), OB_VIEW_SHADOW),
+                         run != 3 ? OB_SHADOW_DEFAULT_CASCADES : 0);
         ob_world_read(&w);
         main_images[run] = ob_world_copy(&w);
         ob_perspective_view_destroy(w.views, side);
@@ -314,7 +317,7 @@ static void second_shadow_casting_sun_leaves_the_first_ones_shadow(void **state)
         ob_world_entity(&w, NULL, "box", w.box, red, 0, 0, 0);
         ob_view *root = ob_composite_view_base(w.composite);
         const ob_frame_stats *st = frame_from_roots(&w, &root, 1, OB_THREADING_SINGLE);
-        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), 1);
+        assert_int_equal(ob_world_count_views(st, OB_VIEW_SHADOW), OB_SHADOW_DEFAULT_CASCADES);
         if (run == 0) assert_int_equal(ob_world_count_skipped(st, OB_SKIP_NOT_NEEDED), 1);
         ob_world_read(&w);
         images[run] = ob_world_copy(&w);
@@ -438,8 +441,8 @@ static void mirror_spheres_stop_at_recursion_bound(void **state)
                 assert_int_equal(ob_world_skip_reason(st, "envmap:m0"), OB_SKIP_RECURSION);
                 assert_int_equal(ob_world_skip_reason(st, "envmap:m1"), OB_SKIP_RECURSION);
                 assert_int_equal(ob_world_skip_reason(st, "envmap:m2"), OB_SKIP_RECURSION);
-                assert_int_equal(ob_world_skip_reason(st, "shadow:sun"), OB_SKIP_RECURSION);
-                assert_int_equal(cut, 4);
+                assert_int_equal(ob_world_skip_reason(st, "shadow:sun:c0"), OB_SKIP_RECURSION);
+                assert_int_equal(cut, 3 + OB_SHADOW_DEFAULT_CASCADES);
                 /* Without their maps the mirrors are drawn plainly lit. */
                 assert_int_equal(ob_world_view_stats(st, "main")->draws, 4);
             } else {
@@ -508,7 +511,7 @@ static void switched_off_light_no_shadow_view(void **state)
     ob_material *m = ob_world_material(&w, "test", OB_MATERIAL_LIT, 0.5f, 0.6f, 0.7f, true);
     ob_world_entity(&w, NULL, "box", w.box, m, 0, 0, 0);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
-    assert_non_null(ob_world_view_stats(st, "shadow:sun"));
+    assert_int_equal(ob_world_shadow_cascades(st, "sun", NULL), OB_SHADOW_DEFAULT_CASCADES);
     ob_light_desc dark = *ob_node_get_light(sun);
     dark.intensity = 0.0f;
     assert_int_equal(ob_node_set_light(sun, &dark), OB_OK);

@@ -31,6 +31,7 @@ static const char full_scene[] =
     "{\n"
     "  \"description\": \"everything\",\n"
     "  \"settings\": { \"size\": [320, 200], \"env_map_size\": 64, \"shadow_map_size\": 512,\n"
+    "                \"shadow_cascades\": 3, \"shadow_distance\": 80, \"shadow_split_lambda\": 0.5,\n"
     "                \"threads\": \"auto\", \"clear_color\": [0.1, 0.2, 0.3], \"ambient\": [1, 1, 1, 0],\n"
     "                \"exposure\": 1.5, \"env_map\": \"cube\", \"sky_color\": [2, 1, 0.5, 0.25] },\n"
     "  \"camera\": { \"position\": [1, 2, 3], \"target\": [1, 2, 0], \"fov_degrees\": 40, \"near\": 0.5 },\n"
@@ -82,6 +83,9 @@ static void full_file_parses_to_its_description(void **state)
     assert_int_equal(s->height, 200);
     assert_int_equal(s->env_map_size, 64);
     assert_int_equal(s->shadow_map_size, 512);
+    assert_int_equal(s->shadow_cascades, 3);
+    assert_near(s->shadow_distance, 80.0, 0);
+    assert_near(s->shadow_split_lambda, 0.5, 0);
     assert_true(s->has_threads);
     assert_int_equal(s->threads, -1);
     assert_true(s->has_clear_color);
@@ -346,6 +350,10 @@ static const bad_case bad_cases[] = {
     {"{" E "[42]}", "entities[0]", "expected an entity object, got a number"},
     {"{" E "[{" BOX ", \"transform\": {\"position\": [0, null, 0]}}]}", "entities[0].transform.position[1]",
      "expected a number, got null"},
+    {"{\"settings\": {\"shadow_cascades\": 5}, " E "[]}", "settings.shadow_cascades", "from 1 to 4"},
+    {"{\"settings\": {\"shadow_split_lambda\": 0}, " E "[]}", "settings.shadow_split_lambda",
+     "above 0 and at most 1"},
+    {"{\"settings\": {\"shadow_distance\": -1}, " E "[]}", "settings.shadow_distance", "expected"},
     {"{\"settings\": {\"threads\": \"many\"}, " E "[]}", "settings.threads",
      "expected an integer from 0 to 16 or \"auto\", got a string"},
     {"{\"lights\": [{\"type\": 1}], " E "[]}", "lights[0].type",

@@ -68,7 +68,8 @@ static bool opt_srgb_color(sf_ctx *c, const cJSON *j, const char *key, float w, 
 static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
 {
     static const char *const keys[] = {"size", "env_map_size", "shadow_map_size", "threads",
-                                       "clear_color", "ambient", "exposure", "env_map", "sky_color"};
+                                       "clear_color", "ambient", "exposure", "env_map", "sky_color",
+                                       "shadow_cascades", "shadow_distance", "shadow_split_lambda"};
     if (!ob_json_check_object(&c->rd, j, "an object", keys, OB_ARRAY_COUNT(keys))) return false;
     const cJSON *size = ob_json_member(j, "size");
     if (size) {
@@ -83,8 +84,17 @@ static bool parse_settings(sf_ctx *c, const cJSON *j, ob_scene_file_settings *s)
     if (!ob_json_opt_u32(&c->rd, j, "env_map_size", OB_SETTING_ENV_MAP_MIN, OB_SETTING_ENV_MAP_MAX,
                          &s->env_map_size) ||
         !ob_json_opt_u32(&c->rd, j, "shadow_map_size", OB_SETTING_SHADOW_MAP_MIN, OB_SETTING_SHADOW_MAP_MAX,
-                         &s->shadow_map_size))
+                         &s->shadow_map_size) ||
+        !ob_json_opt_u32(&c->rd, j, "shadow_cascades", 1, OB_SHADOW_MAX_CASCADES, &s->shadow_cascades) ||
+        !ob_json_opt_float(&c->rd, j, "shadow_distance", OB_JSON_POSITIVE, &s->shadow_distance) ||
+        !ob_json_opt_float(&c->rd, j, "shadow_split_lambda", OB_JSON_RANGE(0.0, 1.0),
+                           &s->shadow_split_lambda))
         return false;
+    if (ob_json_member(j, "shadow_split_lambda") && !(s->shadow_split_lambda > 0.0f)) {
+        ob_json_push_key(&c->rd, "shadow_split_lambda");
+        return ob_json_fail(&c->rd, "expected a number above 0 and at most 1 (the share of "
+                            "logarithmic splits), got 0");
+    }
     const cJSON *threads = ob_json_member(j, "threads");
     if (threads) {
         size_t mark = ob_json_push_key(&c->rd, "threads");

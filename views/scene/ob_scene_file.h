@@ -75,6 +75,9 @@ typedef struct ob_scene_file_settings {
     uint32_t width, height;       /* 1..OB_SETTING_SIZE_MAX */
     uint32_t env_map_size;        /* 0 = not given; else OB_SETTING_ENV_MAP_MIN..MAX */
     uint32_t shadow_map_size;     /* 0 = not given; else OB_SETTING_SHADOW_MAP_MIN..MAX */
+    uint32_t shadow_cascades;     /* 0 = not given; else 1..OB_SHADOW_MAX_CASCADES */
+    float shadow_distance;        /* 0 = not given; else > 0 */
+    float shadow_split_lambda;    /* 0 = not given; else (0, 1] */
     bool has_threads;
     int threads;                  /* 0 = single-threaded, N workers, -1 = "auto" */
     bool has_clear_color;

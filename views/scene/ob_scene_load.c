@@ -568,6 +568,9 @@ void ob_scene_load_stack_desc(const ob_scene_file_settings *s, ob_stack_desc *de
     }
     if (s->env_map_size) desc->env_map_size = s->env_map_size;
     if (s->shadow_map_size) desc->shadow_map_size = s->shadow_map_size;
+    if (s->shadow_cascades) desc->shadow_cascades = s->shadow_cascades;
+    if (s->shadow_distance > 0.0f) desc->shadow_distance = s->shadow_distance;
+    if (s->shadow_split_lambda > 0.0f) desc->shadow_split_lambda = s->shadow_split_lambda;
     if (s->has_clear_color) memcpy(desc->clear_color, s->clear_color, sizeof desc->clear_color);
     if (s->has_ambient) memcpy(desc->ambient, s->ambient, sizeof desc->ambient);
     if (s->exposure > 0.0f) desc->exposure = s->exposure;
@@ -592,6 +595,16 @@ ob_result ob_scene_load_apply_settings(ob_renderer *r, ob_views *views,
         first = res;
     if (views && s->shadow_map_size &&
         (res = ob_views_set_shadow_map_size(views, s->shadow_map_size)) != OB_OK && first == OB_OK)
+        first = res;
+    if (views && s->shadow_cascades &&
+        (res = ob_views_set_shadow_cascades(views, s->shadow_cascades)) != OB_OK && first == OB_OK)
+        first = res;
+    if (views && s->shadow_distance > 0.0f &&
+        (res = ob_views_set_shadow_distance(views, s->shadow_distance)) != OB_OK && first == OB_OK)
+        first = res;
+    if (views && s->shadow_split_lambda > 0.0f &&
+        (res = ob_views_set_shadow_split_lambda(views, s->shadow_split_lambda)) != OB_OK &&
+        first == OB_OK)
         first = res;
     if (views && s->has_env_map_kind && !ob_views_set_env_map_kind(views, s->env_map_kind) &&
         first == OB_OK)

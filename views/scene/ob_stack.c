@@ -22,7 +22,10 @@ ob_stack *ob_stack_create(const ob_stack_desc *desc, ob_result *out_result)
     if (!(s->materials = ob_material_library_create(s->effects, NULL, &r))) goto fail_destroy_stack;
     ob_views_desc vd = {.renderer = s->renderer, .materials = s->materials,
                         .effects = s->effects, .env_map_size = d.env_map_size,
-                        .shadow_map_size = d.shadow_map_size};
+                        .shadow_map_size = d.shadow_map_size,
+                        .shadow_cascades = d.shadow_cascades,
+                        .shadow_distance = d.shadow_distance,
+                        .shadow_split_lambda = d.shadow_split_lambda};
     memcpy(vd.ambient, d.ambient, sizeof vd.ambient);
     vd.env_map_kind = d.env_map_kind;
     if (!(s->views = ob_views_create(&vd, &r))) goto fail_destroy_stack;

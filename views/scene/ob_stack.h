@@ -43,6 +43,9 @@ typedef struct ob_stack_desc {
     ob_env_map_kind env_map_kind;  /* 0 → OB_ENV_MAP_PARABOLOID */
     float sky_color[4];          /* linear; what env maps clear to; all zero → clear_color */
     uint32_t shadow_map_size;    /* 0 → the views' default (1024) */
+    uint32_t shadow_cascades;    /* 0 → the views' default (4); 1..OB_SHADOW_MAX_CASCADES */
+    float shadow_distance;       /* 0 → from what the camera sees (ob_views_desc) */
+    float shadow_split_lambda;   /* 0 → the views' default (0.75); (0, 1] */
     float ambient[4];            /* rgb, w = intensity; zero → the views' default */
     bool overlay;                /* also an overlay view, drawn last over the composite */
     uint32_t msaa;               /* main view's samples per pixel: 0 or 1 → none; 2, 4, 8
