@@ -306,6 +306,17 @@ static void lean_note_frame(ob_demo_lean *l, const ob_frame_stats *st)
     for (uint32_t i = 0; i < st->view_count; i++)
         if (st->views[i].skipped != OB_SKIP_NONE)
             lean_note_view(l, st->views[i].name, st->views[i].skipped);
+    l->drawn_count = l->drawn_more = 0;
+    for (uint32_t i = 0; i < st->view_count; i++) {
+        if (st->views[i].skipped != OB_SKIP_NONE) continue;
+        if (l->drawn_count == OB_DEMO_LEAN_VIEWS) {
+            l->drawn_more++;
+            continue;
+        }
+        snprintf(l->drawn[l->drawn_count].name, sizeof l->drawn[0].name, "%s", st->views[i].name);
+        l->drawn[l->drawn_count].type = st->views[i].type;
+        l->drawn[l->drawn_count++].draws = st->views[i].draws;
+    }
     l->pipelines_created += st->pipelines_created;
     l->variants_created += st->variants_created;
     l->draws = st->draws;
@@ -765,6 +776,12 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
                 ob_skip_reason_name(l->views[i].reason), l->views[i].frames);
     if (l->views_more) fprintf(f, " and up to %u more", l->views_more);
     fputs(l->view_count ? "\n" : " none\n", f);
+    fputs("lean: views drawn (last frame):", f);
+    for (uint32_t i = 0; i < l->drawn_count; i++)
+        fprintf(f, "%s %s (%s, %u draws)", i ? "," : "", l->drawn[i].name,
+                ob_view_type_name(l->drawn[i].type), l->drawn[i].draws);
+    if (l->drawn_more) fprintf(f, " and %u more", l->drawn_more);
+    fputs(l->drawn_count ? "\n" : " none\n", f);
     fprintf(f, "lean: draws: %u entities in %u draw calls (%u as instances, longest run %u; "
                "last frame)\n", l->draws, l->draw_calls, l->instances, l->longest_run);
     uint32_t samples = d->world.main ? ob_perspective_view_samples(d->world.main) : 1;
@@ -815,7 +832,15 @@ static void write_lean_json(ob_demo *d, FILE *f)
         fprintf(f, ",\"reason\":\"%s\",\"frames\":%u}", ob_skip_reason_name(l->views[i].reason),
                 l->views[i].frames);
     }
-    fprintf(f, "],\"views_left_out_more\":%u,\"msaa_samples\":%u,\"draws\":%u,"
+    fputs("],\"views_drawn\":[", f);
+    for (uint32_t i = 0; i < l->drawn_count; i++) {
+        fputs(i ? ",{\"name\":" : "{\"name\":", f);
+        json_string(f, l->drawn[i].name);
+        fprintf(f, ",\"type\":\"%s\",\"draws\":%u}", ob_view_type_name(l->drawn[i].type),
+                l->drawn[i].draws);
+    }
+    fprintf(f, "],\"views_drawn_more\":%u", l->drawn_more);
+    fprintf(f, ",\"views_left_out_more\":%u,\"msaa_samples\":%u,\"draws\":%u,"
             "\"draw_calls\":%u,\"instances\":%u,\"longest_run\":%u,\"materials\":[",
             l->views_more, d->world.main ? ob_perspective_view_samples(d->world.main) : 1, l->draws,
             l->draw_calls, l->instances, l->longest_run);

@@ -93,6 +93,10 @@ typedef struct ob_demo_frame_times {
 typedef struct ob_demo_lean {
     struct { char name[48]; ob_skip_reason reason; uint32_t frames; } views[OB_DEMO_LEAN_VIEWS];
     uint32_t view_count, views_more;  /* views_more: distinct ones past the table */
+    /* The views the last frame drew, in execution order: a shadow view's
+     * name says its light (shadow:<light>, shadow:<light>:c<i> a cascade). */
+    struct { char name[48]; ob_view_type type; uint32_t draws; } drawn[OB_DEMO_LEAN_VIEWS];
+    uint32_t drawn_count, drawn_more;
     uint64_t pipelines_created, variants_created;
     /* The last frame's draws: entities drawn, draw commands, instances of
      * instanced draws, the longest run in one draw. */

@@ -5,7 +5,8 @@
 # "masked" (every texture, mask, vertex colours) leaves out only alpha
 # blending and never a feature it has -- and says that the main view has
 # MSAA targets; without --msaa it says there are none. A scene whose shadowed
-# sun has intensity 0 lists that shadow view as left out (not needed).
+# sun has intensity 0 lists that shadow view as left out (not needed), and
+# the views drawn name each shadow view's light (cascades, spot, point).
 # Run by ctest: cmake -DBIN=<build>/bin -DSRC=<source> -DOUT=<dir> -P view_lean_report.cmake
 foreach(var BIN SRC OUT)
   if(NOT DEFINED ${var})
@@ -78,6 +79,26 @@ set(model ${OUT}/dark.json)
 run_view(dark --frames 2)
 if(NOT dark MATCHES "lean: views left out: shadow:sun \\(not needed, 2 frames\\)")
   message(FATAL_ERROR "a sun of intensity 0: the report does not list its shadow view as left out\n${dark}")
+endif()
+# Every kind of shadow view names its light among the views drawn: the
+# sun's cascades, a spot light's map and a point light's cube (issue 28).
+set(model ${SRC}/tests/golden/scenes/point_shadow.json)
+run_view(point --frames 2)
+string(REGEX MATCH "lean: views drawn \\(last frame\\): [^\n]*" drawn "${point}")
+if(NOT drawn MATCHES "shadow:[^ ,]+ \\(shadow, [1-9][0-9]* draws\\)")
+  message(FATAL_ERROR "point_shadow.json: no drawn shadow view named after its light in '${drawn}'\n${point}")
+endif()
+set(model ${SRC}/tests/golden/scenes/cascades.json)
+run_view(cascades --frames 2)
+string(REGEX MATCH "lean: views drawn \\(last frame\\): [^\n]*" drawn "${cascades}")
+if(NOT drawn MATCHES "shadow:[^ ,:]+:c[0-3] \\(shadow, [1-9][0-9]* draws\\)")
+  message(FATAL_ERROR "cascades.json: no drawn cascade named after its light in '${drawn}'\n${cascades}")
+endif()
+set(model ${SRC}/tests/golden/scenes/spot.json)
+run_view(spot --frames 2)
+string(REGEX MATCH "lean: views drawn \\(last frame\\): [^\n]*" drawn "${spot}")
+if(NOT drawn MATCHES "shadow:[^ ,]+ \\(shadow, [1-9][0-9]* draws\\)")
+  message(FATAL_ERROR "spot.json: no drawn spot shadow view named after its light in '${drawn}'\n${spot}")
 endif()
 
 string(REGEX MATCHALL "lean: [^\n]*" lines "${out}")
