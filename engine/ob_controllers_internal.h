@@ -30,6 +30,14 @@ typedef struct ob_orbit_state {
     double angle;        /* kept in (-2pi, 2pi) so it never loses precision */
 } ob_orbit_state;
 
+/* A node's built-in controllers while NODE_MOTION says it has no others:
+ * 168 bytes beside each other in a dense array by slot, instead of two
+ * 128-byte controller slots and their 24-byte list in two more places. */
+struct node_motion {
+    ob_orbit_state orbit;      /* while NODE_ORBIT */
+    ob_rotation_state spin;    /* while NODE_SPIN */
+};
+
 /* The ob_controller_fn of each (the kernel on the node's slot data). */
 void ob_rotation_controller_step(ob_node *n, double dt, void *user);
 void ob_orbit_controller_step(ob_node *n, double dt, void *user);
@@ -98,6 +106,16 @@ static inline void ob_orbit_kernel(node_xf *x, ob_orbit_state *st, double dt)
     orbit_sincos(st->angle, &sin_a, &cos_a);
     double c = cos_a * st->radius, s = sin_a * st->radius;
     for (int i = 0; i < 3; i++) x->position[i] = st->center[i] + c * st->u[i] + s * st->v[i];
+}
+
+/* Runs the node's controllers in scene->motion (state: its NODE_* byte,
+ * NODE_MOTION set). [the slot's own thread] */
+static inline void ob_motion_run(ob_scene *s, uint32_t slot, uint8_t state, double dt)
+{
+    node_motion *m = &s->motion[slot];
+    if (state & NODE_ORBIT) ob_orbit_kernel(&s->xf[slot], &m->orbit, dt);
+    if (state & NODE_SPIN) ob_rotation_kernel(&s->xf[slot], &m->spin, dt);
+    s->state[slot] = (uint8_t)(state | NODE_DIRTY);
 }
 
 /* Runs controller c of the node in slot: a built-in one's kernel in place,

@@ -4,7 +4,7 @@
  * update data in dense slot arrays of the scene) is described in
  * ob_scene_internal.h.
  */
-#include "ob_scene_internal.h"
+#include "ob_controllers_internal.h"
 
 #include <string.h>
 
@@ -192,6 +192,7 @@ void ob_scene_compact(ob_scene *s)
             s->slot_id[w] = s->slot_id[r];
             s->draw[w] = s->draw[r];
             s->ctl[w] = s->ctl[r];
+            if (s->state[w] & NODE_MOTION) s->motion[w] = s->motion[r];
         }
         w++;
     }
@@ -216,6 +217,8 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
         r = ob_array_reserve((void **)&s->slot_id, &s->slot_id_cap, need, sizeof *s->slot_id);
     if (r == OB_OK) r = ob_array_reserve((void **)&s->draw, &s->draw_cap, need, sizeof *s->draw);
     if (r == OB_OK) r = ob_array_reserve((void **)&s->ctl, &s->ctl_cap, need, sizeof *s->ctl);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->motion, &s->motion_cap, need, sizeof *s->motion);
     if (r != OB_OK) {
         OB_LOG_E(SCENE_LOG, "cannot create entity '%s': %s", n->name, ob_result_text(r));
         return r;
@@ -297,6 +300,7 @@ fail_free_scene:
     ob_free(s->slot_id);
     ob_free(s->draw);
     ob_free(s->ctl);
+    ob_free(s->motion);
     ob_free(s);
     set_result(out_result, r);
     return NULL;
@@ -314,6 +318,7 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->slot_id);
     ob_free(s->draw);
     ob_free(s->ctl);
+    ob_free(s->motion);
     ob_free(s->ctl_pool);
     ob_free(s->retired);
     ob_free(s->order);
@@ -823,8 +828,9 @@ fail_log_non_finite:
 
 /* ------------------------------------------------------------ controllers */
 
-static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const void *state,
-                                size_t size)
+/* Appends a controller to the node's list (see controller_add). */
+static ob_result controller_append(ob_node *n, const ob_controller_desc *d, const void *state,
+                                   size_t size)
 {
     void *release_arg = state ? (void *)state : d->user;
     ob_scene *s = n->scene;
@@ -868,6 +874,55 @@ static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const v
         s->serial_nodes++;
     }
     return OB_OK;
+}
+
+/* The node's built-in controllers in scene->motion into its list, as
+ * ob_node_add_controller_state's: the list must keep the order added. */
+static ob_result motion_unpack(ob_node *n)
+{
+    ob_scene *s = n->scene;
+    uint32_t slot = n->by_id_index;
+    if ((s->state[slot] & NODE_ORBIT)) {
+        ob_result r = controller_append(
+            n, &(ob_controller_desc){.fn = ob_orbit_controller_step, .parallel = true},
+            &s->motion[slot].orbit, sizeof s->motion[slot].orbit);
+        if (r != OB_OK) return r;
+        s->state[slot] &= (uint8_t)~NODE_ORBIT;
+    }
+    if ((s->state[slot] & NODE_SPIN)) {
+        ob_result r = controller_append(
+            n, &(ob_controller_desc){.fn = ob_rotation_controller_step, .parallel = true},
+            &s->motion[slot].spin, sizeof s->motion[slot].spin);
+        if (r != OB_OK) return r;
+        s->state[slot] &= (uint8_t)~NODE_SPIN;
+    }
+    return OB_OK;
+}
+
+static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const void *state,
+                                size_t size)
+{
+    ob_result r = motion_unpack(n);
+    if (r != OB_OK) {
+        if (d->release) d->release(state ? (void *)state : d->user);
+        return r;
+    }
+    return controller_append(n, d, state, size);
+}
+
+ob_result ob_scene_motion_add(ob_node *n, uint8_t kind, const void *state, size_t size)
+{
+    ob_scene *s = n->scene;
+    uint32_t slot = n->by_id_index;
+    if (!s->ctl[slot].count && !(s->state[slot] & kind)) {
+        node_motion *m = &s->motion[slot];
+        memcpy(kind == NODE_ORBIT ? (void *)&m->orbit : (void *)&m->spin, state, size);
+        s->state[slot] |= kind;
+        return OB_OK;
+    }
+    ob_controller_fn fn = kind == NODE_ORBIT ? ob_orbit_controller_step
+                                             : ob_rotation_controller_step;
+    return controller_add(n, &(ob_controller_desc){.fn = fn, .parallel = true}, state, size);
 }
 
 ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)

@@ -95,7 +95,16 @@ enum {
     NODE_IN_LIGHTS = 1u << 3,       /* in the snapshot's lights */
     NODE_PARALLEL = 1u << 4,        /* has leading parallel-safe controllers */
     NODE_SERIAL = 1u << 5,          /* has other controllers */
+    /* A built-in orbit or rotation controller kept in scene->motion: only
+     * while the node has no controller in scene->ctl (and so at most one
+     * of each); the two commute, so they need no order. */
+    NODE_ORBIT = 1u << 6,
+    NODE_SPIN = 1u << 7,
+    NODE_MOTION = NODE_ORBIT | NODE_SPIN,
 };
+
+/* The state of NODE_ORBIT and NODE_SPIN (ob_controllers_internal.h). */
+typedef struct node_motion node_motion;
 
 /* The renderable's pointers and their interned indices (0 without one). */
 typedef struct node_draw {
@@ -153,8 +162,9 @@ struct ob_scene {
     uint32_t *slot_id;             /* the node's id */
     node_draw *draw;
     node_controllers *ctl;
+    node_motion *motion;           /* read only for nodes with NODE_MOTION */
     uint32_t by_id_count, by_id_holes;
-    uint32_t by_id_cap, xf_cap, state_cap, slot_id_cap, draw_cap, ctl_cap;
+    uint32_t by_id_cap, xf_cap, state_cap, slot_id_cap, draw_cap, ctl_cap, motion_cap;
 
     /* order: slots in pre-order (parents first), for serial controllers;
      * by_level: the same nodes by hierarchy level (depth), pre-order within
@@ -208,6 +218,12 @@ void ob_scene_compact(ob_scene *s);
 void ob_scene_intern_trim(ob_scene *s);
 /* Next node in pre-order after n, staying inside the subtree of top. */
 ob_node *ob_scene_preorder_next(const ob_node *n, const ob_node *top);
+
+/* Adds a built-in controller (kind NODE_ORBIT or NODE_SPIN, its state at
+ * state) to n: into scene->motion when the node has no other controller
+ * and none of that kind, else as any controller (after moving those in
+ * scene->motion into its list). Errors: ob_node_add_controller's. */
+ob_result ob_scene_motion_add(ob_node *n, uint8_t kind, const void *state, size_t size);
 
 /* ob_scene_update.c */
 /* Local transform of a node, with its unit rotation. [any thread] */

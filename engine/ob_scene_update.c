@@ -335,8 +335,14 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
 
 /* ------------------------------------------------------------------ loops */
 
-static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, double dt)
+/* The node's parallel-safe controllers (st: its NODE_* byte, with
+ * NODE_PARALLEL or NODE_MOTION). */
+static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, uint8_t st, double dt)
 {
+    if (st & NODE_MOTION) {
+        ob_motion_run(s, slot, st, dt);
+        return;
+    }
     node_controllers *ctl = &s->ctl[slot];
     for (uint32_t k = 0; k < ctl->parallel; k++) ob_controller_run(s, slot, &ctl->slots[k], dt);
 }
@@ -349,7 +355,8 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
     uint32_t end = chunk_end(c->count, chunk, c->grain);
     for (uint32_t i = chunk * c->grain; i < end; i++) {
         uint32_t slot = c->items[i].slot;
-        if (s->state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+        uint8_t st = s->state[slot];
+        if (st & (NODE_PARALLEL | NODE_MOTION)) run_parallel_controllers(s, slot, st, c->dt);
     }
 }
 
@@ -370,7 +377,8 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
         if (c->controllers) {
             for (uint32_t j = i; j < batch_end; j++) {
                 uint32_t slot = c->items[j].slot;
-                if (state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+                uint8_t st = state[slot];
+                if (st & (NODE_PARALLEL | NODE_MOTION)) run_parallel_controllers(s, slot, st, c->dt);
             }
         }
         for (uint32_t j = i; j < batch_end; j++) {

@@ -874,6 +874,66 @@ static ob_result fault_scenario(void)
     return r;
 }
 
+/* The built-in controllers of a node without others live apart from the
+ * controller list (scene->motion) until another controller comes: a node
+ * must move the same whichever way its controllers are kept, with a
+ * second rotation, with serial controllers, and after destroyed nodes'
+ * slots are compacted away. */
+static void builtin_controllers_kept_apart_move_the_same(void **state)
+{
+    (void)state;
+    ob_scene *s = new_scene();
+    ob_node *doomed[80];
+    for (int i = 0; i < 80; i++) {
+        doomed[i] = new_node(s, NULL, "doomed");
+        ob_node_add_rotation_controller(doomed[i], (float[3]){1, 0, 0}, 2);
+    }
+    /* kinds: 0 apart; 1 listed (a no-op first); 2 apart, then a second
+     * rotation; 3 listed with a second rotation; 4 apart, then a serial
+     * controller; 5 listed with one */
+    ob_node *n[6];
+    int released = 0;
+    for (int k = 0; k < 6; k++) {
+        n[k] = new_node(s, NULL, "moving");
+        make_renderable(n[k]);
+        if (k % 2)
+            assert_int_equal(ob_node_add_controller(n[k], &(ob_controller_desc){
+                                 .fn = noop_step, .user = &released, .parallel = true}), OB_OK);
+        assert_int_equal(ob_node_add_orbit_controller(n[k], (double[3]){1e6, 2, 3},
+                                                      (float[3]){0, 1, 0.5f}, 4, 0.9f, 0.3f),
+                         OB_OK);
+        assert_int_equal(ob_node_add_rotation_controller(n[k], (float[3]){1, 2, 3}, 0.7f), OB_OK);
+    }
+    assert_int_equal(ob_scene_update(s, 1.0 / 60.0), OB_OK);
+    for (int k = 2; k < 4; k++)
+        assert_int_equal(ob_node_add_rotation_controller(n[k], (float[3]){0, 0, 1}, -1.1f), OB_OK);
+    for (int k = 4; k < 6; k++)
+        assert_int_equal(ob_node_add_controller(n[k], &(ob_controller_desc){
+                             .fn = noop_step, .user = &released}), OB_OK);
+    for (int i = 0; i < 80; i++) ob_node_destroy(doomed[i]);
+    for (int i = 0; i < 100; i++) assert_int_equal(ob_scene_update(s, i % 3 ? 1.0 / 60.0 : 0.05), OB_OK);
+    for (int k = 0; k < 6; k += 2) {
+        double pa[3], pb[3], qa[4], qb[4];
+        ob_daffine wa, wb;
+        ob_node_get_position(n[k], pa);
+        ob_node_get_position(n[k + 1], pb);
+        ob_node_get_rotation(n[k], qa);
+        ob_node_get_rotation(n[k + 1], qb);
+        ob_node_world_affine(n[k], &wa);
+        ob_node_world_affine(n[k + 1], &wb);
+        assert_memory_equal(pa, pb, sizeof pa);
+        assert_memory_equal(qa, qb, sizeof qa);
+        assert_memory_equal(&wa, &wb, sizeof wa);
+        assert_true(fabs(pa[0] - 1e6) > 0.1); /* it moved */
+    }
+    /* The second rotation turned kinds 2 and 3 on from where 0 and 1 are. */
+    double q0[4], q2[4];
+    ob_node_get_rotation(n[0], q0);
+    ob_node_get_rotation(n[2], q2);
+    assert_true(fabs(q0[0] - q2[0]) + fabs(q0[3] - q2[3]) > 1e-3);
+    ob_scene_destroy(s);
+}
+
 static void allocation_failures_are_clean(void **state)
 {
     (void)state;
@@ -911,6 +971,7 @@ int main(void)
         cmocka_unit_test(destroy_subtree_frees_everything),
         cmocka_unit_test(destroy_many_matches_one_at_a_time),
         cmocka_unit_test(controller_state_kept_by_the_node),
+        cmocka_unit_test(builtin_controllers_kept_apart_move_the_same),
         cmocka_unit_test(bad_transform_rejected_once_and_recovers),
         cmocka_unit_test(bad_update_arguments_refused),
         cmocka_unit_test(cameras_and_lights),
