@@ -10,6 +10,7 @@
 
 void ob_rotation_controller_step(ob_node *n, double dt, void *user)
 {
+    node_world_rotation_keep(n->scene, n->by_id_index);
     ob_rotation_kernel(node_xf_of(n), user, dt);
     node_touch(n);
 }

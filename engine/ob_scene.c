@@ -193,6 +193,7 @@ void ob_scene_compact(ob_scene *s)
             s->draw[w] = s->draw[r];
             s->ctl[w] = s->ctl[r];
             if (s->state[w] & NODE_MOTION) s->motion[w] = s->motion[r];
+            if (!(s->xf[w].flags & XF_WORLD_ROT_LOCAL)) s->world_rot[w] = s->world_rot[r];
         }
         w++;
     }
@@ -219,6 +220,9 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
     if (r == OB_OK) r = ob_array_reserve((void **)&s->ctl, &s->ctl_cap, need, sizeof *s->ctl);
     if (r == OB_OK)
         r = ob_array_reserve((void **)&s->motion, &s->motion_cap, need, sizeof *s->motion);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->world_rot, &s->world_rot_cap, need,
+                             sizeof *s->world_rot);
     if (r != OB_OK) {
         OB_LOG_E(SCENE_LOG, "cannot create entity '%s': %s", n->name, ob_result_text(r));
         return r;
@@ -232,7 +236,7 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
     ob_dquat_identity(x->rotation);
     x->scale[0] = x->scale[1] = x->scale[2] = 1.0f;
     ob_daffine_identity(&x->world);
-    ob_dquat_identity(x->world_rotation);
+    x->flags = XF_WORLD_ROT_LOCAL;
     s->state[slot] = NODE_DIRTY;
     s->slot_id[slot] = n->id;
     s->draw[slot] = (node_draw){0};
@@ -301,6 +305,7 @@ fail_free_scene:
     ob_free(s->draw);
     ob_free(s->ctl);
     ob_free(s->motion);
+    ob_free(s->world_rot);
     ob_free(s);
     set_result(out_result, r);
     return NULL;
@@ -319,6 +324,7 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->draw);
     ob_free(s->ctl);
     ob_free(s->motion);
+    ob_free(s->world_rot);
     ob_free(s->ctl_pool);
     ob_free(s->retired);
     ob_free(s->order);
@@ -587,6 +593,7 @@ void ob_node_set_position(ob_node *n, const double p[3])
 static double *rotation_for_set(ob_node *n)
 {
     node_xf *x = node_xf_of(n);
+    node_world_rotation_keep(n->scene, n->by_id_index);
     x->flags &= ~(uint32_t)XF_ROTATION_UNIT;
     node_touch(n);
     return x->rotation;
@@ -740,7 +747,9 @@ static void node_axes(const ob_node *n, double axes[9])
         }
     }
     /* Zero (or collapsed) scale: the directions live on in the rotations. */
-    ob_dquat_to_mat3(x->world_rotation, axes);
+    double q[4];
+    node_world_rotation(n->scene, n->by_id_index, q);
+    ob_dquat_to_mat3(q, axes);
 }
 
 void ob_node_world_axes(const ob_node *n, float right[3], float up[3], float forward[3])
@@ -769,8 +778,7 @@ void ob_node_world_sphere(const ob_node *n, double center[3], float *radius)
         *radius = 0.0f;
         return;
     }
-    ob_dvec3_copy(x->world_center, center);
-    *radius = x->world_radius;
+    node_world_bound(x, center, radius);
 }
 
 bool ob_node_is_renderable(const ob_node *n)

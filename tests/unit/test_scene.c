@@ -934,6 +934,62 @@ static void builtin_controllers_kept_apart_move_the_same(void **state)
     ob_scene_destroy(s);
 }
 
+typedef struct axes_probe {
+    ob_node *watched;
+    float forward[3];
+} axes_probe;
+
+static void probe_axes(ob_node *n, double dt, void *user)
+{
+    (void)n;
+    (void)dt;
+    axes_probe *p = user;
+    ob_node_world_axes(p->watched, NULL, NULL, p->forward);
+}
+
+/* A zero-scale node's axes come from its world rotation, which is kept as
+ * of the last update however the rotation changes after it: by a setter,
+ * or by a rotation controller seen from a serial one during the update;
+ * under a rotated parent too. */
+static void world_rotation_as_of_last_update(void **state)
+{
+    (void)state;
+    ob_scene *s = new_scene();
+    ob_node *flat = new_node(s, NULL, "flat"), *parent = new_node(s, NULL, "parent");
+    ob_node *child = new_node(s, parent, "child"), *spin = new_node(s, NULL, "spin");
+    ob_node *watcher = new_node(s, NULL, "watcher");
+    const float zero[3] = {0, 0, 0};
+    const float about_y[4] = {0, 0.70710678f, 0, 0.70710678f}; /* 90° about Y */
+    ob_node_set_scale(flat, zero);
+    ob_node_set_rotation(flat, about_y);
+    ob_node_set_rotation(parent, about_y);
+    ob_node_set_scale(child, zero);
+    ob_node_set_rotation(child, about_y);
+    ob_node_set_scale(spin, zero);
+    assert_int_equal(ob_node_add_rotation_controller(spin, (float[3]){0, 1, 0}, 1.0f), OB_OK);
+    axes_probe probe = {.watched = spin};
+    assert_int_equal(ob_node_add_script_controller(watcher, probe_axes, &probe), OB_OK);
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    float f[3], before[3];
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[0], -1, 1e-6); /* -Z turned 90° about Y */
+    ob_node_set_rotation(flat, (float[4]){0, 0, 0, 1});
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[0], -1, 1e-6); /* still the last update's */
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[2], -1, 1e-6);
+    ob_node_world_axes(child, NULL, NULL, f);
+    assert_near(f[2], 1, 1e-6); /* 180° about Y in all */
+    /* The serial controller saw spin as the previous update left it. */
+    ob_node_world_axes(spin, NULL, NULL, before);
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    for (int k = 0; k < 3; k++) assert_float_equal(probe.forward[k], before[k], 0);
+    ob_node_world_axes(spin, NULL, NULL, f);
+    assert_true(fabsf(f[0] - before[0]) + fabsf(f[2] - before[2]) > 0.1f);
+    ob_scene_destroy(s);
+}
+
 static void allocation_failures_are_clean(void **state)
 {
     (void)state;
@@ -977,6 +1033,7 @@ int main(void)
         cmocka_unit_test(cameras_and_lights),
         cmocka_unit_test(look_at_aims_forward),
         cmocka_unit_test(world_sphere_and_axes),
+        cmocka_unit_test(world_rotation_as_of_last_update),
         cmocka_unit_test(find_names_and_user_data),
         cmocka_unit_test(allocation_failures_are_clean),
     };
