@@ -69,7 +69,16 @@ enum {
                                        (the rotation controller's): used as is */
     XF_WORLD_ROT_LOCAL = 1u << 9,   /* the world rotation is the unit rotation (as the
                                        last evaluation made it from this very rotation):
-                                       not stored; else it is scene->world_rot[slot] */
+                                       not stored; else it is scene->world_rot[slot].
+                                       A rotation change stores it first
+                                       (node_world_rotation_keep), except a rotation
+                                       controller's in the fused loop, whose node is
+                                       evaluated right after: should that evaluation
+                                       fail (a non-finite position or scale in the same
+                                       update), the world rotation follows the new
+                                       rotation while the world stays the last valid
+                                       one, which shows only in the axes of a node
+                                       whose last valid world had a zero scale */
 };
 
 /* A node's transform data: three cache lines, everything its evaluation
