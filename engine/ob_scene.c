@@ -884,25 +884,34 @@ static ob_result controller_append(ob_node *n, const ob_controller_desc *d, cons
     return OB_OK;
 }
 
+/* A built-in kind kept in scene->motion (NODE_ORBIT or NODE_SPIN): its
+ * function, and where its state lies in m (size in *out_size). */
+static ob_controller_fn motion_fn(uint8_t kind)
+{
+    return kind == NODE_ORBIT ? ob_orbit_controller_step : ob_rotation_controller_step;
+}
+
+static void *motion_state(node_motion *m, uint8_t kind, size_t *out_size)
+{
+    *out_size = kind == NODE_ORBIT ? sizeof m->orbit : sizeof m->spin;
+    return kind == NODE_ORBIT ? (void *)&m->orbit : (void *)&m->spin;
+}
+
 /* The node's built-in controllers in scene->motion into its list, as
  * ob_node_add_controller_state's: the list must keep the order added. */
 static ob_result motion_unpack(ob_node *n)
 {
+    static const uint8_t kinds[] = {NODE_ORBIT, NODE_SPIN};
     ob_scene *s = n->scene;
     uint32_t slot = n->by_id_index;
-    if ((s->state[slot] & NODE_ORBIT)) {
+    for (size_t k = 0; k < OB_ARRAY_COUNT(kinds); k++) {
+        if (!(s->state[slot] & kinds[k])) continue;
+        size_t size;
+        const void *state = motion_state(&s->motion[slot], kinds[k], &size);
         ob_result r = controller_append(
-            n, &(ob_controller_desc){.fn = ob_orbit_controller_step, .parallel = true},
-            &s->motion[slot].orbit, sizeof s->motion[slot].orbit);
+            n, &(ob_controller_desc){.fn = motion_fn(kinds[k]), .parallel = true}, state, size);
         if (r != OB_OK) return r;
-        s->state[slot] &= (uint8_t)~NODE_ORBIT;
-    }
-    if ((s->state[slot] & NODE_SPIN)) {
-        ob_result r = controller_append(
-            n, &(ob_controller_desc){.fn = ob_rotation_controller_step, .parallel = true},
-            &s->motion[slot].spin, sizeof s->motion[slot].spin);
-        if (r != OB_OK) return r;
-        s->state[slot] &= (uint8_t)~NODE_SPIN;
+        s->state[slot] &= (uint8_t)~kinds[k];
     }
     return OB_OK;
 }
@@ -923,14 +932,13 @@ ob_result ob_scene_motion_add(ob_node *n, uint8_t kind, const void *state, size_
     ob_scene *s = n->scene;
     uint32_t slot = n->by_id_index;
     if (!s->ctl[slot].count && !(s->state[slot] & kind)) {
-        node_motion *m = &s->motion[slot];
-        memcpy(kind == NODE_ORBIT ? (void *)&m->orbit : (void *)&m->spin, state, size);
+        size_t kept;
+        memcpy(motion_state(&s->motion[slot], kind, &kept), state, size);
         s->state[slot] |= kind;
         return OB_OK;
     }
-    ob_controller_fn fn = kind == NODE_ORBIT ? ob_orbit_controller_step
-                                             : ob_rotation_controller_step;
-    return controller_add(n, &(ob_controller_desc){.fn = fn, .parallel = true}, state, size);
+    return controller_add(n, &(ob_controller_desc){.fn = motion_fn(kind), .parallel = true},
+                          state, size);
 }
 
 ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)
