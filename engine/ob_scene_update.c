@@ -325,6 +325,13 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
         b->in_place[k] = !p || (p->flags & (XF_IDENTITY | XF_WORLD_VALID)) ==
                                    (XF_IDENTITY | XF_WORLD_VALID);
         b->st[k] = ob_scene_xf_local(x, b->in_place[k] ? &x->world : &b->world[k], b->q[k]);
+        /* The proxy's two lines are only written, a stage later: asked for
+         * now, they are there by then (3-4 ns an object at 50k). */
+        if (s->state[it.slot] & NODE_IN_RENDERABLES) {
+            const char *pr = (const char *)&s->proxies[x->proxy_index];
+            __builtin_prefetch(pr, 1);
+            __builtin_prefetch(pr + OB_CACHE_LINE, 1);
+        }
     }
     bool changed = false;
     for (uint32_t k = 0; k < b->count; k++)
