@@ -1,6 +1,7 @@
 /* ob_controllers.c — the built-in controllers (rotation, orbit, script).
- * The rotation and orbit controllers keep their state in the node
- * (ob_node_add_controller_state), in double so long runs do not drift;
+ * The rotation and orbit controllers keep their state in the scene
+ * (scene->motion, or as ob_node_add_controller_state's copy once the node
+ * has other controllers), in double so long runs do not drift;
  * their steps are kernels on the node's slot data
  * (ob_controllers_internal.h), which the update runs in its own loop. */
 #include "ob_controllers_internal.h"
@@ -9,6 +10,7 @@
 
 void ob_rotation_controller_step(ob_node *n, double dt, void *user)
 {
+    node_world_rotation_keep(n->scene, n->by_id_index);
     ob_rotation_kernel(node_xf_of(n), user, dt);
     node_touch(n);
 }
@@ -35,9 +37,7 @@ ob_result ob_node_add_rotation_controller(ob_node *n, const float axis[3], float
     }
     ob_rotation_state st = {.axis = {a[0], a[1], a[2]}, .rate = radians_per_second,
                             .step_dt = NAN};
-    return ob_node_add_controller_state(
-        n, &(ob_controller_desc){.fn = ob_rotation_controller_step, .parallel = true}, &st,
-        sizeof st);
+    return ob_scene_motion_add(n, NODE_SPIN, &st, sizeof st);
 }
 
 ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const float axis[3],
@@ -67,9 +67,7 @@ ob_result ob_node_add_orbit_controller(ob_node *n, const double center[3], const
     st->radius = radius;
     st->rate = radians_per_second;
     st->angle = phase;
-    return ob_node_add_controller_state(
-        n, &(ob_controller_desc){.fn = ob_orbit_controller_step, .parallel = true}, st,
-        sizeof *st);
+    return ob_scene_motion_add(n, NODE_ORBIT, st, sizeof *st);
 }
 
 ob_result ob_node_add_script_controller(ob_node *n, ob_controller_fn fn, void *user)

@@ -4,7 +4,7 @@
  * update data in dense slot arrays of the scene) is described in
  * ob_scene_internal.h.
  */
-#include "ob_scene_internal.h"
+#include "ob_controllers_internal.h"
 
 #include <string.h>
 
@@ -192,6 +192,8 @@ void ob_scene_compact(ob_scene *s)
             s->slot_id[w] = s->slot_id[r];
             s->draw[w] = s->draw[r];
             s->ctl[w] = s->ctl[r];
+            if (s->state[w] & NODE_MOTION) s->motion[w] = s->motion[r];
+            if (!(s->xf[w].flags & XF_WORLD_ROT_LOCAL)) s->world_rot[w] = s->world_rot[r];
         }
         w++;
     }
@@ -216,6 +218,11 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
         r = ob_array_reserve((void **)&s->slot_id, &s->slot_id_cap, need, sizeof *s->slot_id);
     if (r == OB_OK) r = ob_array_reserve((void **)&s->draw, &s->draw_cap, need, sizeof *s->draw);
     if (r == OB_OK) r = ob_array_reserve((void **)&s->ctl, &s->ctl_cap, need, sizeof *s->ctl);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->motion, &s->motion_cap, need, sizeof *s->motion);
+    if (r == OB_OK)
+        r = ob_array_reserve((void **)&s->world_rot, &s->world_rot_cap, need,
+                             sizeof *s->world_rot);
     if (r != OB_OK) {
         OB_LOG_E(SCENE_LOG, "cannot create entity '%s': %s", n->name, ob_result_text(r));
         return r;
@@ -229,7 +236,7 @@ static ob_result by_id_append(ob_scene *s, ob_node *n)
     ob_dquat_identity(x->rotation);
     x->scale[0] = x->scale[1] = x->scale[2] = 1.0f;
     ob_daffine_identity(&x->world);
-    ob_dquat_identity(x->world_rotation);
+    x->flags = XF_WORLD_ROT_LOCAL;
     s->state[slot] = NODE_DIRTY;
     s->slot_id[slot] = n->id;
     s->draw[slot] = (node_draw){0};
@@ -297,6 +304,8 @@ fail_free_scene:
     ob_free(s->slot_id);
     ob_free(s->draw);
     ob_free(s->ctl);
+    ob_free(s->motion);
+    ob_free(s->world_rot);
     ob_free(s);
     set_result(out_result, r);
     return NULL;
@@ -314,6 +323,8 @@ void ob_scene_destroy(ob_scene *s)
     ob_free(s->slot_id);
     ob_free(s->draw);
     ob_free(s->ctl);
+    ob_free(s->motion);
+    ob_free(s->world_rot);
     ob_free(s->ctl_pool);
     ob_free(s->retired);
     ob_free(s->order);
@@ -582,6 +593,7 @@ void ob_node_set_position(ob_node *n, const double p[3])
 static double *rotation_for_set(ob_node *n)
 {
     node_xf *x = node_xf_of(n);
+    node_world_rotation_keep(n->scene, n->by_id_index);
     x->flags &= ~(uint32_t)XF_ROTATION_UNIT;
     node_touch(n);
     return x->rotation;
@@ -735,7 +747,9 @@ static void node_axes(const ob_node *n, double axes[9])
         }
     }
     /* Zero (or collapsed) scale: the directions live on in the rotations. */
-    ob_dquat_to_mat3(x->world_rotation, axes);
+    double q[4];
+    node_world_rotation(n->scene, n->by_id_index, q);
+    ob_dquat_to_mat3(q, axes);
 }
 
 void ob_node_world_axes(const ob_node *n, float right[3], float up[3], float forward[3])
@@ -764,8 +778,7 @@ void ob_node_world_sphere(const ob_node *n, double center[3], float *radius)
         *radius = 0.0f;
         return;
     }
-    ob_dvec3_copy(x->world_center, center);
-    *radius = x->world_radius;
+    node_world_bound(x, center, radius);
 }
 
 bool ob_node_is_renderable(const ob_node *n)
@@ -823,8 +836,9 @@ fail_log_non_finite:
 
 /* ------------------------------------------------------------ controllers */
 
-static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const void *state,
-                                size_t size)
+/* Appends a controller to the node's list (see controller_add). */
+static ob_result controller_append(ob_node *n, const ob_controller_desc *d, const void *state,
+                                   size_t size)
 {
     void *release_arg = state ? (void *)state : d->user;
     ob_scene *s = n->scene;
@@ -868,6 +882,63 @@ static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const v
         s->serial_nodes++;
     }
     return OB_OK;
+}
+
+/* A built-in kind kept in scene->motion (NODE_ORBIT or NODE_SPIN): its
+ * function, and where its state lies in m (size in *out_size). */
+static ob_controller_fn motion_fn(uint8_t kind)
+{
+    return kind == NODE_ORBIT ? ob_orbit_controller_step : ob_rotation_controller_step;
+}
+
+static void *motion_state(node_motion *m, uint8_t kind, size_t *out_size)
+{
+    *out_size = kind == NODE_ORBIT ? sizeof m->orbit : sizeof m->spin;
+    return kind == NODE_ORBIT ? (void *)&m->orbit : (void *)&m->spin;
+}
+
+/* The node's built-in controllers in scene->motion into its list, as
+ * ob_node_add_controller_state's: the list must keep the order added. */
+static ob_result motion_unpack(ob_node *n)
+{
+    static const uint8_t kinds[] = {NODE_ORBIT, NODE_SPIN};
+    ob_scene *s = n->scene;
+    uint32_t slot = n->by_id_index;
+    for (size_t k = 0; k < OB_ARRAY_COUNT(kinds); k++) {
+        if (!(s->state[slot] & kinds[k])) continue;
+        size_t size;
+        const void *state = motion_state(&s->motion[slot], kinds[k], &size);
+        ob_result r = controller_append(
+            n, &(ob_controller_desc){.fn = motion_fn(kinds[k]), .parallel = true}, state, size);
+        if (r != OB_OK) return r;
+        s->state[slot] &= (uint8_t)~kinds[k];
+    }
+    return OB_OK;
+}
+
+static ob_result controller_add(ob_node *n, const ob_controller_desc *d, const void *state,
+                                size_t size)
+{
+    ob_result r = motion_unpack(n);
+    if (r != OB_OK) {
+        if (d->release) d->release(state ? (void *)state : d->user);
+        return r;
+    }
+    return controller_append(n, d, state, size);
+}
+
+ob_result ob_scene_motion_add(ob_node *n, uint8_t kind, const void *state, size_t size)
+{
+    ob_scene *s = n->scene;
+    uint32_t slot = n->by_id_index;
+    if (!s->ctl[slot].count && !(s->state[slot] & kind)) {
+        size_t kept;
+        memcpy(motion_state(&s->motion[slot], kind, &kept), state, size);
+        s->state[slot] |= kind;
+        return OB_OK;
+    }
+    return controller_add(n, &(ob_controller_desc){.fn = motion_fn(kind), .parallel = true},
+                          state, size);
 }
 
 ob_result ob_node_add_controller(ob_node *n, const ob_controller_desc *d)

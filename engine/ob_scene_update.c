@@ -87,9 +87,10 @@ static void report_fault(const ob_node *n, local_status st)
                  n->name, n->id);
 }
 
-static bool is_identity(const node_xf *x)
+/* Whether world and world rotation q are exactly the identity. */
+static bool is_identity(const node_xf *x, const double q[4])
 {
-    const double *m = x->world.m, *t = x->world.t, *q = x->world_rotation;
+    const double *m = x->world.m, *t = x->world.t;
     return m[0] == 1.0 && m[1] == 0.0 && m[2] == 0.0 && m[3] == 0.0 && m[4] == 1.0 &&
            m[5] == 0.0 && m[6] == 0.0 && m[7] == 0.0 && m[8] == 1.0 && t[0] == 0.0 &&
            t[1] == 0.0 && t[2] == 0.0 && q[0] == 0.0 && q[1] == 0.0 && q[2] == 0.0 &&
@@ -100,24 +101,25 @@ static bool is_identity(const node_xf *x)
 
 _Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
 
-static uint8_t zero_scale_flag(const node_xf *x)
+static uint8_t zero_scale_flag(const node_xf *x, float world_radius)
 {
-    return x->world_radius == 0.0f && x->local_radius > 0.0f ? OB_RENDER_ZERO_SCALE : 0u;
+    return world_radius == 0.0f && x->local_radius > 0.0f ? OB_RENDER_ZERO_SCALE : 0u;
 }
 
 /* What of proxy i follows the node's world, in two steps so that a batch's
  * values are stored well before they are read back (a load that spans
  * several recent smaller stores waits for them to retire). */
-static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i)
+static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i, const double center[3],
+                              float radius)
 {
     ob_render_proxy *p = &s->proxies[i];
     for (int k = 0; k < 9; k++) p->linear[k] = (float)x->world.m[k];
     for (int k = 0; k < 3; k++) p->world_t[k] = x->world.t[k];
-    s->soa_x[i] = x->world_center[0];
-    s->soa_y[i] = x->world_center[1];
-    s->soa_z[i] = x->world_center[2];
-    s->soa_radius[i] = x->world_radius;
-    s->soa_flags[i] = zero_scale_flag(x);
+    s->soa_x[i] = center[0];
+    s->soa_y[i] = center[1];
+    s->soa_z[i] = center[2];
+    s->soa_radius[i] = radius;
+    s->soa_flags[i] = zero_scale_flag(x, radius);
 }
 
 /* The normal matrix, and whether the matrices are finite in float (the
@@ -137,7 +139,10 @@ void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
     s->proxies[i].geometry = d->geometry;
     s->soa_material[i] = d->material_index;
     s->soa_geometry[i] = d->geometry_index;
-    s->soa_flags[i] = zero_scale_flag(x);
+    double center[3];
+    float radius;
+    node_world_bound(x, center, &radius);
+    s->soa_flags[i] = zero_scale_flag(x, radius);
 }
 
 /* The whole of proxy i for the node in slot. */
@@ -148,7 +153,10 @@ static void proxy_fill(ob_scene *s, uint32_t slot, uint32_t i)
     s->proxies[i].node = s->soa_node[i] = s->by_id[slot];
     s->proxies[i].node_id = s->soa_node_id[i] = s->slot_id[slot];
     ob_scene_proxy_set_renderable(s, slot);
-    proxy_write_world(s, x, i);
+    double center[3];
+    float radius;
+    node_world_bound(x, center, &radius);
+    proxy_write_world(s, x, i, center, radius);
     proxy_write_normal(s, i);
 }
 
@@ -230,10 +238,12 @@ typedef struct eval_batch {
     level_item item[EVAL_BATCH];
     local_status st[EVAL_BATCH];
     bool in_place[EVAL_BATCH];  /* its world and world rotation are its local ones,
-                                   computed straight into its node_xf */
+                                   the world computed straight into its node_xf */
     bool proxy[EVAL_BATCH];     /* stays in the snapshot: its proxy follows */
     uint32_t proxy_index[EVAL_BATCH];
-    double q[EVAL_BATCH][4];    /* unit local rotation */
+    double center[EVAL_BATCH][3]; /* world bound of those with proxy[k] */
+    float radius[EVAL_BATCH];
+    double q[EVAL_BATCH][4];    /* unit local rotation, then world rotation */
     ob_daffine world[EVAL_BATCH];
 } eval_batch;
 
@@ -270,21 +280,19 @@ static bool node_eval(ob_scene *s, eval_batch *b, uint32_t k)
         flags &= ~(uint32_t)XF_WORLD_VALID;
     } else {
         flags |= XF_WORLD_VALID;
-        if (!b->in_place[k]) {
-            x->world = *world;
-            if (through) {
-                ob_dquat_mul(p->world_rotation, b->q[k], x->world_rotation);
-                ob_dquat_normalize(x->world_rotation, x->world_rotation);
-            } else {
-                memcpy(x->world_rotation, b->q[k], sizeof x->world_rotation);
-            }
+        if (!b->in_place[k]) x->world = *world;
+        const double *world_q = b->q[k]; /* from x->rotation as it is */
+        if (through) {
+            double pq[4], *dest = s->world_rot[it.slot].q;
+            node_world_rotation(s, it.parent, pq);
+            ob_dquat_mul(pq, b->q[k], dest);
+            ob_dquat_normalize(dest, dest);
+            world_q = dest;
+            flags &= ~(uint32_t)XF_WORLD_ROT_LOCAL;
+        } else {
+            flags |= XF_WORLD_ROT_LOCAL;
         }
-        if (flags & XF_HAS_RENDERABLE) {
-            double c[3] = {x->local_center[0], x->local_center[1], x->local_center[2]};
-            ob_daffine_transform_point(&x->world, c, x->world_center);
-            x->world_radius = (float)(x->local_radius * ob_daffine_max_scale(&x->world));
-        }
-        if ((flags & XF_HAS_CHILDREN) && is_identity(x)) flags |= XF_IDENTITY;
+        if ((flags & XF_HAS_CHILDREN) && is_identity(x, world_q)) flags |= XF_IDENTITY;
         if (flags & XF_FAULT_REPORTED) {
             flags &= ~(uint32_t)XF_FAULT_REPORTED;
             const ob_node *n = s->by_id[it.slot];
@@ -301,6 +309,7 @@ static bool node_eval(ob_scene *s, eval_batch *b, uint32_t k)
     s->state[it.slot] = (uint8_t)((old & ~(NODE_DIRTY | NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) |
                                   NODE_CHANGED | member);
     b->proxy[k] = (old & member & NODE_IN_RENDERABLES) != 0;
+    if (b->proxy[k]) node_world_bound(x, b->center[k], &b->radius[k]);
     return ((old ^ member) & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) != 0;
 }
 
@@ -315,8 +324,14 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
         const node_xf *p = it.parent == NO_SLOT ? NULL : &s->xf[it.parent];
         b->in_place[k] = !p || (p->flags & (XF_IDENTITY | XF_WORLD_VALID)) ==
                                    (XF_IDENTITY | XF_WORLD_VALID);
-        b->st[k] = b->in_place[k] ? ob_scene_xf_local(x, &x->world, x->world_rotation)
-                                  : ob_scene_xf_local(x, &b->world[k], b->q[k]);
+        b->st[k] = ob_scene_xf_local(x, b->in_place[k] ? &x->world : &b->world[k], b->q[k]);
+        /* The proxy's two lines are only written, a stage later: asked for
+         * now, they are there by then (3-4 ns an object at 50k). */
+        if (s->state[it.slot] & NODE_IN_RENDERABLES) {
+            const char *pr = (const char *)&s->proxies[x->proxy_index];
+            __builtin_prefetch(pr, 1);
+            __builtin_prefetch(pr + OB_CACHE_LINE, 1);
+        }
     }
     bool changed = false;
     for (uint32_t k = 0; k < b->count; k++)
@@ -325,7 +340,7 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
     for (uint32_t k = 0; k < b->count; k++) {
         if (!b->proxy[k]) continue;
         const node_xf *x = &s->xf[b->item[k].slot];
-        proxy_write_world(s, x, x->proxy_index);
+        proxy_write_world(s, x, x->proxy_index, b->center[k], b->radius[k]);
         b->proxy_index[proxies++] = x->proxy_index;
     }
     for (uint32_t k = 0; k < proxies; k++) proxy_write_normal(s, b->proxy_index[k]);
@@ -335,10 +350,18 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
 
 /* ------------------------------------------------------------------ loops */
 
-static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, double dt)
+/* The node's parallel-safe controllers (st: its NODE_* byte, with
+ * NODE_PARALLEL or NODE_MOTION); keep_world as for ob_motion_run. */
+static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, uint8_t st, double dt,
+                                            bool keep_world)
 {
+    if (st & NODE_MOTION) {
+        ob_motion_run(s, slot, st, dt, keep_world);
+        return;
+    }
     node_controllers *ctl = &s->ctl[slot];
-    for (uint32_t k = 0; k < ctl->parallel; k++) ob_controller_run(s, slot, &ctl->slots[k], dt);
+    for (uint32_t k = 0; k < ctl->parallel; k++)
+        ob_controller_run(s, slot, &ctl->slots[k], dt, keep_world);
 }
 
 static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t thread)
@@ -349,7 +372,8 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
     uint32_t end = chunk_end(c->count, chunk, c->grain);
     for (uint32_t i = chunk * c->grain; i < end; i++) {
         uint32_t slot = c->items[i].slot;
-        if (s->state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+        uint8_t st = s->state[slot];
+        if (st & (NODE_PARALLEL | NODE_MOTION)) run_parallel_controllers(s, slot, st, c->dt, true);
     }
 }
 
@@ -370,7 +394,9 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
         if (c->controllers) {
             for (uint32_t j = i; j < batch_end; j++) {
                 uint32_t slot = c->items[j].slot;
-                if (state[slot] & NODE_PARALLEL) run_parallel_controllers(s, slot, c->dt);
+                uint8_t st = state[slot];
+                if (st & (NODE_PARALLEL | NODE_MOTION))
+                    run_parallel_controllers(s, slot, st, c->dt, false);
             }
         }
         for (uint32_t j = i; j < batch_end; j++) {
@@ -540,7 +566,7 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
             /* Re-read the array each time: a controller may add controllers. */
             uint32_t count = s->ctl[slot].count;
             for (uint32_t k = s->ctl[slot].parallel; k < count; k++)
-                ob_controller_run(s, slot, &s->ctl[slot].slots[k], dt);
+                ob_controller_run(s, slot, &s->ctl[slot].slots[k], dt, true);
         }
     }
     bool membership_changed = s->snapshot_dirty;

@@ -874,6 +874,122 @@ static ob_result fault_scenario(void)
     return r;
 }
 
+/* The built-in controllers of a node without others live apart from the
+ * controller list (scene->motion) until another controller comes: a node
+ * must move the same whichever way its controllers are kept, with a
+ * second rotation, with serial controllers, and after destroyed nodes'
+ * slots are compacted away. */
+static void builtin_controllers_kept_apart_move_the_same(void **state)
+{
+    (void)state;
+    ob_scene *s = new_scene();
+    ob_node *doomed[80];
+    for (int i = 0; i < 80; i++) {
+        doomed[i] = new_node(s, NULL, "doomed");
+        ob_node_add_rotation_controller(doomed[i], (float[3]){1, 0, 0}, 2);
+    }
+    /* kinds: 0 apart; 1 listed (a no-op first); 2 apart, then a second
+     * rotation; 3 listed with a second rotation; 4 apart, then a serial
+     * controller; 5 listed with one */
+    ob_node *n[6];
+    int released = 0;
+    for (int k = 0; k < 6; k++) {
+        n[k] = new_node(s, NULL, "moving");
+        make_renderable(n[k]);
+        if (k % 2)
+            assert_int_equal(ob_node_add_controller(n[k], &(ob_controller_desc){
+                                 .fn = noop_step, .user = &released, .parallel = true}), OB_OK);
+        assert_int_equal(ob_node_add_orbit_controller(n[k], (double[3]){1e6, 2, 3},
+                                                      (float[3]){0, 1, 0.5f}, 4, 0.9f, 0.3f),
+                         OB_OK);
+        assert_int_equal(ob_node_add_rotation_controller(n[k], (float[3]){1, 2, 3}, 0.7f), OB_OK);
+    }
+    assert_int_equal(ob_scene_update(s, 1.0 / 60.0), OB_OK);
+    for (int k = 2; k < 4; k++)
+        assert_int_equal(ob_node_add_rotation_controller(n[k], (float[3]){0, 0, 1}, -1.1f), OB_OK);
+    for (int k = 4; k < 6; k++)
+        assert_int_equal(ob_node_add_controller(n[k], &(ob_controller_desc){
+                             .fn = noop_step, .user = &released}), OB_OK);
+    for (int i = 0; i < 80; i++) ob_node_destroy(doomed[i]);
+    for (int i = 0; i < 100; i++) assert_int_equal(ob_scene_update(s, i % 3 ? 1.0 / 60.0 : 0.05), OB_OK);
+    for (int k = 0; k < 6; k += 2) {
+        double pa[3], pb[3], qa[4], qb[4];
+        ob_daffine wa, wb;
+        ob_node_get_position(n[k], pa);
+        ob_node_get_position(n[k + 1], pb);
+        ob_node_get_rotation(n[k], qa);
+        ob_node_get_rotation(n[k + 1], qb);
+        ob_node_world_affine(n[k], &wa);
+        ob_node_world_affine(n[k + 1], &wb);
+        assert_memory_equal(pa, pb, sizeof pa);
+        assert_memory_equal(qa, qb, sizeof qa);
+        assert_memory_equal(&wa, &wb, sizeof wa);
+        assert_true(fabs(pa[0] - 1e6) > 0.1); /* it moved */
+    }
+    /* The second rotation turned kinds 2 and 3 on from where 0 and 1 are. */
+    double q0[4], q2[4];
+    ob_node_get_rotation(n[0], q0);
+    ob_node_get_rotation(n[2], q2);
+    assert_true(fabs(q0[0] - q2[0]) + fabs(q0[3] - q2[3]) > 1e-3);
+    ob_scene_destroy(s);
+}
+
+typedef struct axes_probe {
+    ob_node *watched;
+    float forward[3];
+} axes_probe;
+
+static void probe_axes(ob_node *n, double dt, void *user)
+{
+    (void)n;
+    (void)dt;
+    axes_probe *p = user;
+    ob_node_world_axes(p->watched, NULL, NULL, p->forward);
+}
+
+/* A zero-scale node's axes come from its world rotation, which is kept as
+ * of the last update however the rotation changes after it: by a setter,
+ * or by a rotation controller seen from a serial one during the update;
+ * under a rotated parent too. */
+static void world_rotation_as_of_last_update(void **state)
+{
+    (void)state;
+    ob_scene *s = new_scene();
+    ob_node *flat = new_node(s, NULL, "flat"), *parent = new_node(s, NULL, "parent");
+    ob_node *child = new_node(s, parent, "child"), *spin = new_node(s, NULL, "spin");
+    ob_node *watcher = new_node(s, NULL, "watcher");
+    const float zero[3] = {0, 0, 0};
+    const float about_y[4] = {0, 0.70710678f, 0, 0.70710678f}; /* 90° about Y */
+    ob_node_set_scale(flat, zero);
+    ob_node_set_rotation(flat, about_y);
+    ob_node_set_rotation(parent, about_y);
+    ob_node_set_scale(child, zero);
+    ob_node_set_rotation(child, about_y);
+    ob_node_set_scale(spin, zero);
+    assert_int_equal(ob_node_add_rotation_controller(spin, (float[3]){0, 1, 0}, 1.0f), OB_OK);
+    axes_probe probe = {.watched = spin};
+    assert_int_equal(ob_node_add_script_controller(watcher, probe_axes, &probe), OB_OK);
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    float f[3], before[3];
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[0], -1, 1e-6); /* -Z turned 90° about Y */
+    ob_node_set_rotation(flat, (float[4]){0, 0, 0, 1});
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[0], -1, 1e-6); /* still the last update's */
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    ob_node_world_axes(flat, NULL, NULL, f);
+    assert_near(f[2], -1, 1e-6);
+    ob_node_world_axes(child, NULL, NULL, f);
+    assert_near(f[2], 1, 1e-6); /* 180° about Y in all */
+    /* The serial controller saw spin as the previous update left it. */
+    ob_node_world_axes(spin, NULL, NULL, before);
+    assert_int_equal(ob_scene_update(s, 0.5), OB_OK);
+    for (int k = 0; k < 3; k++) assert_float_equal(probe.forward[k], before[k], 0);
+    ob_node_world_axes(spin, NULL, NULL, f);
+    assert_true(fabsf(f[0] - before[0]) + fabsf(f[2] - before[2]) > 0.1f);
+    ob_scene_destroy(s);
+}
+
 static void allocation_failures_are_clean(void **state)
 {
     (void)state;
@@ -911,11 +1027,13 @@ int main(void)
         cmocka_unit_test(destroy_subtree_frees_everything),
         cmocka_unit_test(destroy_many_matches_one_at_a_time),
         cmocka_unit_test(controller_state_kept_by_the_node),
+        cmocka_unit_test(builtin_controllers_kept_apart_move_the_same),
         cmocka_unit_test(bad_transform_rejected_once_and_recovers),
         cmocka_unit_test(bad_update_arguments_refused),
         cmocka_unit_test(cameras_and_lights),
         cmocka_unit_test(look_at_aims_forward),
         cmocka_unit_test(world_sphere_and_axes),
+        cmocka_unit_test(world_rotation_as_of_last_update),
         cmocka_unit_test(find_names_and_user_data),
         cmocka_unit_test(allocation_failures_are_clean),
     };
