@@ -11,6 +11,8 @@
 #ifndef OB_SHADOW_GLSL
 #define OB_SHADOW_GLSL
 
+#include "pcf.glsl"
+
 layout(set = 1, binding = 0) uniform sampler2DArrayShadow ShadowMap;
 
 // Cascade i's visibility at p; `inside` false (and lit) where p lies
@@ -23,13 +25,7 @@ float ob_shadow_cascade(int i, vec3 p, out bool inside)
     inside = clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) &&
              all(lessThanEqual(uv, vec2(1.0))) && s.z >= 0.0 && s.z <= 1.0;
     if (!inside) return 1.0;
-    vec2 texel = 1.0 / vec2(textureSize(ShadowMap, 0).xy);
-    float layer = float(i);
-    float lit = texture(ShadowMap, vec4(uv + vec2(-0.5, -0.5) * texel, layer, s.z))
-              + texture(ShadowMap, vec4(uv + vec2( 0.5, -0.5) * texel, layer, s.z))
-              + texture(ShadowMap, vec4(uv + vec2(-0.5,  0.5) * texel, layer, s.z))
-              + texture(ShadowMap, vec4(uv + vec2( 0.5,  0.5) * texel, layer, s.z));
-    return lit * 0.25;
+    return ob_pcf4(ShadowMap, uv, float(i), s.z);
 }
 
 float ob_shadow_visibility(vec3 p)

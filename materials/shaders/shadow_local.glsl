@@ -12,6 +12,8 @@
 #ifndef OB_SHADOW_LOCAL_GLSL
 #define OB_SHADOW_LOCAL_GLSL
 
+#include "pcf.glsl"
+
 #define OB_MAX_LOCAL_SHADOW_LAYERS 16
 
 layout(set = 0, binding = 5, std140) uniform PerViewLocalShadows {
@@ -48,12 +50,7 @@ float ob_local_shadow(int first_layer, bool point, vec3 light_pos, vec3 p)
     // leaves a surface facing the light (no slope) to the rounding of two
     // matrix paths, which shows as lines of shadow.
     s.z *= 1.0 + 2.0 * texel.x;
-    float l = float(layer);
-    float lit = texture(LocalShadowMaps, vec4(uv + vec2(-0.5, -0.5) * texel, l, s.z))
-              + texture(LocalShadowMaps, vec4(uv + vec2( 0.5, -0.5) * texel, l, s.z))
-              + texture(LocalShadowMaps, vec4(uv + vec2(-0.5,  0.5) * texel, l, s.z))
-              + texture(LocalShadowMaps, vec4(uv + vec2( 0.5,  0.5) * texel, l, s.z));
-    return lit * 0.25;
+    return ob_pcf4(LocalShadowMaps, uv, float(layer), s.z);
 }
 
 #endif
