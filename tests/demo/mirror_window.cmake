@@ -22,22 +22,8 @@ set(frames 6)
 set(common --objects 120 --size 320x240 --frames ${frames} --quiet)
 
 function(run name)
-  execute_process(COMMAND ${ARGN} ${common} --out ${OUT}/${name}.png
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
-  set(last_out "${out}" PARENT_SCOPE)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${name}: exited with ${rc}\n${out}\n${err}")
-  endif()
-  # The window shows what the PNG holds only with an sRGB swapchain.
-  if(err MATCHES "offers no B8G8R8A8/R8G8B8A8 sRGB format")
-    message(FATAL_ERROR "${name}: the swapchain is not sRGB\n${err}")
-  endif()
-  if(NOT out MATCHES "validation: 0 errors, 0 warnings")
-    message(FATAL_ERROR "${name}: the run did not report a silent validation layer\n${out}")
-  endif()
-  if("${ARGN}" MATCHES "--window" AND NOT out MATCHES "window: ${frames} frames presented, 0 skipped")
-    message(FATAL_ERROR "${name}: not every frame was presented\n${out}")
-  endif()
+  ob_window_run(${name} ${ARGN} ${common})
+  set(last_out "${last_out}" PARENT_SCOPE)
 endfunction()
 
 # -a: the first free display; the screen is larger than the window.

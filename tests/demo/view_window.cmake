@@ -22,18 +22,8 @@ set(common ${scene} --size 320x200 --frames ${frames} --quiet --threads 2)
 set(xvfb ${XVFB_RUN} -a -s "-screen 0 640x480x24")
 
 function(run name)
-  execute_process(COMMAND ${ARGN} --out ${OUT}/${name}.png
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
-  set(last_out "${out}" PARENT_SCOPE)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${name}: exited with ${rc}\n${out}\n${err}")
-  endif()
-  if(NOT out MATCHES "validation: 0 errors, 0 warnings")
-    message(FATAL_ERROR "${name}: the run did not report a silent validation layer\n${out}")
-  endif()
-  if("${ARGN}" MATCHES "--window" AND NOT out MATCHES "window: ${frames} frames presented, 0 skipped")
-    message(FATAL_ERROR "${name}: not every frame was presented\n${out}")
-  endif()
+  ob_window_run(${name} ${ARGN})
+  set(last_out "${last_out}" PARENT_SCOPE)
 endfunction()
 
 run(window ${xvfb} ${BIN}/obelisk-view ${common} --window --no-overlay --input "${script}"
