@@ -675,6 +675,72 @@ static void non_finite_entity_left_out(void **state)
     }
 }
 
+/* ------------------------------------------------------------ draw order */
+
+/* The main view's draw list is in (class and priority, key) order, ties in
+ * entity id order, with thousands of items of several materials and meshes,
+ * opaque and blended (the sort's long-list path), and the same list in
+ * every threading mode. */
+static void draw_list_in_key_then_id_order(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_world_look(&w, 0, 4, 30, 0, 0, 0);
+    ob_world_light(&w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 8, 3);
+    ob_material *mats[4] = {
+        ob_world_material(&w, "red", OB_MATERIAL_LIT, 0.8f, 0.2f, 0.2f, false),
+        ob_world_material(&w, "green", OB_MATERIAL_LIT, 0.2f, 0.8f, 0.2f, false),
+        ob_world_material(&w, "grey", OB_MATERIAL_UNLIT, 0.5f, 0.5f, 0.5f, false),
+        ob_world_material_desc(&w, &(ob_material_desc){
+            .name = "glass", .kind = OB_MATERIAL_LIT, .diffuse = {0.3f, 0.3f, 0.9f, 0.5f},
+            .blended = true, .priority = 3}),
+    };
+    ob_geometry *shapes[3] = {w.box, w.sphere, w.plane};
+    const int side = 60; /* 3600 entities, most in view */
+    for (int i = 0; i < side * side; i++)
+        ob_world_entity(&w, NULL, "e", shapes[(i / 7) % 3], mats[(i * 5) % 4],
+                        -15.0 + 30.0 * (i % side) / side, 0, -15.0 + 30.0 * (i / side) / side);
+    ob_view *v = ob_perspective_view_base(w.main);
+    ob_draw_item *first = NULL;
+    uint32_t first_count = 0;
+    for (int mode = 0; mode < 2; mode++) {
+        ob_test_world_frame(&w, mode ? OB_THREADING_MULTI : OB_THREADING_SINGLE, 0);
+        assert_true(v->item_count > 2048);
+        uint32_t blended = 0;
+        for (uint32_t i = 0; i < v->item_count; i++) {
+            const ob_draw_item *it = &v->items[i];
+            blended += it->sort_hi >> 31;
+            if (i == 0) continue;
+            const ob_draw_item *prev = &v->items[i - 1];
+            bool before = prev->sort_hi < it->sort_hi ||
+                          (prev->sort_hi == it->sort_hi &&
+                           (prev->sort_key < it->sort_key ||
+                            (prev->sort_key == it->sort_key && prev->node_id < it->node_id)));
+            if (!before)
+                fail_msg("draw list items %u and %u out of order: (%08x, %016llx, id %u) then "
+                         "(%08x, %016llx, id %u)", i - 1, i, prev->sort_hi,
+                         (unsigned long long)prev->sort_key, prev->node_id, it->sort_hi,
+                         (unsigned long long)it->sort_key, it->node_id);
+        }
+        assert_true(blended > 0 && blended < v->item_count);
+        if (mode == 0) {
+            first_count = v->item_count;
+            first = malloc(sizeof *first * first_count);
+            assert_non_null(first);
+            memcpy(first, v->items, sizeof *first * first_count);
+        } else {
+            assert_int_equal(v->item_count, first_count);
+            for (uint32_t i = 0; i < first_count; i++) {
+                assert_int_equal(v->items[i].node_id, first[i].node_id);
+                assert_true(v->items[i].sort_key == first[i].sort_key);
+            }
+        }
+    }
+    free(first);
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -695,6 +761,7 @@ int main(void)
         cmocka_unit_test(empty_view_records_nothing),
         cmocka_unit_test(degenerate_camera_still_renders),
         cmocka_unit_test(non_finite_entity_left_out),
+        cmocka_unit_test(draw_list_in_key_then_id_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
