@@ -266,6 +266,32 @@ void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
  * upper 3x3 of ob_mat4_normal_cofactor's result, bit for bit. dest must not
  * alias m. Returns whether every value of m is finite; then so is every
  * value of dest (the rescaling keeps the products in range). */
+/* The cofactor part of ob_mat3_normal_cofactor, without its checks and
+ * rescaling: for an m the caller knows to be finite with its largest
+ * magnitude in [2^-60, 2^60] (then the same result, bit for bit, and
+ * finite). */
+inline void ob_mat3_normal_cofactor_in_range(const float m[9], float dest[9])
+{
+    float c0 = m[0], c1 = m[1], c2 = m[2], c3 = m[3], c4 = m[4], c5 = m[5], c6 = m[6],
+          c7 = m[7], c8 = m[8];
+    /* Column i is column i+1 x column i+2. */
+    dest[0] = c4 * c8 - c5 * c7;
+    dest[1] = c5 * c6 - c3 * c8;
+    dest[2] = c3 * c7 - c4 * c6;
+    dest[3] = c7 * c2 - c8 * c1;
+    dest[4] = c8 * c0 - c6 * c2;
+    dest[5] = c6 * c1 - c7 * c0;
+    dest[6] = c1 * c5 - c2 * c4;
+    dest[7] = c2 * c3 - c0 * c5;
+    dest[8] = c0 * c4 - c1 * c3;
+    /* The cofactor is det * inverse-transpose: a mirroring matrix (negative
+     * determinant) would turn normals inward. The sign of det (column 0
+     * dotted with column 0 of the cofactor, in double so that it cannot
+     * underflow) turns them back: the inverse-transpose's direction at any
+     * scale. */
+    if ((double)c0 * dest[0] + (double)c1 * dest[1] + (double)c2 * dest[2] < 0.0)
+        for (int i = 0; i < 9; i++) dest[i] = -dest[i];
+}
 inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
 {
     float c0 = m[0], c1 = m[1], c2 = m[2], c3 = m[3], c4 = m[4], c5 = m[5], c6 = m[6],
@@ -300,23 +326,8 @@ inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
         c7 = ldexpf(c7, -e);
         c8 = ldexpf(c8, -e);
     }
-    /* Column i is column i+1 x column i+2. */
-    dest[0] = c4 * c8 - c5 * c7;
-    dest[1] = c5 * c6 - c3 * c8;
-    dest[2] = c3 * c7 - c4 * c6;
-    dest[3] = c7 * c2 - c8 * c1;
-    dest[4] = c8 * c0 - c6 * c2;
-    dest[5] = c6 * c1 - c7 * c0;
-    dest[6] = c1 * c5 - c2 * c4;
-    dest[7] = c2 * c3 - c0 * c5;
-    dest[8] = c0 * c4 - c1 * c3;
-    /* The cofactor is det * inverse-transpose: a mirroring matrix (negative
-     * determinant) would turn normals inward. The sign of det (column 0
-     * dotted with column 0 of the cofactor, in double so that it cannot
-     * underflow) turns them back: the inverse-transpose's direction at any
-     * scale. */
-    if ((double)c0 * dest[0] + (double)c1 * dest[1] + (double)c2 * dest[2] < 0.0)
-        for (int i = 0; i < 9; i++) dest[i] = -dest[i];
+    float scaled[9] = {c0, c1, c2, c3, c4, c5, c6, c7, c8};
+    ob_mat3_normal_cofactor_in_range(scaled, dest);
     return !nan && largest <= 0x1.fffffep127f;
 }
 

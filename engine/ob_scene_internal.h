@@ -253,12 +253,15 @@ static inline void node_world_rotation_keep(ob_scene *s, uint32_t slot)
 }
 
 /* The node's world bound from its world transform and local bound (zero
- * without a renderable), as the update computes it. */
-static inline void node_world_bound(const node_xf *x, double center[3], float *radius)
+ * without a renderable), as the update computes it; the world's largest
+ * column length, which scales it, is returned. */
+static inline double node_world_bound(const node_xf *x, double center[3], float *radius)
 {
     double c[3] = {x->local_center[0], x->local_center[1], x->local_center[2]};
     ob_daffine_transform_point(&x->world, c, center);
-    *radius = (float)(x->local_radius * ob_daffine_max_scale(&x->world));
+    double scale = ob_daffine_max_scale(&x->world);
+    *radius = (float)(x->local_radius * scale);
+    return scale;
 }
 
 typedef enum local_status { LOCAL_OK, LOCAL_NON_FINITE, LOCAL_ZERO_ROTATION } local_status;

@@ -123,11 +123,20 @@ static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i, const d
 }
 
 /* The normal matrix, and whether the matrices are finite in float (the
- * normal one is whenever the linear one is). */
-static void proxy_write_normal(ob_scene *s, uint32_t i)
+ * normal one is whenever the linear one is). scale: the world's largest
+ * column length. Within 2^+-59 every entry of the float linear part is at
+ * most 2^59 and the largest at least 2^59 / sqrt(3) > 2^-60: finite, and
+ * in the range where the cofactor needs neither its checks nor rescaling
+ * (the same bits without them), which is nearly every node. */
+static void proxy_write_normal(ob_scene *s, uint32_t i, double scale)
 {
     ob_render_proxy *p = &s->proxies[i];
-    p->finite = ob_mat3_normal_cofactor(p->linear, p->normal);
+    if (scale >= 0x1p-59 && scale <= 0x1p59) {
+        ob_mat3_normal_cofactor_in_range(p->linear, p->normal);
+        p->finite = true;
+    } else {
+        p->finite = ob_mat3_normal_cofactor(p->linear, p->normal);
+    }
 }
 
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
@@ -155,9 +164,9 @@ static void proxy_fill(ob_scene *s, uint32_t slot, uint32_t i)
     ob_scene_proxy_set_renderable(s, slot);
     double center[3];
     float radius;
-    node_world_bound(x, center, &radius);
+    double scale = node_world_bound(x, center, &radius);
     proxy_write_world(s, x, i, center, radius);
-    proxy_write_normal(s, i);
+    proxy_write_normal(s, i, scale);
 }
 
 void ob_scene_snapshot_drop_dying(ob_scene *s, uint32_t from, bool lights)
@@ -243,6 +252,7 @@ typedef struct eval_batch {
     uint32_t proxy_index[EVAL_BATCH];
     double center[EVAL_BATCH][3]; /* world bound of those with proxy[k] */
     float radius[EVAL_BATCH];
+    double scale[EVAL_BATCH];   /* the world's largest column length, with the bound */
     double q[EVAL_BATCH][4];    /* unit local rotation, then world rotation */
     ob_daffine world[EVAL_BATCH];
 } eval_batch;
@@ -309,7 +319,7 @@ static bool node_eval(ob_scene *s, eval_batch *b, uint32_t k)
     s->state[it.slot] = (uint8_t)((old & ~(NODE_DIRTY | NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) |
                                   NODE_CHANGED | member);
     b->proxy[k] = (old & member & NODE_IN_RENDERABLES) != 0;
-    if (b->proxy[k]) node_world_bound(x, b->center[k], &b->radius[k]);
+    if (b->proxy[k]) b->scale[k] = node_world_bound(x, b->center[k], &b->radius[k]);
     return ((old ^ member) & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) != 0;
 }
 
@@ -341,9 +351,10 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
         if (!b->proxy[k]) continue;
         const node_xf *x = &s->xf[b->item[k].slot];
         proxy_write_world(s, x, x->proxy_index, b->center[k], b->radius[k]);
-        b->proxy_index[proxies++] = x->proxy_index;
+        b->proxy_index[proxies] = x->proxy_index;
+        b->scale[proxies++] = b->scale[k];
     }
-    for (uint32_t k = 0; k < proxies; k++) proxy_write_normal(s, b->proxy_index[k]);
+    for (uint32_t k = 0; k < proxies; k++) proxy_write_normal(s, b->proxy_index[k], b->scale[k]);
     b->count = 0;
     return changed;
 }
