@@ -262,10 +262,6 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
  * overflows nor turns denormal for any finite w. Row and column 3 are those
  * of the identity. */
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
-/* The same for a column-major 3x3 m (the upper 3x3 of w): dest is the
- * upper 3x3 of ob_mat4_normal_cofactor's result, bit for bit. dest must not
- * alias m. Returns whether every value of m is finite; then so is every
- * value of dest (the rescaling keeps the products in range). */
 /* The cofactor part of ob_mat3_normal_cofactor, without its checks and
  * rescaling: for an m the caller knows to be finite with its largest
  * magnitude in [2^-60, 2^60] (then the same result, bit for bit, and
@@ -292,6 +288,10 @@ inline void ob_mat3_normal_cofactor_in_range(const float m[9], float dest[9])
     if ((double)c0 * dest[0] + (double)c1 * dest[1] + (double)c2 * dest[2] < 0.0)
         for (int i = 0; i < 9; i++) dest[i] = -dest[i];
 }
+/* The same for a column-major 3x3 m (the upper 3x3 of w): dest is the
+ * upper 3x3 of ob_mat4_normal_cofactor's result, bit for bit. dest must not
+ * alias m. Returns whether every value of m is finite; then so is every
+ * value of dest (the rescaling keeps the products in range). */
 inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
 {
     float c0 = m[0], c1 = m[1], c2 = m[2], c3 = m[3], c4 = m[4], c5 = m[5], c6 = m[6],

@@ -222,7 +222,7 @@ static uint64_t low_mask(uint32_t width)
 }
 
 /* The runs of set bits of diff (bits wide) into runs[first ..
- * first + max), a gap of up to 8 equal bits taken in (one shift and mask
+ * first + max), a gap of up to 7 equal bits taken in (one shift and mask
  * cover both sides). False when they need more runs or the compact key
  * more than 64 bits. */
 static bool add_runs(uint64_t diff, int bits, bit_runs *out, uint32_t first, uint32_t max)
