@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "ob_math.h"
+#include "ob_view_sort_internal.h"
 
 #include <float.h>
 #if defined(__SSE2__)
@@ -131,250 +132,6 @@ static uint64_t item_key(uint32_t sort_hi, uint32_t state, uint32_t mesh, float 
            (fine << 8);
 }
 
-/* What the sort moves: 16 bytes per visible item. The snapshot index
- * breaks ties: the snapshot is in ascending entity id, each chunk emits
- * its items in that order and the sort is stable, so equal keys stay in id
- * order without sorting on it. */
-typedef struct cull_pair {
-    uint64_t key;
-    uint32_t hi;
-    uint32_t index;
-} cull_pair;
-
-/* Stable insertion sort on (hi, key), for short lists where the radix
- * sort's counting tables cost more than the items. */
-static void sort_pairs_short(cull_pair *a, uint32_t n)
-{
-    for (uint32_t i = 1; i < n; i++) {
-        cull_pair x = a[i];
-        uint32_t j = i;
-        while (j > 0 && (a[j - 1].hi > x.hi || (a[j - 1].hi == x.hi && a[j - 1].key > x.key))) {
-            a[j] = a[j - 1];
-            j--;
-        }
-        a[j] = x;
-    }
-}
-
-/* Stable LSD radix sort on (hi, key), a byte per pass, for lists whose
- * differing bits do not fit the compact key below (kdiff, hdiff: the bits
- * where the OR and the AND of all keys differ). A byte that is the same in
- * every item needs neither counting nor a pass. Returns the buffer that
- * holds the result (a or b). */
-static cull_pair *sort_pairs_bytes(cull_pair *a, cull_pair *b, uint32_t n, uint64_t kdiff,
-                                   uint32_t hdiff)
-{
-    uint32_t digits[12], nd = 0;
-    for (uint32_t d = 0; d < 8; d++)
-        if ((kdiff >> (8 * d)) & 0xffu) digits[nd++] = d;
-    for (uint32_t d = 0; d < 4; d++)
-        if ((hdiff >> (8 * d)) & 0xffu) digits[nd++] = 8 + d;
-    uint32_t count[12][256];
-    for (uint32_t k = 0; k < nd; k++) memset(count[k], 0, sizeof count[k]);
-    for (uint32_t i = 0; i < n; i++) {
-        for (uint32_t k = 0; k < nd; k++) {
-            uint32_t d = digits[k];
-            uint32_t byte = d < 8 ? (uint32_t)(a[i].key >> (8 * d)) & 0xffu
-                                  : (a[i].hi >> (8 * (d - 8))) & 0xffu;
-            count[k][byte]++;
-        }
-    }
-    cull_pair *src = a, *dst = b;
-    for (uint32_t k = 0; k < nd; k++) {
-        uint32_t *c = count[k], sum = 0;
-        for (uint32_t x = 0; x < 256; x++) {
-            uint32_t t = c[x];
-            c[x] = sum;
-            sum += t;
-        }
-        uint32_t d = digits[k];
-        if (d < 8) {
-            uint32_t shift = 8 * d;
-            for (uint32_t i = 0; i < n; i++) dst[c[(src[i].key >> shift) & 0xffu]++] = src[i];
-        } else {
-            uint32_t shift = 8 * (d - 8);
-            for (uint32_t i = 0; i < n; i++) dst[c[(src[i].hi >> shift) & 0xffu]++] = src[i];
-        }
-        cull_pair *t = src;
-        src = dst;
-        dst = t;
-    }
-    return src;
-}
-
-/* The bits of the sort's (hi, key) that differ between items, as runs
- * gathered into one compact key: run r takes (word >> shift[r]) & mask[r]
- * to bit dest[r]. The first KEY_RUNS runs read the key, the next HI_RUNS
- * hi; a run not used has mask 0. Fixed counts, so that the gathering is a
- * straight line of shifts and masks per item. */
-#define KEY_RUNS 4u
-#define HI_RUNS 2u
-
-typedef struct bit_runs {
-    uint64_t mask[KEY_RUNS + HI_RUNS];
-    uint32_t shift[KEY_RUNS + HI_RUNS], dest[KEY_RUNS + HI_RUNS];
-    uint32_t total;            /* bits of the compact key */
-} bit_runs;
-
-static uint64_t low_mask(uint32_t width)
-{
-    return width >= 64 ? ~(uint64_t)0 : ((uint64_t)1 << width) - 1;
-}
-
-/* The runs of set bits of diff (bits wide) into runs[first ..
- * first + max), a gap of up to 7 equal bits taken in (one shift and mask
- * cover both sides). False when they need more runs or the compact key
- * more than 64 bits. */
-static bool add_runs(uint64_t diff, int bits, bit_runs *out, uint32_t first, uint32_t max)
-{
-    int start = -1, last = -1;
-    uint32_t n = 0;
-    for (int b = 0; b <= bits; b++) {
-        bool set = b < bits && ((diff >> b) & 1u);
-        if (set && start >= 0 && b - last <= 8) {
-            last = b;
-            continue;
-        }
-        if (start >= 0 && (set || b == bits)) {
-            /* The run [start, last] ends: a new one starts at b, or the end. */
-            uint32_t width = (uint32_t)(last - start + 1);
-            if (n >= max || out->total + width > 64) return false;
-            out->mask[first + n] = low_mask(width);
-            out->shift[first + n] = (uint32_t)start;
-            out->dest[first + n] = out->total;
-            out->total += width;
-            n++;
-            start = -1;
-        }
-        if (set) start = last = b;
-    }
-    return true;
-}
-
-/* kr, hr: the runs used (constants where the callers are inlined, so that
- * the loops unroll to kr + hr shifts and masks). */
-static inline __attribute__((always_inline)) uint64_t compact_key(const bit_runs *r, uint32_t kr,
-                                                                  uint32_t hr, uint64_t key,
-                                                                  uint32_t hi)
-{
-    uint64_t ck = 0;
-    for (uint32_t k = 0; k < kr; k++) ck |= ((key >> r->shift[k]) & r->mask[k]) << r->dest[k];
-    for (uint32_t k = KEY_RUNS; k < KEY_RUNS + hr; k++)
-        ck |= (((uint64_t)hi >> r->shift[k]) & r->mask[k]) << r->dest[k];
-    return ck;
-}
-
-/* The key back from its compact form: the bits no run covers from any
- * item (fixed), the runs of the key from ck. */
-static inline __attribute__((always_inline)) uint64_t expand_key(const bit_runs *r, uint32_t kr,
-                                                                 uint64_t fixed, uint64_t ck)
-{
-    uint64_t key = fixed;
-    for (uint32_t k = 0; k < kr; k++) key |= ((ck >> r->dest[k]) & r->mask[k]) << r->shift[k];
-    return key;
-}
-
-/* The counting pass: each item's key replaced by its compact key, and the
- * counts of its digits (bits wide, `passes` of them). */
-static inline __attribute__((always_inline)) void count_compact(cull_pair *a, uint32_t n,
-                                                                const bit_runs *r, uint32_t kr,
-                                                                uint32_t hr, uint32_t bits,
-                                                                uint32_t passes,
-                                                                uint32_t (*count)[2048])
-{
-    uint64_t digit = ((uint64_t)1 << bits) - 1;
-    for (uint32_t i = 0; i < n; i++) {
-        uint64_t ck = compact_key(r, kr, hr, a[i].key, a[i].hi);
-        a[i].key = ck;
-        for (uint32_t k = 0; k < passes; k++) count[k][(ck >> (bits * k)) & digit]++;
-    }
-}
-
-/* The last pass, each key restored as it is moved. */
-static inline __attribute__((always_inline)) void last_pass(const cull_pair *src, cull_pair *dst,
-                                                            uint32_t n, const bit_runs *r,
-                                                            uint32_t kr, uint64_t fixed,
-                                                            uint32_t shift, uint64_t digit,
-                                                            uint32_t *c)
-{
-    for (uint32_t i = 0; i < n; i++) {
-        cull_pair p = src[i];
-        uint32_t at = c[(p.key >> shift) & digit]++;
-        p.key = expand_key(r, kr, fixed, p.key);
-        dst[at] = p;
-    }
-}
-
-/* Stable LSD radix sort on (hi, key). Only the bits that differ between
- * items decide the order, so only they are sorted on: one counting pass
- * gathers them into a compact key (stored in place of the key, restored
- * by the last pass), which takes 11 bits per pass on lists long enough for
- * 2048-entry counting tables (8 on shorter ones). On an opaque list the 64
- * bits of (band, state group, mesh, depth) and the 32 of hi shrink to some
- * 30, three passes instead of six or seven over the bytes that differ. The
- * order is the same as sorting the whole (hi, key). Returns the buffer that
- * holds the result (a or b). */
-static cull_pair *sort_pairs(cull_pair *a, cull_pair *b, uint32_t n)
-{
-    if (n <= 48) {
-        sort_pairs_short(a, n);
-        return a;
-    }
-    uint64_t kor = 0, kand = ~(uint64_t)0;
-    uint32_t hor = 0, hand = ~0u;
-    for (uint32_t i = 0; i < n; i++) {
-        kor |= a[i].key;
-        kand &= a[i].key;
-        hor |= a[i].hi;
-        hand &= a[i].hi;
-    }
-    bit_runs runs = {0};
-    /* Up to 96 bits can differ, in any pattern: past 64 bits or the runs
-     * the gathering has, the byte digits of the whole. */
-    bool compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS) &&
-                   add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS);
-    if (!compact) return sort_pairs_bytes(a, b, n, kor ^ kand, hor ^ hand);
-    uint32_t total = runs.total;
-    if (total == 0) return a; /* all equal: stable means as they are */
-    uint64_t fixed = kand;
-    uint32_t kr = 0, hr = 0;
-    for (uint32_t k = 0; k < KEY_RUNS; k++) {
-        fixed &= ~(runs.mask[k] << runs.shift[k]);
-        kr += runs.mask[k] != 0;
-    }
-    for (uint32_t k = KEY_RUNS; k < KEY_RUNS + HI_RUNS; k++) hr += runs.mask[k] != 0;
-    const uint32_t bits = n >= 2048 ? 11u : 8u, size = 1u << bits;
-    uint32_t passes = (total + bits - 1) / bits;
-    uint32_t count[8][2048]; /* 64 bits at 8 a pass */
-    for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
-    /* The usual lists (opaque: hi all equal) get loops of their own. */
-    if (hr == 0 && kr == 1) count_compact(a, n, &runs, 1, 0, bits, passes, count);
-    else if (hr == 0 && kr == 2) count_compact(a, n, &runs, 2, 0, bits, passes, count);
-    else if (hr == 0 && kr == 3) count_compact(a, n, &runs, 3, 0, bits, passes, count);
-    else count_compact(a, n, &runs, KEY_RUNS, HI_RUNS, bits, passes, count);
-    cull_pair *src = a, *dst = b;
-    for (uint32_t k = 0; k < passes; k++) {
-        uint32_t *c = count[k], sum = 0, shift = bits * k;
-        for (uint32_t x = 0; x < size; x++) {
-            uint32_t t = c[x];
-            c[x] = sum;
-            sum += t;
-        }
-        if (k + 1 < passes) {
-            for (uint32_t i = 0; i < n; i++) dst[c[(src[i].key >> shift) & (size - 1)]++] = src[i];
-        } else {
-            if (kr == 1) last_pass(src, dst, n, &runs, 1, fixed, shift, size - 1, c);
-            else if (kr == 2) last_pass(src, dst, n, &runs, 2, fixed, shift, size - 1, c);
-            else if (kr == 3) last_pass(src, dst, n, &runs, 3, fixed, shift, size - 1, c);
-            else last_pass(src, dst, n, &runs, KEY_RUNS, fixed, shift, size - 1, c);
-        }
-        cull_pair *t = src;
-        src = dst;
-        dst = t;
-    }
-    return src;
-}
-
 /* Entities per index of the culling loop: ~10-20 us of work each at most,
  * and at least a few us; in between, as many as give each thread four
  * indices of the wave, so that a wave of one view (a shadow map after the
@@ -403,7 +160,7 @@ typedef struct cull_ctx {
     uint32_t exclude_id;                /* 0: none (ids start at 1) */
     float planes[6][4];                 /* unused planes test nothing */
     uint32_t grain;                     /* entities per chunk */
-    cull_pair *pairs;                   /* chunk c writes from c * grain */
+    ob_sort_pair *pairs;                   /* chunk c writes from c * grain */
     cull_chunk *chunks;
 } cull_ctx;
 
@@ -480,7 +237,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     uint32_t first = chunk * c->grain, end = OB_MIN(c->soa.count, first + c->grain);
     uint32_t type_bit = 1u << c->v->type;
     cull_chunk *out = &c->chunks[chunk];
-    cull_pair *pairs = c->pairs + first;
+    ob_sort_pair *pairs = c->pairs + first;
     *out = (cull_chunk){0};
     if (first >= end) return;
     uint8_t vis[CULL_BLOCK];
@@ -509,7 +266,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         for (uint32_t t = 0; t < nk; t++) {
             uint32_t j = keep[t], i = b + j;
             const ob_view_material *m = &c->mt[c->soa.material[i]];
-            pairs[out->kept++] = (cull_pair){
+            pairs[out->kept++] = (ob_sort_pair){
                 .key = item_key(m->sort_hi, m->state, c->mesh[c->soa.geometry[i]], d2[j]),
                 .hi = m->sort_hi,
                 .index = i,
@@ -548,7 +305,7 @@ static ob_result cull_materials(ob_view *v, const ob_scene *scene, const ob_mate
  * sort's other buffer) and the chunk records. */
 static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks)
 {
-    size_t need = 2 * sizeof(cull_pair) * (size_t)OB_MAX(count, 1u) +
+    size_t need = 2 * sizeof(ob_sort_pair) * (size_t)OB_MAX(count, 1u) +
                   sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u);
     need = (need + 63) & ~(size_t)63;
     if (need <= v->cull_mem_size) return OB_OK;
@@ -605,7 +362,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
         v->material_count = 0;
         return res;
     }
-    cull_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
+    ob_sort_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
     cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .mesh = mesh,
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
@@ -645,7 +402,7 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     ob_view *v = cv->v;
     if (cv->res != OB_OK) return;
     uint64_t t0 = ob_time_ns();
-    cull_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
+    ob_sort_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
     uint32_t n = 0;
     bool far = false;
     uint64_t chunk_ns = 0;
@@ -674,7 +431,7 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
         far |= ch->far_count > 0;
     }
     v->range_reported = far;
-    cull_pair *sorted = n > 1 ? sort_pairs(pairs, other, n) : pairs;
+    ob_sort_pair *sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : pairs;
     for (uint32_t j = 0; j < n; j++) {
         uint32_t i = sorted[j].index;
         v->items[j] = (ob_draw_item){.sort_key = sorted[j].key, .sort_hi = sorted[j].hi,

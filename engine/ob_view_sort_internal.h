@@ -1,0 +1,31 @@
+/* ob_view_sort_internal.h — the sort of a view's draw list (ob_view.c
+ * culls and keys, ob_view_sort.c sorts); tests/unit/test_view_sort.c
+ * checks it against a comparison sort. Not part of the API. */
+#ifndef OB_VIEW_SORT_INTERNAL_H
+#define OB_VIEW_SORT_INTERNAL_H
+
+#include <stdint.h>
+
+/* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
+#pragma GCC visibility push(hidden)
+
+/* What the sort moves: 16 bytes per visible item. The snapshot index
+ * breaks ties: the snapshot is in ascending entity id, each chunk emits
+ * its items in that order and the sort is stable, so equal keys stay in id
+ * order without sorting on it. */
+typedef struct ob_sort_pair {
+    uint64_t key;
+    uint32_t hi;
+    uint32_t index;
+} ob_sort_pair;
+
+/* Sorts a[0..n) by (hi, key), stably, using b (n pairs) as the other
+ * buffer; returns the one that holds the result (a or b). Only the bits
+ * that differ between the items are sorted on (see ob_view_sort.c), in
+ * three passes of 11 bits for a typical opaque view of thousands of items.
+ * [any thread; a and b the caller's] */
+ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n);
+
+#pragma GCC visibility pop
+
+#endif /* OB_VIEW_SORT_INTERNAL_H */

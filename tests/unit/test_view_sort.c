@@ -1,0 +1,103 @@
+/* The draw list's sort (engine/ob_view_sort.c) against a comparison sort:
+ * the same order, stable, for lists of every length and every pattern of
+ * differing bits: the compact-key path (8- and 11-bit passes, runs in the
+ * key and in hi), the byte-wise fallback (more runs, or more than 64
+ * differing bits), all-equal lists and the short insertion sort. Fixed
+ * seeds: the same lists every run. */
+#include "ob_test.h"
+
+#include "ob_view_sort_internal.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_N 20000u
+
+static uint64_t rng_state;
+
+static uint64_t next(void)
+{
+    /* xorshift64 */
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+
+/* (hi, key), then the input position: a stable sort's order. */
+static int compare(const void *pa, const void *pb)
+{
+    const ob_sort_pair *a = pa, *b = pb;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    if (a->key != b->key) return a->key < b->key ? -1 : 1;
+    return a->index < b->index ? -1 : a->index > b->index;
+}
+
+/* n pairs whose keys vary in the bits of kmask and his in those of hmask,
+ * over `values` distinct draws (few: many ties), sorted both ways. */
+static void check(uint32_t n, uint64_t kmask, uint32_t hmask, uint32_t values)
+{
+    static ob_sort_pair a[MAX_N], b[MAX_N], want[MAX_N];
+    uint64_t kbase = next();
+    uint32_t hbase = (uint32_t)next();
+    for (uint32_t i = 0; i < n; i++) {
+        uint64_t r = (next() % values) * 0x9E3779B97F4A7C15ull;
+        a[i] = (ob_sort_pair){.key = (kbase & ~kmask) | (r & kmask),
+                              .hi = (hbase & ~hmask) | ((uint32_t)(r >> 20) & hmask),
+                              .index = i};
+        want[i] = a[i];
+    }
+    qsort(want, n, sizeof *want, compare);
+    const ob_sort_pair *got = ob_sort_pairs(a, b, n);
+    assert_true(got == a || got == b);
+    for (uint32_t i = 0; i < n; i++) {
+        if (got[i].key != want[i].key || got[i].hi != want[i].hi || got[i].index != want[i].index)
+            fail_msg("n %u, key mask %016llx, hi mask %08x: item %u is (%08x, %016llx, %u), "
+                     "want (%08x, %016llx, %u)", n, (unsigned long long)kmask, hmask, i,
+                     got[i].hi, (unsigned long long)got[i].key, got[i].index, want[i].hi,
+                     (unsigned long long)want[i].key, want[i].index);
+    }
+}
+
+/* The keys the culling builds: opaque (band, state, mesh, fine depth) and
+ * blended (depth, state, mesh), long enough for 11-bit passes and not. */
+static void view_like_lists(void **state)
+{
+    (void)state;
+    rng_state = 0x2545F4914F6CDD1Dull;
+    const uint64_t opaque = 0xfc01c0007fffff00ull;  /* the sweep's differing bits */
+    for (uint32_t n = 2; n <= 12000; n = n * 3 + 1) {
+        check(n, opaque, 0, 100000);
+        check(n, opaque, 0x80000003u, 100000); /* and blended, with priorities */
+        check(n, 0xffffffff0003000full, 0, 7);  /* blended: many equal keys */
+    }
+}
+
+/* Random bit patterns: any number of runs, up to all 96 bits differing
+ * (the byte-wise fallback), single bits, nothing differing. */
+static void random_patterns(void **state)
+{
+    (void)state;
+    rng_state = 0x9E3779B97F4A7C15ull;
+    for (uint32_t t = 0; t < 400; t++) {
+        uint32_t n = 1 + (uint32_t)(next() % (t % 4 == 0 ? MAX_N : 3000u));
+        uint64_t kmask = next() & next();
+        uint32_t hmask = t % 3 == 0 ? (uint32_t)(next() & next()) : 0u;
+        if (t % 7 == 0) kmask = ~0ull;
+        if (t % 11 == 0) hmask = ~0u;
+        if (t % 13 == 0) kmask = 1ull << (next() % 64);
+        if (t % 17 == 0) kmask = hmask = 0;
+        uint32_t values = 1 + (uint32_t)(next() % (t % 5 == 0 ? 4u : 100000u));
+        check(n, kmask, hmask, values);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(view_like_lists),
+        cmocka_unit_test(random_patterns),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
