@@ -78,6 +78,7 @@ typedef struct bit_runs {
     uint64_t mask[KEY_RUNS + HI_RUNS];
     uint32_t shift[KEY_RUNS + HI_RUNS], dest[KEY_RUNS + HI_RUNS];
     uint32_t total;            /* bits of the compact key */
+    uint32_t key_runs, hi_runs; /* runs used of each */
 } bit_runs;
 
 static uint64_t low_mask(uint32_t width)
@@ -86,10 +87,11 @@ static uint64_t low_mask(uint32_t width)
 }
 
 /* The runs of set bits of diff (bits wide) into runs[first ..
- * first + max), a gap of up to 7 equal bits taken in (one shift and mask
- * cover both sides). False when they need more runs or the compact key
- * more than 64 bits. */
-static bool add_runs(uint64_t diff, int bits, bit_runs *out, uint32_t first, uint32_t max)
+ * first + max), their number in *n, a gap of up to 7 equal bits taken in
+ * (one shift and mask cover both sides). False when they need more runs or
+ * the compact key more than 64 bits. */
+static bool add_runs(uint64_t diff, int bits, bit_runs *out, uint32_t first, uint32_t max,
+                     uint32_t *count)
 {
     int start = -1, last = -1;
     uint32_t n = 0;
@@ -112,6 +114,7 @@ static bool add_runs(uint64_t diff, int bits, bit_runs *out, uint32_t first, uin
         }
         if (set) start = last = b;
     }
+    *count = n;
     return true;
 }
 
@@ -195,18 +198,14 @@ ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
     bit_runs runs = {0};
     /* Up to 96 bits can differ, in any pattern: past 64 bits or the runs
      * the gathering has, the byte digits of the whole. */
-    bool compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS) &&
-                   add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS);
+    bool compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS, &runs.key_runs) &&
+                   add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS, &runs.hi_runs);
     if (!compact) return sort_pairs_bytes(a, b, n, kor ^ kand, hor ^ hand);
     uint32_t total = runs.total;
     if (total == 0) return a; /* all equal: stable means as they are */
     uint64_t fixed = kand;
-    uint32_t kr = 0, hr = 0;
-    for (uint32_t k = 0; k < KEY_RUNS; k++) {
-        fixed &= ~(runs.mask[k] << runs.shift[k]);
-        kr += runs.mask[k] != 0;
-    }
-    for (uint32_t k = KEY_RUNS; k < KEY_RUNS + HI_RUNS; k++) hr += runs.mask[k] != 0;
+    uint32_t kr = runs.key_runs, hr = runs.hi_runs;
+    for (uint32_t k = 0; k < kr; k++) fixed &= ~(runs.mask[k] << runs.shift[k]);
     const uint32_t bits = n >= 2048 ? 11u : 8u, size = 1u << bits;
     uint32_t passes = (total + bits - 1) / bits;
     uint32_t count[8][2048]; /* 64 bits at 8 a pass */
