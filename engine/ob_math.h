@@ -330,6 +330,19 @@ inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
     ob_mat3_normal_cofactor_in_range(scaled, dest);
     return !nan && largest <= 0x1.fffffep127f;
 }
+/* ob_mat3_normal_cofactor of the float form of a finite double matrix
+ * whose largest column length is max_column (as ob_daffine_max_scale
+ * gives it): within 2^+-59 every entry of m is at most 2^59 and the
+ * largest at least 2^59 / sqrt(3) > 2^-60, finite and where the checks and
+ * the rescaling change nothing, so they are skipped (the same bits). */
+inline bool ob_mat3_normal_cofactor_of_scale(const float m[9], double max_column, float dest[9])
+{
+    if (max_column >= 0x1p-59 && max_column <= 0x1p59) {
+        ob_mat3_normal_cofactor_in_range(m, dest);
+        return true;
+    }
+    return ob_mat3_normal_cofactor(m, dest);
+}
 
 /* Infinite reversed-Z perspective for Vulkan clip space: a view-space point
  * at z = -znear gets depth 1, depth → 0 as -z → infinity, and +Y up in view

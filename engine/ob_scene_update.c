@@ -124,19 +124,11 @@ static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i, const d
 
 /* The normal matrix, and whether the matrices are finite in float (the
  * normal one is whenever the linear one is). scale: the world's largest
- * column length. Within 2^+-59 every entry of the float linear part is at
- * most 2^59 and the largest at least 2^59 / sqrt(3) > 2^-60: finite, and
- * in the range where the cofactor needs neither its checks nor rescaling
- * (the same bits without them), which is nearly every node. */
+ * column length, which spares nearly every node the cofactor's checks. */
 static void proxy_write_normal(ob_scene *s, uint32_t i, double scale)
 {
     ob_render_proxy *p = &s->proxies[i];
-    if (scale >= 0x1p-59 && scale <= 0x1p59) {
-        ob_mat3_normal_cofactor_in_range(p->linear, p->normal);
-        p->finite = true;
-    } else {
-        p->finite = ob_mat3_normal_cofactor(p->linear, p->normal);
-    }
+    p->finite = ob_mat3_normal_cofactor_of_scale(p->linear, scale, p->normal);
 }
 
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
