@@ -29,6 +29,7 @@ typedef struct update_ctx {
     const level_item *items;    /* the current loop's nodes */
     uint32_t count;
     bool controllers;           /* the level loop runs the parallel-safe controllers */
+    bool prefetch;              /* the level loop asks for the next batch's data ahead */
     uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
 } update_ctx;
 
@@ -367,6 +368,38 @@ static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, uint8_t 
         ob_controller_run(s, slot, &ctl->slots[k], dt, keep_world);
 }
 
+/* The parallel-safe controllers of a batch of nodes, as the fused loop
+ * runs them (keep_world false): the built-in ones two nodes at a time. */
+static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t count, double dt)
+{
+    node_xf *orbit_x[EVAL_BATCH], *spin_x[EVAL_BATCH];
+    ob_orbit_state *orbit[EVAL_BATCH];
+    ob_rotation_state *spin[EVAL_BATCH];
+    uint32_t orbits = 0, spins = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        uint32_t slot = items[j].slot;
+        uint8_t st = s->state[slot];
+        if (st & NODE_MOTION) {
+            node_motion *m = &s->motion[slot];
+            if (st & NODE_ORBIT) {
+                orbit_x[orbits] = &s->xf[slot];
+                orbit[orbits++] = &m->orbit;
+            }
+            if (st & NODE_SPIN) {
+                spin_x[spins] = &s->xf[slot];
+                spin[spins++] = &m->spin;
+            }
+            s->state[slot] = (uint8_t)(st | NODE_DIRTY);
+        } else if (st & NODE_PARALLEL) {
+            run_parallel_controllers(s, slot, st, dt, false);
+        }
+    }
+    for (uint32_t k = 0; k < orbits; k += 2)
+        ob_orbit_kernel2(orbit_x + k, orbit + k, OB_MIN(2u, orbits - k), dt);
+    for (uint32_t k = 0; k < spins; k += 2)
+        ob_rotation_kernel2(spin_x + k, spin + k, OB_MIN(2u, spins - k), dt);
+}
+
 static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t thread)
 {
     (void)thread;
@@ -377,6 +410,34 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
         uint32_t slot = c->items[i].slot;
         uint8_t st = s->state[slot];
         if (st & (NODE_PARALLEL | NODE_MOTION)) run_parallel_controllers(s, slot, st, c->dt, true);
+    }
+}
+
+/* Levels of at least this many nodes have their data asked for a batch
+ * ahead: they outgrow the core's own cache, and the update follows its
+ * arrays faster than the hardware's prefetchers ramp up on each new page
+ * of each of them (at 50k moving objects, written out of cache between
+ * updates, 73-75 ns an object against 84-90). Smaller ones are in cache,
+ * where the requests only cost (about 5 ns an object). */
+#define PREFETCH_MIN_NODES 4096u
+
+/* Asks for the transform records of nodes items[0..count), and their
+ * built-in controllers' state when the level loop runs them. Inlined
+ * always: GCC finds a function of prefetches alone free of side effects
+ * and drops its calls. */
+static inline __attribute__((always_inline)) void prefetch_nodes(const ob_scene *s, const level_item *items, uint32_t count,
+                           bool controllers)
+{
+    for (uint32_t j = 0; j < count; j++) {
+        uint32_t slot = items[j].slot;
+        const char *x = (const char *)&s->xf[slot];
+        for (uint32_t line = 0; line < sizeof(node_xf); line += OB_CACHE_LINE)
+            __builtin_prefetch(x + line, 1);
+        if (!controllers) continue;
+        const char *m = (const char *)&s->motion[slot];
+        for (uint32_t at = 0; at < sizeof(node_motion); at += OB_CACHE_LINE)
+            __builtin_prefetch(m + at, 1);
+        __builtin_prefetch(m + sizeof(node_motion) - 1, 1);
     }
 }
 
@@ -394,14 +455,10 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
     b.count = 0;
     for (uint32_t i = chunk * c->grain; i < end; i += EVAL_BATCH) {
         uint32_t batch_end = OB_MIN(end, i + EVAL_BATCH);
-        if (c->controllers) {
-            for (uint32_t j = i; j < batch_end; j++) {
-                uint32_t slot = c->items[j].slot;
-                uint8_t st = state[slot];
-                if (st & (NODE_PARALLEL | NODE_MOTION))
-                    run_parallel_controllers(s, slot, st, c->dt, false);
-            }
-        }
+        if (c->prefetch)
+            prefetch_nodes(s, c->items + batch_end, OB_MIN(end, batch_end + EVAL_BATCH) - batch_end,
+                           c->controllers);
+        if (c->controllers) run_batch_controllers(s, c->items + i, batch_end - i, c->dt);
         for (uint32_t j = i; j < batch_end; j++) {
             level_item it = c->items[j];
             uint8_t st = state[it.slot];
@@ -576,6 +633,7 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
     for (uint32_t d = 0; d < s->level_count; d++) {
         c.items = s->by_level + s->level_start[d];
         c.count = s->level_start[d + 1] - s->level_start[d];
+        c.prefetch = c.count >= PREFETCH_MIN_NODES;
         uint32_t chunks = chunks_of(c.count, grain);
         update_loop(&c, c.count, run_level);
         for (uint32_t k = 0; k < chunks; k++) membership_changed |= c.counts[k] != 0;

@@ -934,6 +934,74 @@ static void builtin_controllers_kept_apart_move_the_same(void **state)
     ob_scene_destroy(s);
 }
 
+/* The update runs the built-in controllers on two nodes at once: a node
+ * moves by the same bits whichever node shares its pair, and alone (the
+ * one-node form, which the listed controllers use): an orbit whose angle
+ * wraps (its fmod), one far from the origin, a rotation so small or so
+ * large that its normalization rescales, each beside ordinary ones. */
+static ob_node *grouped_node(ob_scene *s, uint32_t kind)
+{
+    ob_node *n = new_node(s, NULL, "grouped");
+    make_renderable(n);
+    const double centre[3] = {kind == 3 ? 1e9 : 0.5, -2, 3};
+    const float axis[3] = {0.2f * (float)kind, 1, 0.5f};
+    static const float rates[7] = {0.9f, 80.0f, 0, -1.3f, 2.1f, 0.4f, -60.0f};
+    if (kind != 2)
+        assert_int_equal(ob_node_add_orbit_controller(n, centre, axis, 1.5 + kind, rates[kind],
+                                                      0.1f * (float)kind), OB_OK);
+    if (kind == 4) ob_node_set_rotation_d(n, (double[4]){1e-200, 0, 3e-201, 1e-200});
+    if (kind == 5) ob_node_set_rotation_d(n, (double[4]){0, 2e200, 0, 1e200});
+    if (kind != 3)
+        assert_int_equal(ob_node_add_rotation_controller(n, (float[3]){1, 2.0f - (float)kind, 3},
+                                                         0.3f + 0.5f * (float)kind), OB_OK);
+    return n;
+}
+
+static void builtin_controllers_same_bits_in_any_pair(void **state)
+{
+    (void)state;
+    enum { KINDS = 7, STEPS = 120 };
+    ob_scene *grouped = new_scene(), *shifted = new_scene(), *alone[KINDS];
+    ob_node *g[KINDS], *sh[KINDS], *a[KINDS];
+    /* shifted starts with one more node, so every pair holds other nodes */
+    grouped_node(shifted, 0);
+    for (uint32_t k = 0; k < KINDS; k++) {
+        g[k] = grouped_node(grouped, k);
+        sh[k] = grouped_node(shifted, k);
+        alone[k] = new_scene();
+        a[k] = grouped_node(alone[k], k);
+    }
+    for (int i = 0; i < STEPS; i++) {
+        double dt = i % 4 ? 1.0 / 60.0 : 0.05;
+        assert_int_equal(ob_scene_update(grouped, dt), OB_OK);
+        assert_int_equal(ob_scene_update(shifted, dt), OB_OK);
+        for (uint32_t k = 0; k < KINDS; k++) assert_int_equal(ob_scene_update(alone[k], dt), OB_OK);
+    }
+    for (uint32_t k = 0; k < KINDS; k++) {
+        const ob_node *n[3] = {g[k], sh[k], a[k]};
+        double p[3][3], q[3][4];
+        ob_daffine w[3];
+        for (int v = 0; v < 3; v++) {
+            ob_node_get_position(n[v], p[v]);
+            ob_node_get_rotation(n[v], q[v]);
+            ob_node_world_affine(n[v], &w[v]);
+        }
+        for (int v = 1; v < 3; v++) {
+            assert_memory_equal(p[0], p[v], sizeof p[0]);
+            assert_memory_equal(q[0], q[v], sizeof q[0]);
+            assert_memory_equal(&w[0], &w[v], sizeof w[0]);
+        }
+        /* an orbit took it off the origin; its rotation stays unit */
+        if (k != 2) assert_true(ob_dvec3_length(p[0]) > 0.1);
+        double len = sqrt(q[0][0] * q[0][0] + q[0][1] * q[0][1] + q[0][2] * q[0][2] +
+                          q[0][3] * q[0][3]);
+        assert_near(len, 1.0, 1e-12);
+        ob_scene_destroy(alone[k]);
+    }
+    ob_scene_destroy(grouped);
+    ob_scene_destroy(shifted);
+}
+
 typedef struct axes_probe {
     ob_node *watched;
     float forward[3];
@@ -1022,6 +1090,7 @@ int main(void)
         cmocka_unit_test(renderables_sorted_by_id),
         cmocka_unit_test(rotation_controller_matches_axis_angle),
         cmocka_unit_test(orbit_controller_stays_on_circle),
+        cmocka_unit_test(builtin_controllers_same_bits_in_any_pair),
         cmocka_unit_test(script_controllers_run_in_order_before_world),
         cmocka_unit_test(structure_changes_refused_inside_controllers),
         cmocka_unit_test(destroy_subtree_frees_everything),
