@@ -144,22 +144,30 @@ inline bool ob_dquat_normalize(const double q[4], double dest[4])
 }
 /* q must be unit. dest may alias v. */
 void ob_dquat_rotate(const double q[4], const double v[3], double dest[3]);
+/* The column-major rotation matrix of unit quaternion (x, y, z, w), each
+ * column times its scale (s0, s1, s2), into dest[0..9), in arithmetic type
+ * T: double, or a vector of doubles (the scene update's lanes), so that
+ * every form does the same operations in the same order. */
+#define OB_QUAT_TO_MAT3_SCALED(T, x, y, z, w, s0, s1, s2, dest)                                \
+    do {                                                                                      \
+        T xx_ = (x) * (x), yy_ = (y) * (y), zz_ = (z) * (z);                                  \
+        T xy_ = (x) * (y), xz_ = (x) * (z), yz_ = (y) * (z);                                  \
+        T wx_ = (w) * (x), wy_ = (w) * (y), wz_ = (w) * (z);                                  \
+        (dest)[0] = (1.0 - 2.0 * (yy_ + zz_)) * (s0);                                         \
+        (dest)[1] = 2.0 * (xy_ + wz_) * (s0);                                                 \
+        (dest)[2] = 2.0 * (xz_ - wy_) * (s0);                                                 \
+        (dest)[3] = 2.0 * (xy_ - wz_) * (s1);                                                 \
+        (dest)[4] = (1.0 - 2.0 * (xx_ + zz_)) * (s1);                                         \
+        (dest)[5] = 2.0 * (yz_ + wx_) * (s1);                                                 \
+        (dest)[6] = 2.0 * (xz_ + wy_) * (s2);                                                 \
+        (dest)[7] = 2.0 * (yz_ - wx_) * (s2);                                                 \
+        (dest)[8] = (1.0 - 2.0 * (xx_ + yy_)) * (s2);                                         \
+    } while (0)
 /* Column-major rotation matrix of unit q. */
 inline void ob_dquat_to_mat3(const double q[4], double dest[9])
 {
-    double x = q[0], y = q[1], z = q[2], w = q[3];
-    double xx = x * x, yy = y * y, zz = z * z;
-    double xy = x * y, xz = x * z, yz = y * z;
-    double wx = w * x, wy = w * y, wz = w * z;
-    dest[0] = 1.0 - 2.0 * (yy + zz);
-    dest[1] = 2.0 * (xy + wz);
-    dest[2] = 2.0 * (xz - wy);
-    dest[3] = 2.0 * (xy - wz);
-    dest[4] = 1.0 - 2.0 * (xx + zz);
-    dest[5] = 2.0 * (yz + wx);
-    dest[6] = 2.0 * (xz + wy);
-    dest[7] = 2.0 * (yz - wx);
-    dest[8] = 1.0 - 2.0 * (xx + yy);
+    /* Times 1.0: exact, so the unscaled matrix. */
+    OB_QUAT_TO_MAT3_SCALED(double, q[0], q[1], q[2], q[3], 1.0, 1.0, 1.0, dest);
 }
 /* Unit quaternion of an orthonormal, right-handed column-major matrix. */
 void ob_dmat3_to_dquat(const double m[9], double dest[4]);
@@ -177,18 +185,7 @@ void ob_daffine_identity(ob_daffine *dest);
 inline void ob_daffine_from_trs(const double t[3], const double q[4], const double s[3],
                                 ob_daffine *dest)
 {
-    double r[9];
-    ob_dquat_to_mat3(q, r);
-    double s0 = s[0], s1 = s[1], s2 = s[2];
-    dest->m[0] = r[0] * s0;
-    dest->m[1] = r[1] * s0;
-    dest->m[2] = r[2] * s0;
-    dest->m[3] = r[3] * s1;
-    dest->m[4] = r[4] * s1;
-    dest->m[5] = r[5] * s1;
-    dest->m[6] = r[6] * s2;
-    dest->m[7] = r[7] * s2;
-    dest->m[8] = r[8] * s2;
+    OB_QUAT_TO_MAT3_SCALED(double, q[0], q[1], q[2], q[3], s[0], s[1], s[2], dest->m);
     dest->t[0] = t[0];
     dest->t[1] = t[1];
     dest->t[2] = t[2];
@@ -207,13 +204,16 @@ inline void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine 
         r.t[k] = a->m[k] * b->t[0] + a->m[3 + k] * b->t[1] + a->m[6 + k] * b->t[2] + a->t[k];
     *dest = r;
 }
+/* Row r of m * (x, y, z) + t for a column-major m, in any arithmetic type
+ * (as OB_QUAT_TO_MAT3_SCALED). */
+#define OB_AFFINE_ROW(m, t, r, x, y, z) ((m)[r] * (x) + (m)[3 + (r)] * (y) + (m)[6 + (r)] * (z) + (t)[r])
 /* dest may alias p. */
 inline void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double dest[3])
 {
     double x = p[0], y = p[1], z = p[2];
-    double r0 = a->m[0] * x + a->m[3] * y + a->m[6] * z + a->t[0];
-    double r1 = a->m[1] * x + a->m[4] * y + a->m[7] * z + a->t[1];
-    double r2 = a->m[2] * x + a->m[5] * y + a->m[8] * z + a->t[2];
+    double r0 = OB_AFFINE_ROW(a->m, a->t, 0, x, y, z);
+    double r1 = OB_AFFINE_ROW(a->m, a->t, 1, x, y, z);
+    double r2 = OB_AFFINE_ROW(a->m, a->t, 2, x, y, z);
     dest[0] = r0;
     dest[1] = r1;
     dest[2] = r2;
@@ -228,6 +228,11 @@ inline bool ob_daffine_is_finite(const ob_daffine *a)
                ((m[8] - m[8]) + (t[0] - t[0])) + ((t[1] - t[1]) + (t[2] - t[2]));
     return z == z;
 }
+/* The squared length of column c of a column-major 3x3 m, in any
+ * arithmetic type (as OB_QUAT_TO_MAT3_SCALED). */
+#define OB_COLUMN_LENGTH2(m, c)                                                               \
+    ((m)[(c) * 3] * (m)[(c) * 3] + (m)[(c) * 3 + 1] * (m)[(c) * 3 + 1] +                      \
+     (m)[(c) * 3 + 2] * (m)[(c) * 3 + 2])
 /* Largest column length of the linear part: the factor a bounding sphere's
  * radius grows by. */
 inline double ob_daffine_max_scale(const ob_daffine *a)
@@ -237,8 +242,7 @@ inline double ob_daffine_max_scale(const ob_daffine *a)
      * over (as fmax would). */
     double best = 0.0;
     for (int c = 0; c < 3; c++) {
-        const double *col = &a->m[c * 3];
-        double d = col[0] * col[0] + col[1] * col[1] + col[2] * col[2];
+        double d = OB_COLUMN_LENGTH2(a->m, c);
         best = d > best ? d : best;
     }
     return sqrt(best);

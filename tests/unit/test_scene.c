@@ -1002,6 +1002,69 @@ static void builtin_controllers_same_bits_in_any_pair(void **state)
     ob_scene_destroy(shifted);
 }
 
+/* The update evaluates the common node (a renderable leaf under the root,
+ * shown, valid, its rotation unit) in a pass of its own, two at a time; a
+ * light on the same node sends it through the general evaluation. Both
+ * give the same world, proxy and bound bits, at any scale: mirrored, zero,
+ * in one axis, so large or so small that the normal matrix rescales. */
+static void common_nodes_evaluate_as_any_other(void **state)
+{
+    (void)state;
+    enum { NODES = 9, STEPS = 40 };
+    static const float scales[NODES][3] = {{1, 1, 1}, {-1, 2, 0.5f}, {0, 0, 0}, {3e30f, 1e30f, 2e30f},
+                                           {1e-25f, 2e-25f, 1e-25f}, {1, 1, 1}, {0.5f, 0.5f, 0.5f},
+                                           {2, -3, 4}, {0, 1, 1}};
+    ob_scene *sc[2] = {new_scene(), new_scene()};
+    ob_node *n[2][NODES];
+    ob_light_desc light = {.type = OB_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 1, .range = 5};
+    for (int v = 0; v < 2; v++) {
+        for (int k = 0; k < NODES; k++) {
+            n[v][k] = new_node(sc[v], NULL, "common");
+            ob_renderable rd = {.local_center = {0.25f * (float)k, -1, 0.5f}, .local_radius = 1.5f};
+            assert_int_equal(ob_node_set_renderable(n[v][k], &rd), OB_OK);
+            ob_node_set_scale(n[v][k], scales[k]);
+            assert_int_equal(ob_node_add_orbit_controller(n[v][k], (double[3]){1e5 * k, 2, 3},
+                                                          (float[3]){0, 1, 0}, 2 + k, 0.7f, 0.2f * (float)k),
+                             OB_OK);
+            if (k % 3)
+                assert_int_equal(ob_node_add_rotation_controller(n[v][k], (float[3]){1, 2, (float)k}, 1.1f),
+                                 OB_OK);
+            if (v == 1) assert_int_equal(ob_node_set_light(n[v][k], &light), OB_OK);
+        }
+    }
+    for (int i = 0; i < STEPS; i++) {
+        for (int v = 0; v < 2; v++) assert_int_equal(ob_scene_update(sc[v], 1.0 / 30.0), OB_OK);
+        uint32_t count[2];
+        const ob_render_proxy *p[2] = {ob_scene_render_proxies(sc[0], &count[0]),
+                                       ob_scene_render_proxies(sc[1], &count[1])};
+        ob_render_soa soa[2];
+        ob_scene_render_soa(sc[0], &soa[0]);
+        ob_scene_render_soa(sc[1], &soa[1]);
+        assert_int_equal(count[0], NODES);
+        assert_int_equal(count[1], NODES);
+        for (uint32_t k = 0; k < NODES; k++) {
+            assert_memory_equal(p[0][k].linear, p[1][k].linear, sizeof p[0][k].linear);
+            assert_memory_equal(p[0][k].normal, p[1][k].normal, sizeof p[0][k].normal);
+            assert_memory_equal(p[0][k].world_t, p[1][k].world_t, sizeof p[0][k].world_t);
+            assert_int_equal(p[0][k].finite, p[1][k].finite);
+            assert_memory_equal(&soa[0].x[k], &soa[1].x[k], sizeof soa[0].x[k]);
+            assert_memory_equal(&soa[0].y[k], &soa[1].y[k], sizeof soa[0].y[k]);
+            assert_memory_equal(&soa[0].z[k], &soa[1].z[k], sizeof soa[0].z[k]);
+            assert_memory_equal(&soa[0].radius[k], &soa[1].radius[k], sizeof soa[0].radius[k]);
+            assert_int_equal(soa[0].flags[k], soa[1].flags[k]);
+            ob_daffine w[2];
+            ob_node_world_affine(n[0][k], &w[0]);
+            ob_node_world_affine(n[1][k], &w[1]);
+            assert_memory_equal(&w[0], &w[1], sizeof w[0]);
+        }
+        /* a zero scale is flagged; the huge and tiny ones stay finite */
+        assert_int_equal(soa[0].flags[2], OB_RENDER_ZERO_SCALE);
+        assert_true(p[0][3].finite && p[0][4].finite);
+    }
+    ob_scene_destroy(sc[0]);
+    ob_scene_destroy(sc[1]);
+}
+
 typedef struct axes_probe {
     ob_node *watched;
     float forward[3];
@@ -1091,6 +1154,7 @@ int main(void)
         cmocka_unit_test(rotation_controller_matches_axis_angle),
         cmocka_unit_test(orbit_controller_stays_on_circle),
         cmocka_unit_test(builtin_controllers_same_bits_in_any_pair),
+        cmocka_unit_test(common_nodes_evaluate_as_any_other),
         cmocka_unit_test(script_controllers_run_in_order_before_world),
         cmocka_unit_test(structure_changes_refused_inside_controllers),
         cmocka_unit_test(destroy_subtree_frees_everything),
