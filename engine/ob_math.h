@@ -206,7 +206,8 @@ inline void ob_daffine_mul(const ob_daffine *a, const ob_daffine *b, ob_daffine 
 }
 /* Row r of m * (x, y, z) + t for a column-major m, in any arithmetic type
  * (as OB_QUAT_TO_MAT3_SCALED). */
-#define OB_AFFINE_ROW(m, t, r, x, y, z) ((m)[r] * (x) + (m)[3 + (r)] * (y) + (m)[6 + (r)] * (z) + (t)[r])
+#define OB_AFFINE_ROW(m, t, r, x, y, z)                                                       \
+    ((m)[r] * (x) + (m)[3 + (r)] * (y) + (m)[6 + (r)] * (z) + (t)[r])
 /* dest may alias p. */
 inline void ob_daffine_transform_point(const ob_daffine *a, const double p[3], double dest[3])
 {

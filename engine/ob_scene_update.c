@@ -29,7 +29,7 @@ typedef struct update_ctx {
     const level_item *items;    /* the current loop's nodes */
     uint32_t count;
     bool controllers;           /* the level loop runs the parallel-safe controllers */
-    bool prefetch;              /* the level loop asks for the next batch's data ahead */
+    bool prefetch;              /* the level loop asks for its nodes' data ahead */
     uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
 } update_ctx;
 
@@ -418,11 +418,12 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         for (int k = 0; k < 3; k++) xl->world.t[k] = t[k][l];
         xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
                     XF_WORLD_ROT_LOCAL;
-        s->state[slot] = (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
+        s->state[slot] =
+            (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
         /* proxy_write_world, then proxy_write_normal */
         ob_render_proxy *p = &s->proxies[i];
-        /* Stored one by one and read back so: a wider read of narrower
-         * recent stores waits for them to retire. */
+        /* The normal matrix reads the floats back from the proxy (taken
+         * from locals instead, it came out slower). */
         for (int k = 0; k < 9; k++) p->linear[k] = (float)m[k][l];
         for (int k = 0; k < 3; k++) p->world_t[k] = t[k][l];
         float r = (float)radius[l];
@@ -503,7 +504,7 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
  * PREFETCH_AHEAD nodes ahead, proxies (whose index the record holds) one
  * step ahead. At 50k moving objects, written out of cache between
  * updates: 84-90 ns an object without, 73-75 with the records, 57-58 with
- * the proxies too. Smaller levels are in cache, where the requests only
+ * the proxies too, 52-53 with the bounds. Smaller levels are in cache, where the requests only
  * cost (about 5 ns an object). */
 #define PREFETCH_MIN_NODES 4096u
 #define PREFETCH_AHEAD 16u
@@ -512,8 +513,9 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
  * built-in controllers' state when the level loop runs them. Inlined
  * always: GCC finds a function of prefetches alone free of side effects
  * and drops its calls. */
-static inline __attribute__((always_inline)) void prefetch_nodes(const ob_scene *s, const level_item *items, uint32_t count,
-                           bool controllers)
+static inline __attribute__((always_inline)) void prefetch_nodes(const ob_scene *s,
+                                                                 const level_item *items,
+                                                                 uint32_t count, bool controllers)
 {
     for (uint32_t j = 0; j < count; j++) {
         uint32_t slot = items[j].slot;
@@ -567,7 +569,8 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
     for (uint32_t i = chunk * c->grain; i < end; i += LEVEL_STEP) {
         uint32_t step_end = OB_MIN(end, i + LEVEL_STEP);
         if (c->prefetch) {
-            uint32_t from = OB_MIN(end, i + PREFETCH_AHEAD), to = OB_MIN(end, step_end + PREFETCH_AHEAD);
+            uint32_t from = OB_MIN(end, i + PREFETCH_AHEAD);
+            uint32_t to = OB_MIN(end, step_end + PREFETCH_AHEAD);
             prefetch_nodes(s, c->items + from, to - from, c->controllers);
             from = OB_MIN(end, i + LEVEL_STEP);
             to = OB_MIN(end, step_end + LEVEL_STEP);
@@ -585,7 +588,8 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
                 state[it.slot] = (uint8_t)(st & ~NODE_CHANGED);
             }
         }
-        for (uint32_t k = 0; k < simples; k += 2) eval_simple2(s, simple + k, OB_MIN(2u, simples - k));
+        for (uint32_t k = 0; k < simples; k += 2)
+            eval_simple2(s, simple + k, OB_MIN(2u, simples - k));
         if (b.count > EVAL_BATCH - LEVEL_STEP || (b.count && step_end == end))
             changed |= eval_batch_run(s, &b);
     }

@@ -1011,9 +1011,10 @@ static void common_nodes_evaluate_as_any_other(void **state)
 {
     (void)state;
     enum { NODES = 9, STEPS = 40 };
-    static const float scales[NODES][3] = {{1, 1, 1}, {-1, 2, 0.5f}, {0, 0, 0}, {3e30f, 1e30f, 2e30f},
-                                           {1e-25f, 2e-25f, 1e-25f}, {1, 1, 1}, {0.5f, 0.5f, 0.5f},
-                                           {2, -3, 4}, {0, 1, 1}};
+    static const float scales[NODES][3] = {
+        {1, 1, 1},  {-1, 2, 0.5f},           {0, 0, 0},          {3e30f, 1e30f, 2e30f},
+        {1e-25f, 2e-25f, 1e-25f}, {1, 1, 1}, {0.5f, 0.5f, 0.5f}, {2, -3, 4},
+        {0, 1, 1}};
     ob_scene *sc[2] = {new_scene(), new_scene()};
     ob_node *n[2][NODES];
     ob_light_desc light = {.type = OB_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 1, .range = 5};
@@ -1024,10 +1025,12 @@ static void common_nodes_evaluate_as_any_other(void **state)
             assert_int_equal(ob_node_set_renderable(n[v][k], &rd), OB_OK);
             ob_node_set_scale(n[v][k], scales[k]);
             assert_int_equal(ob_node_add_orbit_controller(n[v][k], (double[3]){1e5 * k, 2, 3},
-                                                          (float[3]){0, 1, 0}, 2 + k, 0.7f, 0.2f * (float)k),
+                                                          (float[3]){0, 1, 0}, 2 + k, 0.7f,
+                                                          0.2f * (float)k),
                              OB_OK);
             if (k % 3)
-                assert_int_equal(ob_node_add_rotation_controller(n[v][k], (float[3]){1, 2, (float)k}, 1.1f),
+                assert_int_equal(ob_node_add_rotation_controller(n[v][k],
+                                                                 (float[3]){1, 2, (float)k}, 1.1f),
                                  OB_OK);
             if (v == 1) assert_int_equal(ob_node_set_light(n[v][k], &light), OB_OK);
         }
