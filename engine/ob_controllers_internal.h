@@ -67,12 +67,12 @@ static inline void ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *c
     uint32_t i1 = n > 1 ? 1 : 0;
 #define A(c) (ob_v2d){x[0]->rotation[c], x[i1]->rotation[c]}
 #define B(c) (ob_v2d){st[0]->step[c], st[i1]->step[c]}
-    ob_v2d a0 = A(0), a1 = A(1), a2 = A(2), a3 = A(3), b0 = B(0), b1 = B(1), b2 = B(2), b3 = B(3);
+    ob_v2d a[4] = {A(0), A(1), A(2), A(3)}, b[4] = {B(0), B(1), B(2), B(3)};
 #undef A
 #undef B
     /* ob_dquat_mul(rotation, step), then ob_dquat_normalize's usual case. */
-    ob_v2d q[4] = {a3 * b0 + a0 * b3 + a1 * b2 - a2 * b1, a3 * b1 - a0 * b2 + a1 * b3 + a2 * b0,
-                   a3 * b2 + a0 * b1 - a1 * b0 + a2 * b3, a3 * b3 - a0 * b0 - a1 * b1 - a2 * b2};
+    ob_v2d q[4] = {OB_QUAT_MUL_X(a, b), OB_QUAT_MUL_Y(a, b), OB_QUAT_MUL_Z(a, b),
+                   OB_QUAT_MUL_W(a, b)};
     ob_v2d n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     ob_v2d inv = 1.0 / (ob_v2d){sqrt(n2[0]), sqrt(n2[1])};
     for (uint32_t l = 0; l < n; l++) {
@@ -83,7 +83,7 @@ static inline void ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *c
          * rescales; a non-finite q is stored as is, so the update names
          * the node. */
         bool unit = true;
-        if (n2[l] > 0x1p-900 && n2[l] < 0x1p900)
+        if (OB_DQUAT_NORM2_USUAL(n2[l]))
             for (int c = 0; c < 4; c++) r[c] *= inv[l];
         else
             unit = ob_dquat_normalize(r, r);

@@ -99,18 +99,26 @@ void ob_dquat_identity(double dest[4]);
 /* Rotation of `angle` radians about `axis` (need not be unit; a zero axis
  * gives the identity). */
 void ob_dquat_from_axis_angle(const double axis[3], double angle, double dest[4]);
+/* Components x, y, z, w of the quaternion product a * b (a[0..4), b[0..4)
+ * in x, y, z, w order), in any arithmetic type (as OB_QUAT_TO_MAT3_SCALED
+ * below). */
+#define OB_QUAT_MUL_X(a, b) ((a)[3] * (b)[0] + (a)[0] * (b)[3] + (a)[1] * (b)[2] - (a)[2] * (b)[1])
+#define OB_QUAT_MUL_Y(a, b) ((a)[3] * (b)[1] - (a)[0] * (b)[2] + (a)[1] * (b)[3] + (a)[2] * (b)[0])
+#define OB_QUAT_MUL_Z(a, b) ((a)[3] * (b)[2] + (a)[0] * (b)[1] - (a)[1] * (b)[0] + (a)[2] * (b)[3])
+#define OB_QUAT_MUL_W(a, b) ((a)[3] * (b)[3] - (a)[0] * (b)[0] - (a)[1] * (b)[1] - (a)[2] * (b)[2])
 /* dest = a * b (b applied first). dest may alias a or b. */
 inline void ob_dquat_mul(const double a[4], const double b[4], double dest[4])
 {
-    double x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
-    double y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
-    double z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
-    double w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    double x = OB_QUAT_MUL_X(a, b), y = OB_QUAT_MUL_Y(a, b);
+    double z = OB_QUAT_MUL_Z(a, b), w = OB_QUAT_MUL_W(a, b);
     dest[0] = x;
     dest[1] = y;
     dest[2] = z;
     dest[3] = w;
 }
+/* Whether ob_dquat_normalize takes its usual case for a squared length n2
+ * (then each component times 1 / sqrt(n2)). */
+#define OB_DQUAT_NORM2_USUAL(n2) ((n2) > 0x1p-900 && (n2) < 0x1p900)
 /* Unit quaternion along q. Returns false (dest untouched) when q is zero or
  * not finite. dest may alias q. */
 inline bool ob_dquat_normalize(const double q[4], double dest[4])
@@ -120,7 +128,7 @@ inline bool ob_dquat_normalize(const double q[4], double dest[4])
     /* The usual case (a near-unit rotation, every update of every node):
      * the squares neither overflow nor underflow, so no rescaling (four
      * divisions) is needed. A NaN or infinite component fails the test. */
-    if (n2 > 0x1p-900 && n2 < 0x1p900) {
+    if (OB_DQUAT_NORM2_USUAL(n2)) {
         double inv = 1.0 / sqrt(n2);
         dest[0] = x * inv;
         dest[1] = y * inv;
