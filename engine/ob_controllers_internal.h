@@ -177,26 +177,11 @@ static inline void ob_orbit_kernel(node_xf *x, ob_orbit_state *st, double dt)
     ob_orbit_kernel2(xs, sts, 1, dt);
 }
 
-/* Runs the node's controllers in scene->motion (state: its NODE_* byte,
- * NODE_MOTION set). keep_world: other controllers run before the node's
- * evaluation and may read its world rotation, which must stay the last
- * update's (when they do not, it is left to follow the rotation: the
- * evaluation comes right after). [the slot's own thread] */
-static inline void ob_motion_run(ob_scene *s, uint32_t slot, uint8_t state, double dt,
-                                 bool keep_world)
-{
-    node_motion *m = &s->motion[slot];
-    if (state & NODE_ORBIT) ob_orbit_kernel(&s->xf[slot], &m->orbit, dt);
-    if (state & NODE_SPIN) {
-        if (keep_world) node_world_rotation_keep(s, slot);
-        ob_rotation_kernel(&s->xf[slot], &m->spin, dt);
-    }
-    s->state[slot] = (uint8_t)(state | NODE_DIRTY);
-}
-
 /* Runs controller c of the node in slot: a built-in one's kernel in place,
- * any other through its function. keep_world: as for ob_motion_run.
- * [the slot's own thread] */
+ * any other through its function. keep_world: other controllers run
+ * before the node's evaluation and may read its world rotation, which must
+ * stay the last update's (when they do not, it is left to follow the
+ * rotation: the evaluation comes right after). [the slot's own thread] */
 static inline void ob_controller_run(ob_scene *s, uint32_t slot, ob_controller_slot *c, double dt,
                                      bool keep_world)
 {

@@ -438,23 +438,11 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
 
 /* ------------------------------------------------------------------ loops */
 
-/* The node's parallel-safe controllers (st: its NODE_* byte, with
- * NODE_PARALLEL or NODE_MOTION); keep_world as for ob_motion_run. */
-static inline void run_parallel_controllers(ob_scene *s, uint32_t slot, uint8_t st, double dt,
-                                            bool keep_world)
-{
-    if (st & NODE_MOTION) {
-        ob_motion_run(s, slot, st, dt, keep_world);
-        return;
-    }
-    node_controllers *ctl = &s->ctl[slot];
-    for (uint32_t k = 0; k < ctl->parallel; k++)
-        ob_controller_run(s, slot, &ctl->slots[k], dt, keep_world);
-}
-
-/* The parallel-safe controllers of a batch of nodes, as the fused loop
- * runs them (keep_world false): the built-in ones two nodes at a time. */
-static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t count, double dt)
+/* The parallel-safe controllers of up to LEVEL_STEP nodes: those in
+ * scene->motion (NODE_MOTION) two nodes at a time, the others in each
+ * node's list in order; keep_world as for ob_controller_run. */
+static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t count, double dt,
+                                  bool keep_world)
 {
     node_xf *orbit_x[LEVEL_STEP], *spin_x[LEVEL_STEP];
     ob_orbit_state *orbit[LEVEL_STEP];
@@ -470,12 +458,15 @@ static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t
                 orbit[orbits++] = &m->orbit;
             }
             if (st & NODE_SPIN) {
+                if (keep_world) node_world_rotation_keep(s, slot);
                 spin_x[spins] = &s->xf[slot];
                 spin[spins++] = &m->spin;
             }
             s->state[slot] = (uint8_t)(st | NODE_DIRTY);
         } else if (st & NODE_PARALLEL) {
-            run_parallel_controllers(s, slot, st, dt, false);
+            node_controllers *ctl = &s->ctl[slot];
+            for (uint32_t k = 0; k < ctl->parallel; k++)
+                ob_controller_run(s, slot, &ctl->slots[k], dt, keep_world);
         }
     }
     for (uint32_t k = 0; k < orbits; k += 2)
@@ -490,11 +481,8 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
     const update_ctx *c = user;
     ob_scene *s = c->s;
     uint32_t end = chunk_end(c->count, chunk, c->grain);
-    for (uint32_t i = chunk * c->grain; i < end; i++) {
-        uint32_t slot = c->items[i].slot;
-        uint8_t st = s->state[slot];
-        if (st & (NODE_PARALLEL | NODE_MOTION)) run_parallel_controllers(s, slot, st, c->dt, true);
-    }
+    for (uint32_t i = chunk * c->grain; i < end; i += LEVEL_STEP)
+        run_batch_controllers(s, c->items + i, OB_MIN(end, i + LEVEL_STEP) - i, c->dt, true);
 }
 
 /* Levels of at least this many nodes have their data asked for ahead:
@@ -576,7 +564,7 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
             to = OB_MIN(end, step_end + LEVEL_STEP);
             prefetch_proxies(s, c->items + from, to - from);
         }
-        if (c->controllers) run_batch_controllers(s, c->items + i, step_end - i, c->dt);
+        if (c->controllers) run_batch_controllers(s, c->items + i, step_end - i, c->dt, false);
         uint32_t simple[LEVEL_STEP], simples = 0;
         for (uint32_t j = i; j < step_end; j++) {
             level_item it = c->items[j];
