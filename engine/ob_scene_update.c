@@ -29,7 +29,6 @@ typedef struct update_ctx {
     const level_item *items;    /* the current loop's nodes */
     uint32_t count;
     bool controllers;           /* the level loop runs the parallel-safe controllers */
-    bool prefetch;              /* the level loop asks for its nodes' data ahead */
     uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
 } update_ctx;
 
@@ -552,11 +551,12 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
     uint8_t *state = s->state;
     uint32_t end = chunk_end(c->count, chunk, c->grain);
     bool changed = false;
+    bool prefetch = c->count >= PREFETCH_MIN_NODES;
     eval_batch b;
     b.count = 0;
     for (uint32_t i = chunk * c->grain; i < end; i += LEVEL_STEP) {
         uint32_t step_end = OB_MIN(end, i + LEVEL_STEP);
-        if (c->prefetch) {
+        if (prefetch) {
             uint32_t from = OB_MIN(end, i + PREFETCH_AHEAD);
             uint32_t to = OB_MIN(end, step_end + PREFETCH_AHEAD);
             prefetch_nodes(s, c->items + from, to - from, c->controllers);
@@ -745,7 +745,6 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
     for (uint32_t d = 0; d < s->level_count; d++) {
         c.items = s->by_level + s->level_start[d];
         c.count = s->level_start[d + 1] - s->level_start[d];
-        c.prefetch = c.count >= PREFETCH_MIN_NODES;
         uint32_t chunks = chunks_of(c.count, grain);
         update_loop(&c, c.count, run_level);
         for (uint32_t k = 0; k < chunks; k++) membership_changed |= c.counts[k] != 0;
