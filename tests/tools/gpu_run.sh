@@ -15,6 +15,9 @@
 #   scale  test_extreme_scale alone (the scale invariance cases)
 #   images BoxTextured and 2CylinderEngine at 640x480, 4x MSAA, into $OUT
 #   bench  obelisk-bench --quick (frame periods on the GPU)
+#   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instanced
+#          and then one draw per entity (--no-instancing): the parallel frame's
+#          and instancing's figures on the machine's cores (docs/benchmark.md)
 # DEADLINE (seconds, default 420) bounds the whole run; a step gets what is
 # left or is skipped. OB_DEVICE defaults to gpu (never lavapipe).
 set -u
@@ -83,6 +86,15 @@ for s in $steps; do
     timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --quick --no-stability --no-progress \
       --json "$OUT/bench_quick.json" >"$OUT/bench_quick.log" 2>&1
     say "bench rc=$?" ;;
+  frame16)
+    for v in inst:"--modes ST,2,4,8,16,auto" draw:"--modes ST,16 --no-instancing"; do
+      n=${v%%:*}; a=${v#*:}
+      # shellcheck disable=SC2086  # $a is a list of options
+      timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --views 16 --objects 100000 $a --rounds 3 \
+        --no-stability --no-progress --json "$OUT/frame16_$n.json" >"$OUT/frame16_$n.log" 2>&1
+      say "frame16 $n rc=$?"
+      grep -E '^ +16 +100000 ' "$OUT/frame16_$n.log" | tee -a "$OUT/summary.txt"
+    done ;;
   *) say "unknown step '$s'" ;;
   esac
 done
