@@ -283,6 +283,7 @@ static ob_result instance_create(ob_device *dev, const char *app_name)
         dev->instance = VK_NULL_HANDLE;
         return vr == VK_ERROR_INCOMPATIBLE_DRIVER ? OB_ERR_NO_DEVICE : ob_result_from_vk(vr);
     }
+    ob_device_pin_drivers();
     r = messenger_create(dev, debug_utils);
     if (r != OB_OK) instance_destroy(dev);
     return r;

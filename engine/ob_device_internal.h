@@ -26,6 +26,11 @@ typedef struct ob_physical_choice {
     ob_device_caps caps;   /* what the device supports; enabled as-is */
 } ob_physical_choice;
 
+/* Keeps every shared object loaded at the call (the Vulkan loader, the
+ * drivers, the layers) loaded for the rest of the process (ob_device_pin.c
+ * says why). Called right after an instance is created. [any thread] */
+void ob_device_pin_drivers(void);
+
 /* Picks a physical device for `selector` (NULL/"" = automatic, "lavapipe",
  * "gpu" or a decimal index). On failure logs every device seen with the
  * reason it was rejected and returns OB_ERR_NO_DEVICE (or

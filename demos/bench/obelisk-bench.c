@@ -178,6 +178,7 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
             o->perf = takes = false;
         } else if (!strcmp(a, "--no-instancing")) {
             o->no_instancing = true;
+            takes = false;
         } else if (!strcmp(a, "--no-stability")) {
             o->stability = takes = false;
 

@@ -1,8 +1,11 @@
 /* Device creation, selection, validation capture, OB_VK_CHECK, deferred
  * deletion, device loss and fault injection on every creation point. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* dl_iterate_phdr */
 #include "ob_test.h"
 #include "ob_resources.h"
+
+#include <dlfcn.h>
+#include <link.h>
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -365,11 +368,54 @@ static void every_host_allocation_of_creation_fails_cleanly(void **state)
     walk_creation_faults(OB_FAULT_HOST_ALLOC, 1);
 }
 
+/* The shared objects loaded while a device exists (the driver among them)
+ * stay loaded after the last device is destroyed: unloading and reloading
+ * NVIDIA's driver exhausts glibc's static TLS after about a dozen instances
+ * (ob_device_pin.c), so a program that makes renderers in turn must not
+ * cycle it. */
+typedef struct loaded_list {
+    char names[512][256];
+    int count;
+} loaded_list;
+
+static int note_loaded(struct dl_phdr_info *info, size_t size, void *data)
+{
+    (void)size;
+    loaded_list *l = data;
+    if (info->dlpi_name && info->dlpi_name[0] && l->count < 512)
+        snprintf(l->names[l->count++], sizeof l->names[0], "%s", info->dlpi_name);
+    return 0;
+}
+
+static void driver_stays_loaded_after_the_last_device(void **state)
+{
+    (void)state;
+    static loaded_list during;
+    during.count = 0;
+    ob_device *dev = ob_test_device_create();
+    assert_non_null(dev);
+    dl_iterate_phdr(note_loaded, &during);
+    ob_device_destroy(dev);
+    assert_true(during.count > 0);
+    int gone = 0;
+    for (int i = 0; i < during.count; i++) {
+        void *h = dlopen(during.names[i], RTLD_LAZY | RTLD_NOLOAD);
+        if (h) {
+            dlclose(h);
+        } else {
+            print_message("unloaded with the last device: %s\n", during.names[i]);
+            gone++;
+        }
+    }
+    assert_int_equal(gone, 0);
+}
+
 int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(device_reports_name_driver_and_timestamps),
+        cmocka_unit_test(driver_stays_loaded_after_the_last_device),
         cmocka_unit_test(env_lavapipe_selects_the_cpu_device),
         cmocka_unit_test(gpu_selector_never_returns_the_cpu_device),
         cmocka_unit_test(unknown_index_fails_with_a_list_of_devices),

@@ -15,15 +15,16 @@
 # here); and the assimp test models the tests read.
 #
 # Usage: tests/tools/gpu_pack.sh        (after ./setup.sh build, or cmake --build build)
-#   KEEP="test_a test_b"  the gpu test executables to carry (default below)
+#   KEEP="test_a test_b"  the test executables to carry (default: every one
+#                         that ctest labels gpu; xz keeps the copies of the
+#                         static glslang in them to ~0.4 MB each)
 #   DEST=DIR              where to write (default .gpu)
 set -euo pipefail
 PROJ=${PROJ:-$(git -C "$(dirname "$0")" rev-parse --show-toplevel)}
 DEST=${DEST:-$PROJ/.gpu}
-KEEP=${KEEP:-test_render test_determinism test_workers test_colour test_pbr test_texture test_adopt \
-test_stack test_view_queue test_extreme_scale test_scene_load test_device test_resources \
-test_pipeline_manager test_faults}
 [ -x "$PROJ/build/bin/obelisk-view" ] || { echo "gpu_pack: build first (no $PROJ/build/bin/obelisk-view)" >&2; exit 2; }
+KEEP=${KEEP:-$(ctest --test-dir "$PROJ/build" -N -L gpu | sed -n 's/.*Test *#[0-9]*: \(test_[a-z0-9_]*\)$/\1/p' | tr '\n' ' ')}
+[ -n "${KEEP// /}" ] || { echo "gpu_pack: ctest lists no gpu tests in $PROJ/build" >&2; exit 2; }
 
 stage=$(mktemp -d); trap 'rm -rf "$stage"' EXIT
 root=$stage/ob; mkdir -p "$root/main" "$root/libs" "$root/layers" "$root/models" "$root/cmake/bin" "$root/cmake/share"

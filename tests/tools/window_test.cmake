@@ -2,7 +2,7 @@
 # each: ob_window_test_begin(NAME VAR...) fails when one of the named -D
 # variables is missing, and ends the including script with SKIP when the
 # build has no window support (-DWINDOW=OFF) or xvfb-run is missing
-# (-DXVFB_RUN empty); ./setup.sh installs both (libglfw3-dev, xvfb, xauth).
+# (-DXVFB_RUN empty, or a path this machine lacks); ./setup.sh installs both (libglfw3-dev, xvfb, xauth).
 # A macro, so that its return() ends the test script itself.
 macro(ob_window_test_begin name)
   foreach(var ${ARGN})
@@ -16,6 +16,12 @@ macro(ob_window_test_begin name)
   endif()
   if(NOT XVFB_RUN)
     message("SKIP: xvfb-run not found (Debian: xvfb xauth)")
+    return()
+  endif()
+  # The path found at configure time, gone on this machine (a build carried
+  # to a GPU machine by tests/tools/gpu_pack.sh, which has no X server).
+  if(NOT EXISTS "${XVFB_RUN}")
+    message("SKIP: ${XVFB_RUN} is not on this machine (Debian: xvfb xauth)")
     return()
   endif()
 endmacro()
