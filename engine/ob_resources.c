@@ -28,16 +28,9 @@ ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, V
                               const char *what, const char *name, VkDeviceMemory *out_memory)
 {
     *out_memory = VK_NULL_HANDLE;
-    /* DEVICE_LOCAL is a preference: a type without it is the fallback when
-     * none has it, or when its heap is full (a discrete GPU's 256 MB BAR,
-     * the only device-local host-visible heap without resizable BAR). */
-    const VkMemoryPropertyFlags plain = flags & ~(VkMemoryPropertyFlags)VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
     uint32_t type = ob_device_memory_type(dev, req->memoryTypeBits, flags);
-    uint32_t fallback = plain != flags ? ob_device_memory_type(dev, req->memoryTypeBits, plain) : UINT32_MAX;
-    if (type == UINT32_MAX) {
-        type = fallback;
-        fallback = UINT32_MAX;
-    }
+    if (type == UINT32_MAX && flags == VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
+        type = ob_device_memory_type(dev, req->memoryTypeBits, 0);
     if (type == UINT32_MAX) {
         OB_LOG_E("resources", "%s '%s': no memory type with properties 0x%x among types 0x%x", what, name,
                  (unsigned)flags, req->memoryTypeBits);
@@ -48,20 +41,7 @@ ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, V
         .allocationSize = req->size,
         .memoryTypeIndex = type,
     };
-    VkResult vr;
-    if (fallback != UINT32_MAX && fallback != type) {
-        vr = OB_VK_CREATE(vkAllocateMemory(ob_device_vk(dev), &info, NULL, out_memory));
-        if (vr == VK_ERROR_OUT_OF_DEVICE_MEMORY) {
-            OB_LOG_D("resources", "%s '%s': device-local memory full, using memory type %u", what, name,
-                     fallback);
-            info.memoryTypeIndex = fallback;
-            vr = OB_VK_CHECK_CREATE(vkAllocateMemory(ob_device_vk(dev), &info, NULL, out_memory));
-        } else {
-            vr = ob_vk_check(vr, "vkAllocateMemory", __FILE__, __LINE__);
-        }
-    } else {
-        vr = OB_VK_CHECK_CREATE(vkAllocateMemory(ob_device_vk(dev), &info, NULL, out_memory));
-    }
+    VkResult vr = OB_VK_CHECK_CREATE(vkAllocateMemory(ob_device_vk(dev), &info, NULL, out_memory));
     if (vr < 0) {
         *out_memory = VK_NULL_HANDLE;
         ob_device_note_result(dev, vr);

@@ -77,9 +77,8 @@ typedef ob_res_vk_buffer ob_staging;
 ob_result ob_staging_create(ob_device *dev, uint64_t size, const char *owner_name, ob_staging *out_staging);
 void ob_staging_destroy(ob_device *dev, ob_staging *staging);
 
-/* Allocates memory of `flags` for req. DEVICE_LOCAL in flags is a
- * preference: without a type that has it, or when its heap is out of memory,
- * a type with the other flags is used. Logs `what` 'name' on failure. */
+/* Allocates memory of `flags` for req (falls back to any type when no
+ * DEVICE_LOCAL type matches). Logs `what` 'name' on failure. */
 ob_result ob_res_memory_alloc(ob_device *dev, const VkMemoryRequirements *req, VkMemoryPropertyFlags flags,
                               const char *what, const char *name, VkDeviceMemory *out_memory);
 

@@ -20,10 +20,19 @@ file(MAKE_DIRECTORY ${OUT})
 # 3: this test checks what the bench writes (two passes are enough to keep
 # the faster and check both hashes), never its times, and the sanitizer
 # passes run it too.
+# The charts need gnuplot (./setup.sh installs it); a build carried to a
+# machine without it (tests/tools/gpu_pack.sh) checks everything else.
+find_program(GNUPLOT gnuplot)
+set(charts)
+if(GNUPLOT)
+  set(charts --charts ${OUT}/charts)
+else()
+  message(STATUS "gnuplot is not on this machine: the charts are not checked")
+endif()
 execute_process(
   COMMAND ${BIN}/obelisk-bench --quick --warmup 1 --rounds 3 --passes 2 --json ${OUT}/bench.json
           --csv ${OUT}/bench.csv
-          --charts ${OUT}/charts
+          ${charts}
   RESULT_VARIABLE rc
   OUTPUT_FILE ${OUT}/stdout.txt
   ERROR_FILE ${OUT}/stderr.txt
@@ -362,7 +371,7 @@ foreach(line ${csv_lines})
   endif()
 endforeach()
 foreach(png speedup.png error.png)
-  if(NOT EXISTS ${OUT}/charts/${png})
+  if(GNUPLOT AND NOT EXISTS ${OUT}/charts/${png})
     message(FATAL_ERROR "chart ${png} was not written")
   endif()
 endforeach()
