@@ -713,6 +713,14 @@ uint32_t ob_device_memory_type(const ob_device *dev, uint32_t type_bits, VkMemor
     return UINT32_MAX;
 }
 
+bool ob_device_host_memory_is_device_local(const ob_device *dev)
+{
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    uint32_t type = ob_device_memory_type(dev, UINT32_MAX, host);
+    return type != UINT32_MAX &&
+           (dev->mem_props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+}
+
 void ob_device_note_result(ob_device *dev, VkResult res)
 {
     if (res != VK_ERROR_DEVICE_LOST || !dev) return;

@@ -205,6 +205,10 @@ void ob_device_set_name(ob_device *dev, VkObjectType type, uint64_t handle, cons
  * type_bits, or UINT32_MAX. */
 uint32_t ob_device_memory_type(const ob_device *dev, uint32_t type_bits,
                                VkMemoryPropertyFlags required);
+/* Whether the memory the engine maps (the first host-visible, coherent type)
+ * is also device-local: true on lavapipe and integrated GPUs, false on a
+ * discrete GPU, where it is host memory the GPU reads across PCIe. */
+bool ob_device_host_memory_is_device_local(const ob_device *dev);
 
 /* ---- frame slots and deferred deletion --------------------------------
  * The renderer tells the device which frame slot it is recording (after the

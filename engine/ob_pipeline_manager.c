@@ -23,8 +23,10 @@
  * thread (creating one here raced with other workers' handle lookups). */
 typedef struct ring_chunk {
     VkDeviceMemory memory;
-    VkBuffer vk;
-    uint8_t *mapped;
+    VkBuffer vk;                /* what the draws read: bound, and in the sets */
+    uint8_t *mapped;            /* what the host writes: vk's memory, or stage's */
+    VkBuffer stage;             /* a staged ring: the host buffer copied to vk */
+    VkDeviceMemory stage_memory;
     uint64_t size, used;
 } ring_chunk;
 
@@ -92,6 +94,7 @@ struct ob_pipeline_manager {
     uint32_t frames_in_flight;
     uint32_t set_cache_limit;   /* SET_CACHE_LIMIT unless a test lowers it */
     uint64_t chunk_size;
+    bool staged;                /* desc.staged */
     uint32_t ubo_align;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor;
 
@@ -167,6 +170,7 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     pm->frames_in_flight = desc->frames_in_flight ? desc->frames_in_flight : 2;
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
     pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
+    pm->staged = desc->staged;
     /* $OB_SET_CACHE_LIMIT lowers the bound for tests (tests/gpu/test_pipeline_manager.c)
      * that cannot afford a thousand programs. */
     const char *limit = getenv("OB_SET_CACHE_LIMIT");
@@ -191,36 +195,73 @@ done:
 
 static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
 {
-    ob_res_vk_buffer b = {.buffer = c->vk, .memory = c->memory, .mapped = c->mapped};
+    ob_res_vk_buffer b = {.buffer = c->vk, .memory = c->memory};
+    ob_res_vk_buffer st = {.buffer = c->stage, .memory = c->stage_memory};
     ob_res_vk_buffer_free(pm->dev, &b);
+    ob_res_vk_buffer_free(pm->dev, &st);
     memset(c, 0, sizeof *c);
 }
 
-/* A host-visible, coherent, persistently mapped buffer of uniform blocks and
- * per-instance blocks, through the resources' one buffer path. Host memory,
- * not a discrete GPU's device-local host-visible (BAR) memory: on the H100
- * machine that memory is mapped uncached, and recording 8 views x 10k took
- * 14.2 ms there instead of 2.7 (the GPU's reads got faster: 5.9 ms against
- * 10.7). The host only writes the ring, never reads it (blocks are packed in
+/* A chunk of uniform blocks and per-instance blocks, through the resources'
+ * one buffer path: a host-visible, coherent, persistently mapped buffer the
+ * draws read, or, staged, such a buffer that the frame copies to a
+ * device-local one the draws read. Never a discrete GPU's device-local
+ * host-visible (BAR) memory: on the H100 machine that memory is mapped
+ * uncached, and recording 8 views x 10k took 14.2 ms there instead of 2.7
+ * (the GPU's reads got faster: 5.9 ms against 10.7 from host memory). The
+ * host only writes the ring, never reads it (blocks are packed in
  * pm->pack_scratch and copied): NVIDIA's host-visible memory is
  * write-combined. [own thread] */
 static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
 {
-    ob_res_vk_buffer b;
+    ob_res_vk_buffer host, dev;
     memset(c, 0, sizeof *c);
+    const VkBufferUsageFlags read = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
     ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size,
-                                        VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
-                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                                        pm->staged ? VK_BUFFER_USAGE_TRANSFER_SRC_BIT : read,
                                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
                                             VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                        true, "uniform ring of pipeline manager", pm->name, &b);
+                                        true, pm->staged ? "uniform ring (host side) of pipeline manager"
+                                                         : "uniform ring of pipeline manager",
+                                        pm->name, &host);
     if (r != OB_OK) return r;
-    c->vk = b.buffer;
-    c->memory = b.memory;
-    c->mapped = b.mapped;
+    c->mapped = host.mapped;
     c->size = pm->chunk_size;
+    if (!pm->staged) {
+        c->vk = host.buffer;
+        c->memory = host.memory;
+    } else {
+        r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size, read | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false,
+                                  "uniform ring of pipeline manager", pm->name, &dev);
+        if (r != OB_OK) {
+            ob_res_vk_buffer_free(pm->dev, &host);
+            memset(c, 0, sizeof *c);
+            return r;
+        }
+        c->stage = host.buffer;
+        c->stage_memory = host.memory;
+        c->vk = dev.buffer;
+        c->memory = dev.memory;
+        ob_device_set_name(pm->dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)c->stage, pm->name);
+    }
     ob_device_set_name(pm->dev, VK_OBJECT_TYPE_BUFFER, (uint64_t)c->vk, pm->name);
     return OB_OK;
+}
+
+uint64_t ob_pipeline_manager_record_uploads(ob_pipeline_manager *pm, VkCommandBuffer cmd)
+{
+    if (!pm->staged) return 0;
+    uint64_t bytes = 0;
+    const frame_ring *fr = pm->ring;
+    for (uint32_t i = 0; i < fr->chunk_count; i++) {
+        const ring_chunk *c = &fr->chunks[i];
+        if (!c->used) continue;
+        VkBufferCopy region = {.srcOffset = 0, .dstOffset = 0, .size = c->used};
+        vkCmdCopyBuffer(cmd, c->stage, c->vk, 1, &region);
+        bytes += c->used;
+    }
+    return bytes;
 }
 
 void ob_pipeline_manager_destroy(ob_pipeline_manager *pm)

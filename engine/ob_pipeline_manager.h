@@ -39,6 +39,10 @@ typedef struct ob_pipeline_manager_desc {
     uint32_t slot;              /* parameter slot: 0 immediate, i = worker i */
     uint32_t frames_in_flight;  /* 0 → 2 */
     uint64_t ring_chunk_size;   /* 0 → 4 MiB; the ring grows by chunks when full */
+    /* The ring is written in host memory and read from a device-local copy
+     * that ob_pipeline_manager_record_uploads makes, before the frame's
+     * draws (ob_renderer_desc.ring_staging). */
+    bool staged;
     const char *name;
 } ob_pipeline_manager_desc;
 
@@ -87,6 +91,13 @@ void ob_pipeline_manager_destroy(ob_pipeline_manager *pm);
 /* Start of a frame in frame slot `slot` (its previous use has completed):
  * rewinds the slot's uniform ring. frame_serial increases every frame. */
 void ob_pipeline_manager_begin_frame(ob_pipeline_manager *pm, uint32_t slot, uint64_t frame_serial);
+/* A staged ring (desc.staged): records into cmd the copies of what this
+ * frame wrote into the ring to the device-local buffers the draws read, and
+ * returns the bytes copied (0, and nothing recorded, when unstaged or
+ * unused). Called once the frame's recording is over, for a command buffer
+ * that runs before the draws; the caller adds the barrier to the reads.
+ * [render thread, the manager idle] */
+uint64_t ob_pipeline_manager_record_uploads(ob_pipeline_manager *pm, VkCommandBuffer cmd);
 
 /* Wrap cmd (already begun by the caller) and forget all current state. */
 void ob_pipeline_manager_begin(ob_pipeline_manager *pm, VkCommandBuffer cmd);

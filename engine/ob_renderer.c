@@ -2,6 +2,7 @@
 #include "ob_renderer_internal.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -68,6 +69,12 @@ static ob_result create_frame_slot(ob_renderer *r, ob_frame_slot *fs, uint32_t i
     char name[32];
     snprintf(name, sizeof name, "primary[%u]", index);
     ob_device_set_name(r->dev, VK_OBJECT_TYPE_COMMAND_BUFFER, (uint64_t)(uintptr_t)fs->primary, name);
+    if (r->ring_staged) {
+        vr = OB_VK_CHECK_CREATE(vkAllocateCommandBuffers(vk, &ai, &fs->upload));
+        if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+        snprintf(name, sizeof name, "ring upload[%u]", index);
+        ob_device_set_name(r->dev, VK_OBJECT_TYPE_COMMAND_BUFFER, (uint64_t)(uintptr_t)fs->upload, name);
+    }
     VkFenceCreateInfo fci = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO,
                              .flags = VK_FENCE_CREATE_SIGNALED_BIT};
     vr = OB_VK_CHECK_CREATE(vkCreateFence(vk, &fci, NULL, &fs->fence));
@@ -93,6 +100,17 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
     if (fs->pool) vkDestroyCommandPool(vk, fs->pool, &fs->alloc.callbacks);
     ob_arena_allocator_release(&fs->alloc);
     memset(fs, 0, sizeof *fs);
+}
+
+/* desc.ring_staging for this device; $OB_RING_STAGING=on|off overrides
+ * AUTO (to run a suite staged on lavapipe, or direct on a GPU). */
+static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
+{
+    const char *env = getenv("OB_RING_STAGING");
+    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "on")) asked = OB_RING_STAGING_ON;
+    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
+    if (asked == OB_RING_STAGING_AUTO) return !ob_device_host_memory_is_device_local(dev);
+    return asked == OB_RING_STAGING_ON;
 }
 
 ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result)
@@ -124,6 +142,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
 
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free_renderer;
+    r->ring_staged = ring_staged(d.ring_staging, r->dev);
     r->reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 1 + r->worker_count}, &res);
     if (!r->reg) goto fail_destroy_renderer;
     res = ob_params_manager(r->reg, 0, &r->params0);
@@ -138,6 +157,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
         .slot = 0,
         .frames_in_flight = r->frames_in_flight,
         .name = "immediate",
+        .staged = r->ring_staged,
     };
     r->immediate = ob_pipeline_manager_create(&pmd, &res);
     if (!r->immediate) goto fail_destroy_renderer;

@@ -71,6 +71,22 @@ typedef enum ob_gpu_timing {
 } ob_gpu_timing;
 #define OB_VIEW_TIMESTAMP_INTERVAL 16u
 
+/* Where the draws read the blocks the pipeline managers write each frame
+ * (uniform blocks, per-instance blocks). */
+typedef enum ob_ring_staging {
+    /* Staged where the device's host-visible memory is not device-local (a
+     * discrete GPU), direct where it is (lavapipe, integrated GPUs). $OB_RING_STAGING=on|off
+     * overrides it. */
+    OB_RING_STAGING_AUTO = 0,
+    /* Written in host memory, copied to device-local memory at the start of
+     * the frame's command buffers: the GPU reads its own memory (on an
+     * H100, instanced draws read host memory across PCIe at 2.6x the GPU
+     * time of one draw each), and the host writes cached memory. */
+    OB_RING_STAGING_ON,
+    /* Written where the draws read them, host-visible memory. */
+    OB_RING_STAGING_OFF,
+} ob_ring_staging;
+
 typedef struct ob_renderer_desc {
     ob_device_desc device;
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
@@ -91,6 +107,7 @@ typedef struct ob_renderer_desc {
     /* Which GPU timestamps frames write (ob_frame_stats.gpu_ms and the
      * views' gpu_ms; -1 where none was written). */
     ob_gpu_timing gpu_timing;
+    ob_ring_staging ring_staging;
 } ob_renderer_desc;
 
 typedef enum ob_skip_reason {
@@ -163,6 +180,10 @@ typedef struct ob_frame_stats {
     /* Host allocations the driver made through the command pools'
      * allocation callbacks while this frame was recorded, all threads. */
     uint64_t cmd_host_allocs;
+    /* Bytes of uniform and per-instance blocks copied to device-local
+     * memory this frame (a staged ring, ob_renderer_desc.ring_staging); 0
+     * unstaged. */
+    uint64_t ring_upload_bytes;
     /* CPU time (CLOCK_THREAD_CPUTIME_ID) of the frame's CPU phases, from the
      * update (when made through ob_renderer_update_scene) to the submission:
      * cpu_render_ns on the render thread in all, cpu_render_parallel_ns the

@@ -65,6 +65,11 @@ typedef struct ob_frame_slot {
     VkCommandPool pool;
     ob_arena_allocator alloc;   /* the pool's */
     VkCommandBuffer primary;
+    /* A staged ring's: the copies of the pipeline managers' rings to the
+     * device-local buffers the draws read, submitted before primary (it
+     * also holds the frame's first timestamp, so that the GPU time counts
+     * the copies). NULL when the ring is not staged. */
+    VkCommandBuffer upload;
     VkFence fence;
     VkQueryPool queries;
     uint32_t query_capacity;
@@ -109,6 +114,7 @@ struct ob_renderer {
     uint32_t cpu_count;
     bool no_affinity;           /* desc.no_thread_affinity */
     ob_gpu_timing gpu_timing;   /* desc.gpu_timing */
+    bool ring_staged;           /* desc.ring_staging resolved for the device */
     uint32_t chunk_draws;
     uint32_t parallel_grain;    /* desc.parallel_grain (0: each loop's own) */
 

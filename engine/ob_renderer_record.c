@@ -30,6 +30,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
         .slot = index,
         .frames_in_flight = r->frames_in_flight,
         .name = name,
+        .staged = r->ring_staged,
     };
     w->pm = ob_pipeline_manager_create(&pmd, &res);
     if (!w->pm) return res;
@@ -800,6 +801,44 @@ static void note_cost(ob_renderer *r, bool multi, uint32_t workers, uint64_t ns,
         if (i != way) r->measured[i].age++;
 }
 
+/* A staged ring's upload buffer, recorded once the frame's recording is
+ * over (the rings hold all it wrote): the frame's first timestamp (after
+ * resetting `queries` of them, 0 for none), every pipeline manager's copy
+ * to the buffers the draws read, and the barrier from the copies to those
+ * reads. Submitted before the primary, so its barrier orders them. */
+static VkResult record_uploads(ob_renderer *r, ob_frame_slot *fs, uint32_t queries)
+{
+    VkCommandBuffer cmd = fs->upload;
+    VkCommandBufferBeginInfo bi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                   .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    VkResult vr = OB_VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    if (vr != VK_SUCCESS) return vr;
+    if (queries) {
+        vkCmdResetQueryPool(cmd, fs->queries, 0, queries);
+        vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 0);
+    }
+    uint64_t bytes = ob_pipeline_manager_record_uploads(r->immediate, cmd);
+    for (uint32_t i = 0; i < r->worker_count; i++)
+        bytes += ob_pipeline_manager_record_uploads(r->workers[i].pm, cmd);
+    if (bytes) {
+        VkMemoryBarrier2 mb = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+                               .srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
+                               .srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                               .dstStageMask = VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT |
+                                               VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                                               VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                               .dstAccessMask = VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT |
+                                                VK_ACCESS_2_UNIFORM_READ_BIT};
+        VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                                .memoryBarrierCount = 1,
+                                .pMemoryBarriers = &mb};
+        vkCmdPipelineBarrier2(cmd, &dep);
+    }
+    r->cur.ring_upload_bytes = bytes;
+    return OB_VK_CHECK(vkEndCommandBuffer(cmd));
+}
+
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count)
 {
     ob_frame_slot *fs = &r->frames[r->slot];
@@ -855,7 +894,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     bool timestamps = fs->queries && 2 * count + 2 <= fs->query_capacity;
     bool view_stamps = timestamps && (r->gpu_timing == OB_GPU_TIMING_EVERY_VIEW ||
                                       r->serial % OB_VIEW_TIMESTAMP_INTERVAL == 0);
-    if (timestamps) {
+    /* Staged, the frame's first stamp is in the upload buffer, which runs
+     * first (record_uploads). */
+    if (timestamps && !fs->upload) {
         vkCmdResetQueryPool(cmd, fs->queries, 0, view_stamps ? 2 * count + 2 : 2);
         vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, fs->queries, 0);
     }
@@ -951,6 +992,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     st->cmd_host_allocs = cmd_allocations(r) - allocs0;
 
     vr = OB_VK_CHECK(vkEndCommandBuffer(cmd));
+    if (vr == VK_SUCCESS && fs->upload)
+        vr = record_uploads(r, fs, timestamps ? (view_stamps ? 2 * count + 2 : 2) : 0);
     if (vr != VK_SUCCESS) {
         undo_states(r);
         ob_device_note_result(r->dev, vr);
@@ -967,15 +1010,16 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
                  (unsigned long long)r->serial);
         return ob_result_from_vk(vr);
     }
-    VkCommandBufferSubmitInfo cbi = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
-                                     .commandBuffer = cmd};
+    VkCommandBufferSubmitInfo cbi[2] = {
+        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = fs->upload},
+        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = cmd}};
     VkSemaphoreSubmitInfo acquired = {0}, ready = {0};
     uint32_t present_sync = ob_renderer_present_sync(r, &acquired, &ready);
     VkSubmitInfo2 si = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
                         .waitSemaphoreInfoCount = present_sync,
                         .pWaitSemaphoreInfos = &acquired,
-                        .commandBufferInfoCount = 1,
-                        .pCommandBufferInfos = &cbi,
+                        .commandBufferInfoCount = fs->upload ? 2 : 1,
+                        .pCommandBufferInfos = fs->upload ? cbi : cbi + 1,
                         .signalSemaphoreInfoCount = present_sync,
                         .pSignalSemaphoreInfos = &ready};
     vr = OB_VK_CHECK(OB_VK_SUBMIT(vkQueueSubmit2(ob_device_vk_queue(r->dev), 1, &si, fs->fence)));

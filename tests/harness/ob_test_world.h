@@ -28,6 +28,7 @@ typedef struct ob_test_world_desc {
     uint32_t parallel_grain;   /* renderer's entities per parallel-loop index; 0 → default */
     uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
     ob_env_map_kind env_map_kind;  /* 0 → paraboloid */
+    ob_ring_staging ring_staging;  /* 0 → the device's (AUTO) */
     const char *cache_dir;     /* pipeline cache folder; NULL → the effect context's default */
     /* The application's instance and device (ob_test_adopt.h) for walks
      * that start many stacks; NULL → the engine's own. */
