@@ -105,6 +105,7 @@ typedef struct ob_bench_report {
     uint32_t settle;                               /* ob_bench_run_desc.settle */
     uint32_t big_draws;                            /* frames of more draws (estimated) use */
     uint32_t big_warmup, big_rounds, big_flight;   /* these counts instead */
+    uint32_t big_passes, big_settle;               /* (a GPU keeps the asked-for ones) */
     uint32_t view_width, view_height;              /* sweep view size */
     uint32_t image_width, image_height, image_frames;
     double seconds;                                /* whole run, wall clock */

@@ -702,6 +702,8 @@ static int run(bench_options *o)
     frame_counts big = counts_for(o, 1000, 1000000);
     rep.big_warmup = big.warmup;
     rep.big_rounds = big.rounds;
+    rep.big_passes = big.passes;
+    rep.big_settle = big.settle;
     rep.big_flight = big.flight;
     uint64_t t0 = ob_time_ns();
     rep.load_start = load_average();
