@@ -7,7 +7,8 @@
  * from a small static TLS reserve that a dlclose does not give back: on an
  * H100 (driver 580.159) a test process's instances failed after about a
  * dozen with "cannot allocate memory in static TLS block", then "Found no
- * drivers". A test binary, the benchmark and an editor that reopens scenes all do this.
+ * drivers". A test binary, the benchmark and an editor that reopens scenes
+ * all do this.
  *
  * So, right after each instance is created, every shared object then
  * loaded (the loader, the ICD, its dependencies, the layers) is re-opened

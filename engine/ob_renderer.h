@@ -75,13 +75,14 @@ typedef enum ob_gpu_timing {
  * (uniform blocks, per-instance blocks). */
 typedef enum ob_ring_staging {
     /* Staged where the device's host-visible memory is not device-local (a
-     * discrete GPU), direct where it is (lavapipe, integrated GPUs). $OB_RING_STAGING=on|off
-     * overrides it. */
+     * discrete GPU), direct where it is (lavapipe, integrated GPUs).
+     * $OB_RING_STAGING=on|off overrides it. */
     OB_RING_STAGING_AUTO = 0,
     /* Written in host memory, copied to device-local memory at the start of
      * the frame's command buffers: the GPU reads its own memory (on an
      * H100, instanced draws read host memory across PCIe at 2.6x the GPU
-     * time of one draw each), and the host writes cached memory. */
+     * time of one draw each), and the host never writes across PCIe (the
+     * H100 machine mapped its device-local host-visible memory uncached). */
     OB_RING_STAGING_ON,
     /* Written where the draws read them, host-visible memory. */
     OB_RING_STAGING_OFF,

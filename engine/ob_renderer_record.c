@@ -997,8 +997,9 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     if (vr != VK_SUCCESS) {
         undo_states(r);
         ob_device_note_result(r->dev, vr);
-        OB_LOG_E("renderer", "frame %llu not submitted: its command buffer could not be ended",
-                 (unsigned long long)r->serial);
+        OB_LOG_E("renderer", "frame %llu not submitted: its command buffer%s could not be %s",
+                 (unsigned long long)r->serial, fs->upload ? "s" : "",
+                 fs->upload ? "recorded (the primary, or the ring's upload)" : "ended");
         return ob_result_from_vk(vr);
     }
     uint64_t t_submit = ob_time_ns();
