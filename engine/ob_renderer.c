@@ -503,6 +503,7 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     v->dep_count = 0;
     v->item_count = 0;
     v->culled = 0;
+    v->lod_items = 0;
     v->material_count = 0;    /* what culling knew is last frame's until it runs */
     v->material_items_valid = false;
     r->queued_by[r->queue_count] = consumer ? queue_index(r, consumer) : -1;

@@ -133,6 +133,8 @@ typedef struct ob_view_stats {
      * of instanced draws, and the most instances of one draw (one recording
      * job's: a run cut between two jobs counts as two). */
     uint32_t draw_calls, instances, longest_run;
+    /* Items drawn at a coarser level of detail than level 0 (ob_view.lod_scale). */
+    uint32_t lod_items;
     uint32_t chunks;
     int32_t worker;              /* worker of the first chunk; -1 = immediate */
     uint64_t cull_ns, record_ns; /* CPU */
@@ -172,6 +174,7 @@ typedef struct ob_frame_stats {
     uint32_t skipped_count;
     struct { char name[48]; ob_skip_reason reason; } skipped[OB_MAX_FRAME_VIEWS];
     uint32_t draws, culled;
+    uint32_t lod_items;                        /* the views' lod_items, summed */
     ob_pipeline_manager_stats pm;              /* summed over every manager */
     /* CPU time (CLOCK_THREAD_CPUTIME_ID) each thread spent recording this
      * frame: [0] the render thread (inline recording or its share of the

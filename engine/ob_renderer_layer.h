@@ -60,13 +60,24 @@ struct ob_material_iface {
                              ob_pipeline_manager *pm, const ob_view *v);
 };
 
+/* Levels of detail a geometry may have, level 0 included. */
+#define OB_LOD_MAX 8u
+
 struct ob_geometry_iface {
-    /* What drawing g takes (buffers, counts, ranges), by value: the view's
-     * loop asks once per run of items of one geometry and draws from it
-     * itself (ob_pipeline_manager_draw_data). [any thread] */
-    void (*draw_data)(const struct ob_geometry *g, ob_draw_data *out);
+    /* What drawing level `lod` of g takes (buffers, counts, ranges), by
+     * value: the view's loop asks once per run of items of one geometry and
+     * level and draws from it itself (ob_pipeline_manager_draw_data). lod is
+     * below what `lods` gives (0 without it). [any thread] */
+    void (*draw_data)(const struct ob_geometry *g, uint32_t lod, ob_draw_data *out);
     /* Stable id for sorting and hashing. [any thread] */
     uint32_t (*id)(const struct ob_geometry *g);
+    /* Optional (NULL: every geometry has level 0 only). g's levels of
+     * detail, 1..OB_LOD_MAX, and in rel_error[l] level l's error over the
+     * radius of g's bound (rel_error[0] = 0; non-decreasing). Culling asks
+     * once per geometry and wave, and draws an item at the coarsest level
+     * whose error projects to within the view's tolerance
+     * (ob_view.lod_scale). [any thread] */
+    uint32_t (*lods)(const struct ob_geometry *g, float rel_error[OB_LOD_MAX]);
 };
 
 /* Install the interface the renderer calls for every renderable's material

@@ -754,6 +754,7 @@ static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
     vs->type = v->type;
     vs->items = v->item_count;
     vs->culled = v->culled;
+    vs->lod_items = v->lod_items;
     vs->cull_ns = v->cull_ns;
     vs->worker = -1;
     vs->hash = ob_cmd_hash_empty();
@@ -761,6 +762,7 @@ static void stat_view(ob_frame_stats *st, uint32_t i, const ob_view *v)
     vs->skipped = (v->layer_count > 0 && !v->custom_record && v->item_count == 0) ? OB_SKIP_EMPTY
                                                                                  : OB_SKIP_NONE;
     st->culled += v->culled;
+    st->lod_items += v->lod_items;
 }
 
 /* Driver host allocations through every command pool so far. */

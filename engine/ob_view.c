@@ -152,11 +152,27 @@ typedef struct cull_chunk {
     uint32_t far[CULL_LOG_MAX];         /* the first ones, snapshot indices */
 } cull_chunk;
 
+/* What culling knows of one geometry (by its scene index): its levels of
+ * detail, each level's error over the bound radius and the mesh field of
+ * its keys. Asked of the geometry interface once per wave. */
+typedef struct cull_geometry {
+    uint32_t levels;                    /* 1: level 0 only */
+    float rel_error[OB_LOD_MAX];
+    uint32_t mesh[OB_LOD_MAX];
+} cull_geometry;
+
+/* A pair's index holds the snapshot index below this bit and the level of
+ * detail from it up (snapshots stay far below 2^28 entities: culling draws
+ * level 0 beyond). */
+#define CULL_LOD_SHIFT 28u
+#define CULL_INDEX_MASK ((1u << CULL_LOD_SHIFT) - 1u)
+
 typedef struct cull_ctx {
     const ob_view *v;
     ob_render_soa soa;
     const ob_view_material *mt;
-    const uint32_t *mesh;               /* per geometry index */
+    const cull_geometry *geo;           /* per geometry index */
+    float lod_scale;                    /* the view's; 0: level 0 always */
     uint32_t exclude_id;                /* 0: none (ids start at 1) */
     float planes[6][4];                 /* unused planes test nothing */
     uint32_t grain;                     /* entities per chunk */
@@ -266,10 +282,22 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         for (uint32_t t = 0; t < nk; t++) {
             uint32_t j = keep[t], i = b + j;
             const ob_view_material *m = &c->mt[c->soa.material[i]];
+            const cull_geometry *g = &c->geo[c->soa.geometry[i]];
+            /* The coarsest level whose error, seen from the nearest point of
+             * the bound, stays within the tolerance. */
+            uint32_t level = 0;
+            if (g->levels > 1 && c->lod_scale > 0.0f) {
+                float r = c->soa.radius[i], t_err = r * c->lod_scale;
+                while (level + 1 < g->levels) {
+                    float need = g->rel_error[level + 1] * t_err + r;
+                    if (!(need * need <= d2[j])) break;
+                    level++;
+                }
+            }
             pairs[out->kept++] = (ob_sort_pair){
-                .key = item_key(m->sort_hi, m->state, c->mesh[c->soa.geometry[i]], d2[j]),
+                .key = item_key(m->sort_hi, m->state, g->mesh[level], d2[j]),
                 .hi = m->sort_hi,
-                .index = i,
+                .index = i | level << CULL_LOD_SHIFT,
             };
         }
         out->culled += n - nk;
@@ -335,9 +363,9 @@ typedef struct cull_wave {
 } cull_wave;
 
 /* Sets up a view of a wave on the render thread: its snapshot, working
- * memory, material table and planes. mesh: the wave's mesh ids. */
+ * memory, material table and planes. geo: the wave's geometry table. */
 static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene,
-                            const ob_material_iface *mi, const uint32_t *mesh, uint32_t grain)
+                            const ob_material_iface *mi, const cull_geometry *geo, uint32_t grain)
 {
     ob_view *v = cv->v;
     uint32_t count = 0;
@@ -345,6 +373,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     ob_scene_render_soa(scene, &v->soa);
     v->item_count = 0;
     v->culled = 0;
+    v->lod_items = 0;
     v->material_count = 0;
     v->material_items_valid = false;
     v->cull_ns = 0;
@@ -364,7 +393,8 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     }
     ob_sort_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
     cv->c = (cull_ctx){
-        .v = v, .soa = v->soa, .mt = v->materials, .mesh = mesh,
+        .v = v, .soa = v->soa, .mt = v->materials, .geo = geo,
+        .lod_scale = count <= CULL_INDEX_MASK && isfinite(v->lod_scale) ? v->lod_scale : 0.0f,
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
         .grain = grain, .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
     };
@@ -432,13 +462,17 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     }
     v->range_reported = far;
     ob_sort_pair *sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : pairs;
+    uint32_t coarse = 0;
     for (uint32_t j = 0; j < n; j++) {
-        uint32_t i = sorted[j].index;
+        uint32_t i = sorted[j].index & CULL_INDEX_MASK;
+        coarse += sorted[j].index > CULL_INDEX_MASK;
         v->items[j] = (ob_draw_item){.sort_key = sorted[j].key, .sort_hi = sorted[j].hi,
                                      .node_id = v->soa.node_id[i], .node = v->soa.node[i],
-                                     .proxy = i};
+                                     .proxy = i,
+                                     .lod = (uint8_t)(sorted[j].index >> CULL_LOD_SHIFT)};
     }
     v->item_count = n;
+    v->lod_items = coarse;
     /* The items the view's post-cull work visits (for_each_material_item):
      * a short list, found here on the pool rather than by a pass over the
      * draw list per use on the render thread. */
@@ -473,11 +507,11 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         for (uint32_t k = 0; k < count; k++) views[k]->item_count = 0;
         return OB_ERR_INVALID_ARGUMENT;
     }
-    /* The views, then the mesh ids of the snapshot's geometries: one
-     * interface call per geometry for the whole wave. */
+    /* The views, then the snapshot's geometries (mesh ids, levels of
+     * detail): one interface call each per geometry for the whole wave. */
     uint32_t gc = ob_scene_geometry_count(scene);
     cull_wave w = {0};
-    w.views = ob_calloc(1, sizeof *w.views * count + sizeof(uint32_t) * gc);
+    w.views = ob_calloc(1, sizeof *w.views * count + sizeof(cull_geometry) * OB_MAX(gc, 1u));
     if (!w.views) {
         OB_LOG_E("view", "%u views not culled: out of host memory; they draw nothing this frame",
                  count);
@@ -487,10 +521,27 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         }
         return OB_ERR_OUT_OF_HOST_MEMORY;
     }
-    uint32_t *mesh = (uint32_t *)(w.views + count);
+    cull_geometry *geo = (cull_geometry *)(void *)(w.views + count);
     for (uint32_t k = 0; k < gc; k++) {
         struct ob_geometry *g = ob_scene_geometry(scene, k);
-        mesh[k] = gi && g ? gi->id(g) : 0;
+        cull_geometry *cg = &geo[k];
+        cg->levels = 1;
+        if (!gi || !g) continue;
+        cg->mesh[0] = gi->id(g);
+        if (gi->lods) {
+            cg->levels = OB_MIN(OB_MAX(gi->lods(g, cg->rel_error), 1u), OB_LOD_MAX);
+            cg->rel_error[0] = 0.0f;
+        }
+        /* A level's error not a number, or below the one before, ends the
+         * chain there: culling never picks what it cannot compare. */
+        for (uint32_t l = 1; l < cg->levels; l++)
+            if (!(cg->rel_error[l] >= cg->rel_error[l - 1]) || !isfinite(cg->rel_error[l])) {
+                cg->levels = l;
+                break;
+            }
+        /* Each level keys as its own mesh, so a run never mixes levels. */
+        for (uint32_t l = 1; l < cg->levels; l++)
+            cg->mesh[l] = (uint32_t)ob_hash_u64(cg->mesh[0], l);
     }
     ob_parallel par = ob_renderer_parallel(r);
     uint32_t entities = 0;
@@ -505,7 +556,7 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
     for (uint32_t k = 0; k < count; k++) {
         cull_view *cv = &w.views[k];
         cv->v = views[k];
-        cv->res = cull_setup(cv, r, scene, mi, mesh, grain);
+        cv->res = cull_setup(cv, r, scene, mi, geo, grain);
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
     }
     if (!ob_parallel_worth(&par, (uint64_t)entities * count, grain)) par.threads = 1;
@@ -593,6 +644,7 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
      * instanced program a run of both is one draw. */
     const struct ob_material *applied = NULL;
     const struct ob_geometry *described = NULL;
+    uint32_t described_lod = 0;
     ob_draw_data dd = {0};
     _Alignas(16) float blocks[RUN_BLOCKS][32];
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
@@ -617,9 +669,11 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                 continue;
             }
         }
-        if (p->geometry != described) {
-            gi->draw_data(p->geometry, &dd);
+        uint32_t lod = v->items[i].lod;
+        if (p->geometry != described || lod != described_lod) {
+            gi->draw_data(p->geometry, lod, &dd);
             described = p->geometry;
+            described_lod = lod;
         }
         if (!ob_pipeline_manager_instanced(pm)) {
             /* A refused matrix is not drawn (a stale one would put this
@@ -645,7 +699,7 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
             j++;
         } while (j < end && n < RUN_BLOCKS && applied &&
                  v->proxies[v->items[j].proxy].material == applied &&
-                 v->proxies[v->items[j].proxy].geometry == p->geometry);
+                 v->proxies[v->items[j].proxy].geometry == p->geometry && v->items[j].lod == lod);
         if (n) ob_pipeline_manager_draw_instances(pm, &dd, &blocks[0][0], n);
         i = j;
     }

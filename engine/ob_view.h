@@ -61,6 +61,7 @@ typedef struct ob_draw_item {
     uint32_t node_id;
     ob_node *node;
     uint32_t proxy;         /* index in the view's proxies (the scene snapshot's) */
+    uint8_t lod;            /* the geometry's level of detail drawn (ob_view.lod_scale) */
 } ob_draw_item;
 
 /* What culling knows of one material (by its scene index, ob_render_soa)
@@ -145,6 +146,13 @@ struct ob_view {
     bool custom_record;               /* records its own draws (overlay, composite):
                                          record() runs once per layer with count 0 */
     bool no_frustum;                  /* cull by render flag only (environment maps) */
+    /* Levels of detail: culling draws an item at the coarsest level of its
+     * geometry whose error e (world units) satisfies
+     * e * lod_scale <= d - r, d the distance from the origin to the item's
+     * bound centre and r its radius: lod_scale is the view's pixels per
+     * world unit at distance 1 over the tolerated error in pixels. 0 (the
+     * default): level 0 always. Set by the view's pre_cull. */
+    float lod_scale;
     const ob_node *cull_exclude;      /* an entity culling leaves out (an env map's owner) */
 
     /* Images read by this view's draws besides its dependencies' targets. */
@@ -170,6 +178,7 @@ struct ob_view {
     void *cull_mem;                   /* culling's working memory */
     size_t cull_mem_size;
     uint32_t culled;                  /* entities rejected by frustum or render flag */
+    uint32_t lod_items;               /* items at a level of detail above 0 */
     uint32_t recursion_depth;         /* how deep in the PreRender chain it was queued */
     ob_view *deps[OB_VIEW_MAX_DEPS];  /* views that must execute before this one */
     uint32_t dep_count;

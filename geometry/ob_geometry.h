@@ -70,6 +70,21 @@ const ob_vertex_layout *ob_vertex_layout_extended_uv1(void);
 
 typedef struct ob_geometry ob_geometry;
 
+/* Levels of detail: level 0 (desc.mesh) and at most this many levels in
+ * all. */
+#define OB_GEOMETRY_MAX_LODS 8u
+
+/* A coarser level of a geometry: drawn instead of the finer ones where its
+ * error projects to less than the views' pixel tolerance
+ * (ob_views_set_lod_error). */
+typedef struct ob_geometry_lod {
+    const ob_mesh *mesh;   /* its vertices are uploaded like level 0's (same layout) */
+    /* > 0 and finite, in the mesh's units: the farthest the level's surface
+     * lies from level 0's (ob_mesh_deviation measures it). Levels come
+     * finest first: each error at least the one before. */
+    float error;
+} ob_geometry_lod;
+
 typedef struct ob_geometry_desc {
     const ob_mesh *mesh;
     const char *name;       /* copied; NULL → "geometry". Used in logs and debug names */
@@ -98,16 +113,26 @@ typedef struct ob_geometry_desc {
      * so even without this flag; to draw it with a layout without TEXCOORD1,
      * pass a copy of the ob_mesh with uv1 set to NULL. */
     bool texcoord1;
+    /* Coarser levels after desc->mesh (level 0), finest first; at most
+     * OB_GEOMETRY_MAX_LODS - 1; none for procedural geometry. They share
+     * level 0's buffers, topology and bounds (a level pokes out of the bound
+     * by at most its error, which is less than the tolerance where it is
+     * drawn), and each is validated like level 0. */
+    const ob_geometry_lod *lods;
+    uint32_t lod_count;
 } ob_geometry_desc;
 
-/* Validates the mesh for the topology first (ob_mesh_validate_primitives:
+/* Validates the mesh (and each level's) for the topology first (ob_mesh_validate_primitives:
  * indices in range, finite attributes; logged under the name) and uploads
  * nothing if it fails. Then uploads the vertices and indices into
  * device-local buffers (staged, waits for the copy; TRANSFER_SRC too, so
  * tools and tests can read them back) and computes the bounds
  * from the vertices (mesh->bounds is not trusted).
  * Returns NULL and sets *out_result (may be NULL) on failure:
- * OB_ERR_INVALID_ARGUMENT (no device, desc or mesh; bad mesh),
+ * OB_ERR_INVALID_ARGUMENT (no device, desc or mesh; bad mesh; a level
+ * without a mesh, with an error not finite, not positive or less than the
+ * level before's, or on procedural geometry), OB_ERR_LIMIT (more levels
+ * than OB_GEOMETRY_MAX_LODS),
  * OB_ERR_OUT_OF_RANGE / OB_ERR_NON_FINITE (mesh contents),
  * OB_ERR_UNSUPPORTED (topology), or the buffer creation's error. Nothing
  * stays allocated on failure. [render thread] */
@@ -121,7 +146,7 @@ void ob_geometry_destroy(ob_device *dev, ob_geometry *geo);
  * (the topology accessor: TRIANGLE_LIST). */
 ob_buffer ob_geometry_vertex_buffer(const ob_geometry *g);
 ob_buffer ob_geometry_index_buffer(const ob_geometry *g);   /* VK_INDEX_TYPE_UINT32 */
-uint32_t ob_geometry_index_count(const ob_geometry *g);
+uint32_t ob_geometry_index_count(const ob_geometry *g);      /* level 0's */
 uint32_t ob_geometry_vertex_count(const ob_geometry *g);
 uint32_t ob_geometry_instance_count(const ob_geometry *g);  /* 1 for meshes */
 const ob_vertex_layout *ob_geometry_layout(const ob_geometry *g);  /* standard, extended or extended_uv1 */
@@ -129,6 +154,12 @@ VkPrimitiveTopology ob_geometry_topology(const ob_geometry *g);
 const ob_bounds *ob_geometry_bounds(const ob_geometry *g);
 uint32_t ob_geometry_id(const ob_geometry *g);              /* never 0 for a live geometry */
 const char *ob_geometry_name(const ob_geometry *g);
+/* Levels of detail: how many (1 without coarser ones; 0 on NULL), and level
+ * `level`'s error (0 for level 0 and out of range) and index count (0 out
+ * of range). */
+uint32_t ob_geometry_lod_count(const ob_geometry *g);
+float ob_geometry_lod_error(const ob_geometry *g, uint32_t level);
+uint32_t ob_geometry_lod_index_count(const ob_geometry *g, uint32_t level);
 
 /* The engine's interface to geometry (engine/ob_renderer_layer.h): a
  * geometry's draw data and stable id. ob_views_create installs it. Static

@@ -655,3 +655,115 @@ ob_result ob_mesh_fullscreen_triangle(ob_mesh *out)
     emit_tri(out->indices, 0, 1, 2);
     return finish(out);
 }
+
+/* ------------------------------------------------------------ deviation */
+
+static void v3_sub(const float a[3], const float b[3], float out[3])
+{
+    for (int k = 0; k < 3; k++) out[k] = a[k] - b[k];
+}
+
+static float v3_dot(const float a[3], const float b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Squared distance from p to triangle abc: the closest point by its Voronoi
+ * region (Ericson, Real-Time Collision Detection, 5.1.5). */
+static float point_triangle_d2(const float p[3], const float a[3], const float b[3],
+                               const float c[3])
+{
+    float ab[3], ac[3], ap[3], q[3], d[3];
+    v3_sub(b, a, ab);
+    v3_sub(c, a, ac);
+    v3_sub(p, a, ap);
+    float d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f) return v3_dot(ap, ap);
+    float bp[3];
+    v3_sub(p, b, bp);
+    float d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0.0f && d4 <= d3) return v3_dot(bp, bp);
+    float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+        float t = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++) q[k] = a[k] + t * ab[k];
+        v3_sub(p, q, d);
+        return v3_dot(d, d);
+    }
+    float cp[3];
+    v3_sub(p, c, cp);
+    float d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0.0f && d5 <= d6) return v3_dot(cp, cp);
+    float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+        float t = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++) q[k] = a[k] + t * ac[k];
+        v3_sub(p, q, d);
+        return v3_dot(d, d);
+    }
+    float va = d3 * d6 - d5 * d4;
+    if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f) {
+        float t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++) q[k] = b[k] + t * (c[k] - b[k]);
+        v3_sub(p, q, d);
+        return v3_dot(d, d);
+    }
+    float den = 1.0f / (va + vb + vc), v = vb * den, w = vc * den;
+    for (int k = 0; k < 3; k++) q[k] = a[k] + ab[k] * v + ac[k] * w;
+    v3_sub(p, q, d);
+    return v3_dot(d, d);
+}
+
+static float nearest_d2(const float p[3], const ob_mesh *m)
+{
+    float best = INFINITY;
+    for (uint32_t t = 0; t + 2 < m->index_count; t += 3) {
+        float d2 = point_triangle_d2(p, m->vertices[m->indices[t]].position,
+                                     m->vertices[m->indices[t + 1]].position,
+                                     m->vertices[m->indices[t + 2]].position);
+        if (d2 < best) best = d2;
+    }
+    return best;
+}
+
+/* The largest distance from a's sample points to b's surface, squared. */
+static float one_way_d2(const ob_mesh *a, const ob_mesh *b)
+{
+    float worst = 0.0f;
+    for (uint32_t i = 0; i < a->vertex_count; i++)
+        worst = fmaxf(worst, nearest_d2(a->vertices[i].position, b));
+    for (uint32_t t = 0; t + 2 < a->index_count; t += 3) {
+        const float *p[3] = {a->vertices[a->indices[t]].position,
+                             a->vertices[a->indices[t + 1]].position,
+                             a->vertices[a->indices[t + 2]].position};
+        float q[3];
+        for (int e = 0; e < 3; e++) {
+            for (int k = 0; k < 3; k++) q[k] = 0.5f * (p[e][k] + p[(e + 1) % 3][k]);
+            worst = fmaxf(worst, nearest_d2(q, b));
+        }
+        for (int k = 0; k < 3; k++) q[k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0f;
+        worst = fmaxf(worst, nearest_d2(q, b));
+    }
+    return worst;
+}
+
+ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out)
+{
+    if (!out) return OB_ERR_INVALID_ARGUMENT;
+    *out = 0.0f;
+    ob_result r = ob_mesh_validate(a, "deviation: first mesh");
+    if (r == OB_OK) r = ob_mesh_validate(b, "deviation: second mesh");
+    if (r != OB_OK) return r;
+    uint64_t ta = a->index_count / 3, tb = b->index_count / 3;
+    uint64_t tests = ((uint64_t)a->vertex_count + 4 * ta) * tb +
+                     ((uint64_t)b->vertex_count + 4 * tb) * ta;
+    if (tests > OB_MESH_DEVIATION_MAX_TESTS) {
+        OB_LOG_E("mesh", "deviation of meshes of %llu and %llu triangles: %llu tests, over the "
+                 "%llu allowed; give the level's error yourself", (unsigned long long)ta,
+                 (unsigned long long)tb, (unsigned long long)tests,
+                 (unsigned long long)OB_MESH_DEVIATION_MAX_TESTS);
+        return OB_ERR_LIMIT;
+    }
+    *out = sqrtf(fmaxf(one_way_d2(a, b), one_way_d2(b, a)));
+    return OB_OK;
+}

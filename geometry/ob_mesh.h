@@ -148,6 +148,17 @@ ob_result ob_mesh_cone(float radius, float height, uint32_t slices, ob_mesh *out
 ob_result ob_mesh_torus(float major_radius, float minor_radius, uint32_t major_segments,
                         uint32_t minor_segments, ob_mesh *out);
 
+/* How far apart two triangle-list meshes' surfaces are, both ways: the
+ * largest distance from a point of one (its vertices, edge midpoints and
+ * triangle centroids) to the nearest triangle of the other, in *out. The
+ * error of a level of detail (ob_geometry_lod.error) against level 0. Brute
+ * force: (points of a × triangles of b + the other way round) distance
+ * tests, refused over OB_MESH_DEVIATION_MAX_TESTS (OB_ERR_LIMIT, logged):
+ * meant for the small meshes levels of detail save most on. Either mesh
+ * failing ob_mesh_validate: its error. */
+#define OB_MESH_DEVIATION_MAX_TESTS (1ull << 28)
+ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out);
+
 /* One triangle covering clip space [-1,1]² at z=0 — positions (-1,-1),
  * (3,-1), (-1,3) with uv (0,0), (2,0), (0,2) so uv spans 0..1 on screen
  * (uv 0,0 at the top-left in Vulkan). Normal +Z. Its winding flips with

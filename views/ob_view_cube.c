@@ -83,7 +83,11 @@ uint8_t ob_views_cube_faces(const double rel[3], double radius)
 
 static bool cube_pre_cull(ob_view *v, ob_renderer *r)
 {
-    return ob_views_env_pre_cull(v, r, ((ob_cube_view *)v)->owner);
+    ob_cube_view *cv = (ob_cube_view *)v;
+    /* A 90-degree face has half its side in pixels per world unit at
+     * distance 1 at its centre, and twice that at its edges: the edges'. */
+    v->lod_scale = ob_views_lod_scale(cv->ctx, (float)v->width);
+    return ob_views_env_pre_cull(v, r, cv->owner);
 }
 
 static void cube_post_cull(ob_view *v, ob_renderer *r)

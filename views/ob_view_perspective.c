@@ -54,6 +54,8 @@ static bool perspective_pre_cull(ob_view *v, ob_renderer *r)
     scale_clip_to_near(pv->proj, znear);
     ob_mat4_mul(pv->proj, pv->view, v->view_proj);
     v->cull_exclude = NULL;
+    /* Rows of pixels per world unit at distance 1, for levels of detail. */
+    v->lod_scale = ob_views_lod_scale(pv->ctx, 0.5f * (float)v->height / tanf(0.5f * fovy));
     return true;
 }
 

@@ -574,6 +574,7 @@ ob_views *ob_views_create(const ob_views_desc *desc, ob_result *out_result)
     if (r == OB_OK) r = ob_views_set_shadow_cascades(ctx, desc->shadow_cascades);
     if (r == OB_OK) r = ob_views_set_shadow_distance(ctx, desc->shadow_distance);
     if (r == OB_OK) r = ob_views_set_shadow_split_lambda(ctx, desc->shadow_split_lambda);
+    if (r == OB_OK) r = ob_views_set_lod_error(ctx, desc->lod_error);
     if (r != OB_OK) goto fail_destroy_views;
     if ((unsigned)desc->env_map_kind >= OB_ENV_MAP_KIND_COUNT) {
         OB_LOG_E("views", "env_map_kind %d is not a kind of environment map", (int)desc->env_map_kind);
@@ -658,6 +659,24 @@ static ob_result check_map_size(const ob_views *ctx, const char *what, uint32_t 
 }
 
 void ob_views_set_light_tiles(ob_views *ctx, bool on) { ctx->light_tiles_off = !on; }
+
+void ob_views_set_lod(ob_views *ctx, bool on) { ctx->lod_off = !on; }
+
+ob_result ob_views_set_lod_error(ob_views *ctx, float pixels)
+{
+    if (!(pixels >= 0.0f) || !isfinite(pixels)) {
+        OB_LOG_E("views", "level-of-detail error %g pixels refused: >= 0 and finite (0: the "
+                 "default, 1)", (double)pixels);
+        return OB_ERR_INVALID_ARGUMENT;
+    }
+    ctx->lod_error = pixels > 0.0f ? pixels : 1.0f;
+    return OB_OK;
+}
+
+float ob_views_lod_scale(const ob_views *ctx, float pixels_per_unit)
+{
+    return ctx->lod_off || !(pixels_per_unit > 0.0f) ? 0.0f : pixels_per_unit / ctx->lod_error;
+}
 
 ob_result ob_views_set_env_map_size(ob_views *ctx, uint32_t size)
 {

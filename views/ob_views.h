@@ -72,6 +72,7 @@ typedef struct ob_views_desc {
     float shadow_split_lambda;   /* 0 → OB_SHADOW_DEFAULT_SPLIT_LAMBDA; (0, 1]: the share of
                                     logarithmic splits against uniform ones */
     float ambient[4];            /* rgb, w = intensity; zero → (1,1,1,0.15) */
+    float lod_error;             /* pixels a level of detail may be off by; 0 → 1 */
 } ob_views_desc;
 
 /* Cascaded shadow maps of the shaded directional light (docs/architecture.md,
@@ -105,6 +106,15 @@ ob_result ob_views_set_shadow_split_lambda(ob_views *ctx, float lambda);
  * beyond its range), only slower; for measuring and checking the grid.
  * [render thread, between frames] */
 void ob_views_set_light_tiles(ob_views *ctx, bool on);
+/* Levels of detail (ob_geometry_desc.lods), on by default: camera views and
+ * cube environment maps draw each entity at the coarsest level of its
+ * geometry whose error, projected from the point of its bound nearest the
+ * camera, is at most `pixels` (0 → the default, 1; negative or not finite
+ * refused, OB_ERR_INVALID_ARGUMENT, logged). Shadow maps and paraboloid
+ * maps draw level 0. Off, every view draws level 0: the pixels of a scene
+ * without levels. [render thread, between frames] */
+ob_result ob_views_set_lod_error(ob_views *ctx, float pixels);
+void ob_views_set_lod(ob_views *ctx, bool on);
 /* Env map kind for maps created afterwards (an entity keeps the map it has);
  * an unknown kind is refused: logged, false, the old kind kept. [render
  * thread, between frames] */

@@ -44,6 +44,8 @@ struct ob_views {
     uint32_t *over_limit;        /* ids of lights logged as over OB_MAX_LIGHTS, ascending */
     uint32_t over_limit_count, over_limit_cap;
     bool light_tiles_off;        /* ob_views_set_light_tiles(false): every light in tile 0 */
+    bool lod_off;                /* ob_views_set_lod(false): level 0 everywhere */
+    float lod_error;             /* pixels, > 0 */
     ob_local_shadows *local_shadows; /* point and spot lights' shadow views, made on first need */
 
     ob_effect *text_effect, *composite_effect, *particle_sim_effect;
@@ -97,6 +99,9 @@ void ob_views_env_usage(const ob_env_params *p, const ob_view *v, ob_params *par
 /* pre_cull of an environment map: queue v, centre it on its owner, which
  * culling leaves out. [render thread] */
 bool ob_views_env_pre_cull(ob_view *v, ob_renderer *r, const ob_node *owner);
+/* ob_view.lod_scale for a view of pixels_per_unit pixels per world unit at
+ * distance 1: 0 with levels of detail off. */
+float ob_views_lod_scale(const ob_views *ctx, float pixels_per_unit);
 /* Which layers an item reaches: a bit per layer, from the item's centre
  * relative to the map's and its radius, already widened by far more than
  * the float rounding of a vertex relative to the owner. */

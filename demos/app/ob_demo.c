@@ -677,7 +677,7 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             "\"push_constants\":[%u,%u],\"vertex_binds\":[%u,%u],\"index_binds\":[%u,%u],"
             "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
             "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\","
-            "\"draw_calls\":%u,\"instances\":%u,\"descriptor_sets_allocated\":%u,"
+            "\"draw_calls\":%u,\"instances\":%u,\"lod_items\":%u,\"descriptor_sets_allocated\":%u,"
             "\"descriptor_sets_held\":%u,\"threading\":\"%s\",\"cpu_work_ms\":%.4f,"
             "\"waiting_ms\":%.4f,\"gpu_wait_ms\":%.4f,\"acquire_ms\":%.4f,\"present_ms\":%.4f,"
             "\"views\":[",
@@ -692,7 +692,7 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             st->pm.index_binds_requested, st->pm.index_binds_issued,
             (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
             st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash,
-            st->pm.draw_calls, st->pm.instances, st->pm.descriptor_sets_allocated,
+            st->pm.draw_calls, st->pm.instances, st->lod_items, st->pm.descriptor_sets_allocated,
             st->pm.descriptor_sets_held, ob_threading_name(st->mode),
             ob_frame_stats_cpu_work_ns(st) * 1e-6, ob_frame_stats_wait_ns(st) * 1e-6,
             st->gpu_wait_ns * 1e-6, st->acquire_ns * 1e-6, st->present_ns * 1e-6);
@@ -702,11 +702,11 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
                 "%s{\"name\":\"%s\",\"type\":\"%s\",\"items\":%u,\"draws\":%u,\"culled\":%u,"
                 "\"chunks\":%u,\"worker\":%d,\"cull_ms\":%.4f,\"record_ms\":%.4f,\"gpu_ms\":%.4f,"
                 "\"hash\":\"%016llx\",\"skipped\":\"%s\",\"draw_calls\":%u,\"instances\":%u,"
-                "\"longest_run\":%u}",
+                "\"longest_run\":%u,\"lod_items\":%u}",
                 i ? "," : "", v->name, ob_view_type_name(v->type), v->items, v->draws, v->culled,
                 v->chunks, v->worker, v->cull_ns * 1e-6, v->record_ns * 1e-6, v->gpu_ms,
                 (unsigned long long)v->hash.hash, ob_skip_reason_name(v->skipped), v->draw_calls,
-                v->instances, v->longest_run);
+                v->instances, v->longest_run, v->lod_items);
     }
     fputs("],\"skipped\":[", f);
     for (uint32_t i = 0; i < st->skipped_count; i++)

@@ -146,9 +146,11 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                "frame = in-flight period over %u frames; frames over ~%u draws: %u rounds of %u "
                "frame(s), %u warm-up, %u in flight; spdup = median over rounds of ST rec+asm / this, "
                "[p25,p75]; cpu-rt, cpu-wk, cpu-wmx = recording CPU time of the render thread, "
-               "all workers, busiest worker (nan: not reported by the engine)\n",
+               "all workers, busiest worker (nan: not reported by the engine); levels of detail "
+               "%s, instancing %s\n",
             rep->rounds, rep->passes, rep->settle, rep->warmup, rep->flight, rep->big_draws,
-            rep->big_rounds, rep->big_passes, rep->big_warmup, rep->big_flight);
+            rep->big_rounds, rep->big_passes, rep->big_warmup, rep->big_flight,
+            rep->lod ? "on" : "off", rep->instancing ? "on" : "off");
     print_header(f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
     fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
@@ -524,11 +526,13 @@ static void json_perf(FILE *f, const ob_bench_report *rep)
     fprintf(f, "\"settings\":{\"warmup\":%u,\"rounds\":%u,\"passes\":%u,\"settle\":%u,"
                "\"flight\":%u,\"big_frames\":{\"over_draws\":%u,\"warmup\":%u,\"rounds\":%u,"
                "\"passes\":%u,\"settle\":%u,\"flight\":%u},"
-               "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u},\n",
+               "\"view_size\":[%u,%u],\"image_size\":[%u,%u],\"image_frames\":%u,"
+               "\"lod\":%s,\"instancing\":%s},\n",
             rep->warmup, rep->rounds, rep->passes, rep->settle, rep->flight, rep->big_draws,
             rep->big_warmup, rep->big_rounds, rep->big_passes, rep->big_settle, rep->big_flight,
             rep->view_width, rep->view_height,
-            rep->image_width, rep->image_height, rep->image_frames);
+            rep->image_width, rep->image_height, rep->image_frames, rep->lod ? "true" : "false",
+            rep->instancing ? "true" : "false");
     fputs("\"sweep\":[\n  ", f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) {
         if (i) fputs(",\n  ", f);

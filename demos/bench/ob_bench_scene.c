@@ -64,7 +64,7 @@ static ob_result build_sweep(ob_bench_scene *s, ob_demo *d, const ob_bench_scene
     ob_mesh ground_mesh = {0};
     ob_geometry *shapes[OB_MIRROR_SCENE_SHAPES], *ground = NULL;
     ob_material *palette[OB_MIRROR_SCENE_COLOURS], *ground_mat = NULL;
-    ob_result r = ob_mirror_scene_shapes(d, shapes);
+    ob_result r = ob_mirror_scene_shapes(d, true, shapes);
     if (r == OB_OK && (r = ob_mesh_plane(ground_size, ground_size, 8, &ground_mesh)) == OB_OK &&
         !(ground = ob_demo_geometry(d, &ground_mesh, "ground")))
         r = OB_ERR_BAD_MODEL;

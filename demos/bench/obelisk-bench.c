@@ -48,6 +48,7 @@ typedef struct bench_options {
     bool quick, progress;
     bool perf, stability;      /* which sections run */
     bool no_instancing;        /* --no-instancing: one draw per entity */
+    bool no_lod;               /* --no-lod: the sweep's shapes at level 0 everywhere */
     bool cpu_device;           /* the device is a CPU (lavapipe): big frames get fewer frames */
     ob_gpu_timing gpu_timing;  /* --gpu-timing */
     const char *json, *csv, *charts;
@@ -71,6 +72,8 @@ static const char usage_text[] =
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
     "  --no-instancing    one draw per entity (the per-draw push block), for comparison\n"
+    "  --no-lod           the sweep's shapes at full detail however small (levels of detail\n"
+    "                     off), for comparison\n"
     "  --gpu-timing sampled|views|off   GPU timestamps: the frame's every frame and each\n"
     "                     view's every 16th (default), every view every frame, or none\n"
     "  --json FILE        write every result and the summary as JSON\n"
@@ -180,9 +183,11 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
         } else if (!strcmp(a, "--no-instancing")) {
             o->no_instancing = true;
             takes = false;
+        } else if (!strcmp(a, "--no-lod")) {
+            o->no_lod = true;
+            takes = false;
         } else if (!strcmp(a, "--no-stability")) {
             o->stability = takes = false;
-
         } else if (!v) {
             fprintf(stderr, "obelisk-bench: %s needs a value (or is unknown)\n%s", a, usage_text);
             return false;
@@ -406,6 +411,7 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     ob_bench_scene s = {0};
     ob_result r = ob_demo_init(&d, &dopt);
     if (r == OB_OK && o->no_instancing) ob_material_library_set_instancing(d.world.stack->materials, false);
+    if (r == OB_OK && o->no_lod) ob_views_set_lod(d.world.views, false);
     ob_bench_scene_desc sd = {.kind = OB_BENCH_SCENE_SWEEP, .objects = objects, .views = views,
                               .seed = o->seed};
     if (r == OB_OK && !rep->device_name[0]) {
@@ -689,6 +695,7 @@ static int run(bench_options *o)
                            .warmup = o->warmup, .rounds = o->rounds, .passes = o->passes,
                            .settle = o->settle, .flight = o->flight,
                            .view_width = o->view_width, .view_height = o->view_height,
+                           .lod = !o->no_lod, .instancing = !o->no_instancing,
                            .image_width = o->image_width, .image_height = o->image_height,
                            .image_frames = o->quick ? 3 : 4};
     rep.pool_workers = pool_size(o, rep.cores);

@@ -133,22 +133,56 @@ static ob_result add_mirrors(ob_demo *d, ob_geometry *ball_geometry, ob_material
     return OB_OK;
 }
 
-ob_result ob_mirror_scene_shapes(ob_demo *d, ob_geometry *out[OB_MIRROR_SCENE_SHAPES])
+/* Shape k at level of detail `level`: level 0 is the scene's shape, each
+ * level after it has about 0.6 times the segments (at least 3; the box has
+ * level 0 only). */
+static ob_result shape_mesh(int k, uint32_t level, ob_mesh *out)
 {
-    ob_mesh meshes[OB_MIRROR_SCENE_SHAPES] = {{0}};
-    float half[3] = {box_half, box_half, box_half};
-    ob_result r;
-    if ((r = ob_mesh_box(half, &meshes[0])) == OB_OK &&
-        (r = ob_mesh_sphere(shape_sphere.radius, shape_sphere.slices, shape_sphere.stacks,
-                            &meshes[1])) == OB_OK &&
-        (r = ob_mesh_torus(shape_torus.major, shape_torus.minor, shape_torus.major_segments,
-                           shape_torus.minor_segments, &meshes[2])) == OB_OK &&
-        (r = ob_mesh_cone(shape_cone.radius, shape_cone.height, shape_cone.slices,
-                          &meshes[3])) == OB_OK) {
-        for (int k = 0; k < OB_MIRROR_SCENE_SHAPES && r == OB_OK; k++)
-            if (!(out[k] = ob_demo_geometry(d, &meshes[k], shape_names[k]))) r = OB_ERR_BAD_MODEL;
+    static const float keep[OB_MIRROR_SCENE_SHAPE_LODS] = {1.0f, 0.6f, 0.4f, 0.25f};
+    float f = keep[level];
+#define SEG(n) ((uint32_t)fmaxf(3.0f, floorf((float)(n) * f + 0.5f)))
+    switch (k) {
+    case 0: return ob_mesh_box((const float[3]){box_half, box_half, box_half}, out);
+    case 1: return ob_mesh_sphere(shape_sphere.radius, SEG(shape_sphere.slices),
+                                  OB_MAX(2u, SEG(shape_sphere.stacks)), out);
+    case 2: return ob_mesh_torus(shape_torus.major, shape_torus.minor,
+                                 SEG(shape_torus.major_segments), SEG(shape_torus.minor_segments),
+                                 out);
+    default: return ob_mesh_cone(shape_cone.radius, shape_cone.height, SEG(shape_cone.slices), out);
     }
-    for (int k = 0; k < OB_MIRROR_SCENE_SHAPES; k++) ob_mesh_release(&meshes[k]);
+#undef SEG
+}
+
+/* Shape k with its levels of detail (none for the box or without lods). */
+static ob_geometry *shape_geometry(ob_demo *d, int k, bool lods, ob_result *out_result)
+{
+    ob_mesh meshes[OB_MIRROR_SCENE_SHAPE_LODS] = {{0}};
+    ob_geometry_lod levels[OB_MIRROR_SCENE_SHAPE_LODS - 1] = {{0}};
+    uint32_t count = lods && k != 0 ? OB_MIRROR_SCENE_SHAPE_LODS : 1;
+    ob_geometry *g = NULL;
+    ob_result r = OB_OK;
+    for (uint32_t l = 0; l < count && r == OB_OK; l++) {
+        if ((r = shape_mesh(k, l, &meshes[l])) != OB_OK || l == 0) continue;
+        levels[l - 1].mesh = &meshes[l];
+        r = ob_mesh_deviation(&meshes[0], &meshes[l], &levels[l - 1].error);
+        /* A coarser level is never claimed better than the one before. */
+        if (l > 1) levels[l - 1].error = fmaxf(levels[l - 1].error, levels[l - 2].error);
+    }
+    if (r == OB_OK) {
+        ob_geometry_desc gd = {.mesh = &meshes[0], .name = shape_names[k], .lods = levels,
+                               .lod_count = count - 1};
+        g = ob_stack_add_geometry_desc(d->world.stack, &gd, &r);
+    }
+    for (uint32_t l = 0; l < count; l++) ob_mesh_release(&meshes[l]);
+    *out_result = r;
+    return g;
+}
+
+ob_result ob_mirror_scene_shapes(ob_demo *d, bool lods, ob_geometry *out[OB_MIRROR_SCENE_SHAPES])
+{
+    ob_result r = OB_OK;
+    for (int k = 0; k < OB_MIRROR_SCENE_SHAPES && r == OB_OK; k++)
+        out[k] = shape_geometry(d, k, lods, &r);
     return r;
 }
 
@@ -232,7 +266,7 @@ ob_result ob_mirror_scene_build(ob_demo *d, const ob_mirror_scene_desc *desc)
 {
     ob_mesh ball_mesh = {0}, ground_mesh = {0};
     ob_geometry *shapes[OB_MIRROR_SCENE_SHAPES];
-    ob_result r = ob_mirror_scene_shapes(d, shapes);
+    ob_result r = ob_mirror_scene_shapes(d, false, shapes);
     if (r != OB_OK || (r = ob_mesh_sphere(ball.radius, ball.slices, ball.stacks, &ball_mesh)) != OB_OK ||
         (r = ob_mesh_plane(ground.width, ground.depth, ground.subdivisions, &ground_mesh)) != OB_OK)
         goto done;

@@ -37,8 +37,12 @@ ob_result ob_mirror_scene_build(ob_demo *d, const ob_mirror_scene_desc *desc);
  * engine; what they made belongs to d. */
 #define OB_MIRROR_SCENE_SHAPES 4      /* box, sphere, torus, cone */
 #define OB_MIRROR_SCENE_COLOURS 8
-/* The four shapes' geometry, uploaded in that order (ids follow). */
-ob_result ob_mirror_scene_shapes(ob_demo *d, ob_geometry *out[OB_MIRROR_SCENE_SHAPES]);
+/* The four shapes' geometry, uploaded in that order (ids follow). With
+ * lods, the sphere, torus and cone get coarser levels of detail (fewer
+ * segments; each level's error measured with ob_mesh_deviation), which
+ * views draw where an entity is small on screen; the box has none. */
+#define OB_MIRROR_SCENE_SHAPE_LODS 4  /* levels of the curved shapes, level 0 included */
+ob_result ob_mirror_scene_shapes(ob_demo *d, bool lods, ob_geometry *out[OB_MIRROR_SCENE_SHAPES]);
 /* The eight lit colours, named "diffuse". */
 ob_result ob_mirror_scene_palette(ob_demo *d, bool casts_shadows,
                                   ob_material *out[OB_MIRROR_SCENE_COLOURS]);

@@ -3,6 +3,7 @@
  * no resources behind; no validation messages. */
 #include "ob_test.h"
 #include "ob_geometry.h"
+#include "ob_renderer_layer.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -342,6 +343,111 @@ static void failures_leave_no_resources(void **state)
     ob_test_assert_no_validation(dev);
 }
 
+/* Levels of detail share the buffers: each level's indices read back at its
+ * first index, its vertices at its vertex offset, through the geometry
+ * interface's draw data; the errors come back as given. */
+static void levels_of_detail_share_the_buffers(void **state)
+{
+    (void)state;
+    ob_mesh fine, mid, coarse;
+    assert_int_equal(ob_mesh_sphere(1.0f, 16, 10, &fine), OB_OK);
+    assert_int_equal(ob_mesh_sphere(1.0f, 8, 5, &mid), OB_OK);
+    assert_int_equal(ob_mesh_sphere(1.0f, 4, 3, &coarse), OB_OK);
+    float e_mid, e_coarse, e_self;
+    assert_int_equal(ob_mesh_deviation(&fine, &mid, &e_mid), OB_OK);
+    assert_int_equal(ob_mesh_deviation(&fine, &coarse, &e_coarse), OB_OK);
+    assert_int_equal(ob_mesh_deviation(&fine, &fine, &e_self), OB_OK);
+    /* A chord of a unit circle 2*pi/8 long sags 1 - cos(pi/8) = 0.076 at
+     * its middle; the coarse sphere is much further off; a mesh is 0 from
+     * itself. */
+    assert_true(e_mid > 0.07f && e_mid < 0.3f);
+    assert_true(e_coarse > e_mid && e_coarse < 1.0f);
+    assert_true(e_self < 1e-6f);
+
+    ob_geometry_lod lods[2] = {{&mid, e_mid}, {&coarse, e_coarse}};
+    ob_result r;
+    ob_geometry *g = ob_geometry_create(dev, &(ob_geometry_desc){.mesh = &fine, .name = "ball",
+                                                                 .lods = lods, .lod_count = 2}, &r);
+    assert_int_equal(r, OB_OK);
+    assert_int_equal(ob_geometry_lod_count(g), 3);
+    assert_int_equal(ob_geometry_index_count(g), fine.index_count);
+    assert_int_equal(ob_geometry_vertex_count(g), fine.vertex_count);
+    assert_true(ob_geometry_lod_error(g, 0) == 0.0f);
+    assert_true(ob_geometry_lod_error(g, 2) == e_coarse);
+    assert_int_equal(ob_geometry_lod_index_count(g, 1), mid.index_count);
+    assert_int_equal(ob_geometry_lod_index_count(g, 3), 0);
+    const ob_bounds *b = ob_geometry_bounds(g);
+    assert_true(fabsf(b->radius - 1.0f) < 1e-4f);   /* level 0's */
+
+    const ob_geometry_iface *gi = ob_geometry_iface_get();
+    float rel[OB_LOD_MAX];
+    assert_int_equal(gi->lods(g, rel), 3);
+    assert_true(rel[0] == 0.0f && fabsf(rel[1] - e_mid / b->radius) < 1e-6f);
+    uint32_t total_vertices = fine.vertex_count + mid.vertex_count + coarse.vertex_count;
+    uint32_t total_indices = fine.index_count + mid.index_count + coarse.index_count;
+    uint32_t *indices = read_back(ob_geometry_index_buffer(g), total_indices * 4ull);
+    ob_vertex *vertices = read_back(ob_geometry_vertex_buffer(g), total_vertices * sizeof(ob_vertex));
+    const ob_mesh *level[3] = {&fine, &mid, &coarse};
+    for (uint32_t l = 0; l < 3; l++) {
+        ob_draw_data dd;
+        gi->draw_data(g, l, &dd);
+        assert_int_equal(dd.count, level[l]->index_count);
+        assert_memory_equal(indices + dd.first, level[l]->indices, dd.count * 4u);
+        assert_memory_equal(vertices + dd.vertex_offset, level[l]->vertices,
+                            level[l]->vertex_count * sizeof(ob_vertex));
+    }
+    free(indices);
+    free(vertices);
+    ob_geometry_destroy(dev, g);
+    ob_mesh_release(&fine);
+    ob_mesh_release(&mid);
+    ob_mesh_release(&coarse);
+}
+
+/* Levels that cannot be drawn right are refused, naming the level, and
+ * nothing is uploaded. */
+static void bad_levels_are_refused(void **state)
+{
+    (void)state;
+    ob_mesh fine, coarse, broken;
+    assert_int_equal(ob_mesh_sphere(1.0f, 12, 8, &fine), OB_OK);
+    assert_int_equal(ob_mesh_sphere(1.0f, 4, 3, &coarse), OB_OK);
+    assert_int_equal(ob_mesh_sphere(1.0f, 4, 3, &broken), OB_OK);
+    broken.indices[2] = broken.vertex_count + 5;
+    ob_resource_counts before = ob_resource_counts_get(dev);
+    struct {
+        ob_geometry_lod lods[2];
+        uint32_t count;
+        ob_result want;
+    } cases[] = {
+        {{{&coarse, NAN}}, 1, OB_ERR_INVALID_ARGUMENT},
+        {{{&coarse, 0.0f}}, 1, OB_ERR_INVALID_ARGUMENT},
+        {{{&coarse, -1.0f}}, 1, OB_ERR_INVALID_ARGUMENT},
+        {{{NULL, 0.1f}}, 1, OB_ERR_INVALID_ARGUMENT},
+        {{{&coarse, 0.2f}, {&coarse, 0.1f}}, 2, OB_ERR_INVALID_ARGUMENT},   /* errors go down */
+        {{{&broken, 0.2f}}, 1, OB_ERR_OUT_OF_RANGE},
+        {{{&coarse, 0.2f}}, OB_GEOMETRY_MAX_LODS, OB_ERR_LIMIT},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        ob_result r = OB_OK;
+        ob_geometry_desc gd = {.mesh = &fine, .name = "ball", .lods = cases[k].lods,
+                               .lod_count = cases[k].count};
+        assert_null(ob_geometry_create(dev, &gd, &r));
+        assert_int_equal(r, cases[k].want);
+    }
+    /* Procedural geometry has no levels to choose between. */
+    ob_result r = OB_OK;
+    ob_geometry_lod one = {&coarse, 0.2f};
+    assert_null(ob_geometry_create(dev, &(ob_geometry_desc){.vertex_count = 6, .lods = &one,
+                                                            .lod_count = 1}, &r));
+    assert_int_equal(r, OB_ERR_INVALID_ARGUMENT);
+    ob_resource_counts after = ob_resource_counts_get(dev);
+    assert_int_equal(after.buffers, before.buffers);
+    ob_mesh_release(&fine);
+    ob_mesh_release(&coarse);
+    ob_mesh_release(&broken);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -352,6 +458,8 @@ int main(void)
         cmocka_unit_test(broken_mesh_uploads_nothing),
         cmocka_unit_test(line_list_topology_is_kept),
         cmocka_unit_test(failures_leave_no_resources),
+        cmocka_unit_test(levels_of_detail_share_the_buffers),
+        cmocka_unit_test(bad_levels_are_refused),
     };
     return cmocka_run_group_tests(tests, create_device, destroy_device);
 }

@@ -92,20 +92,31 @@ void ob_stack_destroy(ob_stack *s)
     ob_free(s);
 }
 
-ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char *name,
-                                   ob_result *out_result)
+ob_geometry *ob_stack_add_geometry_desc(ob_stack *s, const ob_geometry_desc *desc,
+                                        ob_result *out_result)
 {
-    ob_result r = ob_array_reserve((void **)&s->geometry, &s->geometry_cap,
-                                   s->geometry_count + 1, sizeof *s->geometry);
+    const char *name = desc && desc->name ? desc->name : "";
+    ob_result r = desc ? ob_array_reserve((void **)&s->geometry, &s->geometry_cap,
+                                          s->geometry_count + 1, sizeof *s->geometry)
+                       : OB_ERR_INVALID_ARGUMENT;
     ob_geometry *g = NULL;
-    if (r != OB_OK) OB_LOG_E("stack", "geometry '%s': no memory to keep it", name ? name : "");
+    if (r != OB_OK) OB_LOG_E("stack", "geometry '%s': %s", name,
+                             desc ? "no memory to keep it" : "no description");
     if (r == OB_OK) {
-        ob_geometry_desc gd = {.mesh = mesh, .name = name, .id = s->geometry_count + 1};
+        ob_geometry_desc gd = *desc;
+        if (!gd.id) gd.id = s->geometry_count + 1;
         g = ob_geometry_create(s->device, &gd, &r);
         if (g) s->geometry[s->geometry_count++] = g;
     }
     if (out_result) *out_result = r;
     return g;
+}
+
+ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char *name,
+                                   ob_result *out_result)
+{
+    return ob_stack_add_geometry_desc(s, &(ob_geometry_desc){.mesh = mesh, .name = name},
+                                      out_result);
 }
 
 ob_node *ob_stack_add_entity(ob_stack *s, ob_node *parent, const char *name, ob_geometry *geometry,

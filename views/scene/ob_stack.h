@@ -90,6 +90,10 @@ void ob_stack_destroy(ob_stack *s);
  * *out_result set, logged. */
 ob_geometry *ob_stack_add_geometry(ob_stack *s, const ob_mesh *mesh, const char *name,
                                    ob_result *out_result);
+/* The same from a full description (levels of detail, layout, topology);
+ * desc->id 0 → its index + 1. */
+ob_geometry *ob_stack_add_geometry_desc(ob_stack *s, const ob_geometry_desc *desc,
+                                        ob_result *out_result);
 /* A node of s->scene under parent (NULL → root) drawing geometry with
  * material, its bounds taken from the geometry. Failure: NULL, *out_result
  * set, nothing left in the scene. */
