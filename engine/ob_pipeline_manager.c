@@ -903,6 +903,7 @@ static inline ob_result draw_plain(ob_pipeline_manager *pm, uint32_t vertex_coun
     fold(pm, ob_hash_u64(h, ((uint64_t)first_vertex << 32) | first_instance));
     pm->stats.draws++;
     pm->stats.draw_calls++;
+    pm->stats.vertices += (uint64_t)vertex_count * instance_count;
     return OB_OK;
 }
 
@@ -921,6 +922,7 @@ static inline ob_result draw_indexed(ob_pipeline_manager *pm, uint32_t index_cou
     fold(pm, h);
     pm->stats.draws++;
     pm->stats.draw_calls++;
+    pm->stats.vertices += (uint64_t)index_count * instance_count;
     return OB_OK;
 }
 
@@ -1027,6 +1029,7 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
     pm->stats.draws += count;
     pm->stats.draw_calls++;
     pm->stats.instances += count;
+    pm->stats.vertices += (uint64_t)d->count * count;
     if (count > pm->stats.longest_run) pm->stats.longest_run = count;
     return OB_OK;
 }
@@ -1121,6 +1124,7 @@ void ob_pipeline_manager_stats_add(ob_pipeline_manager_stats *into, const ob_pip
     for (size_t i = 0; i < n32; i++) a[i] += b[i];
     into->uniform_bytes += s->uniform_bytes;
     into->skipped_draws += s->skipped_draws;
+    into->vertices += s->vertices;
     /* A level, not a counter: the largest of any manager. */
     if (s->descriptor_sets_held > into->descriptor_sets_held) into->descriptor_sets_held = s->descriptor_sets_held;
     if (s->longest_run > into->longest_run) into->longest_run = s->longest_run;

@@ -82,6 +82,10 @@ typedef struct ob_pipeline_manager_stats {
     /* The most instances one draw drew (a level: the largest of any
      * manager, or of a view's recording jobs). */
     uint32_t longest_run;
+    /* Vertices the draws submitted: each draw's index (or vertex) count
+     * times its instances; indirect draws are not counted (their counts
+     * are on the device). With levels of detail, what they saved. */
+    uint64_t vertices;
 } ob_pipeline_manager_stats;
 
 ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *desc,

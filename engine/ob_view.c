@@ -173,6 +173,7 @@ typedef struct cull_ctx {
     const ob_view_material *mt;
     const cull_geometry *geo;           /* per geometry index */
     float lod_scale;                    /* the view's; 0: level 0 always */
+    bool lod_ortho;                     /* the view's: the same scale at any distance */
     uint32_t exclude_id;                /* 0: none (ids start at 1) */
     float planes[6][4];                 /* unused planes test nothing */
     uint32_t grain;                     /* entities per chunk */
@@ -287,10 +288,13 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
              * the bound, stays within the tolerance. */
             uint32_t level = 0;
             if (g->levels > 1 && c->lod_scale > 0.0f) {
+                /* Orthographic: the error in pixels is the same at any
+                 * distance, measured against one pixel. */
                 float r = c->soa.radius[i], t_err = r * c->lod_scale;
+                float base = c->lod_ortho ? 0.0f : r, reach2 = c->lod_ortho ? 1.0f : d2[j];
                 while (level + 1 < g->levels) {
-                    float need = g->rel_error[level + 1] * t_err + r;
-                    if (!(need * need <= d2[j])) break;
+                    float need = g->rel_error[level + 1] * t_err + base;
+                    if (!(need * need <= reach2)) break;
                     level++;
                 }
             }
@@ -395,6 +399,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .geo = geo,
         .lod_scale = count <= CULL_INDEX_MASK && isfinite(v->lod_scale) ? v->lod_scale : 0.0f,
+        .lod_ortho = v->lod_ortho,
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
         .grain = grain, .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
     };

@@ -151,8 +151,12 @@ struct ob_view {
      * e * lod_scale <= d - r, d the distance from the origin to the item's
      * bound centre and r its radius: lod_scale is the view's pixels per
      * world unit at distance 1 over the tolerated error in pixels. 0 (the
-     * default): level 0 always. Set by the view's pre_cull. */
+     * default): level 0 always. With lod_ortho (an orthographic view, a
+     * shadow cascade), lod_scale is its pixels per world unit over the
+     * tolerance at any distance: the condition is e * lod_scale <= 1. Set
+     * by the view's pre_cull. */
     float lod_scale;
+    bool lod_ortho;
     const ob_node *cull_exclude;      /* an entity culling leaves out (an env map's owner) */
 
     /* Images read by this view's draws besides its dependencies' targets. */

@@ -82,6 +82,8 @@ static bool local_pre_cull(ob_view *v, ob_renderer *r)
         ob_views_cube_face_view(0, sv->view);
         ob_mat4_identity(v->view_proj);
         v->no_frustum = true;   /* every direction: the face reach sorts items */
+        /* Cube faces: their edges' pixels per unit, as for cube maps. */
+        v->lod_scale = ob_views_lod_scale(sv->ctx, (float)v->width);
     } else {
         /* The cone plus a little for the PCF taps at its rim. */
         float fov = fminf(2.0f * l->outer_angle + 0.05f, (float)LOCAL_SHADOW_PI * 0.98f);
@@ -89,6 +91,7 @@ static bool local_pre_cull(ob_view *v, ob_renderer *r)
         ob_node_view_relative(sv->light, v->origin, sv->view);
         ob_mat4_mul(sv->proj, sv->view, v->view_proj);
         v->no_frustum = false;
+        v->lod_scale = ob_views_lod_scale(sv->ctx, 0.5f * (float)v->height / tanf(0.5f * fov));
     }
     v->cull_exclude = NULL;
     return true;

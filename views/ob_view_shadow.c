@@ -163,6 +163,9 @@ static void fit_cascade(ob_shadow_cascade *sc, const double axes[9], const doubl
     ob_math_ortho_reverse_z((float)-half, (float)half, (float)-half, (float)half, (float)-reach,
                             (float)(half + texel), sc->proj);
     ob_mat4_mul(sc->proj, sc->view, v->view_proj);
+    /* Levels of detail by texels: the same size at any distance. */
+    v->lod_scale = ob_views_lod_scale(sc->set->ctx, (float)(1.0 / texel));
+    v->lod_ortho = true;
 }
 
 /* Splits and fits every cascade for consumer c; false when c sees no

@@ -106,13 +106,14 @@ ob_result ob_views_set_shadow_split_lambda(ob_views *ctx, float lambda);
  * beyond its range), only slower; for measuring and checking the grid.
  * [render thread, between frames] */
 void ob_views_set_light_tiles(ob_views *ctx, bool on);
-/* Levels of detail (ob_geometry_desc.lods), on by default: camera views and
- * cube environment maps draw each entity at the coarsest level of its
- * geometry whose error, projected from the point of its bound nearest the
- * camera, is at most `pixels` (0 → the default, 1; negative or not finite
- * refused, OB_ERR_INVALID_ARGUMENT, logged). Shadow maps and paraboloid
- * maps draw level 0. Off, every view draws level 0: the pixels of a scene
- * without levels. [render thread, between frames] */
+/* Levels of detail (ob_geometry_desc.lods), on by default: camera views,
+ * cube environment maps and the point and spot lights' shadow maps draw
+ * each entity at the coarsest level of its geometry whose error, projected
+ * from the point of its bound nearest the camera, is at most `pixels` (0 →
+ * the default, 1; negative or not finite refused, OB_ERR_INVALID_ARGUMENT,
+ * logged); shadow cascades measure it in texels, the same at any distance.
+ * Paraboloid maps draw level 0. Off, every view draws level 0: the pixels
+ * of a scene without levels. [render thread, between frames] */
 ob_result ob_views_set_lod_error(ob_views *ctx, float pixels);
 void ob_views_set_lod(ob_views *ctx, bool on);
 /* Env map kind for maps created afterwards (an entity keeps the map it has);

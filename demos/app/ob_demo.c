@@ -677,7 +677,7 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             "\"push_constants\":[%u,%u],\"vertex_binds\":[%u,%u],\"index_binds\":[%u,%u],"
             "\"uniform_bytes\":%llu,\"blocks_packed\":%u,\"blocks_reused\":%u,"
             "\"pipelines_created\":%u,\"variants_created\":%u,\"frame_hash\":\"%016llx\","
-            "\"draw_calls\":%u,\"instances\":%u,\"lod_items\":%u,\"descriptor_sets_allocated\":%u,"
+            "\"draw_calls\":%u,\"instances\":%u,\"lod_items\":%u,\"vertices\":%llu,\"descriptor_sets_allocated\":%u,"
             "\"descriptor_sets_held\":%u,\"threading\":\"%s\",\"cpu_work_ms\":%.4f,"
             "\"waiting_ms\":%.4f,\"gpu_wait_ms\":%.4f,\"acquire_ms\":%.4f,\"present_ms\":%.4f,"
             "\"views\":[",
@@ -692,7 +692,8 @@ void ob_demo_write_stats_json(FILE *f, const ob_frame_stats *st, const ob_demo_m
             st->pm.index_binds_requested, st->pm.index_binds_issued,
             (unsigned long long)st->pm.uniform_bytes, st->pm.blocks_packed, st->pm.blocks_reused,
             st->pipelines_created, st->variants_created, (unsigned long long)st->frame_hash,
-            st->pm.draw_calls, st->pm.instances, st->lod_items, st->pm.descriptor_sets_allocated,
+            st->pm.draw_calls, st->pm.instances, st->lod_items,
+            (unsigned long long)st->pm.vertices, st->pm.descriptor_sets_allocated,
             st->pm.descriptor_sets_held, ob_threading_name(st->mode),
             ob_frame_stats_cpu_work_ns(st) * 1e-6, ob_frame_stats_wait_ns(st) * 1e-6,
             st->gpu_wait_ns * 1e-6, st->acquire_ns * 1e-6, st->present_ns * 1e-6);

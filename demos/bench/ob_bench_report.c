@@ -213,6 +213,9 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
     fprintf(f, "\n  %-30s %.3f (GPU ms, ST, 10k x 8 views: instanced %.1f, one draw per entity "
                "%.1f)", "gpu_time_instanced_vs_per_draw", s->gpu_time_instanced_vs_per_draw_10k_8views,
             s->gpu_ms_10k_8views, s->gpu_ms_10k_8views_per_draw);
+    fprintf(f, "\n  %-30s %.1f (ST, 10k x 8: vertices submitted per entity drawn; %.1f%% of "
+               "them at a coarser level of detail)", "vertices_per_draw",
+            s->vertices_per_draw_10k_8views, 100.0 * s->lod_share_10k_8views);
     fprintf(f, "\n  %-30s %.3f with the tile grid, %.3f with every light everywhere "
                "(frame cost from 4 to 256 lights at fixed coverage; below 1: sub-linear)",
             "lights_cost_exponent_4_to_256", s->lights_cost_exponent_4_to_256,
@@ -301,7 +304,8 @@ static void json_result(FILE *f, const ob_bench_result *r)
     fprintf(f, ",\"threading\":\"%s\",\"workers\":%u,\"workers_used\":",
             ob_threading_name(r->mode.threading), r->mode.workers);
     json_num(f, r->workers_used);
-    fprintf(f, ",\"frames\":%u,\"views\":%u,\"draws\":%u", r->frames, r->views, r->draws);
+    fprintf(f, ",\"frames\":%u,\"views\":%u,\"draws\":%u,\"vertices\":%.0f,\"lod_items\":%u",
+            r->frames, r->views, r->draws, r->vertices, r->lod_items);
     static const char *const names[] = {"update_ms", "pre_render_ms", "record_ms", "assemble_ms",
                                         "submit_ms", "record_total_ms", "cpu_frame_ms", "gpu_ms",
                                         "frame_ms", "draws_per_s", "speedup_record",
@@ -434,6 +438,8 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     json_field(f, "gpu_ms_10k_8views_per_draw", s->gpu_ms_10k_8views_per_draw);
     json_field(f, "gpu_time_instanced_vs_per_draw_10k_8views",
                s->gpu_time_instanced_vs_per_draw_10k_8views);
+    json_field(f, "vertices_per_draw_10k_8views", s->vertices_per_draw_10k_8views);
+    json_field(f, "lod_share_10k_8views", s->lod_share_10k_8views);
     json_field(f, "lights_cost_exponent_4_to_256", s->lights_cost_exponent_4_to_256);
     json_field(f, "lights_cost_exponent_4_to_256_all", s->lights_cost_exponent_4_to_256_all);
     json_field(f, "teardown_ns_per_entity_batch", s->teardown_ns_per_entity_batch);

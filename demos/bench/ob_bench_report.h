@@ -75,6 +75,9 @@ typedef struct ob_bench_summary {
      * their ratio. */
     double gpu_ms_10k_8views, gpu_ms_10k_8views_per_draw;
     double gpu_time_instanced_vs_per_draw_10k_8views;
+    /* ST, 10k x 8 views: vertices submitted per entity drawn, and the share
+     * of entities drawn at a coarser level of detail. */
+    double vertices_per_draw_10k_8views, lod_share_10k_8views;
     /* The lights section (ob_bench_lights.h): the exponent of the frame
      * cost's growth from 4 to 256 point lights at fixed coverage, with the
      * tile grid and with every light in every fragment (below 1:

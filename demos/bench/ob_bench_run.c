@@ -18,7 +18,7 @@ typedef struct sample {
     double update_ms, update_cpu_ms, pre_render_ms, record_ms, assemble_ms, submit_ms;
     double cpu_frame_ms, cpu_no_update_ms, record_total_ms, gpu_ms, wall_ms;
     double serial_fraction;
-    double draws, views;
+    double draws, views, vertices, lod_items;
     double cpu_render_ms, cpu_workers_ms, cpu_max_worker_ms, host_allocs_per_object;
     uint32_t workers;
     ob_pipeline_manager_stats pm;
@@ -121,6 +121,7 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
         .submit_ms = st->submit_ns * 1e-6, .cpu_frame_ms = st->frame_ns * 1e-6,
         .record_total_ms = (st->record_ns + st->assemble_ns) * 1e-6,
         .gpu_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
+        .vertices = (double)st->pm.vertices, .lod_items = st->lod_items,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
         .serial_fraction = NAN,
     };
@@ -469,6 +470,8 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->workers_used = n ? workers / n : 0.0;
         o->draws = (uint32_t)MEDIAN(m, SAMPLE_IDLE, draws);
         o->views = (uint32_t)MEDIAN(m, SAMPLE_IDLE, views);
+        o->vertices = MEDIAN(m, SAMPLE_IDLE, vertices);
+        o->lod_items = (uint32_t)MEDIAN(m, SAMPLE_IDLE, lod_items);
         /* Each kept idle frame carries its mode's update of the round. */
         o->update_ms = MEDIAN(m, SAMPLE_IDLE, update_ms);
         o->update_cpu_ms = MEDIAN(m, SAMPLE_IDLE, update_cpu_ms);

@@ -100,6 +100,8 @@ typedef struct ob_bench_result {
     uint32_t frames;           /* measured idle frames */
     uint32_t draws;            /* per frame (median) */
     uint32_t views;            /* views recorded per frame (median) */
+    double vertices;           /* vertices the draws submitted per frame (median) */
+    uint32_t lod_items;        /* items drawn at a coarser level of detail (median) */
     double workers_used;       /* mean active workers of the measured frames (auto varies) */
     /* medians, milliseconds, idle loop */
     double update_ms;          /* the mode's own update of each round (wall) */

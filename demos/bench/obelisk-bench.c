@@ -598,6 +598,9 @@ static void summarize(ob_bench_report *rep)
                                         ? rep->per_draw_10k_8views.results[0].gpu_ms : NAN;
     s->gpu_time_instanced_vs_per_draw_10k_8views =
         s->gpu_ms_10k_8views / s->gpu_ms_10k_8views_per_draw;
+    double draws8 = e8 && e8->results[0].draws ? (double)e8->results[0].draws : NAN;
+    s->vertices_per_draw_10k_8views = e8 ? e8->results[0].vertices / draws8 : NAN;
+    s->lod_share_10k_8views = e8 ? e8->results[0].lod_items / draws8 : NAN;
     const ob_bench_sweep_entry *e50 = find_entry(rep, 1, 50000);
     s->update_ns_per_object =
         e50 ? spread_scaled(e50->results[0].update_round_ms, 1e6 / e50->objects) : none;

@@ -3,8 +3,8 @@
  * tolerance, so a near entity keeps level 0 and a far one takes a coarse
  * level; the level never goes down with distance; the picture moves by
  * about a pixel at most; a larger tolerance takes coarser levels; off,
- * every item is level 0; and the levels, pixels and command hashes are the
- * same in every threading mode. */
+ * every item is level 0; shadow cascades choose by texels; and the levels,
+ * pixels and command hashes are the same in every threading mode. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,9 +35,9 @@ static ob_geometry *ball(ob_test_world *w)
 }
 
 /* A row of balls at 3, 4.5, 6.75, ... units in front of the camera (each
- * 1.5 times farther), a little to the side so none hides the next, and a
- * floor of one level. */
-static void build_row(ob_test_world *w, ob_node *out[ROW])
+ * 1.5 times farther), a little to the side so none hides the next, a
+ * floor of one level and the sun, casting shadows or not. */
+static void build_row(ob_test_world *w, bool shadows, ob_node *out[ROW])
 {
     ob_geometry *g = ball(w);
     ob_material *m = ob_world_material(w, "ball", OB_MATERIAL_LIT, 0.8f, 0.5f, 0.3f, true);
@@ -49,7 +49,7 @@ static void build_row(ob_test_world *w, ob_node *out[ROW])
         out[k] = ob_world_entity(w, NULL, name, g, m, side, 0.0, -d);
     }
     ob_world_entity(w, NULL, "floor", w->plane, m, 0, -0.6, -5);
-    ob_world_light(w, OB_LIGHT_DIRECTIONAL, false, 1.0f, 2, 4, 3);
+    ob_world_light(w, OB_LIGHT_DIRECTIONAL, shadows, 1.0f, 2, 4, 3);
     ob_world_look(w, 0, 0.3, 0, 0, 0, -10);
 }
 
@@ -67,7 +67,7 @@ static void near_keeps_level_0_far_takes_the_coarsest(void **state)
     ob_test_world w;
     ob_test_world_create(&w, NULL);
     ob_node *row[ROW];
-    build_row(&w, row);
+    build_row(&w, false, row);
     const ob_view *main = ob_perspective_view_base(w.main);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     int before = 0, coarse = 0;
@@ -118,7 +118,7 @@ static void levels_keep_the_picture(void **state)
     ob_test_world w;
     ob_test_world_create(&w, NULL);
     ob_node *row[ROW];
-    build_row(&w, row);
+    build_row(&w, false, row);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint64_t hash_on = st->frame_hash;
     uint8_t *on = ob_world_snapshot(&w);
@@ -145,7 +145,7 @@ static void every_mode_draws_the_same_levels(void **state)
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.parallel_grain = 4});
     ob_node *row[ROW];
-    build_row(&w, row);
+    build_row(&w, false, row);
     const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
     uint64_t hash = st->frame_hash;
     uint8_t *ref = ob_world_snapshot(&w);
@@ -164,6 +164,40 @@ static void every_mode_draws_the_same_levels(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* Shadow cascades choose by texels, the same at any distance; point and
+ * spot lights' maps as perspective views: with a shadowed sun, some
+ * shadow-map items are drawn coarser, none with levels off, and the frame
+ * is the same in every mode. */
+static void shadow_maps_choose_levels_by_texels(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_node *row[ROW];
+    build_row(&w, true, row);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    uint64_t hash = st->frame_hash;
+    uint32_t shadow_coarse = 0, shadow_views = 0;
+    for (uint32_t k = 0; k < st->view_count; k++)
+        if (st->views[k].type == OB_VIEW_SHADOW) {
+            shadow_views++;
+            shadow_coarse += st->views[k].lod_items;
+        }
+    assert_true(shadow_views > 0);
+    assert_true(shadow_coarse > 0);
+    uint8_t *ref = ob_world_snapshot(&w);
+    st = ob_test_world_frame(&w, OB_THREADING_MULTI, 0);
+    assert_true(st->frame_hash == hash);
+    uint8_t *mt = ob_world_snapshot(&w);
+    assert_memory_equal(ref, mt, (size_t)w.width * w.height * 4);
+    ob_views_set_lod(w.views, false);
+    st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+    for (uint32_t k = 0; k < st->view_count; k++) assert_int_equal(st->views[k].lod_items, 0);
+    free(ref);
+    free(mt);
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -171,6 +205,7 @@ int main(void)
         cmocka_unit_test(near_keeps_level_0_far_takes_the_coarsest),
         cmocka_unit_test(levels_keep_the_picture),
         cmocka_unit_test(every_mode_draws_the_same_levels),
+        cmocka_unit_test(shadow_maps_choose_levels_by_texels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
