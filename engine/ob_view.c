@@ -157,7 +157,9 @@ typedef struct cull_chunk {
  * its keys. Asked of the geometry interface once per wave. */
 typedef struct cull_geometry {
     uint32_t levels;                    /* 1: level 0 only */
-    float rel_error[OB_LOD_MAX];
+    /* Levels 1.. (entry l - 1 for level l); +infinity past the last, so
+     * that every geometry is tested over the same lanes. */
+    float rel_error[OB_LOD_MAX - 1];
     uint32_t mesh[OB_LOD_MAX];
 } cull_geometry;
 
@@ -287,15 +289,17 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
             /* The coarsest level whose error, seen from the nearest point of
              * the bound, stays within the tolerance. */
             uint32_t level = 0;
-            if (g->levels > 1 && c->lod_scale > 0.0f) {
-                /* Orthographic: the error in pixels is the same at any
-                 * distance, measured against one pixel. */
+            if (c->lod_scale > 0.0f) {
+                /* Errors do not go down with the level, so the levels that
+                 * pass are 1..level: count them, without branches (the
+                 * level changes with distance in no order a predictor
+                 * learns). Orthographic: the error in pixels is the same
+                 * at any distance, measured against one pixel. */
                 float r = c->soa.radius[i], t_err = r * c->lod_scale;
                 float base = c->lod_ortho ? 0.0f : r, reach2 = c->lod_ortho ? 1.0f : d2[j];
-                while (level + 1 < g->levels) {
-                    float need = g->rel_error[level + 1] * t_err + base;
-                    if (!(need * need <= reach2)) break;
-                    level++;
+                for (uint32_t l = 0; l < OB_LOD_MAX - 1; l++) {
+                    float need = g->rel_error[l] * t_err + base;
+                    level += need * need <= reach2;
                 }
             }
             pairs[out->kept++] = (ob_sort_pair){
@@ -530,23 +534,28 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
     for (uint32_t k = 0; k < gc; k++) {
         struct ob_geometry *g = ob_scene_geometry(scene, k);
         cull_geometry *cg = &geo[k];
+        float rel[OB_LOD_MAX] = {0};
         cg->levels = 1;
-        if (!gi || !g) continue;
-        cg->mesh[0] = gi->id(g);
-        if (gi->lods) {
-            cg->levels = OB_MIN(OB_MAX(gi->lods(g, cg->rel_error), 1u), OB_LOD_MAX);
-            cg->rel_error[0] = 0.0f;
+        uint32_t id = 0;
+        if (gi && g) {
+            id = gi->id(g);
+            if (gi->lods) cg->levels = OB_MIN(OB_MAX(gi->lods(g, rel), 1u), OB_LOD_MAX);
         }
         /* A level's error not a number, or below the one before, ends the
          * chain there: culling never picks what it cannot compare. */
+        rel[0] = 0.0f;
         for (uint32_t l = 1; l < cg->levels; l++)
-            if (!(cg->rel_error[l] >= cg->rel_error[l - 1]) || !isfinite(cg->rel_error[l])) {
+            if (!(rel[l] >= rel[l - 1]) || !isfinite(rel[l])) {
                 cg->levels = l;
                 break;
             }
-        /* Each level keys as its own mesh, so a run never mixes levels. */
-        for (uint32_t l = 1; l < cg->levels; l++)
-            cg->mesh[l] = (uint32_t)ob_hash_u64(cg->mesh[0], l);
+        for (uint32_t l = 1; l < OB_LOD_MAX; l++)
+            cg->rel_error[l - 1] = l < cg->levels ? rel[l] : INFINITY;
+        /* Each level keys as its own mesh, next to its level 0, so a run
+         * never mixes levels and small ids (a stack's) keep few differing
+         * bits for the sort. */
+        _Static_assert(OB_LOD_MAX == 8u, "three bits of the mesh field hold the level");
+        for (uint32_t l = 0; l < OB_LOD_MAX; l++) cg->mesh[l] = id << 3 | l;
     }
     ob_parallel par = ob_renderer_parallel(r);
     uint32_t entities = 0;

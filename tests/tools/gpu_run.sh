@@ -16,8 +16,9 @@
 #   images BoxTextured and 2CylinderEngine at 640x480, 4x MSAA, into $OUT
 #   bench  obelisk-bench --quick (frame periods on the GPU)
 #   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instanced
-#          and then one draw per entity (--no-instancing): the parallel frame's
-#          and instancing's figures on the machine's cores (docs/benchmark.md)
+#          and then one draw per entity (--no-instancing), then instanced with
+#          levels of detail off (--no-lod): the parallel frame's, instancing's
+#          and the levels' figures on the machine's cores (docs/benchmark.md)
 # DEADLINE (seconds, default 420) bounds the whole run; a step gets what is
 # left or is skipped. OB_DEVICE defaults to gpu (never lavapipe).
 set -u
@@ -87,7 +88,8 @@ for s in $steps; do
       --json "$OUT/bench_quick.json" >"$OUT/bench_quick.log" 2>&1
     say "bench rc=$?" ;;
   frame16)
-    for v in inst:"--modes ST,2,4,8,16,auto" draw:"--modes ST,16 --no-instancing"; do
+    for v in inst:"--modes ST,2,4,8,16,auto" draw:"--modes ST,16 --no-instancing" \
+             nolod:"--modes ST,16 --no-lod"; do
       n=${v%%:*}; a=${v#*:}
       # shellcheck disable=SC2086  # $a is a list of options
       timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --views 16 --objects 100000 $a --rounds 3 \
