@@ -343,6 +343,16 @@ static bool world_mirrors(const float world_normal[32])
     return det < 0.0;
 }
 
+/* The same of a per-instance block (three rows of the world matrix). */
+static bool rows_mirror(const float rows[OB_INSTANCE_FLOATS])
+{
+    const float *w = rows;
+    double a[3] = {w[0], w[4], w[8]}, b[3] = {w[1], w[5], w[9]}, c[3] = {w[2], w[6], w[10]};
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    return det < 0.0;
+}
+
 void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
     pm->world = world_normal;
@@ -1022,7 +1032,7 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
     uint64_t tail = indexed ? (((uint64_t)d->first << 32) | (uint32_t)d->vertex_offset)
                             : ((uint64_t)d->first << 32);
     for (uint32_t k = 0; k < count; k++) {
-        uint64_t hk = ob_hash_block(h, blocks + 32u * k, 64);
+        uint64_t hk = ob_hash_block(h, blocks + OB_INSTANCE_FLOATS * k, OB_INSTANCE_STRIDE);
         hk = ob_hash_u64(hk, ((uint64_t)d->count << 32) | 1u);
         fold(pm, ob_hash_u64(hk, tail));
     }
@@ -1046,10 +1056,11 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
     /* A mirroring instance needs the other front face: the run is cut
      * where the determinant's sign changes. */
     for (uint32_t start = 0; start < count;) {
-        bool mirrors = world_mirrors(blocks + 32u * start);
+        bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);
         uint32_t end = start + 1;
-        while (end < count && world_mirrors(blocks + 32u * end) == mirrors) end++;
-        ob_result r = draw_instance_run(pm, d, blocks + 32u * start, end - start, mirrors);
+        while (end < count && rows_mirror(blocks + OB_INSTANCE_FLOATS * end) == mirrors) end++;
+        ob_result r = draw_instance_run(pm, d, blocks + OB_INSTANCE_FLOATS * start, end - start,
+                                        mirrors);
         if (r != OB_OK) return r;
         start = end;
     }

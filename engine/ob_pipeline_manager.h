@@ -170,10 +170,11 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
 /* Whether the program set reads the per-draw block per instance
  * (ob_program.instanced): then draws go through draw_instances. */
 bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
-/* count instances of d in one draw: blocks holds count per-draw blocks (32
- * floats each, as ob_render_proxy_per_draw gives them, all finite), copied
- * into this frame's ring. The command hash folds one value per instance, the
- * same whatever the count, so a run cut into several draws hashes alike.
+/* count instances of d in one draw: blocks holds count per-instance blocks
+ * (OB_INSTANCE_FLOATS each, the world matrix's rows, as
+ * ob_render_proxy_instance gives them, all finite), copied into this
+ * frame's ring. The command hash folds one value per instance, the same
+ * whatever the count, so a run cut into several draws hashes alike.
  * OB_ERR_WRONG_STATE when the program is not instanced. */
 ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
                                              const float *blocks, uint32_t count);

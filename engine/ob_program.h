@@ -71,18 +71,21 @@ typedef struct ob_program {
      * and no uniform block reads the world matrix: a draw's world matrix goes
      * straight into the push constants, not through the parameters. */
     bool push_world_normal;
-    /* The vertex stage reads the per-draw block per instance (the standard
-     * shaders' INSTANCED variant: locations OB_INSTANCE_LOCATION..+6 of
+    /* The vertex stage reads the world matrix per instance (the standard
+     * shaders' INSTANCED variant: locations OB_INSTANCE_LOCATION..+2 of
      * vertex binding 1, instance rate, OB_INSTANCE_STRIDE bytes): a run of
      * draws of one mesh and material is one instanced draw. Set by the
      * effect from reflection, never by the user. */
     bool instanced;
 } ob_program;
 
-/* The per-instance block: the 32 floats of the per-draw block (world
- * matrix, normal matrix), as vertex attributes of binding 1. */
+/* The per-instance block: the world matrix's three rows (the translation,
+ * camera-relative, in their w; ob_render_proxy_instance), as vertex
+ * attributes of binding 1. The shader derives the normal matrix. */
 #define OB_INSTANCE_LOCATION 8u
-#define OB_INSTANCE_STRIDE 128u
+#define OB_INSTANCE_ROWS 3u
+#define OB_INSTANCE_FLOATS (4u * OB_INSTANCE_ROWS)
+#define OB_INSTANCE_STRIDE (4u * OB_INSTANCE_FLOATS)
 
 /* Builds set layouts, the pipeline layout and parameter mappings. Errors: a
  * uniform block outside set 0 or a resource outside set 1, too many bindings

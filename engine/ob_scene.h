@@ -169,6 +169,23 @@ static inline bool ob_render_proxy_per_draw(const ob_render_proxy *p, const doub
     return p->finite && isfinite(t[0]) && isfinite(t[1]) && isfinite(t[2]);
 }
 
+/* The per-instance block of a proxy (OB_INSTANCE_STRIDE, ob_program.h):
+ * its world matrix relative to origin as three rows, dest[4 r + c] the
+ * upper 3x3's row r, column c, and dest[4 r + 3] the translation's r
+ * (subtracted in double). False when some value is not finite in float, as
+ * ob_render_proxy_per_draw says (dest is written anyway). */
+static inline bool ob_render_proxy_instance(const ob_render_proxy *p, const double origin[3],
+                                            float dest[12])
+{
+    float t[3];
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++) dest[r * 4 + c] = p->linear[c * 3 + r];
+        t[r] = (float)(p->world_t[r] - origin[r]);
+        dest[r * 4 + 3] = t[r];
+    }
+    return p->finite && isfinite(t[0]) && isfinite(t[1]) && isfinite(t[2]);
+}
+
 /* ------------------------------------------------------------------- nodes */
 
 /* New node under parent (NULL → root) with identity transform, named `name`

@@ -639,7 +639,7 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
 #define PROXY_PREFETCH 16u
 
 /* Instances gathered before a draw: a longer run takes several draws (its
- * hash is the same either way). 16 KiB of stack. */
+ * hash is the same either way). 6 KiB of stack. */
 #define RUN_BLOCKS 128u
 
 static void log_not_finite(const ob_view *v, const ob_render_proxy *p)
@@ -660,7 +660,8 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
     const struct ob_geometry *described = NULL;
     uint32_t described_lod = 0;
     ob_draw_data dd = {0};
-    _Alignas(16) float blocks[RUN_BLOCKS][32];
+    _Alignas(16) float block[32];
+    _Alignas(16) float rows[RUN_BLOCKS][OB_INSTANCE_FLOATS];
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     for (uint32_t i = first; i < end;) {
         /* Items are in draw order, proxies in id order: fetch a few ahead so
@@ -692,8 +693,8 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
         if (!ob_pipeline_manager_instanced(pm)) {
             /* A refused matrix is not drawn (a stale one would put this
              * entity where the previous one was). */
-            bool finite = ob_render_proxy_per_draw(p, v->origin, blocks[0]);
-            if (!finite || ob_pipeline_manager_draw_data(pm, &dd, blocks[0]) == OB_ERR_NON_FINITE)
+            bool finite = ob_render_proxy_per_draw(p, v->origin, block);
+            if (!finite || ob_pipeline_manager_draw_data(pm, &dd, block) == OB_ERR_NON_FINITE)
                 log_not_finite(v, p);
             i++;
             continue;
@@ -708,13 +709,13 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
                 __builtin_prefetch(ahead);
                 __builtin_prefetch((const char *)ahead + 64);
             }
-            if (ob_render_proxy_per_draw(q, v->origin, blocks[n])) n++;
+            if (ob_render_proxy_instance(q, v->origin, rows[n])) n++;
             else log_not_finite(v, q);
             j++;
         } while (j < end && n < RUN_BLOCKS && applied &&
                  v->proxies[v->items[j].proxy].material == applied &&
                  v->proxies[v->items[j].proxy].geometry == p->geometry && v->items[j].lod == lod);
-        if (n) ob_pipeline_manager_draw_instances(pm, &dd, &blocks[0][0], n);
+        if (n) ob_pipeline_manager_draw_instances(pm, &dd, &rows[0][0], n);
         i = j;
     }
 }

@@ -312,8 +312,9 @@ static ob_result resolve_vertex_input(ob_effect *e, const ob_effect_desc *desc,
     if (layout) e->stride = layout->stride;
     for (uint32_t i = 0; i < vs->vertex_input_count; i++) {
         const ob_vertex_input *in = &vs->vertex_inputs[i];
-        if (in->location >= OB_INSTANCE_LOCATION && in->location < OB_INSTANCE_LOCATION + 7u) {
-            /* The per-instance block: column k at byte 16 k of binding 1. */
+        if (in->location >= OB_INSTANCE_LOCATION &&
+            in->location < OB_INSTANCE_LOCATION + OB_INSTANCE_ROWS) {
+            /* The per-instance block: row k at byte 16 k of binding 1. */
             e->attributes[e->attribute_count++] = (VkVertexInputAttributeDescription){
                 .location = in->location,
                 .binding = 1,

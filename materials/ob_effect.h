@@ -38,8 +38,8 @@ extern "C" {
 
 #define OB_EFFECT_MAX_ATTRIBUTES 8
 /* Vertex inputs of the pipeline: the layout's, and the per-instance block's
- * seven (ob_program.instanced). */
-#define OB_EFFECT_MAX_INPUTS (OB_EFFECT_MAX_ATTRIBUTES + 7u)
+ * three rows (ob_program.instanced, OB_INSTANCE_ROWS). */
+#define OB_EFFECT_MAX_INPUTS (OB_EFFECT_MAX_ATTRIBUTES + 3u)
 #define OB_EFFECT_MAX_PIPELINES 16
 
 /* Vertex input of an effect: one interleaved vertex buffer (binding 0).

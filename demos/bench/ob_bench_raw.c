@@ -8,6 +8,8 @@
 #define COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 #define DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
 #define PUSH_SIZE 128u
+#define ROW_FLOATS 12u              /* the engine's per-instance block (OB_INSTANCE_FLOATS) */
+#define ROW_SIZE (4u * ROW_FLOATS)
 
 static const char raw_vert[] =
     "#version 450\n"
@@ -18,21 +20,26 @@ static const char raw_vert[] =
     "    vNormal = mat3(NormalMatrix) * vec3(0.0, 1.0, 0.0);\n"
     "    gl_Position = WorldMatrix * vec4(inPosition, 1.0);\n"
     "}\n";
-/* The instanced loop's: the same matrices per instance, from binding 1. */
+/* The instanced loop's: the engine's per-instance block, the world
+ * matrix's three rows from binding 1, and the normal matrix derived from it
+ * as the standard shaders do (ob_normal_matrix, common.glsl). */
 static const char raw_vert_instanced[] =
     "#version 450\n"
     "layout(location = 0) in vec3 inPosition;\n"
-    "layout(location = 8) in vec4 w0;\n"
-    "layout(location = 9) in vec4 w1;\n"
-    "layout(location = 10) in vec4 w2;\n"
-    "layout(location = 11) in vec4 w3;\n"
-    "layout(location = 12) in vec4 n0;\n"
-    "layout(location = 13) in vec4 n1;\n"
-    "layout(location = 14) in vec4 n2;\n"
+    "layout(location = 8) in vec4 r0;\n"
+    "layout(location = 9) in vec4 r1;\n"
+    "layout(location = 10) in vec4 r2;\n"
     "layout(location = 0) out vec3 vNormal;\n"
     "void main() {\n"
-    "    vNormal = mat3(n0.xyz, n1.xyz, n2.xyz) * vec3(0.0, 1.0, 0.0);\n"
-    "    gl_Position = mat4(w0, w1, w2, w3) * vec4(inPosition, 1.0);\n"
+    "    mat4 w = mat4(vec4(r0.x, r1.x, r2.x, 0.0), vec4(r0.y, r1.y, r2.y, 0.0),\n"
+    "                  vec4(r0.z, r1.z, r2.z, 0.0), vec4(r0.w, r1.w, r2.w, 1.0));\n"
+    "    mat3 m = mat3(w);\n"
+    "    vec3 a = max(abs(m[0]), max(abs(m[1]), abs(m[2])));\n"
+    "    float big = max(a.x, max(a.y, a.z));\n"
+    "    if (big > 0.0) m *= 1.0 / big;\n"
+    "    vNormal = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1])) *\n"
+    "              vec3(0.0, 1.0, 0.0);\n"
+    "    gl_Position = w * vec4(inPosition, 1.0);\n"
     "}\n";
 static const char raw_frag[] =
     "#version 450\n"
@@ -52,12 +59,13 @@ struct ob_bench_raw {
     VkShaderModule vert, frag, vert_instanced;
     VkPipelineLayout layout, layout_instanced;
     VkPipeline pipeline, pipeline_instanced;
-    ob_buffer instances;       /* the 32 floats of each draw, as instance data */
+    ob_buffer instances;       /* the world rows of each draw, as instance data */
     void *instance_data;       /* its mapping: written at each recording */
     VkCommandPool pool;
     VkCommandBuffer cmd;
     raw_draw *draws;
     float *push;               /* 32 floats per draw, 32-byte aligned */
+    float *rows;               /* ROW_FLOATS per draw: the world matrix's rows */
     uint32_t count;
     uint32_t width, height;    /* the view's, for viewport and scissor */
     /* The pool's allocator: the engine's own (a recording pool's), so that
@@ -110,15 +118,15 @@ static ob_result make_pipeline(ob_demo *d, raw_state *s, bool instanced)
     };
     VkVertexInputBindingDescription bindings[2] = {
         {0, sizeof(ob_vertex), VK_VERTEX_INPUT_RATE_VERTEX},
-        {1, PUSH_SIZE, VK_VERTEX_INPUT_RATE_INSTANCE}};
-    VkVertexInputAttributeDescription attributes[8] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
-    for (uint32_t k = 0; k < 7; k++)
+        {1, ROW_SIZE, VK_VERTEX_INPUT_RATE_INSTANCE}};
+    VkVertexInputAttributeDescription attributes[4] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+    for (uint32_t k = 0; k < 3; k++)
         attributes[1 + k] = (VkVertexInputAttributeDescription){8 + k, 1,
                                                                 VK_FORMAT_R32G32B32A32_SFLOAT, 16 * k};
     VkPipelineVertexInputStateCreateInfo vi = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
         .vertexBindingDescriptionCount = instanced ? 2u : 1u, .pVertexBindingDescriptions = bindings,
-        .vertexAttributeDescriptionCount = instanced ? 8u : 1u,
+        .vertexAttributeDescriptionCount = instanced ? 4u : 1u,
         .pVertexAttributeDescriptions = attributes};
     VkPipelineInputAssemblyStateCreateInfo ia = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
@@ -183,7 +191,8 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
     ob_device *dev = ob_renderer_device(d->world.r);
     s->draws = ob_calloc(v->item_count, sizeof *s->draws);
     s->push = ob_aligned_alloc(32, sizeof(float) * 32 * v->item_count);
-    if (!s->draws || !s->push) return OB_ERR_OUT_OF_HOST_MEMORY;
+    s->rows = ob_aligned_alloc(16, sizeof(float) * ROW_FLOATS * v->item_count);
+    if (!s->draws || !s->push || !s->rows) return OB_ERR_OUT_OF_HOST_MEMORY;
     for (uint32_t i = 0; i < v->item_count; i++) {
         const ob_node *n = v->items[i].node;
         const ob_renderable *rd = ob_node_get_renderable(n);
@@ -194,6 +203,9 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
         mat4 inv;
         glm_mat4_inv((vec4 *)world, inv);
         glm_mat4_transpose_to(inv, (vec4 *)normal);
+        float *rows = &s->rows[ROW_FLOATS * s->count];
+        for (uint32_t r = 0; r < 3; r++)
+            for (uint32_t c = 0; c < 4; c++) rows[4 * r + c] = world[4 * c + r];
         s->draws[s->count++] = (raw_draw){ob_buffer_vk(dev, ob_geometry_vertex_buffer(g)),
                                           ob_buffer_vk(dev, ob_geometry_index_buffer(g)),
                                           ob_geometry_index_count(g)};
@@ -231,7 +243,7 @@ static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instance
     if (instanced) {
         /* The frame's instance data written (as a dynamic scene must), bound
          * once. */
-        memcpy(s->instance_data, s->push, (size_t)PUSH_SIZE * s->count);
+        memcpy(s->instance_data, s->rows, (size_t)ROW_SIZE * s->count);
         VkBuffer inst = ob_buffer_vk(s->dev, s->instances);
         VkDeviceSize zero = 0;
         vkCmdBindVertexBuffers(s->cmd, 1, 1, &inst, &zero);
@@ -300,6 +312,7 @@ void ob_bench_raw_destroy(ob_bench_raw *s)
     if (s->frag) vkDestroyShaderModule(s->vk, s->frag, NULL);
     ob_free(s->draws);
     ob_aligned_free(s->push);
+    ob_aligned_free(s->rows);
     ob_free(s);
 }
 
@@ -323,7 +336,7 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
     if (r == OB_OK) r = make_pipeline(d, s, true);
     if (r == OB_OK) {
         s->instances = ob_buffer_create(s->dev, &(ob_buffer_desc){
-            .size = (uint64_t)PUSH_SIZE * s->count, .usage = OB_BUFFER_VERTEX,
+            .size = (uint64_t)ROW_SIZE * s->count, .usage = OB_BUFFER_VERTEX,
             .host_visible = true, .name = "raw baseline instances"}, &r);
         s->instance_data = ob_buffer_mapped(s->dev, s->instances);
     }

@@ -54,9 +54,10 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
 /* Resets the pool and records every draw once, timed. Failure: OB_ERR_VULKAN
  * (logged); *out is then zero. */
 ob_result ob_bench_raw_record(ob_bench_raw *raw, ob_bench_raw_sample *out);
-/* The same draws instanced: the matrices copied as instance data into a
- * mapped buffer (binding 1) at each recording, as a scene that moves must,
- * and a run of one mesh as one vkCmdDrawIndexed. */
+/* The same draws instanced: the world matrices' rows (the engine's 48-byte
+ * per-instance block) copied as instance data into a mapped buffer
+ * (binding 1) at each recording, as a scene that moves must, and a run of
+ * one mesh as one vkCmdDrawIndexed. */
 ob_result ob_bench_raw_record_instanced(ob_bench_raw *raw, ob_bench_raw_sample *out);
 /* Destroys what create made. NULL ok. */
 void ob_bench_raw_destroy(ob_bench_raw *raw);

@@ -43,30 +43,49 @@ layout(set = 0, binding = 1, std140) uniform PerMaterial {
 };
 
 #if defined(INSTANCED)
-// Instanced (the INSTANCED variant): the per-draw block comes per instance
-// from a vertex buffer of instance rate (binding 1, 128 bytes an instance,
-// the same 32 floats as the push block), so one draw covers a run of
-// entities with one material and mesh. Only the vertex stage reads it;
-// a vertex shader says which it is with OB_VERTEX_STAGE before including
-// this file.
+// Instanced (the INSTANCED variant): the world matrix comes per instance
+// from a vertex buffer of instance rate (binding 1, 48 bytes an instance:
+// its three rows, the translation in w), so one draw covers a run of
+// entities with one material and mesh. Only the vertex stage reads it; a
+// vertex shader says which it is with OB_VERTEX_STAGE before including this
+// file. NormalMatrix is derived from it (ob_normal_matrix), as the
+// standard shaders do on both paths.
 #if defined(OB_VERTEX_STAGE)
-layout(location = 8) in vec4 obInstanceWorld0;
-layout(location = 9) in vec4 obInstanceWorld1;
-layout(location = 10) in vec4 obInstanceWorld2;
-layout(location = 11) in vec4 obInstanceWorld3;
-layout(location = 12) in vec4 obInstanceNormal0;
-layout(location = 13) in vec4 obInstanceNormal1;
-layout(location = 14) in vec4 obInstanceNormal2;
-#define WorldMatrix mat4(obInstanceWorld0, obInstanceWorld1, obInstanceWorld2, obInstanceWorld3)
-#define NormalMatrix mat4(obInstanceNormal0, obInstanceNormal1, obInstanceNormal2, vec4(0.0, 0.0, 0.0, 1.0))
+layout(location = 8) in vec4 obInstanceRow0;
+layout(location = 9) in vec4 obInstanceRow1;
+layout(location = 10) in vec4 obInstanceRow2;
+#define WorldMatrix mat4(vec4(obInstanceRow0.x, obInstanceRow1.x, obInstanceRow2.x, 0.0), \
+                         vec4(obInstanceRow0.y, obInstanceRow1.y, obInstanceRow2.y, 0.0), \
+                         vec4(obInstanceRow0.z, obInstanceRow1.z, obInstanceRow2.z, 0.0), \
+                         vec4(obInstanceRow0.w, obInstanceRow1.w, obInstanceRow2.w, 1.0))
+#define NormalMatrix mat4(ob_normal_matrix(WorldMatrix))
 #endif
 #else
 // 128 bytes: exactly the smallest push-constant limit (lavapipe's).
+// NormalMatrix is there for custom effects; the standard shaders derive it
+// from WorldMatrix (ob_normal_matrix), as the instanced variant must.
 layout(push_constant, std430) uniform PerDraw {
     mat4 WorldMatrix;          // model -> camera-relative world
     mat4 NormalMatrix;         // inverse transpose of WorldMatrix's upper 3x3
 };
 #endif
+
+// The normal matrix of world matrix w: the cofactor matrix of its upper
+// 3x3 (det * inverse-transpose) times the determinant's sign, so normals
+// stay outward under a mirror, as the engine's ob_mat3_normal_cofactor
+// gives it; of that 3x3 divided by its largest entry first, so that
+// nothing under- or overflows at any scale. Its size means nothing:
+// normals through it go through ob_unit_normal.
+mat3 ob_normal_matrix(mat4 w)
+{
+    mat3 m = mat3(w);
+    vec3 a = max(abs(m[0]), max(abs(m[1]), abs(m[2])));
+    float big = max(a.x, max(a.y, a.z));
+    if (big > 0.0) m *= 1.0 / big;
+    vec3 c0 = cross(m[1], m[2]);
+    float s = dot(m[0], c0) < 0.0 ? -1.0 : 1.0;
+    return s * mat3(c0, cross(m[2], m[0]), cross(m[0], m[1]));
+}
 
 // normalize() of a zero vector is NaN; a zero scale produces zero normals,
 // and a NaN would poison the whole pixel (and blending around it).

@@ -51,6 +51,9 @@ layout(location = 4) out vec4 vTangent;    // world xyz, w = bitangent sign
 layout(location = 5) out float vHemisphere;
 #endif
 
+// The normal matrix is derived from WorldMatrix (ob_normal_matrix) on both
+// paths, so that one draw per entity and an instanced run give the same
+// pixels.
 void main()
 {
     vec4 world = WorldMatrix * vec4(inPosition, 1.0);
@@ -62,7 +65,7 @@ void main()
 #if defined(DEPTH_ONLY)
     vNormal = vec3(0.0);
 #else
-    vNormal = ob_unit_normal(mat3(NormalMatrix) * inNormal);
+    vNormal = ob_unit_normal(ob_normal_matrix(WorldMatrix) * inNormal);
 #endif
 #if defined(VERTEX_COLOR)
     vColor = inColor;
