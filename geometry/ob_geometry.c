@@ -186,6 +186,18 @@ static ob_geometry *create_procedural(const ob_geometry_desc *desc, ob_result *o
     return g;
 }
 
+ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *levels, uint32_t count)
+{
+    if (!level0 || (count && !levels)) return OB_ERR_INVALID_ARGUMENT;
+    for (uint32_t l = 0; l < count; l++) {
+        ob_result r = ob_mesh_deviation(level0, levels[l].mesh, &levels[l].error);
+        if (r != OB_OK) return r;
+        /* A coarser level is never claimed better than the one before. */
+        if (l > 0) levels[l].error = fmaxf(levels[l].error, levels[l - 1].error);
+    }
+    return OB_OK;
+}
+
 /* Checks desc's coarser levels (their errors and counts; each mesh as
  * level 0 is checked) and gathers every level's mesh into meshes. */
 static ob_result check_levels(const ob_geometry_desc *desc, const char *name, uint32_t per_primitive,

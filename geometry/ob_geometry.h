@@ -85,6 +85,12 @@ typedef struct ob_geometry_lod {
     float error;
 } ob_geometry_lod;
 
+/* Measures each level's error against level 0 (ob_mesh_deviation), kept
+ * at least the level before's so the chain is valid for
+ * ob_geometry_desc.lods. Fails as ob_mesh_deviation does (OB_ERR_LIMIT for
+ * meshes too large to measure; levels[].error then unset). */
+ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *levels, uint32_t count);
+
 typedef struct ob_geometry_desc {
     const ob_mesh *mesh;
     const char *name;       /* copied; NULL → "geometry". Used in logs and debug names */

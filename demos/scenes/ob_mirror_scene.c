@@ -161,13 +161,9 @@ static ob_geometry *shape_geometry(ob_demo *d, int k, bool lods, ob_result *out_
     uint32_t count = lods && k != 0 ? OB_MIRROR_SCENE_SHAPE_LODS : 1;
     ob_geometry *g = NULL;
     ob_result r = OB_OK;
-    for (uint32_t l = 0; l < count && r == OB_OK; l++) {
-        if ((r = shape_mesh(k, l, &meshes[l])) != OB_OK || l == 0) continue;
-        levels[l - 1].mesh = &meshes[l];
-        r = ob_mesh_deviation(&meshes[0], &meshes[l], &levels[l - 1].error);
-        /* A coarser level is never claimed better than the one before. */
-        if (l > 1) levels[l - 1].error = fmaxf(levels[l - 1].error, levels[l - 2].error);
-    }
+    for (uint32_t l = 0; l < count && r == OB_OK; l++)
+        if ((r = shape_mesh(k, l, &meshes[l])) == OB_OK && l > 0) levels[l - 1].mesh = &meshes[l];
+    if (r == OB_OK) r = ob_geometry_measure_lods(&meshes[0], levels, count - 1);
     if (r == OB_OK) {
         ob_geometry_desc gd = {.mesh = &meshes[0], .name = shape_names[k], .lods = levels,
                                .lod_count = count - 1};

@@ -2,14 +2,18 @@
  * small file arrives as it says (entities, materials, lights, camera,
  * particles, settings) and renders; a missing model is reported with the
  * file and the entity and the rest renders; a malformed file gives the file
- * and the JSON path and leaves the scene untouched; and a failure at any
+ * and the JSON path and leaves the scene untouched; a generator's "lods"
+ * gives its geometry that many coarser levels; and a failure at any
  * allocation or Vulkan creation during a load leaves nothing in the scene
  * and nothing leaked. */
+#define _POSIX_C_SOURCE 200809L
 #include "ob_test.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "ob_scene_load.h"
 
@@ -392,6 +396,55 @@ static void test_load_malformed_leaves_scene(void **state)
     ob_stack_destroy(s);
 }
 
+/* "lods" on a generator: the geometry carries that many coarser levels,
+ * fewer where the segments reach their minimum (a cone of 8 slices: 5,
+ * then 3); the same generator with other lods is another geometry; the
+ * frame renders. */
+static void test_load_generator_lods(void **state)
+{
+    (void)state;
+    static const char text[] =
+        "{\"camera\": {\"position\": [0, 1, 6], \"target\": [0, 0, 0]},\n"
+        " \"entities\": [\n"
+        "  {\"name\": \"ball\", \"geometry\": {\"generator\": \"sphere\", \"lods\": 3}},\n"
+        "  {\"name\": \"plain\", \"geometry\": {\"generator\": \"sphere\"},\n"
+        "   \"transform\": {\"position\": [1.5, 0, 0]}},\n"
+        "  {\"name\": \"cone\", \"geometry\": {\"generator\": \"cone\", \"slices\": 8, \"lods\": 7},\n"
+        "   \"transform\": {\"position\": [-1.5, 0, 0]}},\n"
+        "  {\"name\": \"ring\", \"geometry\": {\"generator\": \"torus\", \"lods\": 2},\n"
+        "   \"transform\": {\"position\": [0, 1.5, 0]}}]}\n";
+    char dir[] = "/tmp/ob-test-lods-XXXXXX", path[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/lods.json", dir);
+    assert_int_equal(ob_file_write(path, text, sizeof text - 1), OB_OK);
+    ob_stack *s = make_stack(NULL);
+    ob_scene_loaded l;
+    ob_scene_file_error err;
+    ob_result r = ob_scene_load_stack(s, &(ob_scene_load_desc){.path = path}, &l, &err);
+    if (r != OB_OK) fail_msg("load failed: %s", err.message);
+    assert_int_equal(l.geometry_count, 4);
+    static const uint32_t levels[] = {4, 1, 3, 3};
+    for (uint32_t i = 0; i < 4; i++) {
+        const ob_renderable *rd = ob_node_get_renderable(l.entities[i]);
+        const ob_geometry *g = rd->geometry;
+        if (ob_geometry_lod_count(g) != levels[i])
+            fail_msg("%s: %u levels, expected %u", ob_node_name(l.entities[i]),
+                     ob_geometry_lod_count(g), levels[i]);
+        for (uint32_t k = 1; k < levels[i]; k++) {
+            assert_true(ob_geometry_lod_error(g, k) > 0.0f);
+            assert_true(ob_geometry_lod_error(g, k) >= ob_geometry_lod_error(g, k - 1));
+            assert_true(ob_geometry_lod_index_count(g, k) < ob_geometry_lod_index_count(g, k - 1));
+        }
+    }
+    uint8_t *rgba = render_rgba(s);
+    free(rgba);
+    ob_renderer_wait_idle(s->renderer);
+    ob_scene_unload(&l);
+    ob_stack_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
 /* Every fault point of one kind during a load in turn: a load that fails
  * says so with the file, leaves the scene's node count and its camera as
  * they were, and the next load (unarmed) still renders. A fault inside the
@@ -480,6 +533,7 @@ int main(void)
         cmocka_unit_test(test_load_gltf_hierarchy),
         cmocka_unit_test(test_load_frames_without_camera),
         cmocka_unit_test(test_load_malformed_leaves_scene),
+        cmocka_unit_test(test_load_generator_lods),
         cmocka_unit_test(test_load_host_faults),
         cmocka_unit_test(test_load_vk_faults),
     };

@@ -386,17 +386,17 @@ static bool parse_materials(sf_ctx *c, const cJSON *j)
 typedef struct generator_info {
     const char *name;
     ob_scene_file_geometry_kind kind;
-    const char *keys[5];
+    const char *keys[6];
     uint32_t key_count;
 } generator_info;
 
 static const generator_info generators[] = {
     {"box", OB_SCENE_GEOMETRY_BOX, {"generator", "size"}, 2},
-    {"sphere", OB_SCENE_GEOMETRY_SPHERE, {"generator", "radius", "slices", "stacks"}, 4},
+    {"sphere", OB_SCENE_GEOMETRY_SPHERE, {"generator", "radius", "slices", "stacks", "lods"}, 5},
     {"plane", OB_SCENE_GEOMETRY_PLANE, {"generator", "width", "depth", "subdivisions"}, 4},
-    {"cone", OB_SCENE_GEOMETRY_CONE, {"generator", "radius", "height", "slices"}, 4},
+    {"cone", OB_SCENE_GEOMETRY_CONE, {"generator", "radius", "height", "slices", "lods"}, 5},
     {"torus", OB_SCENE_GEOMETRY_TORUS,
-     {"generator", "major_radius", "minor_radius", "major_segments", "minor_segments"}, 5},
+     {"generator", "major_radius", "minor_radius", "major_segments", "minor_segments", "lods"}, 6},
 };
 
 static bool parse_model(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
@@ -471,7 +471,8 @@ static bool parse_generator(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g
         g->segments[0] = 32, g->segments[1] = 16;
         return ob_json_opt_float(&c->rd, j, "radius", OB_JSON_POSITIVE, &g->radius) &&
                ob_json_opt_u32(&c->rd, j, "slices", 3, max, &g->segments[0]) &&
-               ob_json_opt_u32(&c->rd, j, "stacks", 2, max, &g->segments[1]);
+               ob_json_opt_u32(&c->rd, j, "stacks", 2, max, &g->segments[1]) &&
+               ob_json_opt_u32(&c->rd, j, "lods", 0, OB_SCENE_FILE_MAX_LODS, &g->lods);
     case OB_SCENE_GEOMETRY_PLANE:
         g->width = g->depth = 10.0f;
         g->segments[0] = 1;
@@ -484,7 +485,8 @@ static bool parse_generator(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g
         g->segments[0] = 32;
         return ob_json_opt_float(&c->rd, j, "radius", OB_JSON_POSITIVE, &g->radius) &&
                ob_json_opt_float(&c->rd, j, "height", OB_JSON_POSITIVE, &g->height) &&
-               ob_json_opt_u32(&c->rd, j, "slices", 3, max, &g->segments[0]);
+               ob_json_opt_u32(&c->rd, j, "slices", 3, max, &g->segments[0]) &&
+               ob_json_opt_u32(&c->rd, j, "lods", 0, OB_SCENE_FILE_MAX_LODS, &g->lods);
     case OB_SCENE_GEOMETRY_TORUS:
         g->major_radius = 0.5f;
         g->minor_radius = 0.15f;
@@ -492,7 +494,8 @@ static bool parse_generator(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g
         if (!ob_json_opt_float(&c->rd, j, "major_radius", OB_JSON_POSITIVE, &g->major_radius) ||
             !ob_json_opt_float(&c->rd, j, "minor_radius", OB_JSON_POSITIVE, &g->minor_radius) ||
             !ob_json_opt_u32(&c->rd, j, "major_segments", 3, max, &g->segments[0]) ||
-            !ob_json_opt_u32(&c->rd, j, "minor_segments", 3, max, &g->segments[1]))
+            !ob_json_opt_u32(&c->rd, j, "minor_segments", 3, max, &g->segments[1]) ||
+            !ob_json_opt_u32(&c->rd, j, "lods", 0, OB_SCENE_FILE_MAX_LODS, &g->lods))
             return false;
         if (!(g->minor_radius < g->major_radius)) {
             ob_json_push_key(&c->rd, ob_json_member(j, "minor_radius") ? "minor_radius" : "major_radius");
@@ -886,7 +889,8 @@ bool ob_scene_file_geometry_equal(const ob_scene_file_geometry *a, const ob_scen
     return memcmp(a->size, b->size, sizeof a->size) == 0 && a->radius == b->radius &&
            a->height == b->height && a->width == b->width && a->depth == b->depth &&
            a->major_radius == b->major_radius && a->minor_radius == b->minor_radius &&
-           a->segments[0] == b->segments[0] && a->segments[1] == b->segments[1];
+           a->segments[0] == b->segments[0] && a->segments[1] == b->segments[1] &&
+           a->lods == b->lods;
 }
 
 const char *ob_scene_file_geometry_kind_name(ob_scene_file_geometry_kind kind)

@@ -131,6 +131,10 @@ typedef enum ob_scene_file_geometry_kind {
 /* A generator's parameters (defaults filled in) or a resolved model path.
  * Two entities whose geometry descriptions compare equal
  * (ob_scene_file_geometry_equal) can share one uploaded geometry. */
+/* Coarser levels of detail a generator may ask for ("lods"): all a geometry
+ * holds besides level 0 (OB_GEOMETRY_MAX_LODS - 1, checked by the loader). */
+#define OB_SCENE_FILE_MAX_LODS 7u
+
 typedef struct ob_scene_file_geometry {
     ob_scene_file_geometry_kind kind;
     float size[3];                /* box: full extents */
@@ -140,6 +144,7 @@ typedef struct ob_scene_file_geometry {
     float major_radius, minor_radius;  /* torus */
     uint32_t segments[2];         /* sphere: slices, stacks; cone: slices, 0;
                                      plane: subdivisions, 0; torus: major, minor */
+    uint32_t lods;                /* sphere, cone, torus: coarser levels of detail */
     char *model;                  /* MODEL: the path as the loader gets it */
     bool model_relative;          /* MODEL: the file gave a relative path (joined to its folder) */
 } ob_scene_file_geometry;

@@ -77,6 +77,24 @@ static void material_path(const ob_scene_file_material *m, char *buf, size_t siz
 
 /* ------------------------------------------------------------ geometry */
 
+static ob_result generate_mesh(const ob_scene_file_geometry *g, ob_mesh *mesh);
+
+_Static_assert(OB_SCENE_FILE_MAX_LODS == OB_GEOMETRY_MAX_LODS - 1,
+               "a scene file asks for as many levels as a geometry holds");
+
+/* The generator's mesh at level of detail `level`: level 0 as the file
+ * gives it, each level after with 0.6 times the segments of the one before
+ * (at least the generator's minimum). */
+static ob_result generate_mesh_level(const ob_scene_file_geometry *g, uint32_t level, ob_mesh *mesh)
+{
+    ob_scene_file_geometry c = *g;
+    double f = pow(0.6, level);
+    uint32_t least[2] = {3, g->kind == OB_SCENE_GEOMETRY_SPHERE ? 2u : 3u};
+    for (int k = 0; k < 2; k++)
+        if (c.segments[k]) c.segments[k] = OB_MAX(least[k], (uint32_t)lround(c.segments[k] * f));
+    return generate_mesh(&c, mesh);
+}
+
 static ob_result generate_mesh(const ob_scene_file_geometry *g, ob_mesh *mesh)
 {
     switch (g->kind) {
@@ -112,6 +130,44 @@ static ob_result left_out(loader *L, const ob_scene_file_entity *e, ob_result wh
     return OB_OK;
 }
 
+/* The coarser levels the entity's generator asks for ("lods"), generated
+ * into mesh[1..] and measured into lods; how many. Levels that would repeat
+ * the one before (the segments at their minimum) are not made. A level that
+ * cannot be made or measured (a mesh too large for ob_mesh_deviation) is
+ * logged naming the file and the entity, and the geometry goes on with the
+ * levels before it. */
+static uint32_t entity_lods(loader *L, const ob_scene_file_entity *e, ob_mesh mesh[OB_GEOMETRY_MAX_LODS],
+                            ob_geometry_lod lods[OB_GEOMETRY_MAX_LODS - 1])
+{
+    const ob_scene_file_geometry *g = &e->geometry;
+    if (!g->lods) return 0;
+    ob_mesh level0 = {0};
+    ob_result r = generate_mesh(g, &level0);
+    uint32_t n = 0;
+    for (uint32_t l = 1; l <= g->lods && r == OB_OK; l++) {
+        ob_mesh *m = &mesh[n + 1];
+        if ((r = generate_mesh_level(g, l, m)) != OB_OK) break;
+        const ob_mesh *before = n ? &mesh[n] : &level0;
+        if (m->index_count == before->index_count) {
+            ob_mesh_release(m);
+            break;
+        }
+        lods[n].mesh = m;
+        if ((r = ob_geometry_measure_lods(&level0, &lods[n], 1)) != OB_OK) {
+            ob_mesh_release(m);
+            break;
+        }
+        if (n) lods[n].error = fmaxf(lods[n].error, lods[n - 1].error);
+        n++;
+    }
+    ob_mesh_release(&level0);
+    if (r != OB_OK)
+        OB_LOG_W(LOG_MODULE, "%s: entities[%u] '%s': level of detail %u of %u not made (%s); the "
+                 "geometry has %u", L->sf->path ? L->sf->path : "scene", e->index, e->name, n + 1,
+                 g->lods, ob_result_name(r), n + 1);
+    return n;
+}
+
 /* The entity's geometry, uploaded once per distinct description into *out_g.
  * *out_g NULL with OB_OK: its model did not load (reported, left out). */
 static ob_result entity_geometry(loader *L, const ob_scene_file_entity *e, ob_geometry **out_g)
@@ -130,16 +186,18 @@ static ob_result entity_geometry(loader *L, const ob_scene_file_entity *e, ob_ge
                              sizeof *o->geometry);
     if (r != OB_OK) return fail(L, r, "", "out of memory");
 
-    ob_mesh mesh = {0};
+    ob_mesh mesh[OB_GEOMETRY_MAX_LODS] = {{0}};
+    ob_geometry_lod lods[OB_GEOMETRY_MAX_LODS - 1] = {{0}};
     ob_geometry *g = NULL;
-    r = generate_mesh(&e->geometry, &mesh);
+    uint32_t levels = entity_lods(L, e, mesh, lods);
+    r = generate_mesh(&e->geometry, &mesh[0]);
     if (r == OB_OK) {
         uint32_t id = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
-        ob_geometry_desc gd = {.mesh = &mesh, .name = ob_scene_file_geometry_kind_name(e->geometry.kind),
-                               .id = id};
+        ob_geometry_desc gd = {.mesh = &mesh[0], .name = ob_scene_file_geometry_kind_name(e->geometry.kind),
+                               .id = id, .lods = lods, .lod_count = levels};
         g = ob_geometry_create(ob_renderer_device(L->t.renderer), &gd, &r);
     }
-    ob_mesh_release(&mesh);
+    for (uint32_t l = 0; l < OB_GEOMETRY_MAX_LODS; l++) ob_mesh_release(&mesh[l]);
     if (!g) {
         char path[48];
         snprintf(path, sizeof path, "entities[%u].geometry", e->index);
