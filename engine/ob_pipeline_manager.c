@@ -332,26 +332,27 @@ void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeli
     pm->program = program;
 }
 
-/* Whether the world's 3x3 mirrors: the sign of its determinant, in double
- * (a product of three float columns neither underflows nor overflows). */
-static bool world_mirrors(const float world_normal[32])
+/* Whether the 3x3 whose entry (row r, column c) is w[c * col + r * row]
+ * mirrors: the sign of its determinant, in double (a product of three
+ * float columns neither underflows nor overflows). */
+static bool det3_negative(const float *w, int col, int row)
 {
-    const float *w = world_normal;
-    double a[3] = {w[0], w[1], w[2]}, b[3] = {w[4], w[5], w[6]}, c[3] = {w[8], w[9], w[10]};
+    double a[3], b[3], c[3];
+    for (int r = 0; r < 3; r++) {
+        a[r] = w[r * row];
+        b[r] = w[col + r * row];
+        c[r] = w[2 * col + r * row];
+    }
     double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
                  a[2] * (b[0] * c[1] - b[1] * c[0]);
     return det < 0.0;
 }
 
+/* The per-draw block's world matrix (column-major 4x4) mirrors. */
+static bool world_mirrors(const float world_normal[32]) { return det3_negative(world_normal, 4, 1); }
+
 /* The same of a per-instance block (three rows of the world matrix). */
-static bool rows_mirror(const float rows[OB_INSTANCE_FLOATS])
-{
-    const float *w = rows;
-    double a[3] = {w[0], w[4], w[8]}, b[3] = {w[1], w[5], w[9]}, c[3] = {w[2], w[6], w[10]};
-    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
-                 a[2] * (b[0] * c[1] - b[1] * c[0]);
-    return det < 0.0;
-}
+static bool rows_mirror(const float rows[OB_INSTANCE_FLOATS]) { return det3_negative(rows, 1, 4); }
 
 void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {

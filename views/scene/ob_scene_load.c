@@ -130,42 +130,36 @@ static ob_result left_out(loader *L, const ob_scene_file_entity *e, ob_result wh
     return OB_OK;
 }
 
-/* The coarser levels the entity's generator asks for ("lods"), generated
- * into mesh[1..] and measured into lods; how many. Levels that would repeat
- * the one before (the segments at their minimum) are not made. A level that
- * cannot be made or measured (a mesh too large for ob_mesh_deviation) is
- * logged naming the file and the entity, and the geometry goes on with the
- * levels before it. */
+/* The coarser levels the entity's generator asks for ("lods") of level 0
+ * in mesh[0], generated into mesh[1..] and measured into lods; how many.
+ * Levels that would repeat the one before (the segments at their minimum)
+ * are not made. Levels that cannot be made or measured (a mesh too large
+ * for ob_mesh_deviation: the first level, the largest, fails first) are
+ * logged naming the file and the entity, and the geometry goes on without
+ * levels. */
 static uint32_t entity_lods(loader *L, const ob_scene_file_entity *e, ob_mesh mesh[OB_GEOMETRY_MAX_LODS],
                             ob_geometry_lod lods[OB_GEOMETRY_MAX_LODS - 1])
 {
     const ob_scene_file_geometry *g = &e->geometry;
     if (!g->lods) return 0;
-    ob_mesh level0 = {0};
-    ob_result r = generate_mesh(g, &level0);
+    ob_result r = OB_OK;
     uint32_t n = 0;
-    for (uint32_t l = 1; l <= g->lods && r == OB_OK; l++) {
+    while (r == OB_OK && n < g->lods) {
         ob_mesh *m = &mesh[n + 1];
-        if ((r = generate_mesh_level(g, l, m)) != OB_OK) break;
-        const ob_mesh *before = n ? &mesh[n] : &level0;
-        if (m->index_count == before->index_count) {
+        if ((r = generate_mesh_level(g, n + 1, m)) != OB_OK) break;
+        if (m->index_count == mesh[n].index_count) {
             ob_mesh_release(m);
             break;
         }
-        lods[n].mesh = m;
-        if ((r = ob_geometry_measure_lods(&level0, &lods[n], 1)) != OB_OK) {
-            ob_mesh_release(m);
-            break;
-        }
-        if (n) lods[n].error = fmaxf(lods[n].error, lods[n - 1].error);
-        n++;
+        lods[n++].mesh = m;
     }
-    ob_mesh_release(&level0);
-    if (r != OB_OK)
-        OB_LOG_W(LOG_MODULE, "%s: entities[%u] '%s': level of detail %u of %u not made (%s); the "
-                 "geometry has %u", L->sf->path ? L->sf->path : "scene", e->index, e->name, n + 1,
-                 g->lods, ob_result_name(r), n + 1);
-    return n;
+    if (r == OB_OK) r = ob_geometry_measure_lods(&mesh[0], lods, n);
+    if (r == OB_OK) return n;
+    OB_LOG_W(LOG_MODULE, "%s: entities[%u] '%s': its %u levels of detail not made (%s); the "
+             "geometry has level 0 only", L->sf->path ? L->sf->path : "scene", e->index, e->name,
+             g->lods, ob_result_name(r));
+    for (uint32_t l = 1; l < OB_GEOMETRY_MAX_LODS; l++) ob_mesh_release(&mesh[l]);
+    return 0;
 }
 
 /* The entity's geometry, uploaded once per distinct description into *out_g.
@@ -189,9 +183,9 @@ static ob_result entity_geometry(loader *L, const ob_scene_file_entity *e, ob_ge
     ob_mesh mesh[OB_GEOMETRY_MAX_LODS] = {{0}};
     ob_geometry_lod lods[OB_GEOMETRY_MAX_LODS - 1] = {{0}};
     ob_geometry *g = NULL;
-    uint32_t levels = entity_lods(L, e, mesh, lods);
     r = generate_mesh(&e->geometry, &mesh[0]);
     if (r == OB_OK) {
+        uint32_t levels = entity_lods(L, e, mesh, lods);
         uint32_t id = L->desc->first_geometry_id ? L->desc->first_geometry_id + L->ids_used : 0;
         ob_geometry_desc gd = {.mesh = &mesh[0], .name = ob_scene_file_geometry_kind_name(e->geometry.kind),
                                .id = id, .lods = lods, .lod_count = levels};
