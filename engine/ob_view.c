@@ -152,15 +152,17 @@ typedef struct cull_chunk {
     uint32_t far[CULL_LOG_MAX];         /* the first ones, snapshot indices */
 } cull_chunk;
 
-/* What culling knows of one geometry (by its scene index): its levels of
- * detail, each level's error over the bound radius and the mesh field of
- * its keys. Asked of the geometry interface once per wave. */
+/* What culling knows of one geometry (by its scene index): each level of
+ * detail's error over the bound radius and the mesh field of its keys.
+ * Asked of the geometry interface once per wave. */
 typedef struct cull_geometry {
-    uint32_t levels;                    /* 1: level 0 only */
     /* Levels 1.. (entry l - 1 for level l); +infinity past the last, so
      * that every geometry is tested over the same lanes. */
     float rel_error[OB_LOD_MAX - 1];
-    uint32_t mesh[OB_LOD_MAX];
+    /* The mesh id shifted by three bits: level l keys as mesh | l, next to
+     * its level 0, so a run never mixes levels and small ids (a stack's)
+     * keep few differing bits for the sort. */
+    uint32_t mesh;
 } cull_geometry;
 
 /* A pair's index holds the snapshot index below this bit and the level of
@@ -303,7 +305,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
                 }
             }
             pairs[out->kept++] = (ob_sort_pair){
-                .key = item_key(m->sort_hi, m->state, g->mesh[level], d2[j]),
+                .key = item_key(m->sort_hi, m->state, g->mesh | level, d2[j]),
                 .hi = m->sort_hi,
                 .index = i | level << CULL_LOD_SHIFT,
             };
@@ -535,27 +537,23 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         struct ob_geometry *g = ob_scene_geometry(scene, k);
         cull_geometry *cg = &geo[k];
         float rel[OB_LOD_MAX] = {0};
-        cg->levels = 1;
-        uint32_t id = 0;
+        uint32_t levels = 1, id = 0;
         if (gi && g) {
             id = gi->id(g);
-            if (gi->lods) cg->levels = OB_MIN(OB_MAX(gi->lods(g, rel), 1u), OB_LOD_MAX);
+            if (gi->lods) levels = OB_MIN(OB_MAX(gi->lods(g, rel), 1u), OB_LOD_MAX);
         }
         /* A level's error not a number, or below the one before, ends the
          * chain there: culling never picks what it cannot compare. */
         rel[0] = 0.0f;
-        for (uint32_t l = 1; l < cg->levels; l++)
+        for (uint32_t l = 1; l < levels; l++)
             if (!(rel[l] >= rel[l - 1]) || !isfinite(rel[l])) {
-                cg->levels = l;
+                levels = l;
                 break;
             }
         for (uint32_t l = 1; l < OB_LOD_MAX; l++)
-            cg->rel_error[l - 1] = l < cg->levels ? rel[l] : INFINITY;
-        /* Each level keys as its own mesh, next to its level 0, so a run
-         * never mixes levels and small ids (a stack's) keep few differing
-         * bits for the sort. */
+            cg->rel_error[l - 1] = l < levels ? rel[l] : INFINITY;
         _Static_assert(OB_LOD_MAX == 8u, "three bits of the mesh field hold the level");
-        for (uint32_t l = 0; l < OB_LOD_MAX; l++) cg->mesh[l] = id << 3 | l;
+        cg->mesh = id << 3;
     }
     ob_parallel par = ob_renderer_parallel(r);
     uint32_t entities = 0;
