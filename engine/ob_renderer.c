@@ -128,7 +128,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     }
     if (d.worker_count > OB_MAX_WORKERS) d.worker_count = OB_MAX_WORKERS;
     r->worker_count = d.worker_count;
-    r->chunk_draws = d.chunk_draws ? d.chunk_draws : 2048;
+    r->chunk_draws = d.chunk_draws;   /* 0: build_jobs sizes jobs per frame */
     r->parallel_grain = d.parallel_grain;
     r->no_affinity = d.no_thread_affinity;
     r->gpu_timing = d.gpu_timing;

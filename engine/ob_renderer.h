@@ -92,7 +92,9 @@ typedef struct ob_renderer_desc {
     ob_device_desc device;
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
     ob_threading threading;      /* initial mode */
-    uint32_t chunk_draws;        /* target draws per job when splitting a view; 0 → 2048 */
+    /* Target draws per job when splitting a view. 0 → sized per frame:
+     * the frame's draws over 4 jobs per active thread, at least 2048. */
+    uint32_t chunk_draws;
     /* Entities (nodes) per index of the parallel loops of PreRender and of
      * ob_renderer_update_scene; a loop goes to the pool only when each
      * thread gets two indices' worth. 0 → 4096 for culling, 1024 for the

@@ -50,6 +50,7 @@ typedef struct run_plan {
     ob_threading modes[FRAMES];
     uint32_t workers[FRAMES];
     ob_ring_staging staging;   /* 0: the device's */
+    bool sized_jobs;           /* the renderer sizes its jobs (chunk_draws 0), not 64 draws */
 } run_plan;
 
 static uint32_t next_random(uint32_t *s)
@@ -127,7 +128,8 @@ static void run(const run_plan *plan, run_result *out)
     ob_test_world w;
     ob_test_world_create(&w, &(ob_test_world_desc){.workers = 8, .width = WIDTH,
                                                    .height = HEIGHT, .env_map_size = 32,
-                                                   .shadow_map_size = 128, .chunk_draws = 64,
+                                                   .shadow_map_size = 128,
+                                                   .chunk_draws = plan->sized_jobs ? 0 : 64,
                                                    .parallel_grain = 16,
                                                    .env_map_kind = plan->env,
                                                    .ring_staging = plan->staging});
@@ -316,6 +318,27 @@ static void staged_ring_same_frames_as_direct(void **state)
     same_as_reference(&direct, plans, OB_ARRAY_COUNT(plans));
 }
 
+/* Jobs sized by the renderer (the default) rather than 64 draws each: a
+ * view is cut by the frame's draws per thread, or by its last recording
+ * time (the main view here, slow on lavapipe), and the frames are the same
+ * as ever. */
+static void renderer_sized_jobs_same_frames(void **state)
+{
+    (void)state;
+    run_plan st_plan = constant_plan("single-threaded", OB_THREADING_SINGLE, 0);
+    run_plan plans[] = {constant_plan("sized jobs, 2 workers", OB_THREADING_MULTI, 2),
+                        constant_plan("sized jobs, 8 workers", OB_THREADING_MULTI, 8)};
+    run_result ref, got;
+    run(&st_plan, &ref);
+    for (size_t k = 0; k < OB_ARRAY_COUNT(plans); k++) {
+        plans[k].sized_jobs = true;
+        run(&plans[k], &got);
+        assert_same(&ref, &got, plans[k].name);
+        release(&got);
+    }
+    release(&ref);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -324,6 +347,7 @@ int main(void)
         cmocka_unit_test(switching_mode_every_frame_changes_nothing),
         cmocka_unit_test(cube_env_maps_same_in_every_threading_mode),
         cmocka_unit_test(staged_ring_same_frames_as_direct),
+        cmocka_unit_test(renderer_sized_jobs_same_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
