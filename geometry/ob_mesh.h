@@ -159,6 +159,27 @@ ob_result ob_mesh_torus(float major_radius, float minor_radius, uint32_t major_s
 #define OB_MESH_DEVIATION_MAX_TESTS (1ull << 28)
 ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out);
 
+/* A coarser copy of a triangle-list mesh, for a level of detail
+ * (ob_geometry_lod): edges are collapsed cheapest first, one end onto the
+ * other, costed by the summed squared distances to the original planes
+ * around them (quadric error metrics, Garland & Heckbert 1997), until at
+ * most target_index_count indices are left or the next collapse would cost
+ * more than max_error (INFINITY: no bound). Every output vertex is an input
+ * vertex, with its normal, uv, tangent, colour and second uv, so textures
+ * and shading carry over. Kept in place: vertices on a seam (several
+ * vertices at one position), on a border or on a non-manifold edge, so the
+ * outline and the uv charts stay; a collapse that would fold the surface
+ * (the link condition) or turn a triangle over is skipped. Deterministic.
+ * *out_error (may be NULL): the square root of the costliest collapse made,
+ * in the mesh's units, which bounds how far a moved vertex lies from the
+ * planes it left; ob_mesh_deviation measures the real distance where the
+ * mesh is small enough. *out is a new mesh (ob_mesh_release it), a copy of
+ * the input when nothing could be collapsed. Errors: ob_mesh_validate's,
+ * OB_ERR_INVALID_ARGUMENT for a NULL out or a negative or NaN max_error,
+ * OB_ERR_OUT_OF_HOST_MEMORY; *out is then zeroed. [any thread] */
+ob_result ob_mesh_simplify(const ob_mesh *in, uint32_t target_index_count, float max_error,
+                           ob_mesh *out, float *out_error);
+
 /* One triangle covering clip space [-1,1]² at z=0 — positions (-1,-1),
  * (3,-1), (-1,3) with uv (0,0), (2,0), (0,2) so uv spans 0..1 on screen
  * (uv 0,0 at the top-left in Vulkan). Normal +Z. Its winding flips with
