@@ -3,6 +3,7 @@
 
 #include "ob_renderer_layer.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -195,6 +196,59 @@ ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *level
         /* A coarser level is never claimed better than the one before. */
         if (l > 0) levels[l].error = fmaxf(levels[l].error, levels[l - 1].error);
     }
+    return OB_OK;
+}
+
+/* Whether ob_mesh_deviation takes a and b (its test count, as it counts). */
+static bool deviation_affordable(const ob_mesh *a, const ob_mesh *b)
+{
+    uint64_t ta = a->index_count / 3, tb = b->index_count / 3;
+    uint64_t tests = ((uint64_t)a->vertex_count + 4 * ta) * tb +
+                     ((uint64_t)b->vertex_count + 4 * tb) * ta;
+    return tests <= OB_MESH_DEVIATION_MAX_TESTS;
+}
+
+ob_result ob_geometry_make_lods(const ob_mesh *level0, uint32_t count, ob_mesh *meshes,
+                                ob_geometry_lod *levels, uint32_t *out_count)
+{
+    if (out_count) *out_count = 0;
+    if (!level0 || !out_count || (count && (!meshes || !levels))) return OB_ERR_INVALID_ARGUMENT;
+    if (count > OB_GEOMETRY_MAX_LODS - 1) {
+        OB_LOG_E(OB_GEOMETRY_LOG, "make_lods: %u levels asked for; at most %u besides level 0",
+                 count, OB_GEOMETRY_MAX_LODS - 1);
+        return OB_ERR_LIMIT;
+    }
+    uint32_t n = 0;
+    ob_result r = OB_OK;
+    const ob_mesh *before = level0;
+    while (n < count) {
+        ob_mesh *m = &meshes[n];
+        float estimate = 0.0f;
+        r = ob_mesh_simplify(before, before->index_count / 2, INFINITY, m, &estimate);
+        if (r != OB_OK) break;
+        /* Seams and borders left too little to collapse: no level. */
+        if ((uint64_t)m->index_count * 10 > (uint64_t)before->index_count * 9) {
+            ob_mesh_release(m);
+            break;
+        }
+        /* Unmeasured, the estimate is against the level before: add its error. */
+        float error = estimate + (n > 0 ? levels[n - 1].error : 0.0f);
+        if (deviation_affordable(level0, m) && (r = ob_mesh_deviation(level0, m, &error)) != OB_OK) {
+            ob_mesh_release(m);
+            break;
+        }
+        /* Never claimed better than the level before, and > 0 as a level's
+         * error must be (a flat region collapses at no cost). */
+        if (n > 0) error = fmaxf(error, levels[n - 1].error);
+        levels[n] = (ob_geometry_lod){.mesh = m, .error = fmaxf(error, FLT_MIN)};
+        before = m;
+        n++;
+    }
+    if (r != OB_OK) {
+        for (uint32_t l = 0; l < n; l++) ob_mesh_release(&meshes[l]);
+        return r;
+    }
+    *out_count = n;
     return OB_OK;
 }
 

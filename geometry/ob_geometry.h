@@ -91,6 +91,20 @@ typedef struct ob_geometry_lod {
  * meshes too large to measure; levels[].error then unset). */
 ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *levels, uint32_t count);
 
+/* Up to `count` coarser levels of level0 made by ob_mesh_simplify, each
+ * with half the indices of the one before, into meshes[0..] (release each)
+ * and levels[0..] (their meshes and errors, ready for ob_geometry_desc);
+ * *out_count how many. Stops early, with fewer, where a level would keep
+ * more than nine tenths of the one before (seams and borders stay, so a
+ * mesh of split vertices makes none). Errors are measured with
+ * ob_mesh_deviation where it takes the meshes, else the simplifier's
+ * estimate (larger than the measured error, so such levels switch late);
+ * kept non-decreasing and > 0. Errors: OB_ERR_LIMIT over
+ * OB_GEOMETRY_MAX_LODS - 1 levels, OB_ERR_INVALID_ARGUMENT, and
+ * ob_mesh_simplify's (no level then left allocated). [any thread] */
+ob_result ob_geometry_make_lods(const ob_mesh *level0, uint32_t count, ob_mesh *meshes,
+                                ob_geometry_lod *levels, uint32_t *out_count);
+
 typedef struct ob_geometry_desc {
     const ob_mesh *mesh;
     const char *name;       /* copied; NULL → "geometry". Used in logs and debug names */

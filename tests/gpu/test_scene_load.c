@@ -445,6 +445,57 @@ static void test_load_generator_lods(void **state)
     rmdir(dir);
 }
 
+/* "lods" on a model: each primitive gets coarser levels made by
+ * ob_mesh_simplify (Debian's Wuson OBJ, skipped saying so without
+ * assimp-testmodels); the same model without them is another geometry,
+ * drawn at level 0; both render. */
+static void test_load_model_lods(void **state)
+{
+    (void)state;
+    const char *model = "/usr/share/assimp/models/OBJ/WusonOBJ.obj";
+    if (access(model, R_OK) != 0) {
+        print_message("SKIP: %s is missing (install Debian's assimp-testmodels)\n", model);
+        return;
+    }
+    char text[512];
+    snprintf(text, sizeof text,
+             "{\"camera\": {\"position\": [0, 1, 6], \"target\": [0, 0, 0]},\n"
+             " \"entities\": [\n"
+             "  {\"name\": \"far\", \"geometry\": {\"model\": \"%s\", \"lods\": 3}},\n"
+             "  {\"name\": \"near\", \"geometry\": {\"model\": \"%s\"},\n"
+             "   \"transform\": {\"position\": [2, 0, 0]}}]}\n", model, model);
+    char dir[] = "/tmp/ob-test-model-lods-XXXXXX", path[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/lods.json", dir);
+    assert_int_equal(ob_file_write(path, text, strlen(text)), OB_OK);
+    ob_stack *s = make_stack(NULL);
+    ob_scene_loaded l;
+    ob_scene_file_error err;
+    ob_result r = ob_scene_load_stack(s, &(ob_scene_load_desc){.path = path}, &l, &err);
+    if (r != OB_OK) fail_msg("load failed: %s", err.message);
+    assert_int_equal(l.model_count, 2);   /* one file, asked for with and without levels */
+    ob_node *far = NULL, *near = NULL;
+    assert_int_equal(renderables_below(l.entities[0], &far), 1);
+    assert_int_equal(renderables_below(l.entities[1], &near), 1);
+    const ob_geometry *g = ob_node_get_renderable(far)->geometry;
+    assert_int_equal(ob_geometry_lod_count(g), 4);
+    for (uint32_t k = 1; k < 4; k++) {
+        assert_true(ob_geometry_lod_error(g, k) > 0.0f);
+        assert_true(ob_geometry_lod_error(g, k) >= ob_geometry_lod_error(g, k - 1));
+        print_message("level %u: %u indices, error %g\n", k, ob_geometry_lod_index_count(g, k),
+                      (double)ob_geometry_lod_error(g, k));
+        assert_true(ob_geometry_lod_index_count(g, k) * 10 <= ob_geometry_lod_index_count(g, k - 1) * 9);
+    }
+    assert_int_equal(ob_geometry_lod_count(ob_node_get_renderable(near)->geometry), 1);
+    uint8_t *rgba = render_rgba(s);
+    free(rgba);
+    ob_renderer_wait_idle(s->renderer);
+    ob_scene_unload(&l);
+    ob_stack_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
 /* Every fault point of one kind during a load in turn: a load that fails
  * says so with the file, leaves the scene's node count and its camera as
  * they were, and the next load (unarmed) still renders. A fault inside the
@@ -534,6 +585,7 @@ int main(void)
         cmocka_unit_test(test_load_frames_without_camera),
         cmocka_unit_test(test_load_malformed_leaves_scene),
         cmocka_unit_test(test_load_generator_lods),
+        cmocka_unit_test(test_load_model_lods),
         cmocka_unit_test(test_load_host_faults),
         cmocka_unit_test(test_load_vk_faults),
     };

@@ -423,6 +423,8 @@ static const bad_case bad_cases[] = {
      "expected an integer from 0 to 7, got 8"},
     {"{" E "[{\"geometry\": {\"generator\": \"box\", \"lods\": 2}}]}", "entities[0].geometry.lods",
      "unknown key"},
+    {"{" E "[{\"geometry\": {\"model\": \"a.obj\", \"lods\": -1}}]}", "entities[0].geometry.lods",
+     "expected an integer from 0 to 7, got -1"},
     {"{" E "[{\"geometry\": {\"generator\": \"torus\", \"minor_radius\": 0.6}}]}",
      "entities[0].geometry.minor_radius", "must be smaller than major_radius"},
     {"{" E "[{\"geometry\": {\"generator\": \"box\", \"size\": -1}}]}", "entities[0].geometry.size",

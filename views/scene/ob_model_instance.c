@@ -25,6 +25,7 @@ struct ob_model_assets {
     ob_model *model;
     char *name;
     uint32_t first_geometry_id;
+    uint32_t lods;              /* desc.lods, at most OB_GEOMETRY_MAX_LODS - 1 */
     ob_material **materials;          /* per model material, NULL when no primitive uses it */
     uint8_t *material_variant;        /* per model material: the VARIANT_* layout its effects read */
     ob_geometry *(*geometry)[VARIANT_COUNT];   /* per primitive */
@@ -165,6 +166,7 @@ ob_model_assets *ob_model_assets_create(const ob_model_assets_desc *desc, ob_mod
     a->textures = desc->textures;
     a->model = model;
     a->first_geometry_id = desc->first_geometry_id;
+    a->lods = OB_MIN(desc->lods, OB_GEOMETRY_MAX_LODS - 1);
     a->name = ob_strdup(desc->name ? desc->name : base_name(model->path));
     a->materials = ob_calloc(model->material_count, sizeof *a->materials);
     a->material_variant = ob_calloc(model->material_count, sizeof *a->material_variant);
@@ -243,10 +245,26 @@ static ob_geometry *variant(ob_model_assets *a, uint32_t p, uint32_t v, ob_resul
                  "TEXCOORD_0 stands in", a->model->path, p, prim->name);
     char name[160];
     snprintf(name, sizeof name, "%s/%s", a->name, prim->name);
+    ob_mesh level_meshes[OB_GEOMETRY_MAX_LODS - 1] = {{0}};
+    ob_geometry_lod lods[OB_GEOMETRY_MAX_LODS - 1] = {{0}};
+    uint32_t levels = 0;
+    if (a->lods) {
+        ob_result lr = ob_geometry_make_lods(&mesh, a->lods, level_meshes, lods, &levels);
+        if (lr != OB_OK)
+            OB_LOG_W(LOG_MODULE, "%s: primitive %u '%s': its levels of detail could not be made "
+                     "(%s); drawn at full detail", a->model->path, p, prim->name,
+                     ob_result_name(lr));
+        else if (levels < a->lods)
+            OB_LOG_I(LOG_MODULE, "%s: primitive %u '%s': %u of the %u levels of detail asked "
+                     "for (its seams and borders stay)", a->model->path, p, prim->name, levels,
+                     a->lods);
+    }
     ob_geometry_desc gd = {.mesh = &mesh, .name = name, .extended = (v & VARIANT_EXTENDED) != 0,
                            .texcoord1 = (v & VARIANT_TEXCOORD1) != 0,
-                           .id = a->first_geometry_id ? a->first_geometry_id + p * VARIANT_COUNT + v : 0};
+                           .id = a->first_geometry_id ? a->first_geometry_id + p * VARIANT_COUNT + v : 0,
+                           .lods = lods, .lod_count = levels};
     ob_geometry *g = ob_geometry_create(ob_renderer_device(a->renderer), &gd, out_result);
+    for (uint32_t l = 0; l < levels; l++) ob_mesh_release(&level_meshes[l]);
     if (!g) {
         OB_LOG_E(LOG_MODULE, "%s: primitive %u '%s' could not be uploaded: %s", a->model->path, p,
                  prim->name, ob_result_name(*out_result));

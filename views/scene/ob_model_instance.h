@@ -93,6 +93,11 @@ typedef struct ob_model_assets_desc {
      * OB_MODEL_ASSETS_IDS_PER_PRIMITIVE × primitive_count ids whatever is
      * uploaded; 0 → each derived from its contents. */
     uint32_t first_geometry_id;
+    /* Coarser levels of detail made for each primitive (0..7,
+     * ob_geometry_make_lods: each half the triangles of the one before);
+     * a primitive that cannot have them is drawn at level 0, with a
+     * warning naming the file and the primitive. */
+    uint32_t lods;
 } ob_model_assets_desc;
 
 /* Takes `model` (closed by ob_model_assets_destroy, or here on failure) and

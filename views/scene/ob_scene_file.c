@@ -401,8 +401,10 @@ static const generator_info generators[] = {
 
 static bool parse_model(sf_ctx *c, const cJSON *j, ob_scene_file_geometry *g)
 {
-    static const char *const keys[] = {"model"};
-    if (!ob_json_check_object(&c->rd, j, "an object", keys, 1)) return false;
+    static const char *const keys[] = {"model", "lods"};
+    if (!ob_json_check_object(&c->rd, j, "an object", keys, 2) ||
+        !ob_json_opt_u32(&c->rd, j, "lods", 0, OB_SCENE_FILE_MAX_LODS, &g->lods))
+        return false;
     size_t mark = ob_json_push_key(&c->rd, "model");
     const char *p = ob_json_string(&c->rd, ob_json_member(j, "model"), "a model file path");
     if (!p) return false;
@@ -885,7 +887,7 @@ void ob_scene_file_release(ob_scene_file *sf)
 bool ob_scene_file_geometry_equal(const ob_scene_file_geometry *a, const ob_scene_file_geometry *b)
 {
     if (a->kind != b->kind) return false;
-    if (a->kind == OB_SCENE_GEOMETRY_MODEL) return strcmp(a->model, b->model) == 0;
+    if (a->kind == OB_SCENE_GEOMETRY_MODEL) return strcmp(a->model, b->model) == 0 && a->lods == b->lods;
     return memcmp(a->size, b->size, sizeof a->size) == 0 && a->radius == b->radius &&
            a->height == b->height && a->width == b->width && a->depth == b->depth &&
            a->major_radius == b->major_radius && a->minor_radius == b->minor_radius &&

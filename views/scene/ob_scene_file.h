@@ -144,7 +144,7 @@ typedef struct ob_scene_file_geometry {
     float major_radius, minor_radius;  /* torus */
     uint32_t segments[2];         /* sphere: slices, stacks; cone: slices, 0;
                                      plane: subdivisions, 0; torus: major, minor */
-    uint32_t lods;                /* sphere, cone, torus: coarser levels of detail */
+    uint32_t lods;                /* sphere, cone, torus, model: coarser levels of detail */
     char *model;                  /* MODEL: the path as the loader gets it */
     bool model_relative;          /* MODEL: the file gave a relative path (joined to its folder) */
 } ob_scene_file_geometry;

@@ -265,7 +265,8 @@ static ob_result entity_model(loader *L, const ob_scene_file_entity *e, ob_model
             }
         }
         ob_model_assets_desc ad = {.renderer = L->t.renderer, .materials = L->t.materials,
-                                   .textures = o->textures, .first_geometry_id = first};
+                                   .textures = o->textures, .first_geometry_id = first,
+                                   .lods = e->geometry.lods};
         a = ob_model_assets_create(&ad, model, &r);   /* takes the model */
         /* A model that reads but whose materials cannot be made is left out
          * like one that does not read; the library's error says why. */
