@@ -400,6 +400,20 @@ static void test_load_malformed_leaves_scene(void **state)
  * fewer where the segments reach their minimum (a cone of 8 slices: 5,
  * then 3); the same generator with other lods is another geometry; the
  * frame renders. */
+/* A loaded scene renders a frame; then it, the stack and the scene file
+ * written for the test (path, in its own folder dir) go. */
+static void render_and_clean_up(ob_stack *s, ob_scene_loaded *l, const char *path, const char *dir)
+{
+    uint8_t *rgba = render_rgba(s);
+    assert_non_null(rgba);
+    free(rgba);
+    ob_renderer_wait_idle(s->renderer);
+    ob_scene_unload(l);
+    ob_stack_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
 static void test_load_generator_lods(void **state)
 {
     (void)state;
@@ -436,13 +450,7 @@ static void test_load_generator_lods(void **state)
             assert_true(ob_geometry_lod_index_count(g, k) < ob_geometry_lod_index_count(g, k - 1));
         }
     }
-    uint8_t *rgba = render_rgba(s);
-    free(rgba);
-    ob_renderer_wait_idle(s->renderer);
-    ob_scene_unload(&l);
-    ob_stack_destroy(s);
-    remove(path);
-    rmdir(dir);
+    render_and_clean_up(s, &l, path, dir);
 }
 
 /* "lods" on a model: each primitive gets coarser levels made by
@@ -487,13 +495,7 @@ static void test_load_model_lods(void **state)
         assert_true(ob_geometry_lod_index_count(g, k) * 10 <= ob_geometry_lod_index_count(g, k - 1) * 9);
     }
     assert_int_equal(ob_geometry_lod_count(ob_node_get_renderable(near)->geometry), 1);
-    uint8_t *rgba = render_rgba(s);
-    free(rgba);
-    ob_renderer_wait_idle(s->renderer);
-    ob_scene_unload(&l);
-    ob_stack_destroy(s);
-    remove(path);
-    rmdir(dir);
+    render_and_clean_up(s, &l, path, dir);
 }
 
 /* Every fault point of one kind during a load in turn: a load that fails
