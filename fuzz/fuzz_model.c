@@ -15,7 +15,8 @@
  * buffer view. ob_model_load_mesh takes a path, so the
  * bytes are written to a file in a per-process temporary folder first.
  * A successful load must give a mesh that passes ob_mesh_validate and has
- * finite bounds; a failed one must leave the mesh empty. A successful open
+ * finite bounds, and simplified (ob_mesh_simplify) a valid mesh no larger;
+ * a failed one must leave the mesh empty. A successful open
  * must give a model keeping every promise of ob_model.h (parents first,
  * indices in range, finite transforms, unit tangents where normal maps
  * are); a failed one must hand out NULL. Anything else, and any sanitizer
@@ -320,6 +321,27 @@ static void gen_gltf(const char *path, const uint8_t *data, size_t size)
     free(t.s);
 }
 
+/* Levels of detail from what the loader gave (ob_mesh_simplify), for
+ * meshes small enough to keep an input fast: a valid mesh of at most as
+ * many indices, every vertex one of the input's; or a refusal (a mesh of
+ * degenerate triangles only) that hands out nothing. */
+static void check_simplified(const ob_mesh *mesh)
+{
+    if (mesh->index_count > 30000) return;
+    ob_mesh lod;
+    float error = -1.0f;
+    ob_result r = ob_mesh_simplify(mesh, mesh->index_count / 4, INFINITY, &lod, &error);
+    if (r != OB_OK) {
+        if (lod.vertices || lod.indices || lod.vertex_count || lod.index_count) abort();
+        if (r != OB_ERR_INVALID_ARGUMENT) abort();
+        return;
+    }
+    if (ob_mesh_validate(&lod, "fuzz lod") != OB_OK || lod.index_count > mesh->index_count ||
+        lod.vertex_count > mesh->vertex_count || !(error >= 0.0f) || !isfinite(lod.bounds.radius))
+        abort();
+    ob_mesh_release(&lod);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1) return 0;
@@ -339,6 +361,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ob_result r = ob_model_load_mesh(&(ob_model_desc){.path = path}, &mesh, &info);
     if (r == OB_OK) {
         check_mesh(&mesh, &info);
+        check_simplified(&mesh);
         ob_mesh_release(&mesh);
     } else if (mesh.vertices || mesh.indices || mesh.vertex_count || mesh.index_count) {
         abort(); /* a failed load hands out nothing */

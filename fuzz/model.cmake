@@ -1,7 +1,7 @@
 # fuzz/model.cmake — the libFuzzer target for the model loader (fuzz_model)
 # and its bounded ctest run, included from fuzz/CMakeLists.txt (which the
 # top level adds when OB_FUZZ is ON). Needs clang. The loader and what it uses (engine/ob_core.c,
-# geometry/ob_mesh.c, geometry/ob_model*.c) are compiled again for this
+# geometry/ob_mesh.c, geometry/ob_mesh_simplify.c, geometry/ob_model*.c) are compiled again for this
 # target with coverage instrumentation (stb too: ob_model_open reads image
 # headers and encodes raw embedded textures) (-fsanitize=fuzzer-no-link) and
 # ASan + UBSan, whatever OB_SANITIZE says, so findings in our code are
@@ -19,6 +19,7 @@ add_library(ob_fuzz_model_lib STATIC
             ${OB_FUZZ_ROOT}/engine/ob_core.c
             ${OB_FUZZ_ROOT}/engine/ob_stb_impl.c
             ${OB_FUZZ_ROOT}/geometry/ob_mesh.c
+            ${OB_FUZZ_ROOT}/geometry/ob_mesh_simplify.c
             ${OB_FUZZ_MODEL_SOURCES})
 target_include_directories(ob_fuzz_model_lib PUBLIC ${OB_FUZZ_ROOT}/engine
                                                     ${OB_FUZZ_ROOT}/geometry ${STB_INCLUDE_DIR})

@@ -169,14 +169,16 @@ ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out);
  * and shading carry over. Kept in place: vertices on a seam (several
  * vertices at one position), on a border or on a non-manifold edge, so the
  * outline and the uv charts stay; a collapse that would fold the surface
- * (the link condition) or turn a triangle over is skipped. Deterministic.
+ * (the link condition) or turn a triangle over is skipped. Triangles with
+ * two corners at one point draw nothing and are dropped. Deterministic.
  * *out_error (may be NULL): the square root of the costliest collapse made,
  * in the mesh's units, which bounds how far a moved vertex lies from the
  * planes it left; ob_mesh_deviation measures the real distance where the
  * mesh is small enough. *out is a new mesh (ob_mesh_release it), a copy of
  * the input when nothing could be collapsed. Errors: ob_mesh_validate's,
- * OB_ERR_INVALID_ARGUMENT for a NULL out or a negative or NaN max_error,
- * OB_ERR_OUT_OF_HOST_MEMORY; *out is then zeroed. [any thread] */
+ * OB_ERR_INVALID_ARGUMENT for a NULL out, a negative or NaN max_error or
+ * a mesh of degenerate triangles only, OB_ERR_OUT_OF_HOST_MEMORY; *out is
+ * then zeroed. [any thread] */
 ob_result ob_mesh_simplify(const ob_mesh *in, uint32_t target_index_count, float max_error,
                            ob_mesh *out, float *out_error);
 

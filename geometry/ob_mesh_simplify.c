@@ -375,11 +375,29 @@ ob_result ob_mesh_simplify(const ob_mesh *in, uint32_t target_index_count, float
         goto done;
     }
     memcpy(s.tris, in->indices, sizeof *s.tris * 3 * tris);
-    if ((r = classify(&s)) != OB_OK || (r = lock_borders(&s)) != OB_OK) goto done;
+    if ((r = classify(&s)) != OB_OK) goto done;
+    /* Triangles with two corners at one point draw nothing: dropped, so no
+     * edge of zero length is ever a candidate (it would collapse a vertex
+     * onto itself and take all its triangles). */
+    uint32_t kept = 0;
+    for (uint32_t t = 0; t < tris; t++) {
+        const uint32_t *v = &s.tris[3 * t];
+        uint32_t a = s.cls[v[0]], b = s.cls[v[1]], c = s.cls[v[2]];
+        if (a == b || b == c || a == c) continue;
+        memmove(&s.tris[3 * kept++], v, 3 * sizeof *v);
+    }
+    s.tri_count = kept;
+    if (kept == 0) {
+        OB_LOG_E(SIMPLIFY_LOG, "simplify: every one of the %u triangles has two corners at one "
+                 "point; nothing to simplify", tris);
+        r = OB_ERR_INVALID_ARGUMENT;
+        goto done;
+    }
+    if ((r = lock_borders(&s)) != OB_OK) goto done;
     /* Each class's quadric: the planes of the triangles around it, each
      * once (unweighted, so the error bounds a distance); degenerate
      * triangles have no plane. */
-    for (uint32_t t = 0; t < tris; t++) {
+    for (uint32_t t = 0; t < s.tri_count; t++) {
         const uint32_t *v = &s.tris[3 * t];
         double nrm[3];
         tri_normal(pos(&s, v[0]), pos(&s, v[1]), pos(&s, v[2]), nrm);

@@ -231,6 +231,51 @@ static void bad_input_refused(void **state)
     ob_mesh_release(&m);
 }
 
+/* Topology a loader can hand over: a triangle with two corners at one
+ * vertex or one point, a triangle twice, the same one wound the other way,
+ * and a stray triangle across the sphere sharing its vertices. The result
+ * is a valid mesh with none of the degenerate ones, fewer triangles, and
+ * the stray's non-manifold edges kept; a mesh of degenerate triangles only
+ * is refused. */
+static void hostile_topology_stays_valid(void **state)
+{
+    (void)state;
+    ob_mesh sphere;
+    assert_int_equal(ob_mesh_sphere(1.0f, 24, 12, &sphere), OB_OK);
+    uint32_t n = sphere.index_count, extra[] = {
+        5, 5, 40,                                  /* two corners at one vertex */
+        sphere.indices[30], sphere.indices[31], sphere.indices[32],   /* twice */
+        sphere.indices[62], sphere.indices[61], sphere.indices[60],   /* wound back */
+        30, 100, 200,                              /* a stray across the inside */
+    };
+    uint32_t *idx = ob_malloc(sizeof *idx * (n + OB_ARRAY_COUNT(extra)));
+    assert_non_null(idx);
+    memcpy(idx, sphere.indices, sizeof *idx * n);
+    memcpy(idx + n, extra, sizeof extra);
+    ob_free(sphere.indices);
+    sphere.indices = idx;
+    sphere.index_count = n + (uint32_t)OB_ARRAY_COUNT(extra);
+    ob_mesh lod;
+    assert_int_equal(ob_mesh_simplify(&sphere, n / 3, INFINITY, &lod, NULL), OB_OK);
+    assert_int_equal(ob_mesh_validate(&lod, "hostile lod"), OB_OK);
+    assert_true(lod.index_count < n);
+    for (uint32_t t = 0; t < lod.index_count / 3; t++) {
+        const uint32_t *v = &lod.indices[3 * t];
+        const float *a = lod.vertices[v[0]].position, *b = lod.vertices[v[1]].position,
+                    *c = lod.vertices[v[2]].position;
+        assert_false(!memcmp(a, b, 12) || !memcmp(b, c, 12) || !memcmp(a, c, 12));
+    }
+    ob_mesh_release(&lod);
+
+    /* Degenerate triangles only. */
+    uint32_t flat[6] = {0, 0, 1, 2, 3, 3};
+    ob_mesh only = {.vertices = sphere.vertices, .vertex_count = sphere.vertex_count,
+                    .indices = flat, .index_count = 6};
+    assert_int_equal(ob_mesh_simplify(&only, 0, INFINITY, &lod, NULL), OB_ERR_INVALID_ARGUMENT);
+    assert_null(lod.indices);
+    ob_mesh_release(&sphere);
+}
+
 static void no_memory_leaves_nothing(void **state)
 {
     (void)state;
@@ -263,6 +308,7 @@ int main(void)
         cmocka_unit_test(attributes_carried_and_deterministic),
         cmocka_unit_test(real_model_simplifies),
         cmocka_unit_test(bad_input_refused),
+        cmocka_unit_test(hostile_topology_stays_valid),
         cmocka_unit_test(no_memory_leaves_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
