@@ -199,15 +199,6 @@ ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *level
     return OB_OK;
 }
 
-/* Whether ob_mesh_deviation takes a and b (its test count, as it counts). */
-static bool deviation_affordable(const ob_mesh *a, const ob_mesh *b)
-{
-    uint64_t ta = a->index_count / 3, tb = b->index_count / 3;
-    uint64_t tests = ((uint64_t)a->vertex_count + 4 * ta) * tb +
-                     ((uint64_t)b->vertex_count + 4 * tb) * ta;
-    return tests <= OB_MESH_DEVIATION_MAX_TESTS;
-}
-
 ob_result ob_geometry_make_lods(const ob_mesh *level0, uint32_t count, ob_mesh *meshes,
                                 ob_geometry_lod *levels, uint32_t *out_count)
 {
@@ -223,17 +214,15 @@ ob_result ob_geometry_make_lods(const ob_mesh *level0, uint32_t count, ob_mesh *
     const ob_mesh *before = level0;
     while (n < count) {
         ob_mesh *m = &meshes[n];
-        float estimate = 0.0f;
-        r = ob_mesh_simplify(before, before->index_count / 2, INFINITY, m, &estimate);
+        r = ob_mesh_simplify(before, before->index_count / 2, INFINITY, m, NULL);
         if (r != OB_OK) break;
         /* Seams and borders left too little to collapse: no level. */
         if ((uint64_t)m->index_count * 10 > (uint64_t)before->index_count * 9) {
             ob_mesh_release(m);
             break;
         }
-        /* Unmeasured, the estimate is against the level before: add its error. */
-        float error = estimate + (n > 0 ? levels[n - 1].error : 0.0f);
-        if (deviation_affordable(level0, m) && (r = ob_mesh_deviation(level0, m, &error)) != OB_OK) {
+        float error = 0.0f;
+        if ((r = ob_mesh_deviation(level0, m, &error)) != OB_OK) {
             ob_mesh_release(m);
             break;
         }

@@ -87,8 +87,8 @@ typedef struct ob_geometry_lod {
 
 /* Measures each level's error against level 0 (ob_mesh_deviation), kept
  * at least the level before's so the chain is valid for
- * ob_geometry_desc.lods. Fails as ob_mesh_deviation does (OB_ERR_LIMIT for
- * meshes too large to measure; levels[].error then unset). */
+ * ob_geometry_desc.lods. Fails as ob_mesh_deviation does (levels[].error
+ * then unset). */
 ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *levels, uint32_t count);
 
 /* Up to `count` coarser levels of level0 made by ob_mesh_simplify, each
@@ -96,12 +96,11 @@ ob_result ob_geometry_measure_lods(const ob_mesh *level0, ob_geometry_lod *level
  * and levels[0..] (their meshes and errors, ready for ob_geometry_desc);
  * *out_count how many. Stops early, with fewer, where a level would keep
  * more than nine tenths of the one before (seams and borders stay, so a
- * mesh of split vertices makes none). Errors are measured with
- * ob_mesh_deviation where it takes the meshes, else the simplifier's
- * estimate (larger than the measured error, so such levels switch late);
- * kept non-decreasing and > 0. Errors: OB_ERR_LIMIT over
- * OB_GEOMETRY_MAX_LODS - 1 levels, OB_ERR_INVALID_ARGUMENT, and
- * ob_mesh_simplify's (no level then left allocated). [any thread] */
+ * mesh of split vertices makes none). Each level's error is measured
+ * against level0 with ob_mesh_deviation, kept non-decreasing and > 0.
+ * Errors: OB_ERR_LIMIT over OB_GEOMETRY_MAX_LODS - 1 levels,
+ * OB_ERR_INVALID_ARGUMENT, ob_mesh_simplify's and ob_mesh_deviation's (no
+ * level then left allocated). [any thread] */
 ob_result ob_geometry_make_lods(const ob_mesh *level0, uint32_t count, ob_mesh *meshes,
                                 ob_geometry_lod *levels, uint32_t *out_count);
 

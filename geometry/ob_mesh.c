@@ -714,24 +714,180 @@ static float point_triangle_d2(const float p[3], const float a[3], const float b
     return v3_dot(d, d);
 }
 
-static float nearest_d2(const float p[3], const ob_mesh *m)
+/* A uniform grid of cube cells over a mesh's triangles: cell c lists (CSR)
+ * every triangle whose bounding box touches it, so the nearest triangle to
+ * a point is found by searching rings of cells outward from the point's
+ * instead of testing every triangle. */
+typedef struct tri_grid {
+    const ob_mesh *m;
+    float lo[3], cell;
+    uint32_t dim[3];
+    uint32_t *start, *tris;   /* cell c's triangles: tris[start[c] .. start[c + 1]) */
+    uint32_t *stamp;          /* per triangle: the last query that tested it */
+    uint32_t serial;
+} tri_grid;
+
+/* Cells per axis at most: 128^3 cells (8 MiB of offsets) for the largest
+ * meshes; about one triangle a cell on a surface for smaller ones. */
+#define GRID_MAX_DIM 128u
+
+static uint32_t grid_axis(const tri_grid *g, float v, int k)
 {
+    float f = (v - g->lo[k]) / g->cell;
+    if (!(f > 0.0f)) return 0;
+    uint32_t i = f >= (float)g->dim[k] ? g->dim[k] - 1 : (uint32_t)f;
+    return i;
+}
+
+static size_t grid_cell(const tri_grid *g, uint32_t x, uint32_t y, uint32_t z)
+{
+    return ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
+}
+
+static void grid_release(tri_grid *g)
+{
+    ob_free(g->start);
+    ob_free(g->tris);
+    ob_free(g->stamp);
+    memset(g, 0, sizeof *g);
+}
+
+static void tri_box(const ob_mesh *m, uint32_t t, float lo[3], float hi[3])
+{
+    for (int k = 0; k < 3; k++) lo[k] = hi[k] = m->vertices[m->indices[3 * t]].position[k];
+    for (int c = 1; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            float v = m->vertices[m->indices[3 * t + c]].position[k];
+            lo[k] = fminf(lo[k], v);
+            hi[k] = fmaxf(hi[k], v);
+        }
+}
+
+static ob_result grid_build(tri_grid *g, const ob_mesh *m)
+{
+    memset(g, 0, sizeof *g);
+    g->m = m;
+    uint32_t tris = m->index_count / 3;
+    float hi[3];
+    for (int k = 0; k < 3; k++) g->lo[k] = hi[k] = m->vertices[m->indices[0]].position[k];
+    for (uint32_t t = 0; t < tris; t++) {
+        float a[3], b[3];
+        tri_box(m, t, a, b);
+        for (int k = 0; k < 3; k++) {
+            g->lo[k] = fminf(g->lo[k], a[k]);
+            hi[k] = fmaxf(hi[k], b[k]);
+        }
+    }
+    float extent = fmaxf(fmaxf(hi[0] - g->lo[0], hi[1] - g->lo[1]), hi[2] - g->lo[2]);
+    uint32_t per_axis = (uint32_t)ceil(sqrt((double)tris));
+    per_axis = per_axis < 1 ? 1 : per_axis > GRID_MAX_DIM ? GRID_MAX_DIM : per_axis;
+    g->cell = extent > 0.0f ? extent / (float)per_axis : 1.0f;
+    size_t cells = 1;
+    for (int k = 0; k < 3; k++) {
+        double n = ceil((double)(hi[k] - g->lo[k]) / g->cell);
+        g->dim[k] = n < 1.0 ? 1u : n > GRID_MAX_DIM ? GRID_MAX_DIM : (uint32_t)n;
+        cells *= g->dim[k];
+    }
+    g->start = ob_calloc(cells + 1, sizeof *g->start);
+    g->stamp = ob_calloc(tris, sizeof *g->stamp);
+    if (!g->start || !g->stamp) goto no_memory;
+    /* Count, then fill, each triangle into the cells its box touches. */
+    uint64_t total = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t t = 0; t < tris; t++) {
+            float a[3], b[3];
+            tri_box(m, t, a, b);
+            uint32_t c0[3], c1[3];
+            for (int k = 0; k < 3; k++) {
+                c0[k] = grid_axis(g, a[k], k);
+                c1[k] = grid_axis(g, b[k], k);
+            }
+            for (uint32_t z = c0[2]; z <= c1[2]; z++)
+                for (uint32_t y = c0[1]; y <= c1[1]; y++)
+                    for (uint32_t x = c0[0]; x <= c1[0]; x++) {
+                        size_t c = grid_cell(g, x, y, z);
+                        if (pass == 0) g->start[c + 1]++, total++;
+                        else g->tris[g->start[c]++] = t;
+                    }
+        }
+        if (pass == 0) {
+            if (total > UINT32_MAX) goto no_memory;
+            for (size_t c = 0; c < cells; c++) g->start[c + 1] += g->start[c];
+            if (!(g->tris = ob_malloc(sizeof *g->tris * (total ? total : 1)))) goto no_memory;
+        }
+    }
+    /* The fill moved each start to the next cell's: shift back. */
+    for (size_t c = cells; c > 0; c--) g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    return OB_OK;
+no_memory:
+    grid_release(g);
+    return OB_ERR_OUT_OF_HOST_MEMORY;
+}
+
+static float tri_d2(const tri_grid *g, const float p[3], uint32_t t)
+{
+    const ob_mesh *m = g->m;
+    return point_triangle_d2(p, m->vertices[m->indices[3 * t]].position,
+                             m->vertices[m->indices[3 * t + 1]].position,
+                             m->vertices[m->indices[3 * t + 2]].position);
+}
+
+/* The squared distance from p to the nearest triangle: rings of cells
+ * around p's (clamped into the grid), until no unvisited cell can hold a
+ * nearer one. A cell r rings out lies at least (r - 1) cells from p on one
+ * axis; one ring more is searched for the rounding of cell indices. */
+static float nearest_d2(tri_grid *g, const float p[3])
+{
+    uint32_t c[3], reach = 0;
+    for (int k = 0; k < 3; k++) {
+        c[k] = grid_axis(g, p[k], k);
+        uint32_t far = c[k] > g->dim[k] - 1 - c[k] ? c[k] : g->dim[k] - 1 - c[k];
+        if (far > reach) reach = far;
+    }
+    uint32_t query = ++g->serial;
     float best = INFINITY;
-    for (uint32_t t = 0; t + 2 < m->index_count; t += 3) {
-        float d2 = point_triangle_d2(p, m->vertices[m->indices[t]].position,
-                                     m->vertices[m->indices[t + 1]].position,
-                                     m->vertices[m->indices[t + 2]].position);
-        if (d2 < best) best = d2;
+    for (uint32_t r = 0; r <= reach; r++) {
+        if (r >= 2) {
+            float lb = (float)(r - 2) * g->cell;
+            if (lb * lb > best) break;
+        }
+        uint32_t lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            lo[k] = c[k] >= r ? c[k] - r : 0;
+            hi[k] = c[k] + r < g->dim[k] ? c[k] + r : g->dim[k] - 1;
+        }
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)
+            for (uint32_t y = lo[1]; y <= hi[1]; y++)
+                for (uint32_t x = lo[0]; x <= hi[0]; x++) {
+                    /* Only the ring's shell: the inside was searched. */
+                    uint32_t dx = x > c[0] ? x - c[0] : c[0] - x, dy = y > c[1] ? y - c[1] : c[1] - y,
+                             dz = z > c[2] ? z - c[2] : c[2] - z;
+                    uint32_t cheb = dx > dy ? dx : dy;
+                    if (dz > cheb) cheb = dz;
+                    if (cheb != r) continue;
+                    size_t cell = grid_cell(g, x, y, z);
+                    for (uint32_t i = g->start[cell]; i < g->start[cell + 1]; i++) {
+                        uint32_t t = g->tris[i];
+                        if (g->stamp[t] == query) continue;
+                        g->stamp[t] = query;
+                        float d2 = tri_d2(g, p, t);
+                        if (d2 < best) best = d2;
+                    }
+                }
     }
     return best;
 }
 
 /* The largest distance from a's sample points to b's surface, squared. */
-static float one_way_d2(const ob_mesh *a, const ob_mesh *b)
+static ob_result one_way_d2(const ob_mesh *a, const ob_mesh *b, float *out)
 {
+    tri_grid g;
+    ob_result r = grid_build(&g, b);
+    if (r != OB_OK) return r;
     float worst = 0.0f;
     for (uint32_t i = 0; i < a->vertex_count; i++)
-        worst = fmaxf(worst, nearest_d2(a->vertices[i].position, b));
+        worst = fmaxf(worst, nearest_d2(&g, a->vertices[i].position));
     for (uint32_t t = 0; t + 2 < a->index_count; t += 3) {
         const float *p[3] = {a->vertices[a->indices[t]].position,
                              a->vertices[a->indices[t + 1]].position,
@@ -739,12 +895,14 @@ static float one_way_d2(const ob_mesh *a, const ob_mesh *b)
         float q[3];
         for (int e = 0; e < 3; e++) {
             for (int k = 0; k < 3; k++) q[k] = 0.5f * (p[e][k] + p[(e + 1) % 3][k]);
-            worst = fmaxf(worst, nearest_d2(q, b));
+            worst = fmaxf(worst, nearest_d2(&g, q));
         }
         for (int k = 0; k < 3; k++) q[k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0f;
-        worst = fmaxf(worst, nearest_d2(q, b));
+        worst = fmaxf(worst, nearest_d2(&g, q));
     }
-    return worst;
+    grid_release(&g);
+    *out = worst;
+    return OB_OK;
 }
 
 ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out)
@@ -754,16 +912,12 @@ ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out)
     ob_result r = ob_mesh_validate(a, "deviation: first mesh");
     if (r == OB_OK) r = ob_mesh_validate(b, "deviation: second mesh");
     if (r != OB_OK) return r;
-    uint64_t ta = a->index_count / 3, tb = b->index_count / 3;
-    uint64_t tests = ((uint64_t)a->vertex_count + 4 * ta) * tb +
-                     ((uint64_t)b->vertex_count + 4 * tb) * ta;
-    if (tests > OB_MESH_DEVIATION_MAX_TESTS) {
-        OB_LOG_E("mesh", "deviation of meshes of %llu and %llu triangles: %llu tests, over the "
-                 "%llu allowed; give the level's error yourself", (unsigned long long)ta,
-                 (unsigned long long)tb, (unsigned long long)tests,
-                 (unsigned long long)OB_MESH_DEVIATION_MAX_TESTS);
-        return OB_ERR_LIMIT;
+    float ab = 0.0f, ba = 0.0f;
+    if ((r = one_way_d2(a, b, &ab)) != OB_OK || (r = one_way_d2(b, a, &ba)) != OB_OK) {
+        OB_LOG_E(OB_MESH_LOG, "deviation of meshes of %u and %u triangles: no memory for the "
+                 "search grid", a->index_count / 3, b->index_count / 3);
+        return r;
     }
-    *out = sqrtf(fmaxf(one_way_d2(a, b), one_way_d2(b, a)));
+    *out = sqrtf(fmaxf(ab, ba));
     return OB_OK;
 }

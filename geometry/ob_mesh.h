@@ -151,12 +151,12 @@ ob_result ob_mesh_torus(float major_radius, float minor_radius, uint32_t major_s
 /* How far apart two triangle-list meshes' surfaces are, both ways: the
  * largest distance from a point of one (its vertices, edge midpoints and
  * triangle centroids) to the nearest triangle of the other, in *out. The
- * error of a level of detail (ob_geometry_lod.error) against level 0. Brute
- * force: (points of a × triangles of b + the other way round) distance
- * tests, refused over OB_MESH_DEVIATION_MAX_TESTS (OB_ERR_LIMIT, logged):
- * meant for the small meshes levels of detail save most on. Either mesh
- * failing ob_mesh_validate: its error. */
-#define OB_MESH_DEVIATION_MAX_TESTS (1ull << 28)
+ * error of a level of detail (ob_geometry_lod.error) against level 0. The
+ * nearest triangle is searched in a uniform grid over the other mesh (up to
+ * 128 cells an axis), exactly: the same figure as testing every triangle,
+ * in time near the points' count for meshes whose levels lie close.
+ * Errors: either mesh failing ob_mesh_validate (its error),
+ * OB_ERR_OUT_OF_HOST_MEMORY for the grid (logged). */
 ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out);
 
 /* A coarser copy of a triangle-list mesh, for a level of detail
@@ -173,8 +173,7 @@ ob_result ob_mesh_deviation(const ob_mesh *a, const ob_mesh *b, float *out);
  * two corners at one point draw nothing and are dropped. Deterministic.
  * *out_error (may be NULL): the square root of the costliest collapse made,
  * in the mesh's units, which bounds how far a moved vertex lies from the
- * planes it left; ob_mesh_deviation measures the real distance where the
- * mesh is small enough. *out is a new mesh (ob_mesh_release it), a copy of
+ * planes it left; ob_mesh_deviation measures the real distance. *out is a new mesh (ob_mesh_release it), a copy of
  * the input when nothing could be collapsed. Errors: ob_mesh_validate's,
  * OB_ERR_INVALID_ARGUMENT for a NULL out, a negative or NaN max_error or
  * a mesh of degenerate triangles only, OB_ERR_OUT_OF_HOST_MEMORY; *out is

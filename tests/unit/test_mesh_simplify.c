@@ -57,6 +57,133 @@ static void check_vertices_from(const ob_mesh *in, const ob_mesh *out)
     }
 }
 
+/* ---- ob_mesh_deviation against every triangle tested (test-side, double) */
+
+static double seg_d2(const double p[3], const double a[3], const double b[3])
+{
+    double ab[3], ap[3], t = 0.0, l = 0.0;
+    for (int k = 0; k < 3; k++) {
+        ab[k] = b[k] - a[k];
+        ap[k] = p[k] - a[k];
+        t += ab[k] * ap[k];
+        l += ab[k] * ab[k];
+    }
+    t = l > 0.0 ? fmin(fmax(t / l, 0.0), 1.0) : 0.0;
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+    return d2;
+}
+
+/* Squared distance from p to triangle abc: to its plane when p projects
+ * inside, else to the nearest edge. */
+static double ref_tri_d2(const double p[3], const float *fa, const float *fb, const float *fc)
+{
+    double a[3], b[3], c[3], u[3], v[3], w[3], n[3];
+    for (int k = 0; k < 3; k++) {
+        a[k] = fa[k], b[k] = fb[k], c[k] = fc[k];
+        u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = p[k] - a[k];
+    }
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (nn > 0.0) {
+        /* Barycentric coordinates of p's projection. */
+        double uu = 0, uv = 0, vv = 0, wu = 0, wv = 0;
+        for (int k = 0; k < 3; k++) {
+            uu += u[k] * u[k], uv += u[k] * v[k], vv += v[k] * v[k];
+            wu += w[k] * u[k], wv += w[k] * v[k];
+        }
+        double den = uv * uv - uu * vv, s = (uv * wv - vv * wu) / den, t = (uv * wu - uu * wv) / den;
+        if (s >= 0.0 && t >= 0.0 && s + t <= 1.0) {
+            double d = (n[0] * w[0] + n[1] * w[1] + n[2] * w[2]);
+            return d * d / nn;
+        }
+    }
+    return fmin(seg_d2(p, a, b), fmin(seg_d2(p, b, c), seg_d2(p, c, a)));
+}
+
+static double ref_nearest_d2(const double p[3], const ob_mesh *m)
+{
+    double best = INFINITY;
+    for (uint32_t t = 0; t < m->index_count; t += 3)
+        best = fmin(best, ref_tri_d2(p, m->vertices[m->indices[t]].position,
+                                     m->vertices[m->indices[t + 1]].position,
+                                     m->vertices[m->indices[t + 2]].position));
+    return best;
+}
+
+static double ref_one_way(const ob_mesh *a, const ob_mesh *b)
+{
+    double worst = 0.0, p[3];
+    for (uint32_t i = 0; i < a->vertex_count; i++) {
+        for (int k = 0; k < 3; k++) p[k] = a->vertices[i].position[k];
+        worst = fmax(worst, ref_nearest_d2(p, b));
+    }
+    for (uint32_t t = 0; t < a->index_count; t += 3) {
+        const float *q[3] = {a->vertices[a->indices[t]].position,
+                             a->vertices[a->indices[t + 1]].position,
+                             a->vertices[a->indices[t + 2]].position};
+        for (int e = 0; e < 3; e++) {
+            for (int k = 0; k < 3; k++) p[k] = 0.5 * ((double)q[e][k] + q[(e + 1) % 3][k]);
+            worst = fmax(worst, ref_nearest_d2(p, b));
+        }
+        for (int k = 0; k < 3; k++) p[k] = ((double)q[0][k] + q[1][k] + q[2][k]) / 3.0;
+        worst = fmax(worst, ref_nearest_d2(p, b));
+    }
+    return worst;
+}
+
+/* The grid search finds what testing every triangle finds: a sphere
+ * against its levels, a torus against a plane through it, a box against a
+ * far sphere (points outside the grid). */
+static void deviation_is_every_triangle_tested(void **state)
+{
+    (void)state;
+    ob_mesh sphere, torus, plane, box, far, lod;
+    const float half[3] = {0.5f, 0.5f, 0.5f};
+    assert_int_equal(ob_mesh_sphere(1.0f, 32, 16, &sphere), OB_OK);
+    assert_int_equal(ob_mesh_torus(1.0f, 0.3f, 24, 12, &torus), OB_OK);
+    assert_int_equal(ob_mesh_plane(3.0f, 3.0f, 7, &plane), OB_OK);
+    assert_int_equal(ob_mesh_box(half, &box), OB_OK);
+    assert_int_equal(ob_mesh_sphere(0.25f, 12, 6, &far), OB_OK);
+    for (uint32_t v = 0; v < far.vertex_count; v++) far.vertices[v].position[0] += 40.0f;
+    assert_int_equal(ob_mesh_simplify(&sphere, sphere.index_count / 5, INFINITY, &lod, NULL), OB_OK);
+    const ob_mesh *pairs[][2] = {{&sphere, &lod}, {&torus, &plane}, {&box, &far}, {&lod, &torus}};
+    for (size_t i = 0; i < OB_ARRAY_COUNT(pairs); i++) {
+        float got;
+        assert_int_equal(ob_mesh_deviation(pairs[i][0], pairs[i][1], &got), OB_OK);
+        double want = sqrt(fmax(ref_one_way(pairs[i][0], pairs[i][1]),
+                                ref_one_way(pairs[i][1], pairs[i][0])));
+        if (fabs(got - want) > 1e-5 * fmax(1.0, want))
+            fail_msg("pair %zu: deviation %.9g, every triangle tested %.9g", i, (double)got, want);
+    }
+    ob_mesh_release(&lod);
+    ob_mesh_release(&far);
+    ob_mesh_release(&box);
+    ob_mesh_release(&plane);
+    ob_mesh_release(&torus);
+    ob_mesh_release(&sphere);
+}
+
+/* A mesh that testing every triangle could not measure (some 10^10 tests;
+ * it was refused over 2^28) is measured: a 512 x 256 sphere against a level
+ * of an eighth. */
+static void deviation_of_a_large_mesh(void **state)
+{
+    (void)state;
+    ob_mesh sphere, lod;
+    assert_int_equal(ob_mesh_sphere(1.0f, 512, 256, &sphere), OB_OK);
+    assert_int_equal(ob_mesh_simplify(&sphere, sphere.index_count / 8, INFINITY, &lod, NULL), OB_OK);
+    float d = -1.0f;
+    assert_int_equal(ob_mesh_deviation(&sphere, &lod, &d), OB_OK);
+    assert_true(d > 0.0f && d < 0.01f);
+    print_message("512 x 256 sphere (%u triangles) to %u: deviation %.3g\n",
+                  sphere.index_count / 3, lod.index_count / 3, (double)d);
+    ob_mesh_release(&lod);
+    ob_mesh_release(&sphere);
+}
+
 static void sphere_levels_keep_the_shape(void **state)
 {
     (void)state;
@@ -302,6 +429,8 @@ int main(void)
 {
     ob_test_setup_log();
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(deviation_is_every_triangle_tested),
+        cmocka_unit_test(deviation_of_a_large_mesh),
         cmocka_unit_test(sphere_levels_keep_the_shape),
         cmocka_unit_test(flat_grid_keeps_its_outline),
         cmocka_unit_test(max_error_bounds_the_collapses),

@@ -133,8 +133,7 @@ static ob_result left_out(loader *L, const ob_scene_file_entity *e, ob_result wh
 /* The coarser levels the entity's generator asks for ("lods") of level 0
  * in mesh[0], generated into mesh[1..] and measured into lods; how many.
  * Levels that would repeat the one before (the segments at their minimum)
- * are not made. Levels that cannot be made or measured (a mesh too large
- * for ob_mesh_deviation: the first level, the largest, fails first) are
+ * are not made. Levels that cannot be made or measured (no memory) are
  * logged naming the file and the entity, and the geometry goes on without
  * levels. */
 static uint32_t entity_lods(loader *L, const ob_scene_file_entity *e, ob_mesh mesh[OB_GEOMETRY_MAX_LODS],
