@@ -6,7 +6,9 @@
  * the origin in the middle of the image at a reasonable size; a missing or
  * broken model file and a missing scene file return an error naming the
  * file and the stack keeps rendering what it had; a scene file's missing
- * models are reported in the record the stack keeps; ob_stack_destroy
+ * models are reported in the record the stack keeps; a model added with
+ * levels of detail has them and the same file without is drawn at level 0
+ * alone; ob_stack_destroy
  * frees all of it; and a failure at any allocation or Vulkan creation
  * while a model is added leaves the stack rendering and nothing leaked. */
 #include "ob_test.h"
@@ -382,6 +384,50 @@ static void test_add_model_vk_faults(void **state)
     walk_add_model_faults(OB_FAULT_VK_OBJECT);
 }
 
+/* The level count of the first renderable's geometry under n; 0 if none. */
+static uint32_t geometry_levels(ob_node *n)
+{
+    const ob_renderable *rd = ob_node_get_renderable(n);
+    if (rd && rd->geometry) return ob_geometry_lod_count(rd->geometry);
+    for (ob_node *c = ob_node_first_child(n); c; c = ob_node_next_sibling(c)) {
+        uint32_t l = geometry_levels(c);
+        if (l) return l;
+    }
+    return 0;
+}
+
+/* A model added with levels of detail: its primitive's geometry has them;
+ * the same file without is other geometry, at level 0 only; both render. */
+static void test_model_with_levels_of_detail(void **state)
+{
+    (void)state;
+    const char *path = "/usr/share/assimp/models/OBJ/WusonOBJ.obj";
+    if (access(path, R_OK) != 0) {
+        print_message("SKIP: %s is missing (install Debian's assimp-testmodels)\n", path);
+        return;
+    }
+    ob_stack *s = make_stack();
+    ob_result r;
+    ob_node *with = ob_stack_add_model(s, &(ob_stack_model_desc){.path = path, .lods = 2}, &r);
+    assert_non_null(with);
+    ob_node *without = ob_stack_add_model(s, &(ob_stack_model_desc){.path = path,
+                                                                    .position = {2, 0, 0}}, &r);
+    assert_non_null(without);
+    assert_int_equal(geometry_levels(with), 3);
+    assert_int_equal(geometry_levels(without), 1);
+    assert_int_equal(ob_stack_fit_camera(s, NULL), OB_OK);
+    uint8_t *px = malloc((size_t)W * H * 4);   /* test-side image */
+    assert_non_null(px);
+    render(s, px);
+    uint8_t clear[4];
+    memcpy(clear, px, 4);
+    uint32_t covered = 0;
+    for (uint32_t i = 0; i < W * H; i++) covered += !is_clear(px + 4 * i, clear);
+    assert_true(covered > W * H / 50);   /* both bulls are there */
+    free(px);
+    ob_stack_destroy(s);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -392,6 +438,7 @@ int main(void)
         cmocka_unit_test(test_scene_file_reports_what_was_left_out),
         cmocka_unit_test(test_add_model_host_faults),
         cmocka_unit_test(test_add_model_vk_faults),
+        cmocka_unit_test(test_model_with_levels_of_detail),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

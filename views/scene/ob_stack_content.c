@@ -17,6 +17,7 @@ const double ob_sun_direction[3] = {-0.11, -0.77, -0.63};
 typedef struct stack_model {
     char *path;                  /* as the program gave it */
     bool allow_any_folder;       /* part of the key: the same file may be refused without it */
+    uint32_t lods;               /* part of the key: its geometry has these levels */
     ob_model_assets *assets;
 } stack_model;
 
@@ -62,7 +63,7 @@ static ob_result model_assets(ob_stack *s, const ob_stack_model_desc *desc, ob_m
     if (r != OB_OK) return r;
     for (uint32_t i = 0; i < c->model_count; i++) {
         if (strcmp(c->models[i].path, desc->path) != 0 ||
-            c->models[i].allow_any_folder != desc->allow_any_folder)
+            c->models[i].allow_any_folder != desc->allow_any_folder || c->models[i].lods != desc->lods)
             continue;
         *out = c->models[i].assets;
         return OB_OK;
@@ -83,7 +84,7 @@ static ob_result model_assets(ob_stack *s, const ob_stack_model_desc *desc, ob_m
     ob_model_assets *a = NULL;
     if (r == OB_OK) {
         ob_model_assets_desc ad = {.renderer = s->renderer, .materials = s->materials,
-                                   .textures = c->textures};
+                                   .textures = c->textures, .lods = desc->lods};
         a = ob_model_assets_create(&ad, model, &r);   /* takes the model */
     }
     if (!a) {
@@ -91,7 +92,7 @@ static ob_result model_assets(ob_stack *s, const ob_stack_model_desc *desc, ob_m
         return r;
     }
     c->models[c->model_count++] = (stack_model){.path = path, .allow_any_folder = desc->allow_any_folder,
-                                                .assets = a};
+                                                .lods = desc->lods, .assets = a};
     *out = a;
     return OB_OK;
 }

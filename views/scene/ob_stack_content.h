@@ -61,6 +61,12 @@ typedef struct ob_stack_model_desc {
     /* Files the model refers to must resolve inside its folder unless this
      * is true (ob_model_desc.allow_any_folder): trusted content only. */
     bool allow_any_folder;
+    /* Coarser levels of detail for each primitive (0..7; more are taken as
+     * 7): ob_geometry_make_lods, each with half the triangles of the one
+     * before, drawn where their error stays within the views' tolerance
+     * (ob_views_set_lod_error). The same file with another count is
+     * another set of geometry. */
+    uint32_t lods;
 } ob_stack_model_desc;
 
 /* Loads desc->path with its materials and textures (or finds it loaded)
