@@ -668,6 +668,14 @@ static float v3_dot(const float a[3], const float b[3])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* Squared distance from p to the point o + t * e (a point on an edge). */
+static float edge_point_d2(const float p[3], const float o[3], const float e[3], float t)
+{
+    float d[3];
+    for (int k = 0; k < 3; k++) d[k] = p[k] - (o[k] + t * e[k]);
+    return v3_dot(d, d);
+}
+
 /* Squared distance from p to triangle abc: the closest point by its Voronoi
  * region (Ericson, Real-Time Collision Detection, 5.1.5). */
 static float point_triangle_d2(const float p[3], const float a[3], const float b[3],
@@ -684,29 +692,18 @@ static float point_triangle_d2(const float p[3], const float a[3], const float b
     float d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
     if (d3 >= 0.0f && d4 <= d3) return v3_dot(bp, bp);
     float vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
-        float t = d1 / (d1 - d3);
-        for (int k = 0; k < 3; k++) q[k] = a[k] + t * ab[k];
-        v3_sub(p, q, d);
-        return v3_dot(d, d);
-    }
+    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return edge_point_d2(p, a, ab, d1 / (d1 - d3));
     float cp[3];
     v3_sub(p, c, cp);
     float d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
     if (d6 >= 0.0f && d5 <= d6) return v3_dot(cp, cp);
     float vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
-        float t = d2 / (d2 - d6);
-        for (int k = 0; k < 3; k++) q[k] = a[k] + t * ac[k];
-        v3_sub(p, q, d);
-        return v3_dot(d, d);
-    }
+    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return edge_point_d2(p, a, ac, d2 / (d2 - d6));
     float va = d3 * d6 - d5 * d4;
     if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f) {
-        float t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int k = 0; k < 3; k++) q[k] = b[k] + t * (c[k] - b[k]);
-        v3_sub(p, q, d);
-        return v3_dot(d, d);
+        float bc[3];
+        v3_sub(c, b, bc);
+        return edge_point_d2(p, b, bc, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
     }
     float den = 1.0f / (va + vb + vc), v = vb * den, w = vc * den;
     for (int k = 0; k < 3; k++) q[k] = a[k] + ab[k] * v + ac[k] * w;
