@@ -347,6 +347,7 @@ static ob_result logical_create(ob_device *dev)
             .wideLines = caps->wide_lines,
             .independentBlend = caps->independent_blend,
             .multiDrawIndirect = caps->multi_draw_indirect,
+            .drawIndirectFirstInstance = caps->draw_indirect_first_instance,
             .textureCompressionBC = caps->texture_compression_bc,
         },
     };

@@ -188,6 +188,7 @@ typedef struct ob_device_caps {
     bool wide_lines;
     bool independent_blend;
     bool multi_draw_indirect;
+    bool draw_indirect_first_instance;  /* firstInstance of indirect draws honoured */
     bool texture_compression_bc;
     uint32_t timestamp_valid_bits;   /* of the chosen queue family; 0 = none */
     uint32_t device_index;           /* index in vkEnumeratePhysicalDevices */

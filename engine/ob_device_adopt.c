@@ -193,6 +193,7 @@ ob_result ob_device_check_adopted(const ob_vulkan_handles *a, ob_physical_choice
     caps->wide_lines &= en.base.wideLines == VK_TRUE;
     caps->independent_blend &= en.base.independentBlend == VK_TRUE;
     caps->multi_draw_indirect &= en.base.multiDrawIndirect == VK_TRUE;
+    caps->draw_indirect_first_instance &= en.base.drawIndirectFirstInstance == VK_TRUE;
     caps->texture_compression_bc &= en.base.textureCompressionBC == VK_TRUE;
     caps->timestamp_valid_bits = ts_bits;
     out_choice->queue_family = a->queue_family;

@@ -129,6 +129,7 @@ static ob_result probe(VkPhysicalDevice pd, uint32_t index, candidate *c)
     caps->wide_lines = f2.features.wideLines;
     caps->independent_blend = f2.features.independentBlend;
     caps->multi_draw_indirect = f2.features.multiDrawIndirect;
+    caps->draw_indirect_first_instance = f2.features.drawIndirectFirstInstance;
     caps->texture_compression_bc = f2.features.textureCompressionBC;
 
     uint32_t ext_count = 0;

@@ -95,6 +95,8 @@ struct ob_pipeline_manager {
     uint32_t set_cache_limit;   /* SET_CACHE_LIMIT unless a test lowers it */
     uint64_t chunk_size;
     bool staged;                /* desc.staged */
+    bool multi_draw_runs;       /* desc.multi_draw_runs */
+    uint32_t max_draw_indirect; /* draws one multi-draw indirect may hold */
     uint32_t ubo_align;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor;
 
@@ -171,12 +173,14 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
     pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
     pm->staged = desc->staged;
+    pm->multi_draw_runs = desc->multi_draw_runs;
     /* $OB_SET_CACHE_LIMIT lowers the bound for tests (tests/gpu/test_pipeline_manager.c)
      * that cannot afford a thousand programs. */
     const char *limit = getenv("OB_SET_CACHE_LIMIT");
     pm->set_cache_limit = limit && atoi(limit) > 0 ? (uint32_t)atoi(limit) : SET_CACHE_LIMIT;
     const VkPhysicalDeviceLimits *lim = &ob_device_properties(pm->dev)->limits;
     pm->ubo_align = (uint32_t)OB_MAX(lim->minUniformBufferOffsetAlignment, 16u);
+    pm->max_draw_indirect = OB_MAX(lim->maxDrawIndirectCount, 1u);
     pm->push_descriptor = ob_device_push_descriptor_fn(pm->dev);
     pm->ring = &pm->rings[0];
     pm->hash = ob_cmd_hash_empty();
@@ -216,7 +220,8 @@ static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
 {
     ob_res_vk_buffer host, dev;
     memset(c, 0, sizeof *c);
-    const VkBufferUsageFlags read = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+    const VkBufferUsageFlags read = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                    VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
     ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size,
                                         pm->staged ? VK_BUFFER_USAGE_TRANSFER_SRC_BIT : read,
                                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
@@ -977,7 +982,31 @@ bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm)
     return pm->program && pm->program->instanced;
 }
 
-/* One instanced draw of count blocks that mirror alike (mirrors). */
+/* The arguments of a run drawn as multi-draw indirect: count draws of
+ * one instance each, the k-th drawing block first + k, written to this
+ * frame's ring beside the blocks. */
+static ob_result write_run_args(ob_pipeline_manager *pm, const ob_draw_data *d, bool indexed,
+                                uint32_t first, uint32_t count, uint32_t *out_chunk,
+                                uint32_t *out_offset)
+{
+    uint32_t stride = indexed ? (uint32_t)sizeof(VkDrawIndexedIndirectCommand)
+                              : (uint32_t)sizeof(VkDrawIndirectCommand);
+    ob_result r = ring_alloc_aligned(pm, count * stride, 4, out_chunk, out_offset);
+    if (r != OB_OK) return r;
+    uint8_t *dst = pm->ring->chunks[*out_chunk].mapped + *out_offset;
+    if (indexed) {
+        VkDrawIndexedIndirectCommand c = {d->count, 1, d->first, d->vertex_offset, first};
+        for (uint32_t k = 0; k < count; k++, c.firstInstance++) memcpy(dst + k * stride, &c, sizeof c);
+    } else {
+        VkDrawIndirectCommand c = {d->count, 1, d->first, first};
+        for (uint32_t k = 0; k < count; k++, c.firstInstance++) memcpy(dst + k * stride, &c, sizeof c);
+    }
+    return OB_OK;
+}
+
+/* One draw of count blocks that mirror alike (mirrors): instanced, or a
+ * multi-draw indirect of one instance each (pm->multi_draw_runs; a single
+ * block is an instanced draw of one either way). */
 static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *d,
                                    const float *blocks, uint32_t count, bool mirrors)
 {
@@ -997,10 +1026,21 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
         return r;
     }
     memcpy(pm->ring->chunks[chunk].mapped + off, blocks, size);
+    uint32_t first = off / OB_INSTANCE_STRIDE;
+    bool indexed = d->index_buffer.id != 0;
+    bool multi = pm->multi_draw_runs && count > 1;
+    uint32_t args_chunk = 0, args_off = 0;
+    if (multi) {
+        r = write_run_args(pm, d, indexed, first, count, &args_chunk, &args_off);
+        if (r != OB_OK) {
+            pm->stats.skipped_draws += count;
+            log_once(pm, "the ring could not grow for a run's indirect arguments");
+            return r;
+        }
+    }
     pm->world_pending = false;
     pm->vb = d->vertex_buffer;
     pm->vb_offset = d->vertex_buffer_offset;
-    bool indexed = d->index_buffer.id != 0;
     if (indexed) {
         pm->ib = d->index_buffer;
         pm->ib_offset = d->index_buffer_offset;
@@ -1022,11 +1062,17 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
         pm->stats.vertex_binds_requested++;  /* the instance binding's own, so issued <= requested */
         pm->stats.vertex_binds_issued++;
     }
-    uint32_t first = off / OB_INSTANCE_STRIDE;
-    if (indexed)
+    if (multi && indexed)
+        vkCmdDrawIndexedIndirect(pm->cmd, pm->ring->chunks[args_chunk].vk, args_off, count,
+                                 sizeof(VkDrawIndexedIndirectCommand));
+    else if (multi)
+        vkCmdDrawIndirect(pm->cmd, pm->ring->chunks[args_chunk].vk, args_off, count,
+                          sizeof(VkDrawIndirectCommand));
+    else if (indexed)
         vkCmdDrawIndexed(pm->cmd, d->count, count, d->first, d->vertex_offset, first);
     else
         vkCmdDraw(pm->cmd, d->count, count, d->first, first);
+    if (multi) pm->stats.multi_draw_runs++;
     /* One fold per instance, as a draw of it alone would give: the hash
      * does not depend on how a run is cut into draws (recording jobs cut
      * draw lists anywhere). */
@@ -1056,10 +1102,13 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
     }
     /* A mirroring instance needs the other front face: the run is cut
      * where the determinant's sign changes. */
+    /* A multi-draw indirect holds at most maxDrawIndirectCount draws. */
+    uint32_t most = pm->multi_draw_runs ? pm->max_draw_indirect : UINT32_MAX;
     for (uint32_t start = 0; start < count;) {
         bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);
         uint32_t end = start + 1;
-        while (end < count && rows_mirror(blocks + OB_INSTANCE_FLOATS * end) == mirrors) end++;
+        while (end < count && end - start < most && rows_mirror(blocks + OB_INSTANCE_FLOATS * end) == mirrors)
+            end++;
         ob_result r = draw_instance_run(pm, d, blocks + OB_INSTANCE_FLOATS * start, end - start,
                                         mirrors);
         if (r != OB_OK) return r;

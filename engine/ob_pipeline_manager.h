@@ -43,6 +43,9 @@ typedef struct ob_pipeline_manager_desc {
      * that ob_pipeline_manager_record_uploads makes, before the frame's
      * draws (ob_renderer_desc.ring_staging). */
     bool staged;
+    /* Instance runs are drawn as multi-draw indirect, their arguments in
+     * the ring (ob_renderer_desc.instance_runs); else instanced draws. */
+    bool multi_draw_runs;
     const char *name;
 } ob_pipeline_manager_desc;
 
@@ -64,6 +67,7 @@ typedef struct ob_pipeline_manager_stats {
     uint32_t draws, dispatches;     /* draws: entities (an instanced draw counts each instance) */
     uint32_t draw_calls;            /* draw commands recorded */
     uint32_t instances;             /* instances drawn by instanced draws (of draws) */
+    uint32_t multi_draw_runs;       /* of draw_calls: runs drawn as one multi-draw indirect */
     uint32_t pipeline_binds_requested, pipeline_binds_issued;
     uint32_t descriptor_binds_requested, descriptor_binds_issued;  /* set 0 (dynamic UBOs) */
     uint32_t push_descriptor_requested, push_descriptor_issued;     /* set 1 */
@@ -170,9 +174,11 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
 /* Whether the program set reads the per-draw block per instance
  * (ob_program.instanced): then draws go through draw_instances. */
 bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
-/* count instances of d in one draw: blocks holds count per-instance blocks
- * (OB_INSTANCE_FLOATS each, the world matrix's rows, as
- * ob_render_proxy_instance gives them, all finite), copied into this
+/* count instances of d in one command, an instanced draw or (with
+ * desc.multi_draw_runs, for more than one) a multi-draw indirect of one
+ * instance each whose arguments go to the ring: blocks holds count
+ * per-instance blocks (OB_INSTANCE_FLOATS each, the world matrix's rows,
+ * as ob_render_proxy_instance gives them, all finite), copied into this
  * frame's ring. The command hash folds one value per instance, the same
  * whatever the count, so a run cut into several draws hashes alike.
  * OB_ERR_WRONG_STATE when the program is not instanced. */

@@ -113,6 +113,25 @@ static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
     return asked == OB_RING_STAGING_ON;
 }
 
+/* desc.instance_runs for this device (never AUTO); $OB_INSTANCE_RUNS=
+ * instanced|multi overrides AUTO. */
+static ob_instance_runs instance_runs(ob_instance_runs asked, const ob_device *dev)
+{
+    const char *env = getenv("OB_INSTANCE_RUNS");
+    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "instanced")) asked = OB_INSTANCE_RUNS_INSTANCED;
+    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "multi")) asked = OB_INSTANCE_RUNS_MULTI_DRAW;
+    const ob_device_caps *caps = ob_device_get_caps(dev);
+    bool can = caps->multi_draw_indirect && caps->draw_indirect_first_instance;
+    if (asked == OB_INSTANCE_RUNS_AUTO)
+        return can && !ob_device_is_cpu(dev) ? OB_INSTANCE_RUNS_MULTI_DRAW : OB_INSTANCE_RUNS_INSTANCED;
+    if (asked == OB_INSTANCE_RUNS_MULTI_DRAW && !can) {
+        OB_LOG_W("renderer", "instance runs as multi-draw indirect: the device lacks %s; runs are "
+                 "instanced draws", caps->multi_draw_indirect ? "drawIndirectFirstInstance" : "multiDrawIndirect");
+        return OB_INSTANCE_RUNS_INSTANCED;
+    }
+    return asked == OB_INSTANCE_RUNS_MULTI_DRAW ? OB_INSTANCE_RUNS_MULTI_DRAW : OB_INSTANCE_RUNS_INSTANCED;
+}
+
 ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result)
 {
     ob_renderer_desc d = desc ? *desc : (ob_renderer_desc){0};
@@ -143,6 +162,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free_renderer;
     r->ring_staged = ring_staged(d.ring_staging, r->dev);
+    r->instance_runs = instance_runs(d.instance_runs, r->dev);
     r->reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 1 + r->worker_count}, &res);
     if (!r->reg) goto fail_destroy_renderer;
     res = ob_params_manager(r->reg, 0, &r->params0);
@@ -158,6 +178,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
         .frames_in_flight = r->frames_in_flight,
         .name = "immediate",
         .staged = r->ring_staged,
+        .multi_draw_runs = r->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW,
     };
     r->immediate = ob_pipeline_manager_create(&pmd, &res);
     if (!r->immediate) goto fail_destroy_renderer;
@@ -200,6 +221,7 @@ void ob_renderer_destroy(ob_renderer *r)
 }
 
 ob_device *ob_renderer_device(ob_renderer *r) { return r->dev; }
+ob_instance_runs ob_renderer_instance_runs(const ob_renderer *r) { return r->instance_runs; }
 ob_param_registry *ob_renderer_registry(ob_renderer *r) { return r->reg; }
 ob_params *ob_renderer_params(ob_renderer *r) { return &r->params0; }
 uint32_t ob_renderer_worker_count(const ob_renderer *r) { return r->worker_count; }

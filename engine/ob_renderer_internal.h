@@ -115,6 +115,7 @@ struct ob_renderer {
     bool no_affinity;           /* desc.no_thread_affinity */
     ob_gpu_timing gpu_timing;   /* desc.gpu_timing */
     bool ring_staged;           /* desc.ring_staging resolved for the device */
+    ob_instance_runs instance_runs;  /* desc.instance_runs resolved (never AUTO) */
     uint32_t chunk_draws;
     uint32_t parallel_grain;    /* desc.parallel_grain (0: each loop's own) */
 

@@ -31,6 +31,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
         .frames_in_flight = r->frames_in_flight,
         .name = name,
         .staged = r->ring_staged,
+        .multi_draw_runs = r->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW,
     };
     w->pm = ob_pipeline_manager_create(&pmd, &res);
     if (!w->pm) return res;
@@ -856,11 +857,13 @@ static VkResult record_uploads(ob_renderer *r, ob_frame_slot *fs, uint32_t queri
         VkMemoryBarrier2 mb = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
                                .srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
                                .srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                               .dstStageMask = VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT |
+                               .dstStageMask = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT |
+                                               VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT |
                                                VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
                                                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
                                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                               .dstAccessMask = VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT |
+                               .dstAccessMask = VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT |
+                                                VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT |
                                                 VK_ACCESS_2_UNIFORM_READ_BIT};
         VkDependencyInfo dep = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
                                 .memoryBarrierCount = 1,

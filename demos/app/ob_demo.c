@@ -323,6 +323,7 @@ static void lean_note_frame(ob_demo_lean *l, const ob_frame_stats *st)
     l->draw_calls = st->pm.draw_calls;
     l->instances = st->pm.instances;
     l->longest_run = st->pm.longest_run;
+    l->multi_draw_runs = st->pm.multi_draw_runs;
 }
 
 static void on_stats(void *user, const ob_frame_stats *st)
@@ -783,8 +784,9 @@ void ob_demo_print_lean_report(ob_demo *d, FILE *f)
                 ob_view_type_name(l->drawn[i].type), l->drawn[i].draws);
     if (l->drawn_more) fprintf(f, " and %u more", l->drawn_more);
     fputs(l->drawn_count ? "\n" : " none\n", f);
-    fprintf(f, "lean: draws: %u entities in %u draw calls (%u as instances, longest run %u; "
-               "last frame)\n", l->draws, l->draw_calls, l->instances, l->longest_run);
+    fprintf(f, "lean: draws: %u entities in %u draw calls (%u as instances, longest run %u, "
+               "%u runs as multi-draw indirect; last frame)\n",
+            l->draws, l->draw_calls, l->instances, l->longest_run, l->multi_draw_runs);
     uint32_t samples = d->world.main ? ob_perspective_view_samples(d->world.main) : 1;
     if (samples > 1)
         fprintf(f, "lean: MSAA targets: view 'main' draws %ux into multisampled colour and depth "
@@ -842,9 +844,10 @@ static void write_lean_json(ob_demo *d, FILE *f)
     }
     fprintf(f, "],\"views_drawn_more\":%u", l->drawn_more);
     fprintf(f, ",\"views_left_out_more\":%u,\"msaa_samples\":%u,\"draws\":%u,"
-            "\"draw_calls\":%u,\"instances\":%u,\"longest_run\":%u,\"materials\":[",
+            "\"draw_calls\":%u,\"instances\":%u,\"longest_run\":%u,\"multi_draw_runs\":%u,"
+            "\"materials\":[",
             l->views_more, d->world.main ? ob_perspective_view_samples(d->world.main) : 1, l->draws,
-            l->draw_calls, l->instances, l->longest_run);
+            l->draw_calls, l->instances, l->longest_run, l->multi_draw_runs);
     lean_row rows[LEAN_MATERIALS];
     uint32_t other_entities;
     uint32_t row_count = lean_rows(d, rows, &other_entities);

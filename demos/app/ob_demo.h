@@ -100,7 +100,7 @@ typedef struct ob_demo_lean {
     uint64_t pipelines_created, variants_created;
     /* The last frame's draws: entities drawn, draw commands, instances of
      * instanced draws, the longest run in one draw. */
-    uint32_t draws, draw_calls, instances, longest_run;
+    uint32_t draws, draw_calls, instances, longest_run, multi_draw_runs;
 } ob_demo_lean;
 
 typedef struct ob_demo {

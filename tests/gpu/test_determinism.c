@@ -50,6 +50,7 @@ typedef struct run_plan {
     ob_threading modes[FRAMES];
     uint32_t workers[FRAMES];
     ob_ring_staging staging;   /* 0: the device's */
+    ob_instance_runs runs;     /* 0: the device's */
     bool sized_jobs;           /* the renderer sizes its jobs (chunk_draws 0), not 64 draws */
 } run_plan;
 
@@ -132,7 +133,8 @@ static void run(const run_plan *plan, run_result *out)
                                                    .chunk_draws = plan->sized_jobs ? 0 : 64,
                                                    .parallel_grain = 16,
                                                    .env_map_kind = plan->env,
-                                                   .ring_staging = plan->staging});
+                                                   .ring_staging = plan->staging,
+                                                   .instance_runs = plan->runs});
     assert_int_equal(ob_renderer_worker_count(w.r), 8);
     ob_particle_system *ps = NULL;
     build_scene(&w, &ps);
@@ -150,6 +152,12 @@ static void run(const run_plan *plan, run_result *out)
                             : !ob_device_host_memory_is_device_local(ob_renderer_device(w.r))));
         if (staged) assert_true(st->ring_upload_bytes > 0);
         else assert_int_equal(st->ring_upload_bytes, 0);
+        /* Runs are the multi-draws asked for (the features are there on
+         * lavapipe and the GPUs tested), or instanced draws. */
+        if (ob_renderer_instance_runs(w.r) == OB_INSTANCE_RUNS_MULTI_DRAW)
+            assert_true(st->pm.multi_draw_runs > 0);
+        else assert_int_equal(st->pm.multi_draw_runs, 0);
+        if (plan->runs) assert_int_equal(ob_renderer_instance_runs(w.r), plan->runs);
         /* The mode asked for is the mode used (AUTO decides for itself). */
         if (plan->modes[f] == OB_THREADING_SINGLE) assert_int_equal(st->workers, 0);
         if (plan->modes[f] == OB_THREADING_MULTI)
@@ -318,6 +326,24 @@ static void staged_ring_same_frames_as_direct(void **state)
     same_as_reference(&direct, plans, OB_ARRAY_COUNT(plans));
 }
 
+/* Instance runs drawn as multi-draw indirect (a GPU's default), staged or
+ * direct, in every threading mode: the frames of instanced runs. */
+static void multi_draw_runs_same_frames(void **state)
+{
+    (void)state;
+    run_plan ref = constant_plan("instanced, single-threaded", OB_THREADING_SINGLE, 0);
+    ref.runs = OB_INSTANCE_RUNS_INSTANCED;
+    run_plan plans[] = {constant_plan("multi-draw, single-threaded", OB_THREADING_SINGLE, 0),
+                        constant_plan("multi-draw, 3 workers", OB_THREADING_MULTI, 3),
+                        {.name = "multi-draw staged, switching every frame",
+                         .modes = {OB_THREADING_MULTI, OB_THREADING_SINGLE, OB_THREADING_MULTI,
+                                   OB_THREADING_SINGLE, OB_THREADING_AUTO},
+                         .workers = {8, 0, 2, 0, 0},
+                         .staging = OB_RING_STAGING_ON}};
+    for (size_t k = 0; k < OB_ARRAY_COUNT(plans); k++) plans[k].runs = OB_INSTANCE_RUNS_MULTI_DRAW;
+    same_as_reference(&ref, plans, OB_ARRAY_COUNT(plans));
+}
+
 /* Jobs sized by the renderer (the default) rather than 64 draws each: a
  * view is cut by the frame's draws per thread, or by its last recording
  * time (the main view here, slow on lavapipe), and the frames are the same
@@ -347,6 +373,7 @@ int main(void)
         cmocka_unit_test(switching_mode_every_frame_changes_nothing),
         cmocka_unit_test(cube_env_maps_same_in_every_threading_mode),
         cmocka_unit_test(staged_ring_same_frames_as_direct),
+        cmocka_unit_test(multi_draw_runs_same_frames),
         cmocka_unit_test(renderer_sized_jobs_same_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -459,6 +459,61 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* Runs drawn as multi-draw indirect (a GPU's way, asked for here on any
+ * device, staged and direct) draw what instanced draws and one draw per
+ * entity draw: the same pixels and command hashes, one command a run. */
+static void multi_draw_runs_draw_what_instanced_runs_draw(void **state)
+{
+    (void)state;
+    ob_test_world ref;
+    ob_test_world_create(&ref, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16,
+                                                     .instance_runs = OB_INSTANCE_RUNS_INSTANCED});
+    mixed_scene(&ref);
+    assert_int_equal(ob_renderer_instance_runs(ref.r), OB_INSTANCE_RUNS_INSTANCED);
+    ob_frame_stats inst = *ob_test_world_frame(&ref, OB_THREADING_SINGLE, 0);
+    uint8_t *ref_pixels = ob_world_snapshot(&ref);
+    assert_int_equal(inst.pm.multi_draw_runs, 0);
+    assert_true(inst.pm.instances >= 131);
+    ob_test_world_destroy(&ref);
+
+    static const ob_ring_staging staging[] = {OB_RING_STAGING_OFF, OB_RING_STAGING_ON};
+    for (size_t s = 0; s < OB_ARRAY_COUNT(staging); s++) {
+        ob_test_world w;
+        ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16,
+                                                       .ring_staging = staging[s],
+                                                       .instance_runs = OB_INSTANCE_RUNS_MULTI_DRAW});
+        mixed_scene(&w);
+        const ob_device_caps *caps = ob_device_get_caps(ob_renderer_device(w.r));
+        if (!caps->multi_draw_indirect || !caps->draw_indirect_first_instance) {
+            /* Asked for without the features: instanced, as documented. */
+            assert_int_equal(ob_renderer_instance_runs(w.r), OB_INSTANCE_RUNS_INSTANCED);
+            ob_test_world_destroy(&w);
+            free(ref_pixels);
+            skip();
+        }
+        assert_int_equal(ob_renderer_instance_runs(w.r), OB_INSTANCE_RUNS_MULTI_DRAW);
+        const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_SINGLE, 0);
+        /* One command a run, as instanced: the runs of more than one
+         * instance are the multi-draws. */
+        assert_int_equal(st->pm.draw_calls, inst.pm.draw_calls);
+        assert_int_equal(st->pm.instances, inst.pm.instances);
+        assert_true(st->pm.multi_draw_runs > 0 && st->pm.multi_draw_runs <= st->pm.draw_calls);
+        assert_true(st->frame_hash == inst.frame_hash);
+        ob_world_read(&w);
+        assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+        static const uint32_t workers[] = {1, 4};
+        for (size_t k = 0; k < OB_ARRAY_COUNT(workers); k++) {
+            st = ob_test_world_frame(&w, OB_THREADING_MULTI, workers[k]);
+            assert_true(ob_world_view_stats(st, "main")->chunks > 1);
+            assert_true(st->frame_hash == inst.frame_hash);
+            ob_world_read(&w);
+            assert_int_equal(ob_test_image_max_diff(ref_pixels, w.pixels, w.width, w.height), 0);
+        }
+        ob_test_world_destroy(&w);
+    }
+    free(ref_pixels);
+}
+
 /* A view cut into more chunks than one vkCmdExecuteCommands batch holds
  * (one draw per chunk, 300 boxes): every chunk is executed, the image and
  * the hashes are those of the single-threaded frame. */
@@ -654,6 +709,7 @@ int main(void)
         cmocka_unit_test(set_cache_holds_its_bound_across_changing_scenes),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
         cmocka_unit_test(instanced_runs_draw_what_single_draws_draw),
+        cmocka_unit_test(multi_draw_runs_draw_what_instanced_runs_draw),
         cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),

@@ -31,6 +31,7 @@ void ob_test_world_create(ob_test_world *w, const ob_test_world_desc *desc)
     sd->renderer.device.adopt = d.adopt;
     sd->env_map_kind = d.env_map_kind;
     sd->renderer.ring_staging = d.ring_staging;
+    sd->renderer.instance_runs = d.instance_runs;
     ob_world_create(w, &wd);
 }
 

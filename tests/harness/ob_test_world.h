@@ -29,6 +29,7 @@ typedef struct ob_test_world_desc {
     uint32_t msaa;             /* main view's samples per pixel; 0 → 1 */
     ob_env_map_kind env_map_kind;  /* 0 → paraboloid */
     ob_ring_staging ring_staging;  /* 0 → the device's (AUTO) */
+    ob_instance_runs instance_runs;  /* 0 → the device's (AUTO) */
     const char *cache_dir;     /* pipeline cache folder; NULL → the effect context's default */
     /* The application's instance and device (ob_test_adopt.h) for walks
      * that start many stacks; NULL → the engine's own. */

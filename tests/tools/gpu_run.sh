@@ -15,10 +15,13 @@
 #   scale  test_extreme_scale alone (the scale invariance cases)
 #   images BoxTextured and 2CylinderEngine at 640x480, 4x MSAA, into $OUT
 #   bench  obelisk-bench --quick (frame periods on the GPU)
-#   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instanced
-#          and then one draw per entity (--no-instancing), then instanced with
-#          levels of detail off (--no-lod): the parallel frame's, instancing's
-#          and the levels' figures on the machine's cores (docs/benchmark.md)
+#   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instancing
+#          on (runs as the device's default: multi-draw indirect on a GPU), then
+#          runs as instanced draws (OB_INSTANCE_RUNS=instanced), then one draw
+#          per entity (--no-instancing), then levels of detail off (--no-lod):
+#          the parallel frame's, instancing's and the levels' figures on the
+#          machine's cores (docs/benchmark.md)
+#   custom sources .gpu/custom.sh (put there by hand) with this environment
 # DEADLINE (seconds, default 420) bounds the whole run; a step gets what is
 # left or is skipped. OB_DEVICE defaults to gpu (never lavapipe).
 set -u
@@ -88,15 +91,25 @@ for s in $steps; do
       --json "$OUT/bench_quick.json" >"$OUT/bench_quick.log" 2>&1
     say "bench rc=$?" ;;
   frame16)
-    for v in inst:"--modes ST,2,4,8,16,auto" draw:"--modes ST,16 --no-instancing" \
+    for v in inst:"--modes ST,2,4,8,16,auto" hwinst:"--modes ST,16" draw:"--modes ST,16 --no-instancing" \
              nolod:"--modes ST,16 --no-lod"; do
       n=${v%%:*}; a=${v#*:}
+      # hwinst: runs as instanced draws, where the GPU's default is multi-draw indirect
+      runs=; [ "$n" = hwinst ] && runs=instanced
       # shellcheck disable=SC2086  # $a is a list of options
-      timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --views 16 --objects 100000 $a --rounds 3 \
+      OB_INSTANCE_RUNS=$runs timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --views 16 --objects 100000 $a --rounds 3 \
         --no-stability --no-progress --json "$OUT/frame16_$n.json" >"$OUT/frame16_$n.log" 2>&1
       say "frame16 $n rc=$?"
       grep -E '^ +16 +100000 ' "$OUT/frame16_$n.log" | tee -a "$OUT/summary.txt"
     done ;;
+  custom)
+    # .gpu/custom.sh, if the pack has one: a prepared measurement with this
+    # environment ($B, $OUT, left, say) that the steps above do not cover.
+    if [ -f "$here/custom.sh" ]; then
+      # shellcheck disable=SC1091
+      . "$here/custom.sh"
+      say "custom rc=$?"
+    else say "custom: no $here/custom.sh"; fi ;;
   *) say "unknown step '$s'" ;;
   esac
 done
