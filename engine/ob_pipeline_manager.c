@@ -95,7 +95,7 @@ struct ob_pipeline_manager {
     uint32_t set_cache_limit;   /* SET_CACHE_LIMIT unless a test lowers it */
     uint64_t chunk_size;
     bool staged;                /* desc.staged */
-    bool multi_draw_runs;       /* desc.multi_draw_runs */
+    ob_instance_runs runs;      /* desc.runs, AUTO taken as INSTANCED */
     uint32_t max_draw_indirect; /* draws one multi-draw indirect may hold */
     uint32_t ubo_align;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor;
@@ -173,7 +173,7 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
     pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
     pm->staged = desc->staged;
-    pm->multi_draw_runs = desc->multi_draw_runs;
+    pm->runs = desc->runs == OB_INSTANCE_RUNS_AUTO ? OB_INSTANCE_RUNS_INSTANCED : desc->runs;
     /* $OB_SET_CACHE_LIMIT lowers the bound for tests (tests/gpu/test_pipeline_manager.c)
      * that cannot afford a thousand programs. */
     const char *limit = getenv("OB_SET_CACHE_LIMIT");
@@ -1004,9 +1004,10 @@ static ob_result write_run_args(ob_pipeline_manager *pm, const ob_draw_data *d, 
     return OB_OK;
 }
 
-/* One draw of count blocks that mirror alike (mirrors): instanced, or a
- * multi-draw indirect of one instance each (pm->multi_draw_runs; a single
- * block is an instanced draw of one either way). */
+/* Count blocks that mirror alike (mirrors), as pm->runs says: one
+ * instanced draw, one multi-draw indirect of one instance each, or a
+ * direct draw per instance (a single block is an instanced draw of one
+ * on every path). */
 static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *d,
                                    const float *blocks, uint32_t count, bool mirrors)
 {
@@ -1028,7 +1029,8 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
     memcpy(pm->ring->chunks[chunk].mapped + off, blocks, size);
     uint32_t first = off / OB_INSTANCE_STRIDE;
     bool indexed = d->index_buffer.id != 0;
-    bool multi = pm->multi_draw_runs && count > 1;
+    bool multi = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW && count > 1;
+    bool direct = pm->runs == OB_INSTANCE_RUNS_DIRECT;
     uint32_t args_chunk = 0, args_off = 0;
     if (multi) {
         r = write_run_args(pm, d, indexed, first, count, &args_chunk, &args_off);
@@ -1068,6 +1070,11 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
     else if (multi)
         vkCmdDrawIndirect(pm->cmd, pm->ring->chunks[args_chunk].vk, args_off, count,
                           sizeof(VkDrawIndirectCommand));
+    else if (direct && indexed)
+        for (uint32_t k = 0; k < count; k++)
+            vkCmdDrawIndexed(pm->cmd, d->count, 1, d->first, d->vertex_offset, first + k);
+    else if (direct)
+        for (uint32_t k = 0; k < count; k++) vkCmdDraw(pm->cmd, d->count, 1, d->first, first + k);
     else if (indexed)
         vkCmdDrawIndexed(pm->cmd, d->count, count, d->first, d->vertex_offset, first);
     else
@@ -1084,7 +1091,7 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
         fold(pm, ob_hash_u64(hk, tail));
     }
     pm->stats.draws += count;
-    pm->stats.draw_calls++;
+    pm->stats.draw_calls += direct ? count : 1;
     pm->stats.instances += count;
     pm->stats.vertices += (uint64_t)d->count * count;
     if (count > pm->stats.longest_run) pm->stats.longest_run = count;
@@ -1103,7 +1110,7 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
     /* A mirroring instance needs the other front face: the run is cut
      * where the determinant's sign changes. */
     /* A multi-draw indirect holds at most maxDrawIndirectCount draws. */
-    uint32_t most = pm->multi_draw_runs ? pm->max_draw_indirect : UINT32_MAX;
+    uint32_t most = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW ? pm->max_draw_indirect : UINT32_MAX;
     for (uint32_t start = 0; start < count;) {
         bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);
         uint32_t end = start + 1;

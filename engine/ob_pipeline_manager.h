@@ -33,6 +33,40 @@
 
 typedef struct ob_pipeline_manager ob_pipeline_manager;
 
+/* How a run of instances (entities of one material and mesh, in draw
+ * order) becomes commands, with an instanced program (ob_program.instanced;
+ * with a per-draw program each entity is its own draw either way). The
+ * pixels and command hashes are the same on both paths. */
+typedef enum ob_instance_runs {
+    /* Multi-draw indirect on a GPU that has it (multiDrawIndirect and
+     * drawIndirectFirstInstance), one instanced draw on a CPU device
+     * (lavapipe) or where it lacks them. $OB_INSTANCE_RUNS=instanced|multi|
+     * direct overrides it. */
+    OB_INSTANCE_RUNS_AUTO = 0,
+    /* One vkCmdDrawIndexed of the run's count instances. On lavapipe the
+     * run's draw setup is paid once: 0.6x the GPU time of one draw each at
+     * 8 views x 10k. On an H100 small meshes drawn this way take 2x the
+     * GPU time of one draw each (16.7 ms against 8.4 at 16 views x 100k):
+     * the device walks a draw's instances far slower than separate draws. */
+    OB_INSTANCE_RUNS_INSTANCED,
+    /* One vkCmdDrawIndexedIndirect of count draws of one instance each,
+     * their arguments written beside the per-instance blocks (firstInstance
+     * picks the block): one command on the host, one draw an instance on
+     * the device. On that H100: 14.8 ms of GPU time for an idle frame, and
+     * a frame every 8.4-9.8 ms in flight with 16 workers (instanced 16.7).
+     * Asked for where the device lacks either feature, runs are instanced
+     * (logged once). */
+    OB_INSTANCE_RUNS_MULTI_DRAW,
+    /* One vkCmdDrawIndexed per instance, firstInstance picking its block:
+     * a command per entity on the host, as without instancing, but no
+     * push block written. On that H100, capping runs at one instance a
+     * draw gave 9.37 ms of GPU time at 16 views x 100k (instanced 16.7,
+     * multi-draw 14.8, push-block draws 8.44) for 67 ms of ST recording
+     * against 44 instanced. Not chosen by AUTO: what it does in flight
+     * was not measured. */
+    OB_INSTANCE_RUNS_DIRECT,
+} ob_instance_runs;
+
 typedef struct ob_pipeline_manager_desc {
     ob_device *device;
     ob_param_registry *registry;
@@ -43,9 +77,9 @@ typedef struct ob_pipeline_manager_desc {
      * that ob_pipeline_manager_record_uploads makes, before the frame's
      * draws (ob_renderer_desc.ring_staging). */
     bool staged;
-    /* Instance runs are drawn as multi-draw indirect, their arguments in
-     * the ring (ob_renderer_desc.instance_runs); else instanced draws. */
-    bool multi_draw_runs;
+    /* How instance runs are drawn (ob_renderer_desc.instance_runs, which
+     * the renderer resolves for the device; AUTO here is INSTANCED). */
+    ob_instance_runs runs;
     const char *name;
 } ob_pipeline_manager_desc;
 
@@ -175,8 +209,8 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
  * (ob_program.instanced): then draws go through draw_instances. */
 bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
 /* count instances of d in one command, an instanced draw or (with
- * desc.multi_draw_runs, for more than one) a multi-draw indirect of one
- * instance each whose arguments go to the ring: blocks holds count
+ * desc.runs, for more than one) a multi-draw indirect of one instance
+ * each whose arguments go to the ring, or a direct draw per instance: blocks holds count
  * per-instance blocks (OB_INSTANCE_FLOATS each, the world matrix's rows,
  * as ob_render_proxy_instance gives them, all finite), copied into this
  * frame's ring. The command hash folds one value per instance, the same

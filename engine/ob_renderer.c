@@ -114,12 +114,13 @@ static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
 }
 
 /* desc.instance_runs for this device (never AUTO); $OB_INSTANCE_RUNS=
- * instanced|multi overrides AUTO. */
+ * instanced|multi|direct overrides AUTO. */
 static ob_instance_runs instance_runs(ob_instance_runs asked, const ob_device *dev)
 {
     const char *env = getenv("OB_INSTANCE_RUNS");
     if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "instanced")) asked = OB_INSTANCE_RUNS_INSTANCED;
     if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "multi")) asked = OB_INSTANCE_RUNS_MULTI_DRAW;
+    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "direct")) asked = OB_INSTANCE_RUNS_DIRECT;
     const ob_device_caps *caps = ob_device_get_caps(dev);
     bool can = caps->multi_draw_indirect && caps->draw_indirect_first_instance;
     if (asked == OB_INSTANCE_RUNS_AUTO)
@@ -129,7 +130,9 @@ static ob_instance_runs instance_runs(ob_instance_runs asked, const ob_device *d
                  "instanced draws", caps->multi_draw_indirect ? "drawIndirectFirstInstance" : "multiDrawIndirect");
         return OB_INSTANCE_RUNS_INSTANCED;
     }
-    return asked == OB_INSTANCE_RUNS_MULTI_DRAW ? OB_INSTANCE_RUNS_MULTI_DRAW : OB_INSTANCE_RUNS_INSTANCED;
+    return asked == OB_INSTANCE_RUNS_MULTI_DRAW || asked == OB_INSTANCE_RUNS_DIRECT
+               ? asked
+               : OB_INSTANCE_RUNS_INSTANCED;
 }
 
 ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_result)
@@ -178,7 +181,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
         .frames_in_flight = r->frames_in_flight,
         .name = "immediate",
         .staged = r->ring_staged,
-        .multi_draw_runs = r->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW,
+        .runs = r->instance_runs,
     };
     r->immediate = ob_pipeline_manager_create(&pmd, &res);
     if (!r->immediate) goto fail_destroy_renderer;

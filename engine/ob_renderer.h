@@ -88,32 +88,6 @@ typedef enum ob_ring_staging {
     OB_RING_STAGING_OFF,
 } ob_ring_staging;
 
-/* How a run of instances (entities of one material and mesh, in draw
- * order) becomes commands, with an instanced program (ob_program.instanced;
- * with a per-draw program each entity is its own draw either way). The
- * pixels and command hashes are the same on both paths. */
-typedef enum ob_instance_runs {
-    /* Multi-draw indirect on a GPU that has it (multiDrawIndirect and
-     * drawIndirectFirstInstance), one instanced draw on a CPU device
-     * (lavapipe) or where it lacks them. $OB_INSTANCE_RUNS=instanced|multi
-     * overrides it. */
-    OB_INSTANCE_RUNS_AUTO = 0,
-    /* One vkCmdDrawIndexed of the run's count instances. On lavapipe the
-     * run's draw setup is paid once: 0.6x the GPU time of one draw each at
-     * 8 views x 10k. On an H100 small meshes drawn this way take 2x the
-     * GPU time of one draw each (16.7 ms against 8.4 at 16 views x 100k):
-     * the device walks a draw's instances far slower than separate draws. */
-    OB_INSTANCE_RUNS_INSTANCED,
-    /* One vkCmdDrawIndexedIndirect of count draws of one instance each,
-     * their arguments written beside the per-instance blocks (firstInstance
-     * picks the block): one command on the host, one draw an instance on
-     * the device. On that H100: 14.8 ms of GPU time for an idle frame, and
-     * a frame every 8.4-9.8 ms in flight with 16 workers (instanced 16.7).
-     * Asked for where the device lacks either feature, runs are instanced
-     * (logged once). */
-    OB_INSTANCE_RUNS_MULTI_DRAW,
-} ob_instance_runs;
-
 typedef struct ob_renderer_desc {
     ob_device_desc device;
     uint32_t worker_count;       /* pool size; 0 → number of cores (max OB_MAX_WORKERS) */
@@ -137,7 +111,7 @@ typedef struct ob_renderer_desc {
      * views' gpu_ms; -1 where none was written). */
     ob_gpu_timing gpu_timing;
     ob_ring_staging ring_staging;
-    ob_instance_runs instance_runs;
+    ob_instance_runs instance_runs;  /* ob_pipeline_manager.h */
 } ob_renderer_desc;
 
 typedef enum ob_skip_reason {
@@ -256,7 +230,7 @@ void ob_renderer_destroy(ob_renderer *r);
 
 ob_device *ob_renderer_device(ob_renderer *r);
 /* How instance runs are drawn: desc.instance_runs resolved for the device
- * (OB_INSTANCE_RUNS_INSTANCED or OB_INSTANCE_RUNS_MULTI_DRAW). */
+ * (never AUTO). */
 ob_instance_runs ob_renderer_instance_runs(const ob_renderer *r);
 ob_param_registry *ob_renderer_registry(ob_renderer *r);
 /* The immediate parameter manager (slot 0). */

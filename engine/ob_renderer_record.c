@@ -31,7 +31,7 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
         .frames_in_flight = r->frames_in_flight,
         .name = name,
         .staged = r->ring_staged,
-        .multi_draw_runs = r->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW,
+        .runs = r->instance_runs,
     };
     w->pm = ob_pipeline_manager_create(&pmd, &res);
     if (!w->pm) return res;

@@ -139,6 +139,16 @@ static void print_lights(FILE *f, const ob_bench_report *rep)
     }
 }
 
+/* How the renderer drew instance runs. */
+static const char *runs_name(ob_instance_runs runs)
+{
+    switch (runs) {
+    case OB_INSTANCE_RUNS_MULTI_DRAW: return "multi-draw indirect";
+    case OB_INSTANCE_RUNS_DIRECT: return "a direct draw per instance";
+    default: return "instanced draws";
+    }
+}
+
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
     fprintf(f, "sweep: medians (ms) over %u idle rounds of each mode's fastest of %u frames, "
@@ -147,13 +157,12 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                "frame(s), %u warm-up, %u in flight; spdup = median over rounds of ST rec+asm / this, "
                "[p25,p75]; cpu-rt, cpu-wk, cpu-wmx = recording CPU time of the render thread, "
                "all workers, busiest worker (nan: not reported by the engine); levels of detail "
-               "%s, instancing %s%s\n",
+               "%s, instancing %s%s%s%s\n",
             rep->rounds, rep->passes, rep->settle, rep->warmup, rep->flight, rep->big_draws,
             rep->big_rounds, rep->big_passes, rep->big_warmup, rep->big_flight,
             rep->lod ? "on" : "off", rep->instancing ? "on" : "off",
-            !rep->instancing         ? ""
-            : rep->multi_draw_runs ? " (runs as multi-draw indirect)"
-                                   : " (runs as instanced draws)");
+            rep->instancing ? " (runs as " : "", rep->instancing ? runs_name(rep->instance_runs) : "",
+            rep->instancing ? ")" : "");
     print_header(f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
     fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
@@ -456,7 +465,11 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
     fprintf(f, "\"threading_max_abs_diff\":%u,\"hash_mismatches\":%u,\"threading_identical\":%s,",
             s->threading_max_abs_diff, s->hash_mismatches, s->threading_identical ? "true" : "false");
     if (rep->stability) fprintf(f, "\"stability_failed\":%u,", rep->stability->failed);
-    fprintf(f, "\"instance_runs\":\"%s\",", rep->multi_draw_runs ? "multi-draw indirect" : "instanced");
+    /* $OB_INSTANCE_RUNS's words */
+    fprintf(f, "\"instance_runs\":\"%s\",",
+            rep->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW ? "multi"
+            : rep->instance_runs == OB_INSTANCE_RUNS_DIRECT   ? "direct"
+                                                              : "instanced");
     fputs("\"device\":{\"name\":", f);
     json_str(f, rep->device_name);
     fputs(",\"driver\":", f);

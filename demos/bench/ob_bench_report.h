@@ -111,7 +111,7 @@ typedef struct ob_bench_report {
     uint32_t big_passes, big_settle;               /* (a GPU keeps the asked-for ones) */
     uint32_t view_width, view_height;              /* sweep view size */
     bool lod, instancing;                          /* the sweep's levels of detail, instancing */
-    bool multi_draw_runs;                          /* instance runs as multi-draw indirect */
+    ob_instance_runs instance_runs;                /* how the renderer draws instance runs */
     uint32_t image_width, image_height, image_frames;
     double seconds;                                /* whole run, wall clock */
     double load_start, load_end;                   /* 1-minute load average (NAN if unknown) */

@@ -327,8 +327,9 @@ static void staged_ring_same_frames_as_direct(void **state)
 }
 
 /* Instance runs drawn as multi-draw indirect (a GPU's default), staged or
- * direct, in every threading mode: the frames of instanced runs. */
-static void multi_draw_runs_same_frames(void **state)
+ * direct, in every threading mode, or as a direct draw per instance: the
+ * frames of instanced runs. */
+static void multi_draw_and_direct_runs_same_frames(void **state)
 {
     (void)state;
     run_plan ref = constant_plan("instanced, single-threaded", OB_THREADING_SINGLE, 0);
@@ -341,6 +342,8 @@ static void multi_draw_runs_same_frames(void **state)
                          .workers = {8, 0, 2, 0, 0},
                          .staging = OB_RING_STAGING_ON}};
     for (size_t k = 0; k < OB_ARRAY_COUNT(plans); k++) plans[k].runs = OB_INSTANCE_RUNS_MULTI_DRAW;
+    plans[1].runs = OB_INSTANCE_RUNS_DIRECT;
+    plans[1].name = "direct draws, 3 workers";
     same_as_reference(&ref, plans, OB_ARRAY_COUNT(plans));
 }
 
@@ -373,7 +376,7 @@ int main(void)
         cmocka_unit_test(switching_mode_every_frame_changes_nothing),
         cmocka_unit_test(cube_env_maps_same_in_every_threading_mode),
         cmocka_unit_test(staged_ring_same_frames_as_direct),
-        cmocka_unit_test(multi_draw_runs_same_frames),
+        cmocka_unit_test(multi_draw_and_direct_runs_same_frames),
         cmocka_unit_test(renderer_sized_jobs_same_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

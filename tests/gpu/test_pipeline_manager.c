@@ -460,9 +460,10 @@ static void instanced_runs_draw_what_single_draws_draw(void **state)
 }
 
 /* Runs drawn as multi-draw indirect (a GPU's way, asked for here on any
- * device, staged and direct) draw what instanced draws and one draw per
- * entity draw: the same pixels and command hashes, one command a run. */
-static void multi_draw_runs_draw_what_instanced_runs_draw(void **state)
+ * device, staged and direct) or as a direct draw per instance draw what
+ * instanced draws draw: the same pixels and command hashes; one command a
+ * run for the multi-draws, one an instance for the direct draws. */
+static void multi_draw_and_direct_runs_draw_what_instanced_runs_draw(void **state)
 {
     (void)state;
     ob_test_world ref;
@@ -475,6 +476,26 @@ static void multi_draw_runs_draw_what_instanced_runs_draw(void **state)
     assert_int_equal(inst.pm.multi_draw_runs, 0);
     assert_true(inst.pm.instances >= 131);
     ob_test_world_destroy(&ref);
+
+    /* A direct draw per instance: one command each, the same pixels and
+     * hash (it needs no feature). */
+    ob_test_world dw;
+    ob_test_world_create(&dw, &(ob_test_world_desc){.workers = 4, .chunk_draws = 16,
+                                                    .ring_staging = OB_RING_STAGING_ON,
+                                                    .instance_runs = OB_INSTANCE_RUNS_DIRECT});
+    mixed_scene(&dw);
+    assert_int_equal(ob_renderer_instance_runs(dw.r), OB_INSTANCE_RUNS_DIRECT);
+    for (uint32_t workers = 0; workers <= 4; workers += 4) {
+        const ob_frame_stats *st =
+            ob_test_world_frame(&dw, workers ? OB_THREADING_MULTI : OB_THREADING_SINGLE, workers);
+        assert_int_equal(st->pm.instances, inst.pm.instances);
+        assert_int_equal(st->pm.draw_calls, st->pm.draws);
+        assert_int_equal(st->pm.multi_draw_runs, 0);
+        assert_true(st->frame_hash == inst.frame_hash);
+        ob_world_read(&dw);
+        assert_int_equal(ob_test_image_max_diff(ref_pixels, dw.pixels, dw.width, dw.height), 0);
+    }
+    ob_test_world_destroy(&dw);
 
     static const ob_ring_staging staging[] = {OB_RING_STAGING_OFF, OB_RING_STAGING_ON};
     for (size_t s = 0; s < OB_ARRAY_COUNT(staging); s++) {
@@ -709,7 +730,7 @@ int main(void)
         cmocka_unit_test(set_cache_holds_its_bound_across_changing_scenes),
         cmocka_unit_test(primary_and_secondaries_record_the_same),
         cmocka_unit_test(instanced_runs_draw_what_single_draws_draw),
-        cmocka_unit_test(multi_draw_runs_draw_what_instanced_runs_draw),
+        cmocka_unit_test(multi_draw_and_direct_runs_draw_what_instanced_runs_draw),
         cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),

@@ -17,7 +17,8 @@
 #   bench  obelisk-bench --quick (frame periods on the GPU)
 #   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instancing
 #          on (runs as the device's default: multi-draw indirect on a GPU), then
-#          runs as instanced draws (OB_INSTANCE_RUNS=instanced), then one draw
+#          runs as instanced draws (OB_INSTANCE_RUNS=instanced), as a direct
+#          draw per instance (OB_INSTANCE_RUNS=direct), then one draw
 #          per entity (--no-instancing), then levels of detail off (--no-lod):
 #          the parallel frame's, instancing's and the levels' figures on the
 #          machine's cores (docs/benchmark.md)
@@ -91,11 +92,12 @@ for s in $steps; do
       --json "$OUT/bench_quick.json" >"$OUT/bench_quick.log" 2>&1
     say "bench rc=$?" ;;
   frame16)
-    for v in inst:"--modes ST,2,4,8,16,auto" hwinst:"--modes ST,16" draw:"--modes ST,16 --no-instancing" \
-             nolod:"--modes ST,16 --no-lod"; do
+    for v in inst:"--modes ST,2,4,8,16,auto" hwinst:"--modes ST,16" direct:"--modes ST,16" \
+             draw:"--modes ST,16 --no-instancing" nolod:"--modes ST,16 --no-lod"; do
       n=${v%%:*}; a=${v#*:}
-      # hwinst: runs as instanced draws, where the GPU's default is multi-draw indirect
-      runs=; [ "$n" = hwinst ] && runs=instanced
+      # hwinst, direct: runs as instanced draws, as a direct draw per instance
+      # (a GPU's default is multi-draw indirect)
+      runs=; [ "$n" = hwinst ] && runs=instanced; [ "$n" = direct ] && runs=direct
       # shellcheck disable=SC2086  # $a is a list of options
       OB_INSTANCE_RUNS=$runs timeout $(( $(left) * 6 / 10 )) "$B/obelisk-bench" --views 16 --objects 100000 $a --rounds 3 \
         --no-stability --no-progress --json "$OUT/frame16_$n.json" >"$OUT/frame16_$n.log" 2>&1
