@@ -1108,8 +1108,8 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
         return OB_ERR_WRONG_STATE;
     }
     /* A mirroring instance needs the other front face: the run is cut
-     * where the determinant's sign changes. */
-    /* A multi-draw indirect holds at most maxDrawIndirectCount draws. */
+     * where the determinant's sign changes, and a multi-draw indirect holds
+     * at most maxDrawIndirectCount draws. */
     uint32_t most = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW ? pm->max_draw_indirect : UINT32_MAX;
     for (uint32_t start = 0; start < count;) {
         bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);

@@ -36,7 +36,7 @@ typedef struct ob_pipeline_manager ob_pipeline_manager;
 /* How a run of instances (entities of one material and mesh, in draw
  * order) becomes commands, with an instanced program (ob_program.instanced;
  * with a per-draw program each entity is its own draw either way). The
- * pixels and command hashes are the same on both paths. */
+ * pixels and command hashes are the same on every path. */
 typedef enum ob_instance_runs {
     /* Multi-draw indirect on a GPU that has it (multiDrawIndirect and
      * drawIndirectFirstInstance), one instanced draw on a CPU device
@@ -55,7 +55,7 @@ typedef enum ob_instance_runs {
      * the device. On that H100: 14.8 ms of GPU time for an idle frame, and
      * a frame every 8.4-9.8 ms in flight with 16 workers (instanced 16.7).
      * Asked for where the device lacks either feature, runs are instanced
-     * (logged once). */
+     * (logged when the renderer is created). */
     OB_INSTANCE_RUNS_MULTI_DRAW,
     /* One vkCmdDrawIndexed per instance, firstInstance picking its block:
      * a command per entity on the host, as without instancing, but no
@@ -208,11 +208,11 @@ ob_result ob_pipeline_manager_draw_data(ob_pipeline_manager *pm, const ob_draw_d
 /* Whether the program set reads the per-draw block per instance
  * (ob_program.instanced): then draws go through draw_instances. */
 bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
-/* count instances of d in one command, an instanced draw or (with
- * desc.runs, for more than one) a multi-draw indirect of one instance
- * each whose arguments go to the ring, or a direct draw per instance: blocks holds count
- * per-instance blocks (OB_INSTANCE_FLOATS each, the world matrix's rows,
- * as ob_render_proxy_instance gives them, all finite), copied into this
+/* count instances of d, drawn as desc.runs says: one instanced draw, one
+ * multi-draw indirect of one instance each (its arguments in the ring), or
+ * a direct draw per instance. blocks holds count per-instance blocks
+ * (OB_INSTANCE_FLOATS each, the world matrix's rows, as
+ * ob_render_proxy_instance gives them, all finite), copied into this
  * frame's ring. The command hash folds one value per instance, the same
  * whatever the count, so a run cut into several draws hashes alike.
  * OB_ERR_WRONG_STATE when the program is not instanced. */
