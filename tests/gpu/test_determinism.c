@@ -238,6 +238,16 @@ static run_plan constant_plan(const char *name, ob_threading mode, uint32_t work
     return p;
 }
 
+/* Multi-threaded with 8, then ST, 2 workers, ST and AUTO: a plan that
+ * switches mode every frame, ending in AUTO. */
+static run_plan switching_plan(const char *name)
+{
+    return (run_plan){.name = name,
+                      .modes = {OB_THREADING_MULTI, OB_THREADING_SINGLE, OB_THREADING_MULTI,
+                                OB_THREADING_SINGLE, OB_THREADING_AUTO},
+                      .workers = {8, 0, 2, 0, 0}};
+}
+
 static void same_frames_in_every_threading_mode(void **state)
 {
     (void)state;
@@ -318,10 +328,7 @@ static void staged_ring_same_frames_as_direct(void **state)
     direct.staging = OB_RING_STAGING_OFF;
     run_plan plans[] = {constant_plan("staged, single-threaded", OB_THREADING_SINGLE, 0),
                         constant_plan("staged, 3 workers", OB_THREADING_MULTI, 3),
-                        {.name = "staged, switching every frame",
-                         .modes = {OB_THREADING_MULTI, OB_THREADING_SINGLE, OB_THREADING_MULTI,
-                                   OB_THREADING_SINGLE, OB_THREADING_AUTO},
-                         .workers = {8, 0, 2, 0, 0}}};
+                        switching_plan("staged, switching every frame")};
     for (size_t k = 0; k < OB_ARRAY_COUNT(plans); k++) plans[k].staging = OB_RING_STAGING_ON;
     same_as_reference(&direct, plans, OB_ARRAY_COUNT(plans));
 }
@@ -336,14 +343,11 @@ static void multi_draw_and_direct_runs_same_frames(void **state)
     ref.runs = OB_INSTANCE_RUNS_INSTANCED;
     run_plan plans[] = {constant_plan("multi-draw, single-threaded", OB_THREADING_SINGLE, 0),
                         constant_plan("multi-draw, 3 workers", OB_THREADING_MULTI, 3),
-                        {.name = "multi-draw staged, switching every frame",
-                         .modes = {OB_THREADING_MULTI, OB_THREADING_SINGLE, OB_THREADING_MULTI,
-                                   OB_THREADING_SINGLE, OB_THREADING_AUTO},
-                         .workers = {8, 0, 2, 0, 0},
-                         .staging = OB_RING_STAGING_ON}};
+                        switching_plan("multi-draw staged, switching every frame")};
     for (size_t k = 0; k < OB_ARRAY_COUNT(plans); k++) plans[k].runs = OB_INSTANCE_RUNS_MULTI_DRAW;
     plans[1].runs = OB_INSTANCE_RUNS_DIRECT;
     plans[1].name = "direct draws, 3 workers";
+    plans[2].staging = OB_RING_STAGING_ON;
     same_as_reference(&ref, plans, OB_ARRAY_COUNT(plans));
 }
 
