@@ -151,18 +151,18 @@ static const char *runs_name(ob_instance_runs runs)
 
 static void print_perf(const ob_bench_report *rep, FILE *f)
 {
+    char runs[64] = "";
+    if (rep->instancing) snprintf(runs, sizeof runs, " (runs as %s)", runs_name(rep->instance_runs));
     fprintf(f, "sweep: medians (ms) over %u idle rounds of each mode's fastest of %u frames, "
                "each after %u unmeasured frame(s) of its mode (%u warm-up rounds first); "
                "frame = in-flight period over %u frames; frames over ~%u draws: %u rounds of %u "
                "frame(s), %u warm-up, %u in flight; spdup = median over rounds of ST rec+asm / this, "
                "[p25,p75]; cpu-rt, cpu-wk, cpu-wmx = recording CPU time of the render thread, "
                "all workers, busiest worker (nan: not reported by the engine); levels of detail "
-               "%s, instancing %s%s%s%s\n",
+               "%s, instancing %s%s\n",
             rep->rounds, rep->passes, rep->settle, rep->warmup, rep->flight, rep->big_draws,
             rep->big_rounds, rep->big_passes, rep->big_warmup, rep->big_flight,
-            rep->lod ? "on" : "off", rep->instancing ? "on" : "off",
-            rep->instancing ? " (runs as " : "", rep->instancing ? runs_name(rep->instance_runs) : "",
-            rep->instancing ? ")" : "");
+            rep->lod ? "on" : "off", rep->instancing ? "on" : "off", runs);
     print_header(f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
     fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
