@@ -16,6 +16,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #define OB_VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
 
@@ -58,6 +61,7 @@ struct ob_device {
 
     ob_resource_registry *registry;
     char *shader_dir;        /* desc.shader_dir copied; NULL when not given */
+    bool heap_kept;          /* desc.driver_heap took effect (ob_device_keeps_driver_heap) */
 };
 
 /* -------------------------------------------------------- validation capture */
@@ -573,6 +577,50 @@ fail_destroy_instance:
     return r;
 }
 
+/* ------------------------------------------------------- a CPU device's heap */
+
+/* desc.driver_heap: whether a CPU device keeps the C library's freed heap.
+ * An unknown $OB_DRIVER_HEAP is reported and taken as the default. */
+static bool driver_heap_wanted(int requested)
+{
+    if (requested) return requested > 0;
+    const char *env = getenv("OB_DRIVER_HEAP");
+    if (!env || !*env || strcmp(env, "keep") == 0) return true;
+    if (strcmp(env, "system") == 0) return false;
+    OB_LOG_W("device", "OB_DRIVER_HEAP='%s' is neither 'keep' nor 'system': keeping the heap", env);
+    return true;
+}
+
+/* The driver runs in this process on a CPU device, and llvmpipe frees its
+ * bins (the scene's triangles and tile commands, 64 KiB blocks from its
+ * queue thread's arena) after every render pass. glibc then trims the
+ * arena (madvise) and the next pass faults every page in again, zeroed:
+ * 21% of all CPU samples at 8 views x 10k (docs/benchmark.md, session 11).
+ * A trim threshold above what a frame frees keeps the pages. mallopt is
+ * process-wide and cannot be read back, so it is set once; a sanitizer's
+ * allocator refuses it (returns 0), and the device then says so. */
+static void keep_driver_heap(ob_device *dev, int requested)
+{
+    if (dev->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU || !driver_heap_wanted(requested)) return;
+#if defined(__GLIBC__) && defined(M_TRIM_THRESHOLD)
+    static atomic_bool set;
+    static atomic_bool refused;
+    if (!atomic_load(&set) && !atomic_load(&refused)) {
+        if (mallopt(M_TRIM_THRESHOLD, (int)OB_DRIVER_HEAP_KEEP_BYTES) == 1) {
+            atomic_store(&set, true);
+            OB_LOG_I("device", "CPU device: freed heap memory is kept up to %u MiB (glibc M_TRIM_THRESHOLD), "
+                     "so the driver's per-pass allocations do not fault their pages in again",
+                     OB_DRIVER_HEAP_KEEP_BYTES >> 20);
+        } else {
+            atomic_store(&refused, true);
+        }
+    }
+    dev->heap_kept = atomic_load(&set);
+#else
+    (void)dev;
+#endif
+}
+
 /* ------------------------------------------------------- create and destroy */
 
 ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
@@ -616,6 +664,7 @@ ob_device *ob_device_create(const ob_device_desc *desc, ob_result *out_result)
     stage = "resource registry";
     dev->registry = ob_resource_registry_create(&r);
     if (!dev->registry) goto fail_destroy_oneshot;
+    keep_driver_heap(dev, desc->driver_heap);
 
     OB_LOG_I("device", "using #%u '%s' (%s), Vulkan %u.%u.%u, validation %s%s", dev->caps.device_index,
              dev->props.deviceName, dev->driver_info, VK_API_VERSION_MAJOR(dev->props.apiVersion),
@@ -667,6 +716,7 @@ const char *ob_device_name(const ob_device *dev) { return dev->props.deviceName;
 const char *ob_device_shader_dir(const ob_device *dev) { return dev->shader_dir; }
 const char *ob_device_driver_info(const ob_device *dev) { return dev->driver_info; }
 bool ob_device_is_cpu(const ob_device *dev) { return dev->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+bool ob_device_keeps_driver_heap(const ob_device *dev) { return dev->heap_kept; }
 PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev) { return dev->push_descriptor; }
 const ob_device_caps *ob_device_get_caps(const ob_device *dev) { return &dev->caps; }
 bool ob_device_validation_enabled(const ob_device *dev) { return dev->validation; }

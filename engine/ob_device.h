@@ -139,7 +139,23 @@ typedef struct ob_device_desc {
      * program that keeps its own copy of the shaders, or a static program
      * outside the install prefix. */
     const char *shader_dir;
+    /* On a CPU device (lavapipe), keep the C library's freed heap memory
+     * mapped instead of handing it back to the kernel: 0 → $OB_DRIVER_HEAP
+     * ("keep", the default, or "system"); > 0 keep; < 0 leave the C
+     * library's settings alone. llvmpipe allocates its bins (every
+     * triangle it draws, tens of MB a frame) from the heap and frees them
+     * after each render pass; glibc gives that memory back at once and the
+     * next pass faults it in again, page by page: a third of lavapipe's
+     * frame at 8 views x 10k objects (docs/benchmark.md, session 11).
+     * Keeping it sets glibc's M_TRIM_THRESHOLD to OB_DRIVER_HEAP_KEEP_BYTES
+     * for the whole process, once, and for good (it also stops glibc
+     * from raising its mmap threshold by itself). No effect on a GPU,
+     * with another C library, or under a sanitizer's allocator. */
+    int driver_heap;
 } ob_device_desc;
+
+/* What a kept driver heap may hold unused before glibc trims it. */
+#define OB_DRIVER_HEAP_KEEP_BYTES (256u << 20)
 
 typedef struct ob_validation_counts {
     uint32_t errors;
@@ -173,6 +189,9 @@ const char *ob_device_driver_info(const ob_device *dev);
 /* desc.shader_dir as given (a copy owned by the device), NULL when none was. */
 const char *ob_device_shader_dir(const ob_device *dev);
 bool ob_device_is_cpu(const ob_device *dev);
+/* Whether this device keeps the C library's freed heap (desc.driver_heap):
+ * true only on a CPU device whose creation set the trim threshold. */
+bool ob_device_keeps_driver_heap(const ob_device *dev);
 /* Nanoseconds per timestamp tick (0 if timestamps are unsupported). */
 double ob_device_timestamp_period_ns(const ob_device *dev);
 PFN_vkCmdPushDescriptorSetKHR ob_device_push_descriptor_fn(const ob_device *dev);

@@ -565,8 +565,11 @@ ob_result ob_demo_init(ob_demo *d, const ob_demo_options *o)
     }
     ob_stack_desc sd = {
         .renderer = {
+            /* --malloc-threshold is the allocator's policy for this run:
+             * the device must not replace its trim threshold. */
             .device = {.app_name = "obelisk-demo", .instance_extensions = exts,
-                       .instance_extension_count = ext_count, .swapchain = o->window},
+                       .instance_extension_count = ext_count, .swapchain = o->window,
+                       .driver_heap = o->malloc_threshold_kib ? -1 : 0},
             .worker_count = o->threads > 0 ? (uint32_t)o->threads : 0,
             .threading = ob_demo_options_threading(o),
             .gpu_timing = o->gpu_timing,
