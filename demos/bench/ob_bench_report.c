@@ -292,9 +292,10 @@ static void print_stability(const ob_stability *s, FILE *f)
 
 void ob_bench_report_print(const ob_bench_report *rep, FILE *f)
 {
-    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s%s\n",
+    fprintf(f, "\nobelisk-bench%s on %s (%s), %u cores, worker pool %u%s%s%s\n",
             rep->quick ? " --quick" : "", rep->device_name, rep->driver_info, rep->cores,
-            rep->pool_workers, rep->validation ? ", VALIDATION ON (times not meaningful)" : "",
+            rep->pool_workers, rep->driver_heap_kept ? ", driver heap kept" : "",
+            rep->validation ? ", VALIDATION ON (times not meaningful)" : "",
             rep->gpu_timing == OB_GPU_TIMING_SAMPLED ? ""
             : rep->gpu_timing == OB_GPU_TIMING_OFF ? ", no GPU timestamps"
                                                    : ", GPU timestamps on every view");
@@ -470,6 +471,7 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
             rep->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW ? "multi"
             : rep->instance_runs == OB_INSTANCE_RUNS_DIRECT   ? "direct"
                                                               : "instanced");
+    fprintf(f, "\"driver_heap_kept\":%s,", rep->driver_heap_kept ? "true" : "false");
     fputs("\"device\":{\"name\":", f);
     json_str(f, rep->device_name);
     fputs(",\"driver\":", f);
