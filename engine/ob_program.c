@@ -181,7 +181,9 @@ ob_program *ob_program_create(ob_device *dev, ob_param_registry *reg,
         prog->push_mapping = ob_param_mapping_create(reg, pb, prog->name, &r);
         if (!prog->push_mapping) goto fail_destroy_program;
         prog->push_size = (pb->size + 3u) & ~3u;
-        prog->push_stages = stages;
+        /* Only the stages that read the block (ob_shader_reflect): a push
+         * then reaches no stage that merely declares it. */
+        prog->push_stages = refl->push_stages ? refl->push_stages : stages;
         uint32_t limit = OB_MIN(ob_device_properties(dev)->limits.maxPushConstantsSize,
                                 OB_PUSH_CONSTANT_MAX);
         if (prog->push_size > limit) {

@@ -516,11 +516,14 @@ ob_result ob_reflection_from_spirv(const uint32_t *spirv, size_t words, ob_shade
 
     ob_result r = OB_ERR_SHADER_COMPILE;
     spvc_parsed_ir ir;
-    spvc_resources res;
+    spvc_resources res, used;
+    spvc_set active;
     if (spvc_context_parse_spirv(ctx, spirv, words, &ir) != SPVC_SUCCESS ||
         spvc_context_create_compiler(ctx, SPVC_BACKEND_NONE, ir, SPVC_CAPTURE_MODE_TAKE_OWNERSHIP,
                                      &x.comp) != SPVC_SUCCESS ||
-        spvc_compiler_create_shader_resources(x.comp, &res) != SPVC_SUCCESS)
+        spvc_compiler_create_shader_resources(x.comp, &res) != SPVC_SUCCESS ||
+        spvc_compiler_get_active_interface_variables(x.comp, &active) != SPVC_SUCCESS ||
+        spvc_compiler_create_shader_resources_for_active_variables(x.comp, &used, active) != SPVC_SUCCESS)
         goto done;
 
     r = reject_unsupported(&x, res);
@@ -530,7 +533,7 @@ ob_result ob_reflection_from_spirv(const uint32_t *spirv, size_t words, ob_shade
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_SEPARATE_IMAGE, OB_BINDING_SAMPLED_IMAGE);
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_SEPARATE_SAMPLERS, OB_BINDING_SAMPLER);
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_STORAGE_IMAGE, OB_BINDING_STORAGE_IMAGE);
-    if (r == OB_OK) r = reflect_push(&x, res);
+    if (r == OB_OK) r = reflect_push(&x, used);
     if (r == OB_OK && stage == OB_SHADER_VERTEX) r = reflect_vertex_inputs(&x, res);
     if (r == OB_OK && stage == OB_SHADER_COMPUTE) reflect_local_size(&x);
     if (r == OB_OK) reflection_sort(out);

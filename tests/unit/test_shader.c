@@ -271,6 +271,31 @@ static void merge_joins_stages_and_rejects_conflicts(void **state)
     ob_shader_compiler_destroy(c);
 }
 
+/* A stage that includes the push-constant block without reading it (as
+ * the standard fragment shaders include common.glsl's PerDraw) is not one
+ * of its stages: the layout's range and every vkCmdPushConstants then
+ * reach only the stages that read it. On lavapipe a push that reaches the
+ * fragment stage makes llvmpipe store its whole fragment state again, a
+ * 33 KB copy a draw (docs/benchmark.md, session 11). */
+static void push_block_reaches_only_the_stages_that_read_it(void **state)
+{
+    (void)state;
+    ob_shader_compiler *c = compiler_at(NULL, NULL);
+    const ob_shader *vs = get_ok(c, "basic.vert", OB_SHADER_VERTEX, 0, NULL);
+    const ob_shader *fs = get_ok(c, "unread_push.frag", OB_SHADER_FRAGMENT, 0, NULL);
+    assert_int_equal(fs->reflection.push_block, -1);
+    assert_int_equal(fs->reflection.push_stages, 0);
+    assert_non_null(ob_reflection_find_binding(&fs->reflection, "PerFrame"));
+    const ob_reflection *stages[] = {&vs->reflection, &fs->reflection};
+    ob_reflection merged;
+    assert_int_equal(ob_reflection_merge(stages, 2, &merged), OB_OK);
+    assert_true(merged.push_block >= 0);
+    assert_int_equal(merged.blocks[merged.push_block].size, 80);
+    assert_int_equal(merged.push_stages, VK_SHADER_STAGE_VERTEX_BIT);
+    ob_reflection_release(&merged);
+    ob_shader_compiler_destroy(c);
+}
+
 /* -------------------------------------------------------------- variants */
 
 static void define_selects_a_variant(void **state)
@@ -659,6 +684,7 @@ int main(void)
         cmocka_unit_test(in_memory_source_compiles),
         cmocka_unit_test(reflection_gives_std140_layout_and_interface),
         cmocka_unit_test(merge_joins_stages_and_rejects_conflicts),
+        cmocka_unit_test(push_block_reaches_only_the_stages_that_read_it),
         cmocka_unit_test(define_selects_a_variant),
         cmocka_unit_test(syntax_error_names_file_and_line),
         cmocka_unit_test(error_in_include_names_the_included_file),
