@@ -533,6 +533,12 @@ ob_result ob_reflection_from_spirv(const uint32_t *spirv, size_t words, ob_shade
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_SEPARATE_IMAGE, OB_BINDING_SAMPLED_IMAGE);
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_SEPARATE_SAMPLERS, OB_BINDING_SAMPLER);
     if (r == OB_OK) r = reflect_images(&x, res, SPVC_RESOURCE_TYPE_STORAGE_IMAGE, OB_BINDING_STORAGE_IMAGE);
+    /* The push block only where the stage reads it (the push-constant
+     * interface is the statically used block): a stage that merely
+     * includes the declaration, as the standard fragment shaders include
+     * common.glsl's PerDraw, stays out of the range, so no push reaches it
+     * (on lavapipe such a push re-stores llvmpipe's fragment state, 33 KB
+     * a draw). Every other resource is bound for all stages anyway. */
     if (r == OB_OK) r = reflect_push(&x, used);
     if (r == OB_OK && stage == OB_SHADER_VERTEX) r = reflect_vertex_inputs(&x, res);
     if (r == OB_OK && stage == OB_SHADER_COMPUTE) reflect_local_size(&x);
