@@ -603,19 +603,16 @@ static void keep_driver_heap(ob_device *dev, int requested)
 {
     if (dev->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU || !driver_heap_wanted(requested)) return;
 #if defined(__GLIBC__) && defined(M_TRIM_THRESHOLD)
-    static atomic_bool set;
-    static atomic_bool refused;
-    if (!atomic_load(&set) && !atomic_load(&refused)) {
-        if (mallopt(M_TRIM_THRESHOLD, (int)OB_DRIVER_HEAP_KEEP_BYTES) == 1) {
-            atomic_store(&set, true);
+    static atomic_int state;   /* 0 not tried, 1 set, -1 refused */
+    if (atomic_load(&state) == 0) {
+        bool ok = mallopt(M_TRIM_THRESHOLD, (int)OB_DRIVER_HEAP_KEEP_BYTES) == 1;
+        atomic_store(&state, ok ? 1 : -1);
+        if (ok)
             OB_LOG_I("device", "CPU device: freed heap memory is kept up to %u MiB (glibc M_TRIM_THRESHOLD), "
                      "so the driver's per-pass allocations do not fault their pages in again",
                      OB_DRIVER_HEAP_KEEP_BYTES >> 20);
-        } else {
-            atomic_store(&refused, true);
-        }
     }
-    dev->heap_kept = atomic_load(&set);
+    dev->heap_kept = atomic_load(&state) == 1;
 #else
     (void)dev;
 #endif
