@@ -335,6 +335,10 @@ ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
                  "end_frame); refused");
         return OB_ERR_WRONG_STATE;
     }
+    /* As in begin_frame: the update's first loop then finds them awake. */
+    if (r->pending_mode != OB_THREADING_SINGLE && r->update_used_pool)
+        ob_renderer_workers_nudge(r, ob_renderer_parallel_threads(r));
+    r->handouts = 0;
     uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
     r->update.cpu_render_parallel = r->update.cpu_pool = 0;
     r->acc_render_parallel = &r->update.cpu_render_parallel;
@@ -345,6 +349,7 @@ ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
     r->update.cpu_render = ob_thread_cpu_ns() - c0;
     r->update.ns = ob_time_ns() - t0;
     r->update.valid = true;
+    r->update_used_pool = r->handouts > 0;
     return res;
 }
 
@@ -409,24 +414,23 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
         return ob_result_from_vk(vr);
     }
     fs->unsubmitted = false;
+    /* The pool threads the frame's loops will use slept since the last
+     * frame: woken now, they poll by the time PreRender hands out its first
+     * loop (waking one costs some 30-50 us on a 2-core VM, which the rest of
+     * begin_frame and the views' PreRender set-up cover). Only when the last
+     * frame handed work out: a small scene's frame runs on the caller. */
+    if (r->pending_mode != OB_THREADING_SINGLE && r->frame_used_pool)
+        ob_renderer_workers_nudge(r, ob_renderer_parallel_threads(r));
+    r->handouts = 0;
     collect_frame(r, fs, &gpu_wait_ns);
     r->serial++;
     ob_device_begin_frame_slot(r->dev, r->slot);
-    vr = OB_VK_CHECK(vkResetCommandPool(vk, fs->pool, 0));
-    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-    /* The workers' pools of this slot too, here like the primary's, outside
-     * the recording: the slot's fence was waited for, so their secondaries
-     * are done, and the workers are idle. (Each pool frees into its own
-     * arena, so which thread frees costs nothing.) */
-    for (uint32_t i = 0; i < r->worker_count; i++) {
-        ob_worker *w = &r->workers[i];
-        if (w->pool_recorded[r->slot]) {
-            vr = OB_VK_CHECK(vkResetCommandPool(vk, w->pools[r->slot], 0));
-            if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
-            w->pool_recorded[r->slot] = false;
-        }
-        ob_pipeline_manager_begin_frame(w->pm, r->slot, r->serial);
-    }
+    /* The slot's command pools are reset where the frame first records into
+     * each (the primary's in ob_renderer_record_frame, a worker's in
+     * worker_next_cmd, in parallel): the slot's fence, waited for above,
+     * covers them all. */
+    for (uint32_t i = 0; i < r->worker_count; i++)
+        ob_pipeline_manager_begin_frame(r->workers[i].pm, r->slot, r->serial);
     ob_pipeline_manager_begin_frame(r->immediate, r->slot, r->serial);
     /* The slot's fence also covers the submission that waited on its
      * acquire semaphore, so the acquire may signal it again. */
@@ -697,6 +701,7 @@ ob_result ob_renderer_end_frame(ob_renderer *r)
     r->cur.present_ns = r->present ? ob_time_ns() - t_present : 0;
     r->in_frame = false;
     r->acc_render_parallel = r->acc_pool = NULL;
+    r->frame_used_pool = r->handouts > 0;
     if (res != OB_OK) return res;
     r->cur.frame_ns = ob_time_ns() - r->frame_start_ns + r->cur.update_ns;
     r->frames[r->slot].stats = r->cur;

@@ -51,7 +51,7 @@ typedef struct ob_worker {
     uint32_t index;             /* 1-based: parameter slot and pair index */
     ob_pipeline_manager *pm;
     VkCommandPool pools[OB_MAX_FRAMES_IN_FLIGHT];
-    bool pool_recorded[OB_MAX_FRAMES_IN_FLIGHT]; /* reset in begin_frame before its next use */
+    bool pool_recorded[OB_MAX_FRAMES_IN_FLIGHT]; /* holds commands: reset before its next use */
     VkCommandBuffer *cmds[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_count[OB_MAX_FRAMES_IN_FLIGHT], cmd_cap[OB_MAX_FRAMES_IN_FLIGHT];
     uint32_t cmd_used;
@@ -171,6 +171,11 @@ struct ob_renderer {
     uint32_t task_count;
     atomic_uint next_task;
     bool in_parallel;           /* a loop is running: a nested one runs inline */
+    /* Batches handed to pool threads since the last begin_frame or update,
+     * and whether the last frame and the last update handed any out (then
+     * the next one wakes the pool threads early: ob_renderer_workers_nudge). */
+    uint32_t handouts;
+    bool frame_used_pool, update_used_pool;
     /* Where the CPU time of parallel sections is added: the frame's stats,
      * or the pending update's before begin_frame. */
     uint64_t *acc_render_parallel, *acc_pool;
@@ -205,6 +210,9 @@ struct ob_renderer {
  * workers (the pending mode's outside a frame). */
 uint32_t ob_renderer_parallel_threads(const ob_renderer *r);
 ob_result ob_renderer_workers_start(ob_renderer *r);
+/* Wakes pool threads 1..threads-1 that sleep, without a batch: they poll
+ * for one as after a batch, so that the next hand-out finds them awake. */
+void ob_renderer_workers_nudge(ob_renderer *r, uint32_t threads);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
 /* Keep img's tracked state from before this frame's first barrier on it, so
