@@ -86,7 +86,8 @@ static const char usage_text[] =
     "  --warmup N --rounds N --flight N   idle rounds (warm-up 3, measured 15 quick / 7),\n"
     "                     in-flight frames per mode (2 quick / 5)\n"
     "  --passes N         frames per mode in each idle round, the fastest kept (3)\n"
-    "  --settle N         unmeasured frames of a mode before each measured idle one (0)\n"
+    "  --settle N         unmeasured frames of a mode before each measured idle one (2:\n"
+    "                     the frames in flight, so each reuses a slot of its own mode)\n"
     "  --view-size WxH    size of each sweep view (default 256x192)\n"
     "  --size WxH         size of the quality images (default 640x480)\n"
     "  --seed S           scene seed (default 1)\n"
@@ -165,7 +166,13 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
     o->rounds = quick ? 15 : 7;
     o->passes = 3;
     o->flight = quick ? 2 : 5;
-    o->settle = 0;
+    /* Two unmeasured frames of a mode before each measured one: with the
+     * renderer's two frames in flight, the measured frame then reuses a frame
+     * slot its own mode recorded last, as in a program that stays in one
+     * mode. With none, a slot's command pools held another mode's frame,
+     * and each mode paid for freeing the other's commands (inline, all of a
+     * frame's in the primary; on the workers, theirs in each pool). */
+    o->settle = 2;
     *out_exit = 2;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
