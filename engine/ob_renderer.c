@@ -335,10 +335,6 @@ ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
                  "end_frame); refused");
         return OB_ERR_WRONG_STATE;
     }
-    /* As in begin_frame: the update's first loop then finds them awake. */
-    if (r->pending_mode != OB_THREADING_SINGLE && r->update_used_pool)
-        ob_renderer_workers_nudge(r, ob_renderer_parallel_threads(r));
-    r->handouts = 0;
     uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
     r->update.cpu_render_parallel = r->update.cpu_pool = 0;
     r->acc_render_parallel = &r->update.cpu_render_parallel;
@@ -349,7 +345,6 @@ ob_result ob_renderer_update_scene(ob_renderer *r, ob_scene *s, double dt)
     r->update.cpu_render = ob_thread_cpu_ns() - c0;
     r->update.ns = ob_time_ns() - t0;
     r->update.valid = true;
-    r->update_used_pool = r->handouts > 0;
     return res;
 }
 

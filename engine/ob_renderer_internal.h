@@ -171,11 +171,11 @@ struct ob_renderer {
     uint32_t task_count;
     atomic_uint next_task;
     bool in_parallel;           /* a loop is running: a nested one runs inline */
-    /* Batches handed to pool threads since the last begin_frame or update,
-     * and whether the last frame and the last update handed any out (then
-     * the next one wakes the pool threads early: ob_renderer_workers_nudge). */
+    /* Batches handed to pool threads since begin_frame, and whether the last
+     * frame handed any out (then the next wakes them early:
+     * ob_renderer_workers_nudge). */
     uint32_t handouts;
-    bool frame_used_pool, update_used_pool;
+    bool frame_used_pool;
     /* Where the CPU time of parallel sections is added: the frame's stats,
      * or the pending update's before begin_frame. */
     uint64_t *acc_render_parallel, *acc_pool;

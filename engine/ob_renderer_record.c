@@ -954,8 +954,8 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     if (vr != VK_SUCCESS) {
         ob_param_registry_end_recording(r->reg);
         ob_device_note_result(r->dev, vr);
-        OB_LOG_E("renderer", "frame %llu not recorded: its primary command buffer could not begin",
-                 (unsigned long long)r->serial);
+        OB_LOG_E("renderer", "frame %llu not recorded: its primary command buffer could not be "
+                 "reset or begun", (unsigned long long)r->serial);
         return ob_result_from_vk(vr);
     }
     bool timestamps = fs->queries && 2 * count + 2 <= fs->query_capacity;
