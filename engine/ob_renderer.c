@@ -416,7 +416,7 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
      * frame handed work out: a small scene's frame runs on the caller. */
     if (r->pending_mode != OB_THREADING_SINGLE && r->frame_used_pool)
         ob_renderer_workers_nudge(r, ob_renderer_parallel_threads(r));
-    r->handouts = 0;
+    r->handed_out = false;
     collect_frame(r, fs, &gpu_wait_ns);
     r->serial++;
     ob_device_begin_frame_slot(r->dev, r->slot);
@@ -696,7 +696,7 @@ ob_result ob_renderer_end_frame(ob_renderer *r)
     r->cur.present_ns = r->present ? ob_time_ns() - t_present : 0;
     r->in_frame = false;
     r->acc_render_parallel = r->acc_pool = NULL;
-    r->frame_used_pool = r->handouts > 0;
+    r->frame_used_pool = r->handed_out;
     if (res != OB_OK) return res;
     r->cur.frame_ns = ob_time_ns() - r->frame_start_ns + r->cur.update_ns;
     r->frames[r->slot].stats = r->cur;

@@ -171,11 +171,10 @@ struct ob_renderer {
     uint32_t task_count;
     atomic_uint next_task;
     bool in_parallel;           /* a loop is running: a nested one runs inline */
-    /* Batches handed to pool threads since begin_frame, and whether the last
-     * frame handed any out (then the next wakes them early:
+    /* Whether a batch went to the pool threads since begin_frame, and
+     * whether the last frame sent any (then the next wakes them early:
      * ob_renderer_workers_nudge). */
-    uint32_t handouts;
-    bool frame_used_pool;
+    bool handed_out, frame_used_pool;
     /* Where the CPU time of parallel sections is added: the frame's stats,
      * or the pending update's before begin_frame. */
     uint64_t *acc_render_parallel, *acc_pool;

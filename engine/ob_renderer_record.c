@@ -347,7 +347,7 @@ static void hand_out(ob_renderer *r, uint32_t helpers, void (*own)(ob_renderer *
                      void *arg)
 {
     uint64_t c0 = ob_thread_cpu_ns();
-    r->handouts++;
+    r->handed_out = true;
     place_workers(r, helpers);
     atomic_store_explicit(&r->finished, 0u, memory_order_relaxed); /* no batch runs now */
     for (uint32_t i = 0; i < helpers; i++) worker_wake(&r->workers[i]);
