@@ -46,6 +46,10 @@ typedef struct ob_worker {
     atomic_uint ticket;         /* batches handed to it, and the quit */
     atomic_int sleeping;        /* 1: about to wait, or waiting, on go */
     uint32_t seen;              /* tickets it took (its own thread only) */
+    atomic_uint gen;            /* the batch its last ticket was for (batch_state's) */
+    uint32_t gen_taken;         /* the last batch it looked at (its own thread only) */
+    atomic_int prep;            /* 1: reset its share of the slot's pools (see prepare) */
+    uint64_t prep_cpu_ns;       /* thread CPU time of its last such reset */
     sem_t go;
     bool go_ready;
     uint32_t index;             /* 1-based: parameter slot and pair index */
@@ -190,10 +194,24 @@ struct ob_renderer {
      * it says it waits. */
     atomic_uint finished;
     atomic_int waiting;
+    /* The batch being handed out: its number (high 32 bits), whether it is
+     * closed (BATCH_CLOSED) and how many pool threads joined it (the low
+     * bits). A pool thread joins only an open batch; the render thread
+     * closes it once its own share is done and waits for the joined
+     * ones alone, so a thread still waking up costs the render thread
+     * nothing when the work is already done. */
+    atomic_ullong batch_state;
+    uint32_t batch_gen;
+    /* The pools begin_frame has the pool threads reset (see
+     * ob_renderer_workers_prepare): slot prep_slot's of workers
+     * 0..prep_workers-1, worker k's by pool thread k % prep_threads;
+     * prep_pending counts the pool threads not done yet. */
+    uint32_t prep_slot, prep_workers, prep_threads;
+    atomic_uint prep_pending;
     sem_t done;
     bool done_ready;
     atomic_uint next_job;
-    bool quit;
+    atomic_bool quit;           /* read by a pool thread on any ticket, joined or not */
 
     ob_present *present;        /* the attached surface's swapchain; NULL = headless */
 
@@ -212,6 +230,13 @@ ob_result ob_renderer_workers_start(ob_renderer *r);
 /* Wakes pool threads 1..threads-1 that sleep, without a batch: they poll
  * for one as after a batch, so that the next hand-out finds them awake. */
 void ob_renderer_workers_nudge(ob_renderer *r, uint32_t threads);
+/* For a frame that will use `threads` threads, once the slot's fence has
+ * signalled: the pool threads reset the slot's command pools of workers
+ * 0..threads-1 that hold commands, while the render thread goes on with
+ * begin_frame and the views' PreRender set-up (lavapipe frees every
+ * command a pool holds, some 40 us a worker at 8 views x 10k objects).
+ * Nudges the threads when there is nothing to reset. [render thread] */
+void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
 /* Keep img's tracked state from before this frame's first barrier on it, so

@@ -14,8 +14,11 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     w->index = index;
     w->cpu = -1;
     atomic_init(&w->ticket, 0u);
+    atomic_init(&w->gen, 0u);
+    atomic_init(&w->prep, 0);
     atomic_init(&w->sleeping, 0);
     w->seen = 0;
+    w->gen_taken = 0;
     for (uint32_t f = 0; f < OB_MAX_FRAMES_IN_FLIGHT; f++) ob_arena_allocator_init(&w->alloc[f]);
     if (sem_init(&w->go, 0, 0) != 0) {
         OB_LOG_E("renderer", "worker %u: its wake-up semaphore cannot be created", index);
@@ -269,10 +272,29 @@ static void wake_sleeper(atomic_int *flag, sem_t *sem)
 }
 
 /* Gives worker w its next batch (or the quit), set up in r beforehand. */
-static void worker_wake(ob_worker *w)
+static void worker_wake(ob_worker *w, uint32_t gen)
 {
-    atomic_fetch_add(&w->ticket, 1u);
+    atomic_store_explicit(&w->gen, gen, memory_order_relaxed);
+    atomic_fetch_add(&w->ticket, 1u); /* releases gen with it */
     wake_sleeper(&w->sleeping, &w->go);
+}
+
+#define BATCH_CLOSED (1ull << 31)
+
+/* Pool thread w joins the batch its ticket was for, unless it is closed
+ * (the render thread finished it alone while w was waking up) or w already
+ * took it (w read a later gen early: the render thread stores gen before
+ * bumping the ticket, so w may see the next batch's gen on an earlier
+ * ticket, and then that batch's own ticket finds it taken). */
+static bool worker_join(ob_renderer *r, ob_worker *w)
+{
+    uint32_t gen = atomic_load_explicit(&w->gen, memory_order_relaxed);
+    if (gen == w->gen_taken) return false;
+    w->gen_taken = gen;
+    unsigned long long s = atomic_load(&r->batch_state);
+    while ((uint32_t)(s >> 32) == gen && !(s & BATCH_CLOSED))
+        if (atomic_compare_exchange_weak(&r->batch_state, &s, s + 1)) return true;
+    return false;
 }
 
 /* Worker w's wait for its next ticket: polls, then sleeps; a nudge
@@ -288,6 +310,56 @@ void ob_renderer_workers_nudge(ob_renderer *r, uint32_t threads)
 {
     for (uint32_t i = 0; i + 1 < threads && i < r->worker_count; i++)
         if (r->workers[i].started) wake_sleeper(&r->workers[i].sleeping, &r->workers[i].go);
+}
+
+/* Waits for the pool threads' resets of the last prepare (done long before
+ * on any frame that records: they run while the render thread sets up). */
+static void prepare_wait(ob_renderer *r)
+{
+    for (uint32_t k = 1; atomic_load_explicit(&r->prep_pending, memory_order_acquire) != 0; k++) {
+        if ((k & 255u) == 0) sched_yield();
+        else cpu_relax();
+    }
+}
+
+void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads)
+{
+    prepare_wait(r);
+    uint32_t n = OB_MIN(threads, r->worker_count), helpers = OB_MIN(threads - 1, r->worker_count);
+    bool holding = false, started = true;
+    for (uint32_t k = 0; k < n; k++) holding |= r->workers[k].pool_recorded[r->slot];
+    for (uint32_t i = 0; i < helpers; i++) started &= r->workers[i].started;
+    if (threads < 2 || !holding || !started) {
+        ob_renderer_workers_nudge(r, threads);
+        return;
+    }
+    r->prep_slot = r->slot;
+    r->prep_workers = n;
+    r->prep_threads = helpers;
+    atomic_store(&r->prep_pending, helpers);
+    for (uint32_t i = 0; i < helpers; i++) {
+        ob_worker *w = &r->workers[i];
+        atomic_store_explicit(&w->prep, 1, memory_order_relaxed);
+        atomic_fetch_add(&w->ticket, 1u); /* releases prep; gen stays, so no batch is joined */
+        wake_sleeper(&w->sleeping, &w->go);
+    }
+}
+
+/* Pool thread w's share of a prepare: the pools of workers k = its own
+ * index, then every prep_threads-th. A reset that fails is left to
+ * worker_next_cmd, which tries again and reports it. */
+static void worker_prepare(ob_renderer *r, ob_worker *w)
+{
+    uint64_t c0 = ob_thread_cpu_ns();
+    VkDevice vk = ob_device_vk(r->dev);
+    uint32_t f = r->prep_slot;
+    for (uint32_t k = w->index - 1; k < r->prep_workers; k += r->prep_threads) {
+        ob_worker *o = &r->workers[k];
+        if (o->pool_recorded[f] && vkResetCommandPool(vk, o->pools[f], 0) == VK_SUCCESS)
+            o->pool_recorded[f] = false;
+    }
+    w->prep_cpu_ns = ob_thread_cpu_ns() - c0;
+    atomic_fetch_sub_explicit(&r->prep_pending, 1u, memory_order_release);
 }
 
 /* A pool thread's batch is done (its results written before). */
@@ -315,7 +387,9 @@ static void *worker_main(void *arg)
     ob_renderer *r = w->renderer;
     for (;;) {
         worker_wait(w);
-        if (r->quit) break;
+        if (atomic_exchange(&w->prep, 0)) worker_prepare(r, w);
+        if (atomic_load_explicit(&r->quit, memory_order_relaxed)) break;
+        if (!worker_join(r, w)) continue;
         if (r->task_fn) {
             uint64_t c0 = ob_thread_cpu_ns();
             run_tasks(r, w->index);
@@ -350,9 +424,15 @@ static void hand_out(ob_renderer *r, uint32_t helpers, void (*own)(ob_renderer *
     r->handed_out = true;
     place_workers(r, helpers);
     atomic_store_explicit(&r->finished, 0u, memory_order_relaxed); /* no batch runs now */
-    for (uint32_t i = 0; i < helpers; i++) worker_wake(&r->workers[i]);
+    uint32_t gen = ++r->batch_gen;
+    if (gen == 0) gen = ++r->batch_gen; /* 0: no batch taken yet (gen_taken's start) */
+    atomic_store(&r->batch_state, (unsigned long long)gen << 32);
+    for (uint32_t i = 0; i < helpers; i++) worker_wake(&r->workers[i], gen);
     own(r, arg);
-    wait_finished(r, helpers);
+    /* The pool threads that did not join by now never will: the batch is
+     * done without them, and their cpu_ns stays 0. */
+    unsigned long long s = atomic_fetch_or(&r->batch_state, BATCH_CLOSED);
+    wait_finished(r, (unsigned)(s & (BATCH_CLOSED - 1)));
     uint64_t pool = 0;
     for (uint32_t i = 0; i < helpers; i++) pool += r->workers[i].cpu_ns;
     if (r->acc_pool) *r->acc_pool += pool;
@@ -405,6 +485,9 @@ ob_result ob_renderer_workers_start(ob_renderer *r)
         for (int c = 0; c < CPU_SETSIZE && r->cpu_count < OB_ARRAY_COUNT(r->cpus); c++)
             if (CPU_ISSET(c, &allowed)) r->cpus[r->cpu_count++] = c;
     atomic_init(&r->finished, 0u);
+    atomic_init(&r->batch_state, 0ull);
+    atomic_init(&r->prep_pending, 0u);
+    atomic_init(&r->quit, false);
     atomic_init(&r->waiting, 0);
     if (sem_init(&r->done, 0, 0) != 0) {
         OB_LOG_E("renderer", "the workers' completion semaphore cannot be created");
@@ -427,9 +510,10 @@ ob_result ob_renderer_workers_start(ob_renderer *r)
 
 void ob_renderer_workers_stop(ob_renderer *r)
 {
-    r->quit = true;
+    prepare_wait(r);
+    atomic_store_explicit(&r->quit, true, memory_order_relaxed); /* the tickets below release it */
     for (uint32_t i = 0; i < r->worker_count; i++)
-        if (r->workers[i].started) worker_wake(&r->workers[i]);
+        if (r->workers[i].started) worker_wake(&r->workers[i], 0);
     for (uint32_t i = 0; i < r->worker_count; i++) {
         if (r->workers[i].started) pthread_join(r->workers[i].thread, NULL);
         worker_release(r, &r->workers[i]);
@@ -907,6 +991,7 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
     VkDevice vk = ob_device_vk(r->dev);
     VkResult vr;
     uint64_t cpu0 = ob_thread_cpu_ns();
+    prepare_wait(r); /* the pool threads' resets are done before anything reads the pools */
     uint64_t allocs0 = cmd_allocations(r);
     bool is_auto = r->mode == OB_THREADING_AUTO;
     bool multi = r->mode == OB_THREADING_MULTI || (is_auto && r->auto_multi);
@@ -934,9 +1019,15 @@ ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t cou
             if (w->error != OB_OK && res == OB_OK) res = w->error;
             w->error = OB_OK;
             /* The render thread's share is in its own CPU time. */
-            if (i + 1 < active) st->record_cpu_ns[i + 1] = w->cpu_ns;
+            if (i + 1 < active) st->record_cpu_ns[i + 1] = w->cpu_ns + w->prep_cpu_ns;
             w->cpu_ns = 0;
         }
+    }
+    /* The pool threads' resets of the slot's pools (begin_frame) are theirs,
+     * outside any hand-out: recording's driver work. */
+    for (uint32_t i = 0; i < r->worker_count; i++) {
+        st->cpu_pool_ns += r->workers[i].prep_cpu_ns;
+        r->workers[i].prep_cpu_ns = 0;
     }
     st->record_ns = multi ? ob_time_ns() - t_record : 0;
 
