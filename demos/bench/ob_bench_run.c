@@ -173,7 +173,15 @@ static void order_of(uint64_t k, uint32_t n, uint32_t *out)
 
 /* The round's updates, device idle: each mode in the round's order moves
  * the scene on once under its own threading, timed here; the renderer's
- * figures of the call (ob_renderer_last_update_stats) give its CPU split. */
+ * figures of the call (ob_renderer_last_update_stats) give its CPU split.
+ * Like a measured frame, a measured update comes after the mode's settle
+ * updates (unmeasured), so that it finds the mode as a program updating in
+ * it would: pool threads awake from its last hand-out, each core's caches
+ * holding the nodes it wrote, not the last mode's. Without them, the
+ * update of a mode on the workers always came after the wait for the
+ * device or a single-threaded update (the order only rotates): its pool
+ * thread asleep, 15-40 us to join, and the nodes written from the other
+ * core. */
 static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc, collector *c,
                                uint32_t round, const uint32_t *order)
 {
@@ -182,6 +190,9 @@ static ob_result round_updates(ob_bench_scene *s, const ob_bench_run_desc *desc,
     for (uint32_t i = 0; i < desc->mode_count && res == OB_OK; i++) {
         uint32_t m = order[i];
         ob_bench_set_mode(r, &desc->modes[m]);
+        for (uint32_t k = 0; k < desc->settle && res == OB_OK; k++)
+            res = ob_bench_scene_advance(s, desc->dt);
+        if (res != OB_OK) break;
         uint64_t t0 = ob_time_ns(), c0 = ob_thread_cpu_ns();
         res = ob_bench_scene_advance(s, desc->dt);
         uint64_t c1 = ob_thread_cpu_ns(), t1 = ob_time_ns();
