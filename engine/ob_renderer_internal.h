@@ -35,7 +35,9 @@ typedef struct ob_job {
  * thread itself (it would otherwise sleep while the others record). Only the
  * thread recording a batch touches this state; batches are handed over
  * by hand_out (a ticket the thread polls for, a semaphore once it sleeps),
- * so one thread at a time. */
+ * so one thread at a time. Between frames a pool thread may reset the
+ * slot's pool of any worker (ob_renderer_workers_prepare); recording waits
+ * for those resets first. */
 typedef struct ob_worker {
     ob_renderer *renderer;
     pthread_t thread;
