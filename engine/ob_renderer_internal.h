@@ -214,6 +214,7 @@ struct ob_renderer {
     bool done_ready;
     atomic_uint next_job;
     atomic_bool quit;           /* read by a pool thread on any ticket, joined or not */
+    atomic_bool hold_awake;     /* pool threads poll on past POOL_SPIN_NS (see run_jobs) */
 
     ob_present *present;        /* the attached surface's swapchain; NULL = headless */
 
