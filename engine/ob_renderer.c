@@ -422,10 +422,10 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     collect_frame(r, fs, &gpu_wait_ns);
     r->serial++;
     ob_device_begin_frame_slot(r->dev, r->slot);
-    /* The slot's command pools are reset where the frame first records into
-     * each (the primary's in ob_renderer_record_frame, a worker's in
-     * worker_next_cmd, in parallel): the slot's fence, waited for above,
-     * covers them all. */
+    /* The slot's other command pools are reset where the frame first
+     * records into each (the primary's in ob_renderer_record_frame, a
+     * worker's not reset above in worker_next_cmd): the slot's fence,
+     * waited for above, covers them all. */
     for (uint32_t i = 0; i < r->worker_count; i++)
         ob_pipeline_manager_begin_frame(r->workers[i].pm, r->slot, r->serial);
     ob_pipeline_manager_begin_frame(r->immediate, r->slot, r->serial);

@@ -65,12 +65,13 @@ static void worker_release(ob_renderer *r, ob_worker *w)
 }
 
 /* Next secondary command buffer of this worker for the current frame slot
- * (allocated once, reused every time the slot comes round). The first of a
- * frame resets the slot's pool, here on the thread that records into it
- * rather than serially in begin_frame: lavapipe walks every command the
- * pool holds to free it (some 40 us a worker at 8 views x 10k objects), and
- * the workers' resets now run side by side. The slot's fence was waited
- * for in begin_frame, so nothing in the pool is pending. On failure
+ * (allocated once, reused every time the slot comes round). The slot's pool
+ * is usually reset already, by a pool thread in begin_frame
+ * (ob_renderer_workers_prepare); otherwise (the first frame on the workers,
+ * a reset that failed there) the frame's first buffer resets it here, on
+ * the thread that records into it: lavapipe walks every command the pool
+ * holds to free it (some 40 us a worker at 8 views x 10k objects). The
+ * slot's fence was waited for in begin_frame, so nothing in it is pending. On failure
  * returns VK_NULL_HANDLE with *out_result set and logged. */
 static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *out_result)
 {
@@ -279,12 +280,19 @@ static void wake_sleeper(atomic_int *flag, sem_t *sem)
     if (atomic_load(flag) == 1 && atomic_compare_exchange_strong(flag, &one, 0)) sem_post(sem);
 }
 
+/* Hands worker w a ticket: what it is for (w->gen, w->prep, the quit) is
+ * stored before, and the ticket releases it. */
+static void worker_ticket(ob_worker *w)
+{
+    atomic_fetch_add(&w->ticket, 1u);
+    wake_sleeper(&w->sleeping, &w->go);
+}
+
 /* Gives worker w its next batch (or the quit), set up in r beforehand. */
 static void worker_wake(ob_worker *w, uint32_t gen)
 {
     atomic_store_explicit(&w->gen, gen, memory_order_relaxed);
-    atomic_fetch_add(&w->ticket, 1u); /* releases gen with it */
-    wake_sleeper(&w->sleeping, &w->go);
+    worker_ticket(w);
 }
 
 #define BATCH_CLOSED (1ull << 31)
@@ -348,8 +356,7 @@ void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads)
     for (uint32_t i = 0; i < helpers; i++) {
         ob_worker *w = &r->workers[i];
         atomic_store_explicit(&w->prep, 1, memory_order_relaxed);
-        atomic_fetch_add(&w->ticket, 1u); /* releases prep; gen stays, so no batch is joined */
-        wake_sleeper(&w->sleeping, &w->go);
+        worker_ticket(w); /* gen stays, so no batch is joined */
     }
 }
 
