@@ -355,7 +355,9 @@ void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads)
     atomic_store(&r->prep_pending, helpers);
     for (uint32_t i = 0; i < helpers; i++) {
         ob_worker *w = &r->workers[i];
-        atomic_store_explicit(&w->prep, 1, memory_order_relaxed);
+        /* release: a thread still awake from its last ticket may take the
+         * flag before this ticket, and must then see prep_slot and the rest */
+        atomic_store_explicit(&w->prep, 1, memory_order_release);
         worker_ticket(w); /* gen stays, so no batch is joined */
     }
 }
