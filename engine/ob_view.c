@@ -497,10 +497,12 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     if (v->material_items_valid) {
         for (uint32_t k2 = 0; k2 < v->material_count; k2++) v->materials[k2].seen = 0;
         for (uint32_t j = 0; j < n; j++) {
+            const ob_render_proxy *p = &v->proxies[v->items[j].proxy];
             ob_view_material *m = &v->materials[v->soa.material[v->items[j].proxy]];
             if (m->seen && !m->per_entity) continue;
             m->seen = 1;
-            v->material_items[v->material_item_count++] = j;
+            v->material_items[v->material_item_count++] =
+                (ob_view_material_item){.node = p->node, .material = p->material, .item = j};
         }
     }
     cv->ns = chunk_ns + (ob_time_ns() - t0);
@@ -599,17 +601,24 @@ void ob_view_item_sphere(const ob_view *v, uint32_t item, double center[3], floa
     *radius = v->soa.radius[i];
 }
 
-void ob_view_for_each_material_item(ob_view *v, void (*fn)(void *user, ob_view *v, uint32_t item),
+void ob_view_for_each_material_item(ob_view *v,
+                                    void (*fn)(void *user, ob_view *v,
+                                               const ob_view_material_item *e),
                                     void *user)
 {
     if (!v->material_count || !v->material_items_valid) {
         /* Not culled through ob_view_cull (a custom list), or no memory
          * for the short list: every item. */
-        for (uint32_t i = 0; i < v->item_count; i++) fn(user, v, i);
+        for (uint32_t i = 0; i < v->item_count; i++) {
+            ob_node *n = v->items[i].node;
+            const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
+            ob_view_material_item e = {.node = n, .material = rd ? rd->material : NULL, .item = i};
+            fn(user, v, &e);
+        }
         return;
     }
     for (uint32_t k = 0; k < v->material_item_count; k++)
-        if (v->material_items[k] < v->item_count) fn(user, v, v->material_items[k]);
+        if (v->material_items[k].item < v->item_count) fn(user, v, &v->material_items[k]);
 }
 
 typedef struct pre_render_ctx {
@@ -617,11 +626,10 @@ typedef struct pre_render_ctx {
     ob_renderer *r;
 } pre_render_ctx;
 
-static void pre_render_item(void *user, ob_view *v, uint32_t i)
+static void pre_render_item(void *user, ob_view *v, const ob_view_material_item *e)
 {
     const pre_render_ctx *c = user;
-    ob_node *n = v->items[i].node;
-    c->mi->pre_render(ob_node_get_renderable(n)->material, n, c->r, v);
+    if (e->material) c->mi->pre_render(e->material, e->node, c->r, v);
 }
 
 void ob_view_pre_render_items(ob_view *v, ob_renderer *r)

@@ -748,13 +748,11 @@ typedef struct prepare_ctx {
     ob_effect_targets targets;
 } prepare_ctx;
 
-static void prepare_item(void *user, ob_view *v, uint32_t i)
+static void prepare_item(void *user, ob_view *v, const ob_view_material_item *e)
 {
     const prepare_ctx *c = user;
-    ob_node *n = v->items[i].node;
-    const ob_renderable *rd = n ? ob_node_get_renderable(n) : NULL;
-    if (!rd || !rd->material || rd->material->lib != c->lib) return;
-    prepare(rd->material, c->r, n, v, &c->targets);
+    if (!e->material || e->material->lib != c->lib) return;
+    prepare(e->material, c->r, e->node, v, &c->targets);
 }
 
 void ob_material_library_prepare_view(ob_material_library *lib, ob_renderer *r, ob_view *v)
