@@ -76,8 +76,9 @@ typedef struct ob_view_material {
 
 /* An item of a view's draw list that its post-cull work visits, with what
  * that work reads of it: culling fills these on the pool, so the render
- * thread does not follow item -> node -> renderable through memory another
- * core wrote (about 0.5 us an item on the 2-core machine). */
+ * thread does not follow item -> node -> renderable through lines culling
+ * has long evicted or another core wrote (about 0.5 us an item on the
+ * 2-core machine). */
 typedef struct ob_view_material_item {
     ob_node *node;                /* the item's entity */
     struct ob_material *material; /* its material in the snapshot culled */
