@@ -75,6 +75,7 @@ static uint32_t intern_acquire(intern_table *t, void *p, ob_result *out)
         if (*out == OB_OK)
             *out = ob_array_reserve((void **)&t->refs, &t->refs_cap, t->count + 1, sizeof *t->refs);
         if (*out != OB_OK) return 0;
+        t->ptr[0] = NULL; /* read through ob_render_soa's tables */
         i = t->count++;
     }
     t->ptr[i] = p;
@@ -382,13 +383,20 @@ void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out)
     static const uint8_t none_b[1];
     static const uint32_t none_u[1];
     static ob_node *const none_n[1];
+    static void *const none_p[1];
     bool any = s->soa_x != NULL;
+    /* Every index the snapshot uses exists, so its table does (index 0's
+     * entry is NULL). */
+    void *const *mats = s->materials.ptr ? s->materials.ptr : none_p;
+    void *const *geos = s->geometries.ptr ? s->geometries.ptr : none_p;
     *out = (ob_render_soa){
         .count = s->renderable_count,
         .x = any ? s->soa_x : none_d, .y = any ? s->soa_y : none_d, .z = any ? s->soa_z : none_d,
         .radius = any ? s->soa_radius : none_f, .flags = any ? s->soa_flags : none_b,
         .material = any ? s->soa_material : none_u, .geometry = any ? s->soa_geometry : none_u,
         .node_id = any ? s->soa_node_id : none_u, .node = any ? s->soa_node : none_n,
+        .materials = (struct ob_material *const *)mats,
+        .geometries = (struct ob_geometry *const *)geos,
     };
 }
 

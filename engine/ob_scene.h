@@ -100,22 +100,19 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
 ob_node *const *ob_scene_renderables(const ob_scene *s, uint32_t *out_count);
 ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count);
 
-/* A renderable's draw data for the frame, kept in arrays parallel to the
+/* A renderable's world transform for the frame, in an array parallel to the
  * renderables snapshot (same order, same count), so that the views' loops
  * read contiguous memory instead of chasing nodes: the proxy is what
- * recording reads (two cache lines; the array is 64-byte aligned); culling
- * reads the bounds from ob_render_soa. World data is as of the last
- * ob_scene_update (as the node's queries); material and geometry follow
- * ob_node_set_renderable at once. */
+ * recording reads of an entity, one cache line (the array is 64-byte
+ * aligned), and the one line the update writes for each moving entity.
+ * Who the entity is and what it draws (node, id, material, geometry) lie
+ * in ob_render_soa with the bounds; the normal matrix is derived where a
+ * draw needs it (ob_render_proxy_per_draw). World data is as of the last
+ * ob_scene_update (as the node's queries). */
 typedef struct ob_render_proxy {
     float linear[9];             /* world upper 3x3 in float, column-major */
-    float normal[9];             /* its normal matrix (ob_mat4_normal_cofactor), column-major */
+    uint32_t finite;             /* 1: linear is finite in float (and so its normal matrix) */
     double world_t[3];           /* world translation */
-    struct ob_material *material; /* NULL when the node has no renderable now */
-    struct ob_geometry *geometry;
-    ob_node *node;
-    uint32_t node_id;
-    bool finite;                 /* linear and normal are finite in float */
 } ob_render_proxy;
 
 /* The proxies of the snapshot, *out_count of them (= the renderables').
@@ -123,12 +120,13 @@ typedef struct ob_render_proxy {
  * thread, while no mutation runs] */
 const ob_render_proxy *ob_scene_render_proxies(const ob_scene *s, uint32_t *out_count);
 
-/* The snapshot's culling data as a structure of arrays, parallel to the
- * proxies (index i is proxy i, ascending node id), for loops that touch
- * every renderable in every view: the world bound, a flag byte, and the
- * renderable's material and geometry as small dense indices (interned when
- * the renderable is set: ob_scene_material / ob_scene_geometry give the
- * pointer back; 0 is none). Valid like the proxies. */
+/* The snapshot's culling and identity data as a structure of arrays,
+ * parallel to the proxies (index i is proxy i, ascending node id), for
+ * loops that touch every renderable in every view: the world bound, a flag
+ * byte, the renderable's material and geometry as small dense indices
+ * (interned when the renderable is set, following ob_node_set_renderable at
+ * once: the materials / geometries tables give the pointer back; 0 is
+ * none), and the node and its id. Valid like the proxies. */
 #define OB_RENDER_ZERO_SCALE 1u  /* a bound with a local radius but none in the world */
 typedef struct ob_render_soa {
     uint32_t count;
@@ -138,6 +136,11 @@ typedef struct ob_render_soa {
     const uint32_t *material, *geometry;
     const uint32_t *node_id;
     ob_node *const *node;
+    /* Index -> pointer for material and geometry ([0] NULL), as
+     * ob_scene_material / ob_scene_geometry give them for the indices
+     * the snapshot uses. */
+    struct ob_material *const *materials;
+    struct ob_geometry *const *geometries;
 } ob_render_soa;
 void ob_scene_render_soa(const ob_scene *s, ob_render_soa *out);
 /* The pointer behind an index of ob_render_soa (NULL for 0 or an index no
@@ -149,16 +152,18 @@ uint32_t ob_scene_geometry_count(const ob_scene *s);
 
 /* The standard per-draw block of a proxy: its world matrix relative to
  * origin (as ob_node_world_relative gives it for the node) in dest[0..15] and
- * the normal matrix in dest[16..31]. False when some value is not finite in
- * float (dest is written anyway). */
+ * the normal matrix (ob_mat4_normal_cofactor's, bit for bit) in
+ * dest[16..31]. False when some value is not finite in float (dest is
+ * written anyway). */
 static inline bool ob_render_proxy_per_draw(const ob_render_proxy *p, const double origin[3],
                                             float dest[32])
 {
-    float t[3];
+    float t[3], normal[9];
+    ob_mat3_normal_cofactor(p->linear, normal);
     for (int c = 0; c < 3; c++) {
         for (int r = 0; r < 3; r++) {
             dest[c * 4 + r] = p->linear[c * 3 + r];
-            dest[16 + c * 4 + r] = p->normal[c * 3 + r];
+            dest[16 + c * 4 + r] = normal[c * 3 + r];
         }
         dest[c * 4 + 3] = dest[16 + c * 4 + 3] = 0.0f;
         t[c] = (float)(p->world_t[c] - origin[c]);

@@ -19,6 +19,7 @@
  */
 #include "ob_controllers_internal.h"
 
+#include <float.h>
 #include <string.h>
 
 typedef struct update_ctx {
@@ -99,7 +100,7 @@ static bool is_identity(const node_xf *x, const double q[4])
 
 /* ---------------------------------------------------------------- snapshot */
 
-_Static_assert(sizeof(ob_render_proxy) == 2 * OB_CACHE_LINE, "a proxy is two cache lines");
+_Static_assert(sizeof(ob_render_proxy) == OB_CACHE_LINE, "a proxy is one cache line");
 
 static uint8_t zero_scale_flag(const node_xf *x, float world_radius)
 {
@@ -122,13 +123,24 @@ static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i, const d
     s->soa_flags[i] = zero_scale_flag(x, radius);
 }
 
-/* The normal matrix, and whether the matrices are finite in float (the
- * normal one is whenever the linear one is). scale: the world's largest
- * column length, which spares nearly every node the cofactor's checks. */
-static void proxy_write_normal(ob_scene *s, uint32_t i, double scale)
+/* Whether the float form of a finite double 3x3, linear, is finite; scale
+ * its largest column length (as ob_daffine_max_scale gives it). No entry
+ * exceeds that in magnitude, so only a scale beyond FLT_MAX (almost never)
+ * needs the entries looked at. */
+static uint32_t linear_finite(const float linear[9], double scale)
+{
+    if (scale <= FLT_MAX) return 1;
+    uint32_t ok = 1;
+    for (int k = 0; k < 9; k++) ok &= fabsf(linear[k]) <= FLT_MAX;
+    return ok;
+}
+
+/* Whether proxy i's matrix is finite in float, once its values are
+ * stored. */
+static void proxy_write_finite(ob_scene *s, uint32_t i, double scale)
 {
     ob_render_proxy *p = &s->proxies[i];
-    p->finite = ob_mat3_normal_cofactor_of_scale(p->linear, scale, p->normal);
+    p->finite = linear_finite(p->linear, scale);
 }
 
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
@@ -136,8 +148,6 @@ void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
     const node_draw *d = &s->draw[slot];
     const node_xf *x = &s->xf[slot];
     uint32_t i = x->proxy_index;
-    s->proxies[i].material = d->material;
-    s->proxies[i].geometry = d->geometry;
     s->soa_material[i] = d->material_index;
     s->soa_geometry[i] = d->geometry_index;
     double center[3];
@@ -151,14 +161,14 @@ static void proxy_fill(ob_scene *s, uint32_t slot, uint32_t i)
 {
     node_xf *x = &s->xf[slot];
     x->proxy_index = i;
-    s->proxies[i].node = s->soa_node[i] = s->by_id[slot];
-    s->proxies[i].node_id = s->soa_node_id[i] = s->slot_id[slot];
+    s->soa_node[i] = s->by_id[slot];
+    s->soa_node_id[i] = s->slot_id[slot];
     ob_scene_proxy_set_renderable(s, slot);
     double center[3];
     float radius;
     double scale = node_world_bound(x, center, &radius);
     proxy_write_world(s, x, i, center, radius);
-    proxy_write_normal(s, i, scale);
+    proxy_write_finite(s, i, scale);
 }
 
 void ob_scene_snapshot_drop_dying(ob_scene *s, uint32_t from, bool lights)
@@ -334,13 +344,10 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
         b->in_place[k] = !p || (p->flags & (XF_IDENTITY | XF_WORLD_VALID)) ==
                                    (XF_IDENTITY | XF_WORLD_VALID);
         b->st[k] = ob_scene_xf_local(x, b->in_place[k] ? &x->world : &b->world[k], b->q[k]);
-        /* The proxy's two lines are only written, a stage later: asked for
-         * now, they are there by then (3-4 ns an object at 50k). */
-        if (s->state[it.slot] & NODE_IN_RENDERABLES) {
-            const char *pr = (const char *)&s->proxies[x->proxy_index];
-            __builtin_prefetch(pr, 1);
-            __builtin_prefetch(pr + OB_CACHE_LINE, 1);
-        }
+        /* The proxy's line is only written, a stage later: asked for now,
+         * it is there by then (3-4 ns an object at 50k). */
+        if (s->state[it.slot] & NODE_IN_RENDERABLES)
+            __builtin_prefetch(&s->proxies[x->proxy_index], 1);
     }
     bool changed = false;
     for (uint32_t k = 0; k < b->count; k++)
@@ -353,7 +360,7 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
         b->proxy_index[proxies] = x->proxy_index;
         b->scale[proxies++] = b->scale[k];
     }
-    for (uint32_t k = 0; k < proxies; k++) proxy_write_normal(s, b->proxy_index[k], b->scale[k]);
+    for (uint32_t k = 0; k < proxies; k++) proxy_write_finite(s, b->proxy_index[k], b->scale[k]);
     b->count = 0;
     return changed;
 }
@@ -366,7 +373,7 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
  * rotation its own, in the snapshot still. So the world, the bound and
  * the proxy are computed in one pass in SSE2 lanes, with exactly the
  * operations of ob_scene_xf_local, node_world_bound, proxy_write_world and
- * proxy_write_normal in their order (the same bits), without the stages'
+ * proxy_write_finite in their order (the same bits), without the stages'
  * flags and stores in between. */
 static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
 {
@@ -419,10 +426,8 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
                     XF_WORLD_ROT_LOCAL;
         s->state[slot] =
             (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
-        /* proxy_write_world, then proxy_write_normal */
+        /* proxy_write_world, then proxy_write_finite */
         ob_render_proxy *p = &s->proxies[i];
-        /* The normal matrix reads the floats back from the proxy (taken
-         * from locals instead, it came out slower). */
         for (int k = 0; k < 9; k++) p->linear[k] = (float)m[k][l];
         for (int k = 0; k < 3; k++) p->world_t[k] = t[k][l];
         float r = (float)radius[l];
@@ -431,7 +436,7 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         s->soa_z[i] = center[2][l];
         s->soa_radius[i] = r;
         s->soa_flags[i] = zero_scale_flag(xl, r);
-        p->finite = ob_mat3_normal_cofactor_of_scale(p->linear, scale[l], p->normal);
+        p->finite = linear_finite(p->linear, scale[l]);
     }
 }
 
@@ -529,9 +534,7 @@ static inline __attribute__((always_inline)) void prefetch_proxies(const ob_scen
         uint32_t slot = items[j].slot;
         if (!(s->state[slot] & NODE_IN_RENDERABLES)) continue;
         uint32_t i = s->xf[slot].proxy_index;
-        const char *p = (const char *)&s->proxies[i];
-        __builtin_prefetch(p, 1);
-        __builtin_prefetch(p + OB_CACHE_LINE, 1);
+        __builtin_prefetch(&s->proxies[i], 1);
         if (i % 8u == 0 && i + 8 < s->soa_cap) {
             __builtin_prefetch(&s->soa_x[i + 8], 1);
             __builtin_prefetch(&s->soa_y[i + 8], 1);

@@ -479,7 +479,8 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
         coarse += sorted[j].index > CULL_INDEX_MASK;
         v->items[j] = (ob_draw_item){.sort_key = sorted[j].key, .sort_hi = sorted[j].hi,
                                      .node_id = v->soa.node_id[i], .node = v->soa.node[i],
-                                     .proxy = i,
+                                     .proxy = i, .material = v->soa.material[i],
+                                     .geometry = v->soa.geometry[i],
                                      .lod = (uint8_t)(sorted[j].index >> CULL_LOD_SHIFT)};
     }
     v->item_count = n;
@@ -497,12 +498,12 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     if (v->material_items_valid) {
         for (uint32_t k2 = 0; k2 < v->material_count; k2++) v->materials[k2].seen = 0;
         for (uint32_t j = 0; j < n; j++) {
-            const ob_render_proxy *p = &v->proxies[v->items[j].proxy];
-            ob_view_material *m = &v->materials[v->soa.material[v->items[j].proxy]];
+            const ob_draw_item *it = &v->items[j];
+            ob_view_material *m = &v->materials[it->material];
             if (m->seen && !m->per_entity) continue;
             m->seen = 1;
-            v->material_items[v->material_item_count++] =
-                (ob_view_material_item){.node = p->node, .material = p->material, .item = j};
+            v->material_items[v->material_item_count++] = (ob_view_material_item){
+                .node = it->node, .material = v->soa.materials[it->material], .item = j};
         }
     }
     cv->ns = chunk_ns + (ob_time_ns() - t0);
@@ -648,10 +649,10 @@ void ob_view_pre_render_items(ob_view *v, ob_renderer *r)
  * hash is the same either way). 6 KiB of stack. */
 #define RUN_BLOCKS 128u
 
-static void log_not_finite(const ob_view *v, const ob_render_proxy *p)
+static void log_not_finite(const ob_view *v, const ob_draw_item *it)
 {
     OB_LOG_E("view", "view '%s': entity '%s' (id %u): world matrix not finite in float "
-             "(or its derived matrices); not drawn", v->name, ob_node_name(p->node), p->node_id);
+             "(or its derived matrices); not drawn", v->name, ob_node_name(it->node), it->node_id);
 }
 
 void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
@@ -661,47 +662,44 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
     const ob_geometry_iface *gi = ob_renderer_get_geometry_iface(r);
     /* Items are sorted by state: a run of one material is applied once, a
      * run of one geometry asks for its draw data once, and with an
-     * instanced program a run of both is one draw. */
-    const struct ob_material *applied = NULL;
-    const struct ob_geometry *described = NULL;
-    uint32_t described_lod = 0;
+     * instanced program a run of both is one draw. The list says where a
+     * run ends; of an entity, only its proxy's line is read. */
+    uint32_t applied = 0, described = 0, described_lod = 0;
     ob_draw_data dd = {0};
     _Alignas(16) float block[32];
     _Alignas(16) float rows[RUN_BLOCKS][OB_INSTANCE_FLOATS];
+    const ob_draw_item *items = v->items;
     uint32_t end = first + count < v->item_count ? first + count : v->item_count;
     for (uint32_t i = first; i < end;) {
         /* Items are in draw order, proxies in id order: fetch a few ahead so
          * the loop does not wait on memory. */
-        if (i + PROXY_PREFETCH < end) {
-            const ob_render_proxy *ahead = &v->proxies[v->items[i + PROXY_PREFETCH].proxy];
-            __builtin_prefetch(ahead);
-            __builtin_prefetch((const char *)ahead + 64);
-        }
-        const ob_render_proxy *p = &v->proxies[v->items[i].proxy];
-        if (!p->material) {
+        if (i + PROXY_PREFETCH < end)
+            __builtin_prefetch(&v->proxies[items[i + PROXY_PREFETCH].proxy]);
+        const ob_draw_item *it = &items[i];
+        if (!it->material) {
             i++;
             continue;
         }
-        if (p->material != applied) {
-            ob_apply_result a = mi->apply(p->material, p->node, r, pm, v);
-            applied = a == OB_APPLY_MATERIAL ? p->material : NULL;
+        if (it->material != applied) {
+            ob_apply_result a = mi->apply(v->soa.materials[it->material], it->node, r, pm, v);
+            applied = a == OB_APPLY_MATERIAL ? it->material : 0;
             if (a == OB_APPLY_SKIP) {
                 i++;
                 continue;
             }
         }
-        uint32_t lod = v->items[i].lod;
-        if (p->geometry != described || lod != described_lod) {
-            gi->draw_data(p->geometry, lod, &dd);
-            described = p->geometry;
+        uint32_t lod = it->lod;
+        if (it->geometry != described || lod != described_lod) {
+            gi->draw_data(v->soa.geometries[it->geometry], lod, &dd);
+            described = it->geometry;
             described_lod = lod;
         }
         if (!ob_pipeline_manager_instanced(pm)) {
             /* A refused matrix is not drawn (a stale one would put this
              * entity where the previous one was). */
-            bool finite = ob_render_proxy_per_draw(p, v->origin, block);
+            bool finite = ob_render_proxy_per_draw(&v->proxies[it->proxy], v->origin, block);
             if (!finite || ob_pipeline_manager_draw_data(pm, &dd, block) == OB_ERR_NON_FINITE)
-                log_not_finite(v, p);
+                log_not_finite(v, it);
             i++;
             continue;
         }
@@ -709,18 +707,13 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
          * all (an entity-dependent one is applied per item) and this mesh. */
         uint32_t n = 0, j = i;
         do {
-            const ob_render_proxy *q = &v->proxies[v->items[j].proxy];
-            if (j + PROXY_PREFETCH < end) {
-                const ob_render_proxy *ahead = &v->proxies[v->items[j + PROXY_PREFETCH].proxy];
-                __builtin_prefetch(ahead);
-                __builtin_prefetch((const char *)ahead + 64);
-            }
-            if (ob_render_proxy_instance(q, v->origin, rows[n])) n++;
-            else log_not_finite(v, q);
+            if (j + PROXY_PREFETCH < end)
+                __builtin_prefetch(&v->proxies[items[j + PROXY_PREFETCH].proxy]);
+            if (ob_render_proxy_instance(&v->proxies[items[j].proxy], v->origin, rows[n])) n++;
+            else log_not_finite(v, &items[j]);
             j++;
-        } while (j < end && n < RUN_BLOCKS && applied &&
-                 v->proxies[v->items[j].proxy].material == applied &&
-                 v->proxies[v->items[j].proxy].geometry == p->geometry && v->items[j].lod == lod);
+        } while (j < end && n < RUN_BLOCKS && applied && items[j].material == applied &&
+                 items[j].geometry == it->geometry && items[j].lod == lod);
         if (n) ob_pipeline_manager_draw_instances(pm, &dd, &rows[0][0], n);
         i = j;
     }

@@ -61,6 +61,10 @@ typedef struct ob_draw_item {
     uint32_t node_id;
     ob_node *node;
     uint32_t proxy;         /* index in the view's proxies (the scene snapshot's) */
+    /* The renderable's material and geometry as the snapshot's indices
+     * (ob_render_soa: soa.materials[material] is the pointer; 0 none), so
+     * that recording finds a run's end in the list itself. */
+    uint32_t material, geometry;
     uint8_t lod;            /* the geometry's level of detail drawn (ob_view.lod_scale) */
 } ob_draw_item;
 

@@ -741,13 +741,15 @@ typedef struct lean_row {
 static uint32_t lean_rows(ob_demo *d, lean_row rows[LEAN_MATERIALS], uint32_t *out_other)
 {
     uint32_t row_count = 0, other_entities = 0, count = 0;
-    const ob_render_proxy *proxies = d->world.scene ? ob_scene_render_proxies(d->world.scene, &count) : NULL;
+    ob_render_soa soa = {0};
+    if (d->world.scene) ob_scene_render_soa(d->world.scene, &soa);
+    count = soa.count;
     ob_view *main = d->world.main ? ob_perspective_view_base(d->world.main) : NULL;
     for (uint32_t i = 0; i < count; i++) {
-        ob_material *m = proxies[i].material;
+        ob_material *m = soa.materials[soa.material[i]];
         if (!m) continue;
         ob_result r = OB_OK;
-        const ob_effect *e = main ? ob_material_get_view_effect(m, d->world.r, proxies[i].node, main,
+        const ob_effect *e = main ? ob_material_get_view_effect(m, d->world.r, soa.node[i], main,
                                                                 false, &r)
                                   : NULL;
         const char *name = ob_material_name(m), *effect = e ? ob_effect_name(e) : NULL;

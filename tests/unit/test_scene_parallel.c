@@ -284,19 +284,17 @@ static void assert_same_snapshot(const world *a, const world *b)
     const ob_render_proxy *pb = ob_scene_render_proxies(b->s, &nb);
     for (uint32_t i = 0; i < na; i++) {
         assert_memory_equal(pa[i].linear, pb[i].linear, sizeof pa[i].linear);
-        assert_memory_equal(pa[i].normal, pb[i].normal, sizeof pa[i].normal);
         assert_memory_equal(pa[i].world_t, pb[i].world_t, sizeof pa[i].world_t);
-        assert_ptr_equal(pa[i].material, pb[i].material);
-        assert_ptr_equal(pa[i].geometry, pb[i].geometry);
-        assert_int_equal(pa[i].node_id, pb[i].node_id);
-        assert_int_equal(id_or_zero(pa[i].node), pa[i].node_id);
-        assert_int_equal(id_or_zero(pb[i].node), pb[i].node_id);
         assert_int_equal(pa[i].finite, pb[i].finite);
     }
 
     ob_render_soa sa, sb;
     ob_scene_render_soa(a->s, &sa);
     ob_scene_render_soa(b->s, &sb);
+    for (uint32_t i = 0; i < sa.count; i++) {
+        assert_ptr_equal(sa.materials[sa.material[i]], sb.materials[sb.material[i]]);
+        assert_ptr_equal(sa.geometries[sa.geometry[i]], sb.geometries[sb.geometry[i]]);
+    }
     assert_int_equal(sa.count, sb.count);
     assert_memory_equal(sa.x, sb.x, sizeof *sa.x * sa.count);
     assert_memory_equal(sa.y, sb.y, sizeof *sa.y * sa.count);
@@ -334,22 +332,25 @@ static void assert_snapshot_consistent(const world *w)
     for (uint32_t i = 0; i < count; i++) {
         const ob_node *n = items[i];
         assert_true(ob_node_is_renderable(n));
-        assert_ptr_equal(p[i].node, n);
         const ob_renderable *rd = ob_node_get_renderable(n);
         assert_non_null(rd);
-        assert_ptr_equal(p[i].material, rd->material);
         assert_ptr_equal(soa.node[i], n);
+        assert_int_equal(soa.node_id[i], ob_node_id(n));
         assert_ptr_equal(ob_scene_material(w->s, soa.material[i]), rd->material);
         assert_ptr_equal(ob_scene_geometry(w->s, soa.geometry[i]), rd->geometry);
+        assert_ptr_equal(soa.materials[soa.material[i]], rd->material);
+        assert_ptr_equal(soa.geometries[soa.geometry[i]], rd->geometry);
         ob_daffine wm;
         ob_node_world_affine(n, &wm);
-        float m4[16], nm[16];
+        float m4[16], nm[16], block[32];
         ob_daffine_to_relative(&wm, (double[3]){0, 0, 0}, m4);
         ob_mat4_normal_cofactor(m4, nm);
+        assert_true(ob_render_proxy_per_draw(&p[i], (double[3]){0, 0, 0}, block));
+        assert_int_equal(p[i].finite, 1);
         for (int c = 0; c < 3; c++) {
             for (int r = 0; r < 3; r++) {
                 assert_memory_equal(&p[i].linear[c * 3 + r], &m4[c * 4 + r], sizeof(float));
-                assert_memory_equal(&p[i].normal[c * 3 + r], &nm[c * 4 + r], sizeof(float));
+                assert_memory_equal(&block[16 + c * 4 + r], &nm[c * 4 + r], sizeof(float));
             }
         }
         assert_memory_equal(p[i].world_t, wm.t, sizeof wm.t);
