@@ -275,6 +275,23 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
  * overflows nor turns denormal for any finite w. Row and column 3 are those
  * of the identity. */
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
+/* Whether the 3x3 in w has a negative determinant (evaluated in double
+ * from the floats): element (r, c) at w[c * col + r * row]. The engine's one
+ * test of a mirroring world (the front face flips): a column-major 3x3 is
+ * (w, 3, 1), the rows of a per-instance block (w, 1, 4); the same matrix
+ * gives the same answer either way. */
+static inline bool ob_det3_negative(const float *w, int col, int row)
+{
+    double a[3], b[3], c[3];
+    for (int r = 0; r < 3; r++) {
+        a[r] = w[r * row];
+        b[r] = w[col + r * row];
+        c[r] = w[2 * col + r * row];
+    }
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    return det < 0.0;
+}
 /* The cofactor part of ob_mat3_normal_cofactor, without its checks and
  * rescaling: for an m the caller knows to be finite with its largest
  * magnitude in [2^-60, 2^60] (then the same result, bit for bit, and

@@ -1,5 +1,6 @@
 #include "ob_pipeline_manager.h"
 
+#include "ob_math.h"
 #include "ob_resources_internal.h"
 
 #include <stdio.h>
@@ -340,24 +341,17 @@ void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeli
 /* Whether the 3x3 whose entry (row r, column c) is w[c * col + r * row]
  * mirrors: the sign of its determinant, in double (a product of three
  * float columns neither underflows nor overflows). */
-static bool det3_negative(const float *w, int col, int row)
+/* The per-draw block's world matrix (column-major 4x4) mirrors. */
+static bool world_mirrors(const float world_normal[32])
 {
-    double a[3], b[3], c[3];
-    for (int r = 0; r < 3; r++) {
-        a[r] = w[r * row];
-        b[r] = w[col + r * row];
-        c[r] = w[2 * col + r * row];
-    }
-    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
-                 a[2] * (b[0] * c[1] - b[1] * c[0]);
-    return det < 0.0;
+    return ob_det3_negative(world_normal, 4, 1);
 }
 
-/* The per-draw block's world matrix (column-major 4x4) mirrors. */
-static bool world_mirrors(const float world_normal[32]) { return det3_negative(world_normal, 4, 1); }
-
 /* The same of a per-instance block (three rows of the world matrix). */
-static bool rows_mirror(const float rows[OB_INSTANCE_FLOATS]) { return det3_negative(rows, 1, 4); }
+static bool rows_mirror(const float rows[OB_INSTANCE_FLOATS])
+{
+    return ob_det3_negative(rows, 1, 4);
+}
 
 void ob_pipeline_manager_set_world(ob_pipeline_manager *pm, const float world_normal[32])
 {
@@ -1120,6 +1114,26 @@ ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_d
                                         mirrors);
         if (r != OB_OK) return r;
         start = end;
+    }
+    return OB_OK;
+}
+
+ob_result ob_pipeline_manager_draw_instances_facing(ob_pipeline_manager *pm,
+                                                    const ob_draw_data *d, const float *blocks,
+                                                    uint32_t count, bool mirrors)
+{
+    if (count == 0) return OB_OK;
+    if (!pm->program || !pm->program->instanced) {
+        pm->stats.skipped_draws += count;
+        log_once(pm, "instanced draw with a program that reads no per-instance block");
+        return OB_ERR_WRONG_STATE;
+    }
+    uint32_t most = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW ? pm->max_draw_indirect : UINT32_MAX;
+    for (uint32_t start = 0; start < count;) {
+        uint32_t n = OB_MIN(count - start, most);
+        ob_result r = draw_instance_run(pm, d, blocks + OB_INSTANCE_FLOATS * start, n, mirrors);
+        if (r != OB_OK) return r;
+        start += n;
     }
     return OB_OK;
 }

@@ -218,6 +218,13 @@ bool ob_pipeline_manager_instanced(const ob_pipeline_manager *pm);
  * OB_ERR_WRONG_STATE when the program is not instanced. */
 ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
                                              const float *blocks, uint32_t count);
+/* The same for blocks of which all mirror or none does (mirrors says
+ * which, as ob_det3_negative gives it for their rows, and as
+ * ob_render_proxy.mirrors records it for an entity): the caller knows, so
+ * no determinant is taken per instance. The same commands and hash. */
+ob_result ob_pipeline_manager_draw_instances_facing(ob_pipeline_manager *pm,
+                                                    const ob_draw_data *d, const float *blocks,
+                                                    uint32_t count, bool mirrors);
 ob_result ob_pipeline_manager_draw_indirect(ob_pipeline_manager *pm, ob_buffer args, uint64_t offset,
                               uint32_t draw_count);
 ob_result ob_pipeline_manager_draw_indexed_indirect(ob_pipeline_manager *pm, ob_buffer args,

@@ -111,7 +111,9 @@ ob_node *const *ob_scene_lights(const ob_scene *s, uint32_t *out_count);
  * ob_scene_update (as the node's queries). */
 typedef struct ob_render_proxy {
     float linear[9];             /* world upper 3x3 in float, column-major */
-    uint32_t finite;             /* 1: linear is finite in float (and so its normal matrix) */
+    uint8_t finite;              /* 1: linear is finite in float (and so its normal matrix) */
+    uint8_t mirrors;             /* 1: linear's determinant is negative (ob_det3_negative):
+                                    drawn with the other front face */
     double world_t[3];           /* world translation */
 } ob_render_proxy;
 

@@ -127,20 +127,22 @@ static void proxy_write_world(ob_scene *s, const node_xf *x, uint32_t i, const d
  * its largest column length (as ob_daffine_max_scale gives it). No entry
  * exceeds that in magnitude, so only a scale beyond FLT_MAX (almost never)
  * needs the entries looked at. */
-static uint32_t linear_finite(const float linear[9], double scale)
+static uint8_t linear_finite(const float linear[9], double scale)
 {
     if (scale <= FLT_MAX) return 1;
-    uint32_t ok = 1;
+    uint8_t ok = 1;
     for (int k = 0; k < 9; k++) ok &= fabsf(linear[k]) <= FLT_MAX;
     return ok;
 }
 
-/* Whether proxy i's matrix is finite in float, once its values are
- * stored. */
+/* What proxy i's matrix is, once its values are stored: finite in float,
+ * and mirroring (found once per update here, not per instance and view
+ * when it is drawn). */
 static void proxy_write_finite(ob_scene *s, uint32_t i, double scale)
 {
     ob_render_proxy *p = &s->proxies[i];
     p->finite = linear_finite(p->linear, scale);
+    p->mirrors = ob_det3_negative(p->linear, 3, 1);
 }
 
 void ob_scene_proxy_set_renderable(ob_scene *s, uint32_t slot)
@@ -437,6 +439,7 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         s->soa_radius[i] = r;
         s->soa_flags[i] = zero_scale_flag(xl, r);
         p->finite = linear_finite(p->linear, scale[l]);
+        p->mirrors = ob_det3_negative(p->linear, 3, 1);
     }
 }
 

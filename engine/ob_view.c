@@ -704,8 +704,10 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
             continue;
         }
         /* The run: this item and the next ones of the material applied for
-         * all (an entity-dependent one is applied per item) and this mesh. */
+         * all (an entity-dependent one is applied per item), this mesh and
+         * the same front face (the update found which entities mirror). */
         uint32_t n = 0, j = i;
+        uint8_t mirrors = v->proxies[it->proxy].mirrors;
         do {
             if (j + PROXY_PREFETCH < end)
                 __builtin_prefetch(&v->proxies[items[j + PROXY_PREFETCH].proxy]);
@@ -713,8 +715,9 @@ void ob_view_record_items(ob_view *v, ob_renderer *r, ob_pipeline_manager *pm,
             else log_not_finite(v, &items[j]);
             j++;
         } while (j < end && n < RUN_BLOCKS && applied && items[j].material == applied &&
-                 items[j].geometry == it->geometry && items[j].lod == lod);
-        if (n) ob_pipeline_manager_draw_instances(pm, &dd, &rows[0][0], n);
+                 items[j].geometry == it->geometry && items[j].lod == lod &&
+                 v->proxies[items[j].proxy].mirrors == mirrors);
+        if (n) ob_pipeline_manager_draw_instances_facing(pm, &dd, &rows[0][0], n, mirrors);
         i = j;
     }
 }

@@ -286,6 +286,7 @@ static void assert_same_snapshot(const world *a, const world *b)
         assert_memory_equal(pa[i].linear, pb[i].linear, sizeof pa[i].linear);
         assert_memory_equal(pa[i].world_t, pb[i].world_t, sizeof pa[i].world_t);
         assert_int_equal(pa[i].finite, pb[i].finite);
+        assert_int_equal(pa[i].mirrors, pb[i].mirrors);
     }
 
     ob_render_soa sa, sb;
@@ -347,6 +348,7 @@ static void assert_snapshot_consistent(const world *w)
         ob_mat4_normal_cofactor(m4, nm);
         assert_true(ob_render_proxy_per_draw(&p[i], (double[3]){0, 0, 0}, block));
         assert_int_equal(p[i].finite, 1);
+        assert_int_equal(p[i].mirrors, ob_det3_negative(m4, 4, 1));
         for (int c = 0; c < 3; c++) {
             for (int r = 0; r < 3; r++) {
                 assert_memory_equal(&p[i].linear[c * 3 + r], &m4[c * 4 + r], sizeof(float));
