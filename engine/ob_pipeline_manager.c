@@ -1092,30 +1092,14 @@ static ob_result draw_instance_run(ob_pipeline_manager *pm, const ob_draw_data *
     return OB_OK;
 }
 
-ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
-                                             const float *blocks, uint32_t count)
+/* Whether the program set reads a per-instance block; else count draws are
+ * refused, counted and logged. */
+static bool instances_drawable(ob_pipeline_manager *pm, uint32_t count)
 {
-    if (count == 0) return OB_OK;
-    if (!pm->program || !pm->program->instanced) {
-        pm->stats.skipped_draws += count;
-        log_once(pm, "instanced draw with a program that reads no per-instance block");
-        return OB_ERR_WRONG_STATE;
-    }
-    /* A mirroring instance needs the other front face: the run is cut
-     * where the determinant's sign changes, and a multi-draw indirect holds
-     * at most maxDrawIndirectCount draws. */
-    uint32_t most = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW ? pm->max_draw_indirect : UINT32_MAX;
-    for (uint32_t start = 0; start < count;) {
-        bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);
-        uint32_t end = start + 1;
-        while (end < count && end - start < most && rows_mirror(blocks + OB_INSTANCE_FLOATS * end) == mirrors)
-            end++;
-        ob_result r = draw_instance_run(pm, d, blocks + OB_INSTANCE_FLOATS * start, end - start,
-                                        mirrors);
-        if (r != OB_OK) return r;
-        start = end;
-    }
-    return OB_OK;
+    if (pm->program && pm->program->instanced) return true;
+    pm->stats.skipped_draws += count;
+    log_once(pm, "instanced draw with a program that reads no per-instance block");
+    return false;
 }
 
 ob_result ob_pipeline_manager_draw_instances_facing(ob_pipeline_manager *pm,
@@ -1123,17 +1107,33 @@ ob_result ob_pipeline_manager_draw_instances_facing(ob_pipeline_manager *pm,
                                                     uint32_t count, bool mirrors)
 {
     if (count == 0) return OB_OK;
-    if (!pm->program || !pm->program->instanced) {
-        pm->stats.skipped_draws += count;
-        log_once(pm, "instanced draw with a program that reads no per-instance block");
-        return OB_ERR_WRONG_STATE;
-    }
+    if (!instances_drawable(pm, count)) return OB_ERR_WRONG_STATE;
+    /* A multi-draw indirect holds at most maxDrawIndirectCount draws. */
     uint32_t most = pm->runs == OB_INSTANCE_RUNS_MULTI_DRAW ? pm->max_draw_indirect : UINT32_MAX;
     for (uint32_t start = 0; start < count;) {
         uint32_t n = OB_MIN(count - start, most);
         ob_result r = draw_instance_run(pm, d, blocks + OB_INSTANCE_FLOATS * start, n, mirrors);
         if (r != OB_OK) return r;
         start += n;
+    }
+    return OB_OK;
+}
+
+ob_result ob_pipeline_manager_draw_instances(ob_pipeline_manager *pm, const ob_draw_data *d,
+                                             const float *blocks, uint32_t count)
+{
+    if (count == 0) return OB_OK;
+    if (!instances_drawable(pm, count)) return OB_ERR_WRONG_STATE;
+    /* A mirroring instance needs the other front face: the run is cut
+     * where the determinant's sign changes. */
+    for (uint32_t start = 0; start < count;) {
+        bool mirrors = rows_mirror(blocks + OB_INSTANCE_FLOATS * start);
+        uint32_t end = start + 1;
+        while (end < count && rows_mirror(blocks + OB_INSTANCE_FLOATS * end) == mirrors) end++;
+        ob_result r = ob_pipeline_manager_draw_instances_facing(
+            pm, d, blocks + OB_INSTANCE_FLOATS * start, end - start, mirrors);
+        if (r != OB_OK) return r;
+        start = end;
     }
     return OB_OK;
 }
