@@ -17,8 +17,6 @@ extern inline bool ob_daffine_is_finite(const ob_daffine *a);
 extern inline double ob_daffine_max_scale(const ob_daffine *a);
 extern inline void ob_mat3_normal_cofactor_in_range(const float m[9], float dest[9]);
 extern inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9]);
-extern inline bool ob_mat3_normal_cofactor_of_scale(const float m[9], double max_column,
-                                                    float dest[9]);
 
 bool ob_dvec3_normalize(const double a[3], double dest[3])
 {

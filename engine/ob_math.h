@@ -275,11 +275,12 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
  * overflows nor turns denormal for any finite w. Row and column 3 are those
  * of the identity. */
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
-/* Whether the 3x3 in w has a negative determinant (evaluated in double
- * from the floats): element (r, c) at w[c * col + r * row]. The engine's one
- * test of a mirroring world (the front face flips): a column-major 3x3 is
- * (w, 3, 1), the rows of a per-instance block (w, 1, 4); the same matrix
- * gives the same answer either way. */
+/* Whether the 3x3 in w has a negative determinant, evaluated in double
+ * from the floats (a product of three float columns neither underflows
+ * nor overflows there): element (r, c) at w[c * col + r * row]. The
+ * engine's one test of a mirroring world (the front face flips): a
+ * column-major 3x3 is (w, 3, 1), the rows of a per-instance block
+ * (w, 1, 4); the same matrix gives the same answer either way. */
 static inline bool ob_det3_negative(const float *w, int col, int row)
 {
     double a[3], b[3], c[3];
@@ -359,19 +360,6 @@ inline bool ob_mat3_normal_cofactor(const float m[9], float dest[9])
     float scaled[9] = {c0, c1, c2, c3, c4, c5, c6, c7, c8};
     ob_mat3_normal_cofactor_in_range(scaled, dest);
     return !nan && largest <= 0x1.fffffep127f;
-}
-/* ob_mat3_normal_cofactor of the float form of a finite double matrix
- * whose largest column length is max_column (as ob_daffine_max_scale
- * gives it): within 2^+-59 every entry of m is at most 2^59 and the
- * largest at least 2^59 / sqrt(3) > 2^-60, finite and where the checks and
- * the rescaling change nothing, so they are skipped (the same bits). */
-inline bool ob_mat3_normal_cofactor_of_scale(const float m[9], double max_column, float dest[9])
-{
-    if (max_column >= 0x1p-59 && max_column <= 0x1p59) {
-        ob_mat3_normal_cofactor_in_range(m, dest);
-        return true;
-    }
-    return ob_mat3_normal_cofactor(m, dest);
 }
 
 /* Infinite reversed-Z perspective for Vulkan clip space: a view-space point

@@ -338,9 +338,6 @@ void ob_pipeline_manager_set_pipeline(ob_pipeline_manager *pm, VkPipeline pipeli
     pm->program = program;
 }
 
-/* Whether the 3x3 whose entry (row r, column c) is w[c * col + r * row]
- * mirrors: the sign of its determinant, in double (a product of three
- * float columns neither underflows nor overflows). */
 /* The per-draw block's world matrix (column-major 4x4) mirrors. */
 static bool world_mirrors(const float world_normal[32])
 {

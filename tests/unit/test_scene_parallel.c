@@ -292,11 +292,11 @@ static void assert_same_snapshot(const world *a, const world *b)
     ob_render_soa sa, sb;
     ob_scene_render_soa(a->s, &sa);
     ob_scene_render_soa(b->s, &sb);
+    assert_int_equal(sa.count, sb.count);
     for (uint32_t i = 0; i < sa.count; i++) {
         assert_ptr_equal(sa.materials[sa.material[i]], sb.materials[sb.material[i]]);
         assert_ptr_equal(sa.geometries[sa.geometry[i]], sb.geometries[sb.geometry[i]]);
     }
-    assert_int_equal(sa.count, sb.count);
     assert_memory_equal(sa.x, sb.x, sizeof *sa.x * sa.count);
     assert_memory_equal(sa.y, sb.y, sizeof *sa.y * sa.count);
     assert_memory_equal(sa.z, sb.z, sizeof *sa.z * sa.count);
