@@ -249,6 +249,33 @@ static void cull_block(const cull_ctx *c, uint32_t first, uint32_t n, uint8_t *v
     }
 }
 
+/* How many of the levels 1.. pass: those whose error over the bound
+ * radius, rel[l - 1], gives need = rel * t_err + base with need^2 <=
+ * reach2. The same float operations in either form, so the same count:
+ * four levels to a compare, the second group's first lane (level 4, in
+ * the first group too) masked off. */
+static inline uint32_t lod_levels_passing(const float rel[OB_LOD_MAX - 1], float t_err, float base,
+                                          float reach2)
+{
+#if defined(__SSE2__)
+    _Static_assert(OB_LOD_MAX - 1 == 7, "the levels fill two groups of four, one lane shared");
+    static const uint8_t bits4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    const __m128 t = _mm_set1_ps(t_err), b = _mm_set1_ps(base), reach = _mm_set1_ps(reach2);
+    __m128 lo = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(rel), t), b);
+    __m128 hi = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(rel + 3), t), b);
+    int m_lo = _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, lo), reach));
+    int m_hi = _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(hi, hi), reach)) & 0xe;
+    return (uint32_t)bits4[m_lo] + bits4[m_hi];
+#else
+    uint32_t level = 0;
+    for (uint32_t l = 0; l < OB_LOD_MAX - 1; l++) {
+        float need = rel[l] * t_err + base;
+        level += need * need <= reach2;
+    }
+    return level;
+#endif
+}
+
 /* One chunk of the snapshot: test, then key the entities the view keeps
  * into the chunk's part of the pair array, in snapshot order. */
 static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
@@ -299,10 +326,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
                  * at any distance, measured against one pixel. */
                 float r = c->soa.radius[i], t_err = r * c->lod_scale;
                 float base = c->lod_ortho ? 0.0f : r, reach2 = c->lod_ortho ? 1.0f : d2[j];
-                for (uint32_t l = 0; l < OB_LOD_MAX - 1; l++) {
-                    float need = g->rel_error[l] * t_err + base;
-                    level += need * need <= reach2;
-                }
+                level = lod_levels_passing(g->rel_error, t_err, base, reach2);
             }
             pairs[out->kept++] = (ob_sort_pair){
                 .key = item_key(m->sort_hi, m->state, g->mesh | level, d2[j]),
