@@ -276,6 +276,64 @@ static inline uint32_t lod_levels_passing(const float rel[OB_LOD_MAX - 1], float
 #endif
 }
 
+/* Whether the view draws entity i at all: its material renders in the
+ * view's type and it is not the excluded one. */
+static inline bool cull_drawn_here(const cull_ctx *c, uint32_t i, uint32_t type_bit)
+{
+    return (c->mt[c->soa.material[i]].mask & type_bit) != 0 && c->soa.node_id[i] != c->exclude_id;
+}
+
+/* An entity the view would draw that lies beyond float range: the first
+ * CULL_LOG_MAX of a chunk are kept by index for the log. */
+static inline void cull_note_far(cull_chunk *out, uint32_t i)
+{
+    if (out->far_count < CULL_LOG_MAX) out->far[out->far_count] = i;
+    out->far_count++;
+}
+
+/* Which entities of block [b, b + n) the view keeps, into keep (block
+ * offsets, ascending); their count is returned. Kept: inside the frustum
+ * (vis 1), of non-zero size, drawn here (cull_drawn_here). Noted as far:
+ * the same with vis 2, in order (an entity not drawn here or of no size is
+ * not reported). Sixteen at a time the frustum and size tests are two byte
+ * compares, and only their survivors (a third or so, in no order a
+ * predictor could learn: hence no branch per entity before them) have
+ * their material looked up. */
+static uint32_t cull_keep(const cull_ctx *c, cull_chunk *out, uint32_t b, uint32_t n,
+                          const uint8_t *vis, uint32_t type_bit, uint16_t *keep)
+{
+    const uint8_t *flags = c->soa.flags + b;
+    uint32_t nk = 0, j = 0;
+#if defined(__SSE2__)
+    const __m128i one = _mm_set1_epi8(1), two = _mm_set1_epi8(2), zero = _mm_setzero_si128(),
+                  zero_scale = _mm_set1_epi8((char)OB_RENDER_ZERO_SCALE);
+    for (; j + 16 <= n; j += 16) {
+        __m128i v = _mm_loadu_si128((const __m128i *)(vis + j));
+        __m128i f = _mm_loadu_si128((const __m128i *)(flags + j));
+        __m128i sized = _mm_cmpeq_epi8(_mm_and_si128(f, zero_scale), zero);
+        uint32_t in = (uint32_t)_mm_movemask_epi8(_mm_and_si128(_mm_cmpeq_epi8(v, one), sized));
+        uint32_t far = (uint32_t)_mm_movemask_epi8(_mm_and_si128(_mm_cmpeq_epi8(v, two), sized));
+        if (__builtin_expect(far != 0, 0))
+            for (; far; far &= far - 1) {
+                uint32_t i = b + j + (uint32_t)__builtin_ctz(far);
+                if (cull_drawn_here(c, i, type_bit)) cull_note_far(out, i);
+            }
+        for (; in; in &= in - 1) {
+            uint32_t k = j + (uint32_t)__builtin_ctz(in);
+            keep[nk] = (uint16_t)k;
+            nk += cull_drawn_here(c, b + k, type_bit);
+        }
+    }
+#endif
+    for (; j < n; j++) {
+        if (vis[j] == 0 || (flags[j] & OB_RENDER_ZERO_SCALE) || !cull_drawn_here(c, b + j, type_bit))
+            continue;
+        if (vis[j] == 2) cull_note_far(out, b + j);
+        else keep[nk++] = (uint16_t)j;
+    }
+    return nk;
+}
+
 /* One chunk of the snapshot: test, then key the entities the view keeps
  * into the chunk's part of the pair array, in snapshot order. */
 static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
@@ -293,24 +351,8 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     for (uint32_t b = first; b < end; b += CULL_BLOCK) {
         uint32_t n = OB_MIN(CULL_BLOCK, end - b);
         cull_block(c, b, n, vis, d2);
-        /* Which entities the view keeps, without branches (a third or so
-         * are, in no order a predictor could learn), then keys for those
-         * only. The order of the reasons is the log's: an entity not drawn
-         * here or of no size is not reported as far. */
         uint16_t keep[CULL_BLOCK];
-        uint32_t nk = 0;
-        for (uint32_t j = 0; j < n; j++) {
-            uint32_t i = b + j;
-            const ob_view_material *m = &c->mt[c->soa.material[i]];
-            uint32_t ok = ((m->mask & type_bit) != 0) & (c->soa.node_id[i] != c->exclude_id) &
-                          ((c->soa.flags[i] & OB_RENDER_ZERO_SCALE) == 0);
-            if (__builtin_expect(ok & (vis[j] == 2), 0)) {
-                if (out->far_count < CULL_LOG_MAX) out->far[out->far_count] = i;
-                out->far_count++;
-            }
-            keep[nk] = (uint16_t)j;
-            nk += ok & (vis[j] == 1);
-        }
+        uint32_t nk = cull_keep(c, out, b, n, vis, type_bit, keep);
         for (uint32_t t = 0; t < nk; t++) {
             uint32_t j = keep[t], i = b + j;
             const ob_view_material *m = &c->mt[c->soa.material[i]];
