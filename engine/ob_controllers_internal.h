@@ -11,6 +11,9 @@
 #include "ob_scene_internal.h"
 
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
 #pragma GCC visibility push(hidden)
@@ -52,6 +55,13 @@ void ob_orbit_controller_step(ob_node *n, double dt, void *user);
  * chunking. */
 typedef double ob_v2d __attribute__((vector_size(16)));
 typedef uint64_t ob_v2u __attribute__((vector_size(16)));
+/* Both lanes' square roots: the correctly rounded root either way, one
+ * instruction with SSE2 (libm's sqrt carries a branch for errno). */
+#if defined(__SSE2__)
+#define OB_V2D_SQRT(v) ((ob_v2d)_mm_sqrt_pd(v))
+#else
+#define OB_V2D_SQRT(v) ((ob_v2d){sqrt((v)[0]), sqrt((v)[1])})
+#endif
 
 /* q = q * step(axis, rate * dt) for nodes x[0..n) (n 1 or 2; an unused
  * lane repeats lane 0 and is not stored). The caller marks the nodes
@@ -74,7 +84,7 @@ static inline void ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *c
     ob_v2d q[4] = {OB_QUAT_MUL_X(a, b), OB_QUAT_MUL_Y(a, b), OB_QUAT_MUL_Z(a, b),
                    OB_QUAT_MUL_W(a, b)};
     ob_v2d n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    ob_v2d inv = 1.0 / (ob_v2d){sqrt(n2[0]), sqrt(n2[1])};
+    ob_v2d inv = 1.0 / OB_V2D_SQRT(n2);
     for (uint32_t l = 0; l < n; l++) {
         double r[4] = {q[0][l], q[1][l], q[2][l], q[3][l]};
         /* Renormalizing every step keeps |q| = 1 to rounding for any

@@ -21,6 +21,9 @@
 
 #include <float.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 typedef struct update_ctx {
     ob_scene *s;
@@ -394,8 +397,17 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
            (sc[0] - sc[0]) + (sc[1] - sc[1]) + (sc[2] - sc[2]) == 0.0f;
 }
 
+#if defined(__SSE2__)
+/* Stores lane l (0 or 1) of v at d. */
+static inline void lane_store(double *d, ob_v2d v, uint32_t l)
+{
+    if (l) _mm_storeh_pd(d, v);
+    else _mm_storel_pd(d, v);
+}
+#endif
+
 /* Evaluates simple nodes slots[0..n), n 1 or 2 (an unused lane repeats
- * lane 0 and is not stored). */
+ * lane 0). */
 static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
 {
     node_xf *x[2] = {&s->xf[slots[0]], &s->xf[slots[n > 1]]};
@@ -416,9 +428,57 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         ob_v2u more = (ob_v2u)(d > best);
         best = (ob_v2d)(((ob_v2u)d & more) | ((ob_v2u)best & ~more));
     }
-    ob_v2d scale = {sqrt(best[0]), sqrt(best[1])};
+    ob_v2d scale = OB_V2D_SQRT(best);
     ob_v2d radius = L(local_radius) * scale;
 #undef L
+#if defined(__SSE2__)
+    /* Both lanes stored, from the registers: when n is 1 the second repeats
+     * the first node's stores with the same values. The proxies' floats
+     * are converted two lanes at a time, and the mirror test reads them
+     * back as doubles in the lanes: ob_det3_negative's operations on the
+     * same values, so the same answer. */
+    ob_render_proxy *p[2] = {&s->proxies[x[0]->proxy_index], &s->proxies[x[1]->proxy_index]};
+    ob_v2d lf[9];
+    __m128 f[9];
+    for (int k = 0; k < 9; k++) {
+        f[k] = _mm_cvtpd_ps(m[k]);
+        lf[k] = _mm_cvtps_pd(f[k]);
+    }
+    for (int k = 0; k < 8; k += 2) {
+        __m128 pair = _mm_unpacklo_ps(f[k], f[k + 1]); /* k and k + 1 of lane 0, then lane 1 */
+        _mm_storel_pi((__m64 *)&p[0]->linear[k], pair);
+        _mm_storeh_pi((__m64 *)&p[1]->linear[k], pair);
+    }
+    _mm_store_ss(&p[0]->linear[8], f[8]);
+    _mm_store_ss(&p[1]->linear[8], _mm_shuffle_ps(f[8], f[8], 1));
+    const ob_v2d *a = lf, *b = lf + 3, *cc = lf + 6;
+    ob_v2d det = a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) +
+                 a[2] * (b[0] * cc[1] - b[1] * cc[0]);
+    int mirrors = _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
+    __m128 r2 = _mm_cvtpd_ps(radius);
+    float r[2] = {_mm_cvtss_f32(r2), _mm_cvtss_f32(_mm_shuffle_ps(r2, r2, 1))};
+#pragma GCC unroll 2
+    for (uint32_t l = 0; l < 2; l++) {
+        node_xf *xl = x[l];
+        uint32_t slot = slots[n > 1 ? l : 0], i = xl->proxy_index;
+        for (int k = 0; k < 9; k++) lane_store(&xl->world.m[k], m[k], l);
+        for (int k = 0; k < 3; k++) {
+            lane_store(&xl->world.t[k], t[k], l);
+            lane_store(&p[l]->world_t[k], t[k], l);
+        }
+        lane_store(&s->soa_x[i], center[0], l);
+        lane_store(&s->soa_y[i], center[1], l);
+        lane_store(&s->soa_z[i], center[2], l);
+        xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
+                    XF_WORLD_ROT_LOCAL;
+        s->state[slot] =
+            (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
+        s->soa_radius[i] = r[l];
+        s->soa_flags[i] = zero_scale_flag(xl, r[l]);
+        p[l]->finite = linear_finite(p[l]->linear, scale[l]);
+        p[l]->mirrors = (uint8_t)((mirrors >> l) & 1);
+    }
+#else
     for (uint32_t l = 0; l < n; l++) {
         node_xf *xl = x[l];
         uint32_t slot = slots[l], i = xl->proxy_index;
@@ -441,6 +501,7 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         p->finite = linear_finite(p->linear, scale[l]);
         p->mirrors = ob_det3_negative(p->linear, 3, 1);
     }
+#endif
 }
 
 /* ------------------------------------------------------------------ loops */

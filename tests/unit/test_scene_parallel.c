@@ -151,7 +151,8 @@ static void add_node(world *w, bool serial)
     ob_node_set_rotation(n, (float[4]){(float)uniform(w, -1, 1), (float)uniform(w, -1, 1),
                                        (float)uniform(w, -1, 1), (float)uniform(w, 0.1, 2)});
     float sc = i % 997 == 5 ? 0.0f : (float)uniform(w, 0.5, 2);
-    ob_node_set_scale(n, (float[3]){sc, sc * (float)uniform(w, 0.5, 1.5), sc});
+    /* Every seventh mirrors (the proxies' face flips). */
+    ob_node_set_scale(n, (float[3]){i % 7 == 3 ? -sc : sc, sc * (float)uniform(w, 0.5, 1.5), sc});
     uint32_t kind = next_random(w) % 100;
     if (kind < 80) {
         ob_renderable rd = {.material = (struct ob_material *)&materials[next_random(w) % 5],
