@@ -63,11 +63,49 @@ typedef uint64_t ob_v2u __attribute__((vector_size(16)));
 #define OB_V2D_SQRT(v) ((ob_v2d){sqrt((v)[0]), sqrt((v)[1])})
 #endif
 
+/* Stores lane 0 of v at d0 and lane 1 at d1, straight from the register
+ * with SSE2. A group of one node passes its node twice (its lanes are
+ * equal), so that no store waits on a branch. */
+static inline void ob_v2d_store2(double *d0, double *d1, ob_v2d v)
+{
+#if defined(__SSE2__)
+    _mm_storel_pd(d0, v);
+    _mm_storeh_pd(d1, v);
+#else
+    *d0 = v[0];
+    *d1 = v[1];
+#endif
+}
+
+/* ob_rotation_kernel2's stores when a lane's squared norm q2 lies outside
+ * the usual range: lane by lane, as the one-node form. inv: 1 / |q|. */
+static void __attribute__((cold, noinline, unused))
+ob_rotation_store_unusual(node_xf *const x[2], const ob_v2d q[4], ob_v2d n2, ob_v2d inv, uint32_t n)
+{
+    for (uint32_t l = 0; l < n; l++) {
+        double r[4] = {q[0][l], q[1][l], q[2][l], q[3][l]};
+        /* Renormalizing every step keeps |q| = 1 to rounding for any
+         * number of updates, and the update takes q as it is instead of
+         * normalizing it again. Outside the usual range the one-node form
+         * rescales; a non-finite q is stored as is, so the update names
+         * the node. */
+        bool unit = true;
+        if (OB_DQUAT_NORM2_USUAL(n2[l]))
+            for (int c = 0; c < 4; c++) r[c] *= inv[l];
+        else
+            unit = ob_dquat_normalize(r, r);
+        if (unit) x[l]->flags |= XF_ROTATION_UNIT;
+        else x[l]->flags &= ~(uint32_t)XF_ROTATION_UNIT;
+        memcpy(x[l]->rotation, r, sizeof r);
+    }
+}
+
 /* q = q * step(axis, rate * dt) for nodes x[0..n) (n 1 or 2; an unused
- * lane repeats lane 0 and is not stored). The caller marks the nodes
- * dirty. */
-static inline void ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *const st[2],
-                                       uint32_t n, double dt)
+ * lane repeats lane 0, and node 0 takes its stores again). The caller
+ * marks the nodes dirty. */
+/* Inlined always: the caller's loop keeps its lanes in registers. */
+static inline __attribute__((always_inline)) void
+ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *const st[2], uint32_t n, double dt)
 {
     for (uint32_t l = 0; l < n; l++) {
         if (dt == st[l]->step_dt) continue;
@@ -85,22 +123,18 @@ static inline void ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *c
                    OB_QUAT_MUL_W(a, b)};
     ob_v2d n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     ob_v2d inv = 1.0 / OB_V2D_SQRT(n2);
-    for (uint32_t l = 0; l < n; l++) {
-        double r[4] = {q[0][l], q[1][l], q[2][l], q[3][l]};
-        /* Renormalizing every step keeps |q| = 1 to rounding for any
-         * number of updates, and the update takes q as it is instead of
-         * normalizing it again. Outside the usual range the one-node form
-         * rescales; a non-finite q is stored as is, so the update names
-         * the node. */
-        bool unit = true;
-        if (OB_DQUAT_NORM2_USUAL(n2[l]))
-            for (int c = 0; c < 4; c++) r[c] *= inv[l];
-        else
-            unit = ob_dquat_normalize(r, r);
-        if (unit) x[l]->flags |= XF_ROTATION_UNIT;
-        else x[l]->flags &= ~(uint32_t)XF_ROTATION_UNIT;
-        memcpy(x[l]->rotation, r, sizeof r);
+    if (__builtin_expect(!(OB_DQUAT_NORM2_USUAL(n2[0]) && OB_DQUAT_NORM2_USUAL(n2[1])), 0)) {
+        ob_rotation_store_unusual(x, q, n2, inv, n);
+        return;
     }
+    /* The usual case in both lanes (an unused lane repeats lane 0): the
+     * one-node form's multiplications, in the lanes. */
+    for (int c = 0; c < 4; c++) {
+        q[c] *= inv;
+        ob_v2d_store2(&x[0]->rotation[c], &x[i1]->rotation[c], q[c]);
+    }
+    x[0]->flags |= XF_ROTATION_UNIT;
+    x[i1]->flags |= XF_ROTATION_UNIT;
 }
 
 /* sin and cos of two orbit angles (|x| < 2pi, where the state keeps them;
@@ -149,8 +183,8 @@ static inline void orbit_sincos2(const ob_v2d *in_x, ob_v2d *out_s, ob_v2d *out_
 /* position = center + radius (cos a u + sin a v), a += rate * dt, for
  * nodes x[0..n) (n 1 or 2, as for ob_rotation_kernel2). The caller marks
  * the nodes dirty. */
-static inline void ob_orbit_kernel2(node_xf *const x[2], ob_orbit_state *const st[2], uint32_t n,
-                                    double dt)
+static inline __attribute__((always_inline)) void
+ob_orbit_kernel2(node_xf *const x[2], ob_orbit_state *const st[2], uint32_t n, double dt)
 {
     uint32_t i1 = n > 1 ? 1 : 0;
 #define F(field) (ob_v2d){st[0]->field, st[i1]->field}
@@ -159,17 +193,17 @@ static inline void ob_orbit_kernel2(node_xf *const x[2], ob_orbit_state *const s
     ob_v2d u[3] = {F(u[0]), F(u[1]), F(u[2])}, v[3] = {F(v[0]), F(v[1]), F(v[2])};
 #undef F
     /* fmod is exact, and the identity below 2pi: called only above. */
-    for (uint32_t l = 0; l < n; l++) {
-        if (!(fabs(angle[l]) < 2.0 * OB_PI)) angle[l] = fmod(angle[l], 2.0 * OB_PI);
-        st[l]->angle = angle[l];
-    }
+    /* Both lanes: an unused one must stay equal to lane 0. */
+    if (!(fabs(angle[0]) < 2.0 * OB_PI && fabs(angle[1]) < 2.0 * OB_PI))
+        for (uint32_t l = 0; l < 2; l++)
+            if (!(fabs(angle[l]) < 2.0 * OB_PI)) angle[l] = fmod(angle[l], 2.0 * OB_PI);
+    ob_v2d_store2(&st[0]->angle, &st[i1]->angle, angle);
     ob_v2d sin_a, cos_a;
     orbit_sincos2(&angle, &sin_a, &cos_a);
     ob_v2d c = cos_a * radius, s = sin_a * radius;
     ob_v2d p[3];
     for (int k = 0; k < 3; k++) p[k] = center[k] + c * u[k] + s * v[k];
-    for (uint32_t l = 0; l < n; l++)
-        for (int k = 0; k < 3; k++) x[l]->position[k] = p[k][l];
+    for (int k = 0; k < 3; k++) ob_v2d_store2(&x[0]->position[k], &x[i1]->position[k], p[k]);
 }
 
 /* The one-node forms (a group of one). */

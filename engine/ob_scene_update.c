@@ -397,15 +397,6 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
            (sc[0] - sc[0]) + (sc[1] - sc[1]) + (sc[2] - sc[2]) == 0.0f;
 }
 
-#if defined(__SSE2__)
-/* Stores lane l (0 or 1) of v at d. */
-static inline void lane_store(double *d, ob_v2d v, uint32_t l)
-{
-    if (l) _mm_storeh_pd(d, v);
-    else _mm_storel_pd(d, v);
-}
-#endif
-
 /* Evaluates simple nodes slots[0..n), n 1 or 2 (an unused lane repeats
  * lane 0). */
 static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
@@ -457,18 +448,18 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
     int mirrors = _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
     __m128 r2 = _mm_cvtpd_ps(radius);
     float r[2] = {_mm_cvtss_f32(r2), _mm_cvtss_f32(_mm_shuffle_ps(r2, r2, 1))};
-#pragma GCC unroll 2
+    uint32_t i0 = x[0]->proxy_index, i1 = x[1]->proxy_index;
+    for (int k = 0; k < 9; k++) ob_v2d_store2(&x[0]->world.m[k], &x[1]->world.m[k], m[k]);
+    for (int k = 0; k < 3; k++) {
+        ob_v2d_store2(&x[0]->world.t[k], &x[1]->world.t[k], t[k]);
+        ob_v2d_store2(&p[0]->world_t[k], &p[1]->world_t[k], t[k]);
+    }
+    ob_v2d_store2(&s->soa_x[i0], &s->soa_x[i1], center[0]);
+    ob_v2d_store2(&s->soa_y[i0], &s->soa_y[i1], center[1]);
+    ob_v2d_store2(&s->soa_z[i0], &s->soa_z[i1], center[2]);
     for (uint32_t l = 0; l < 2; l++) {
         node_xf *xl = x[l];
-        uint32_t slot = slots[n > 1 ? l : 0], i = xl->proxy_index;
-        for (int k = 0; k < 9; k++) lane_store(&xl->world.m[k], m[k], l);
-        for (int k = 0; k < 3; k++) {
-            lane_store(&xl->world.t[k], t[k], l);
-            lane_store(&p[l]->world_t[k], t[k], l);
-        }
-        lane_store(&s->soa_x[i], center[0], l);
-        lane_store(&s->soa_y[i], center[1], l);
-        lane_store(&s->soa_z[i], center[2], l);
+        uint32_t slot = slots[n > 1 ? l : 0], i = l ? i1 : i0;
         xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
                     XF_WORLD_ROT_LOCAL;
         s->state[slot] =

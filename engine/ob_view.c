@@ -326,7 +326,8 @@ static uint32_t cull_keep(const cull_ctx *c, cull_chunk *out, uint32_t b, uint32
     }
 #endif
     for (; j < n; j++) {
-        if (vis[j] == 0 || (flags[j] & OB_RENDER_ZERO_SCALE) || !cull_drawn_here(c, b + j, type_bit))
+        if (vis[j] == 0 || (flags[j] & OB_RENDER_ZERO_SCALE) ||
+            !cull_drawn_here(c, b + j, type_bit))
             continue;
         if (vis[j] == 2) cull_note_far(out, b + j);
         else keep[nk++] = (uint16_t)j;
