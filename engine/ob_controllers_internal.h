@@ -77,7 +77,7 @@ static inline void ob_v2d_store2(double *d0, double *d1, ob_v2d v)
 #endif
 }
 
-/* ob_rotation_kernel2's stores when a lane's squared norm q2 lies outside
+/* ob_rotation_kernel2's stores when a lane's squared norm n2 lies outside
  * the usual range: lane by lane, as the one-node form. inv: 1 / |q|. */
 static void __attribute__((cold, noinline, unused))
 ob_rotation_store_unusual(node_xf *const x[2], const ob_v2d q[4], ob_v2d n2, ob_v2d inv, uint32_t n)
@@ -102,8 +102,8 @@ ob_rotation_store_unusual(node_xf *const x[2], const ob_v2d q[4], ob_v2d n2, ob_
 
 /* q = q * step(axis, rate * dt) for nodes x[0..n) (n 1 or 2; an unused
  * lane repeats lane 0, and node 0 takes its stores again). The caller
- * marks the nodes dirty. */
-/* Inlined always: the caller's loop keeps its lanes in registers. */
+ * marks the nodes dirty. Inlined always, as the orbit's: the caller's
+ * loop keeps the lanes in registers. */
 static inline __attribute__((always_inline)) void
 ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *const st[2], uint32_t n, double dt)
 {

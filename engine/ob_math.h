@@ -275,6 +275,12 @@ void ob_mat4_mul(const float a[16], const float b[16], float dest[16]);
  * overflows nor turns denormal for any finite w. Row and column 3 are those
  * of the identity. */
 void ob_mat4_normal_cofactor(const float w[16], float dest[16]);
+/* The determinant of the 3x3 of columns a, b, c (three entries each, of
+ * any arithmetic type: the update evaluates it on two matrices in vector
+ * lanes), in the one order ob_det3_negative uses. */
+#define OB_DET3_COLUMNS(a, b, c)                                                                  \
+    ((a)[0] * ((b)[1] * (c)[2] - (b)[2] * (c)[1]) + (a)[1] * ((b)[2] * (c)[0] - (b)[0] * (c)[2]) + \
+     (a)[2] * ((b)[0] * (c)[1] - (b)[1] * (c)[0]))
 /* Whether the 3x3 in w has a negative determinant, evaluated in double
  * from the floats (a product of three float columns neither underflows
  * nor overflows there): element (r, c) at w[c * col + r * row]. The
@@ -289,9 +295,7 @@ static inline bool ob_det3_negative(const float *w, int col, int row)
         b[r] = w[col + r * row];
         c[r] = w[2 * col + r * row];
     }
-    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
-                 a[2] * (b[0] * c[1] - b[1] * c[0]);
-    return det < 0.0;
+    return OB_DET3_COLUMNS(a, b, c) < 0.0;
 }
 /* The cofactor part of ob_mat3_normal_cofactor, without its checks and
  * rescaling: for an m the caller knows to be finite with its largest

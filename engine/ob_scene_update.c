@@ -442,9 +442,7 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
     }
     _mm_store_ss(&p[0]->linear[8], f[8]);
     _mm_store_ss(&p[1]->linear[8], _mm_shuffle_ps(f[8], f[8], 1));
-    const ob_v2d *a = lf, *b = lf + 3, *cc = lf + 6;
-    ob_v2d det = a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) +
-                 a[2] * (b[0] * cc[1] - b[1] * cc[0]);
+    ob_v2d det = OB_DET3_COLUMNS(lf, lf + 3, lf + 6);
     int mirrors = _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
     __m128 r2 = _mm_cvtpd_ps(radius);
     float r[2] = {_mm_cvtss_f32(r2), _mm_cvtss_f32(_mm_shuffle_ps(r2, r2, 1))};
