@@ -397,6 +397,38 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
            (sc[0] - sc[0]) + (sc[1] - sc[1]) + (sc[2] - sc[2]) == 0.0f;
 }
 
+/* proxy_write_world's float 3x3 of two worlds, lanes 0 and 1 of m, into
+ * p[0] and p[1], and whether each mirrors (bit l): ob_det3_negative of the
+ * floats stored. With SSE2 both lanes convert at once and the determinant
+ * runs in the lanes on the same values, so the same answer. */
+static int proxy_linear2(ob_render_proxy *const p[2], const ob_v2d m[9])
+{
+#if defined(__SSE2__)
+    ob_v2d lf[9];
+    __m128 f[9];
+    for (int k = 0; k < 9; k++) {
+        f[k] = _mm_cvtpd_ps(m[k]);
+        lf[k] = _mm_cvtps_pd(f[k]);
+    }
+    for (int k = 0; k < 8; k += 2) {
+        __m128 pair = _mm_unpacklo_ps(f[k], f[k + 1]); /* k and k + 1 of lane 0, then lane 1 */
+        _mm_storel_pi((__m64 *)&p[0]->linear[k], pair);
+        _mm_storeh_pi((__m64 *)&p[1]->linear[k], pair);
+    }
+    _mm_store_ss(&p[0]->linear[8], f[8]);
+    _mm_store_ss(&p[1]->linear[8], _mm_shuffle_ps(f[8], f[8], 1));
+    ob_v2d det = OB_DET3_COLUMNS(lf, lf + 3, lf + 6);
+    return _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
+#else
+    int mirrors = 0;
+    for (uint32_t l = 0; l < 2; l++) {
+        for (int k = 0; k < 9; k++) p[l]->linear[k] = (float)m[k][l];
+        mirrors |= ob_det3_negative(p[l]->linear, 3, 1) << l;
+    }
+    return mirrors;
+#endif
+}
+
 /* Evaluates simple nodes slots[0..n), n 1 or 2 (an unused lane repeats
  * lane 0). */
 static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
@@ -422,30 +454,10 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
     ob_v2d scale = OB_V2D_SQRT(best);
     ob_v2d radius = L(local_radius) * scale;
 #undef L
-#if defined(__SSE2__)
     /* Both lanes stored, from the registers: when n is 1 the second repeats
-     * the first node's stores with the same values. The proxies' floats
-     * are converted two lanes at a time, and the mirror test reads them
-     * back as doubles in the lanes: ob_det3_negative's operations on the
-     * same values, so the same answer. */
+     * the first node's stores with the same values. */
     ob_render_proxy *p[2] = {&s->proxies[x[0]->proxy_index], &s->proxies[x[1]->proxy_index]};
-    ob_v2d lf[9];
-    __m128 f[9];
-    for (int k = 0; k < 9; k++) {
-        f[k] = _mm_cvtpd_ps(m[k]);
-        lf[k] = _mm_cvtps_pd(f[k]);
-    }
-    for (int k = 0; k < 8; k += 2) {
-        __m128 pair = _mm_unpacklo_ps(f[k], f[k + 1]); /* k and k + 1 of lane 0, then lane 1 */
-        _mm_storel_pi((__m64 *)&p[0]->linear[k], pair);
-        _mm_storeh_pi((__m64 *)&p[1]->linear[k], pair);
-    }
-    _mm_store_ss(&p[0]->linear[8], f[8]);
-    _mm_store_ss(&p[1]->linear[8], _mm_shuffle_ps(f[8], f[8], 1));
-    ob_v2d det = OB_DET3_COLUMNS(lf, lf + 3, lf + 6);
-    int mirrors = _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
-    __m128 r2 = _mm_cvtpd_ps(radius);
-    float r[2] = {_mm_cvtss_f32(r2), _mm_cvtss_f32(_mm_shuffle_ps(r2, r2, 1))};
+    int mirrors = proxy_linear2(p, m);
     uint32_t i0 = x[0]->proxy_index, i1 = x[1]->proxy_index;
     for (int k = 0; k < 9; k++) ob_v2d_store2(&x[0]->world.m[k], &x[1]->world.m[k], m[k]);
     for (int k = 0; k < 3; k++) {
@@ -458,39 +470,16 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
     for (uint32_t l = 0; l < 2; l++) {
         node_xf *xl = x[l];
         uint32_t slot = slots[n > 1 ? l : 0], i = l ? i1 : i0;
+        float r = (float)radius[l];
         xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
                     XF_WORLD_ROT_LOCAL;
         s->state[slot] =
             (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
-        s->soa_radius[i] = r[l];
-        s->soa_flags[i] = zero_scale_flag(xl, r[l]);
+        s->soa_radius[i] = r;
+        s->soa_flags[i] = zero_scale_flag(xl, r);
         p[l]->finite = linear_finite(p[l]->linear, scale[l]);
         p[l]->mirrors = (uint8_t)((mirrors >> l) & 1);
     }
-#else
-    for (uint32_t l = 0; l < n; l++) {
-        node_xf *xl = x[l];
-        uint32_t slot = slots[l], i = xl->proxy_index;
-        for (int k = 0; k < 9; k++) xl->world.m[k] = m[k][l];
-        for (int k = 0; k < 3; k++) xl->world.t[k] = t[k][l];
-        xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
-                    XF_WORLD_ROT_LOCAL;
-        s->state[slot] =
-            (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
-        /* proxy_write_world, then proxy_write_finite */
-        ob_render_proxy *p = &s->proxies[i];
-        for (int k = 0; k < 9; k++) p->linear[k] = (float)m[k][l];
-        for (int k = 0; k < 3; k++) p->world_t[k] = t[k][l];
-        float r = (float)radius[l];
-        s->soa_x[i] = center[0][l];
-        s->soa_y[i] = center[1][l];
-        s->soa_z[i] = center[2][l];
-        s->soa_radius[i] = r;
-        s->soa_flags[i] = zero_scale_flag(xl, r);
-        p->finite = linear_finite(p->linear, scale[l]);
-        p->mirrors = ob_det3_negative(p->linear, 3, 1);
-    }
-#endif
 }
 
 /* ------------------------------------------------------------------ loops */
