@@ -119,17 +119,26 @@ void ob_view_add_dependency(ob_view *v, ob_view *dep)
  * and the fine depth, so that draws binding the same state follow each
  * other while the front-to-back order survives between bands; for blended
  * items the full depth, back to front, then state group and mesh. dist2 is
- * >= 0, and positive floats order like their bits. */
+ * >= 0, and positive floats order like their bits.
+ *
+ * The fine depth is the band's last two exponent bits and the mantissa's
+ * top eight: d² to 1/256 of its octave (distance to about 0.2%), ample for
+ * early depth rejection, which is all the opaque order is for. Each bit
+ * more is one more bit the sort moves items on: with twenty, a 10k-object
+ * view's opaque list had 31 differing bits (three 11-bit passes); with ten,
+ * 21 (two). */
+#define KEY_FINE_BITS 10u
+
 static uint64_t item_key(uint32_t sort_hi, uint32_t state, uint32_t mesh, float dist2)
 {
     uint32_t bits;
     memcpy(&bits, &dist2, sizeof bits);
     if (sort_hi >> 31)
         return ((uint64_t)~bits << 32) | ((uint64_t)(state & 0xffffu) << 16) | (mesh & 0xffffu);
-    uint64_t band = bits >> 25;            /* sign 0, top 6 bits of the exponent */
-    uint64_t fine = (bits >> 5) & 0xfffffu; /* the rest of the depth, 20 bits */
+    uint64_t band = bits >> 25; /* sign 0, top 6 bits of the exponent */
+    uint64_t fine = (bits >> (25 - KEY_FINE_BITS)) & ((1u << KEY_FINE_BITS) - 1u);
     return (band << 58) | ((uint64_t)(state & 0xfffu) << 46) | ((uint64_t)(mesh & 0x3ffffu) << 28) |
-           (fine << 8);
+           (fine << (28 - KEY_FINE_BITS));
 }
 
 /* Entities per index of the culling loop: ~10-20 us of work each at most,
