@@ -141,8 +141,11 @@ ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *const st[2], uint32_
  * NaN for a non-finite x), within an ulp of libm's: fdlibm's reduction by
  * pi/2 in three parts and its kernels on [-pi/4, pi/4], inline and without
  * libm's range checks and calls, which cost the update more than anything
- * else of the orbit (about a fifth of a warm update at 50k objects). */
-static inline void orbit_sincos2(const ob_v2d *in_x, ob_v2d *out_s, ob_v2d *out_c)
+ * else of the orbit (about a fifth of a warm update at 50k objects).
+ * Inlined always: called from two places, GCC made it a function whose
+ * arguments go through memory. */
+static inline __attribute__((always_inline)) void
+orbit_sincos2(const ob_v2d *in_x, ob_v2d *out_s, ob_v2d *out_c)
 {
     ob_v2d x = *in_x;
     static const double two_over_pi = 6.36619772367581382433e-01;

@@ -372,14 +372,14 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
 
 /* The common node, two at a time: a renderable leaf whose local transform
  * changed, under the root or another valid, shown identity, itself shown,
- * valid and without a fault to take back, its rotation unit and its
- * position and scale finite (simple_node). For it node_eval's outcome is
- * known before it runs: valid, its world its local transform, its world
- * rotation its own, in the snapshot still. So the world, the bound and
- * the proxy are computed in one pass in SSE2 lanes, with exactly the
- * operations of ob_scene_xf_local, node_world_bound, proxy_write_world and
- * proxy_write_finite in their order (the same bits), without the stages'
- * flags and stores in between. */
+ * valid and without a fault to take back, its rotation unit (simple_node)
+ * and its position and scale finite (eval_simple2 tests those in its
+ * lanes). For it node_eval's outcome is known before it runs: valid, its
+ * world its local transform, its world rotation its own, in the snapshot
+ * still. So the world, the bound and the proxy are computed in one pass in
+ * SSE2 lanes, with exactly the operations of ob_scene_xf_local,
+ * node_world_bound, proxy_write_world and proxy_write_finite in their order
+ * (the same bits), without the stages' flags and stores in between. */
 static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
 {
     enum { PARENT = XF_IDENTITY | XF_WORLD_VALID | XF_EFFECTIVE_HIDDEN,
@@ -387,14 +387,8 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
                   XF_WORLD_VALID | XF_HAS_RENDERABLE | XF_ROTATION_UNIT };
     if (it.parent != NO_SLOT && (s->xf[it.parent].flags & PARENT) != (XF_IDENTITY | XF_WORLD_VALID))
         return false;
-    const node_xf *x = &s->xf[it.slot];
-    if ((x->flags & NODE) != (XF_WORLD_VALID | XF_HAS_RENDERABLE | XF_ROTATION_UNIT) ||
-        (st & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) != NODE_IN_RENDERABLES)
-        return false;
-    const double *t = x->position;
-    const float *sc = x->scale;
-    return (t[0] - t[0]) + (t[1] - t[1]) + (t[2] - t[2]) == 0.0 &&
-           (sc[0] - sc[0]) + (sc[1] - sc[1]) + (sc[2] - sc[2]) == 0.0f;
+    return (s->xf[it.slot].flags & NODE) == (XF_WORLD_VALID | XF_HAS_RENDERABLE | XF_ROTATION_UNIT) &&
+           (st & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) == NODE_IN_RENDERABLES;
 }
 
 /* proxy_write_world's float 3x3 of two worlds, lanes 0 and 1 of m, into
@@ -430,16 +424,23 @@ static int proxy_linear2(ob_render_proxy *const p[2], const ob_v2d m[9])
 }
 
 /* Evaluates simple nodes slots[0..n), n 1 or 2 (an unused lane repeats
- * lane 0). */
-static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
+ * lane 0). False, with nothing written, when a position or scale is not
+ * finite: those nodes take node_eval's way, which names them. */
+static bool eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
 {
     node_xf *x[2] = {&s->xf[slots[0]], &s->xf[slots[n > 1]]};
 #define L(e) (ob_v2d){x[0]->e, x[1]->e}
+    ob_v2d t[3] = {L(position[0]), L(position[1]), L(position[2])};
+    ob_v2d sc[3] = {L(scale[0]), L(scale[1]), L(scale[2])};
+    /* ob_scene_xf_local's test, in the lanes: v - v is 0 for a finite v
+     * and NaN otherwise (a float's double is finite when it is). */
+    ob_v2d bad = ((t[0] - t[0]) + (t[1] - t[1])) + ((t[2] - t[2]) + (sc[0] - sc[0])) +
+                 ((sc[1] - sc[1]) + (sc[2] - sc[2]));
+    if (__builtin_expect(!(bad[0] == 0.0 && bad[1] == 0.0), 0)) return false;
     /* ob_daffine_from_trs(position, rotation, scale): the rotation is unit */
     ob_v2d m[9];
     OB_QUAT_TO_MAT3_SCALED(ob_v2d, L(rotation[0]), L(rotation[1]), L(rotation[2]), L(rotation[3]),
-                           L(scale[0]), L(scale[1]), L(scale[2]), m);
-    ob_v2d t[3] = {L(position[0]), L(position[1]), L(position[2])};
+                           sc[0], sc[1], sc[2], m);
     /* node_world_bound */
     ob_v2d cx = L(local_center[0]), cy = L(local_center[1]), cz = L(local_center[2]);
     ob_v2d center[3];
@@ -480,6 +481,7 @@ static void eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
         p[l]->finite = linear_finite(p[l]->linear, scale[l]);
         p[l]->mirrors = (uint8_t)((mirrors >> l) & 1);
     }
+    return true;
 }
 
 /* ------------------------------------------------------------------ loops */
@@ -493,6 +495,26 @@ static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t
     node_xf *orbit_x[LEVEL_STEP], *spin_x[LEVEL_STEP];
     ob_orbit_state *orbit[LEVEL_STEP];
     ob_rotation_state *spin[LEVEL_STEP];
+    /* The usual step (a whole one of nodes that each have both built-in
+     * controllers and no others) in a straight line, the pairs known. */
+    bool usual = count == LEVEL_STEP && !keep_world;
+    for (uint32_t j = 0; j < count; j++)
+        usual &= (s->state[items[j].slot] & NODE_MOTION) == NODE_MOTION;
+    if (usual) {
+        for (uint32_t j = 0; j < LEVEL_STEP; j++) {
+            uint32_t slot = items[j].slot;
+            node_motion *m = &s->motion[slot];
+            orbit_x[j] = &s->xf[slot];
+            orbit[j] = &m->orbit;
+            spin[j] = &m->spin;
+            s->state[slot] |= NODE_DIRTY;
+        }
+        for (uint32_t k = 0; k < LEVEL_STEP; k += 2) {
+            ob_orbit_kernel2(orbit_x + k, orbit + k, 2, dt);
+            ob_rotation_kernel2(orbit_x + k, spin + k, 2, dt);
+        }
+        return;
+    }
     uint32_t orbits = 0, spins = 0;
     for (uint32_t j = 0; j < count; j++) {
         uint32_t slot = items[j].slot;
@@ -610,19 +632,27 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
             prefetch_proxies(s, c->items + from, to - from);
         }
         if (c->controllers) run_batch_controllers(s, c->items + i, step_end - i, c->dt, false);
-        uint32_t simple[LEVEL_STEP], simples = 0;
+        uint32_t simple[LEVEL_STEP], simple_parent[LEVEL_STEP], simples = 0;
         for (uint32_t j = i; j < step_end; j++) {
             level_item it = c->items[j];
             uint8_t st = state[it.slot];
             if ((st & NODE_DIRTY) || (it.parent != NO_SLOT && (state[it.parent] & NODE_CHANGED))) {
-                if (simple_node(s, it, st)) simple[simples++] = it.slot;
-                else b.item[b.count++] = it;
+                if (simple_node(s, it, st)) {
+                    simple_parent[simples] = it.parent;
+                    simple[simples++] = it.slot;
+                } else {
+                    b.item[b.count++] = it;
+                }
             } else if (st & NODE_CHANGED) {
                 state[it.slot] = (uint8_t)(st & ~NODE_CHANGED);
             }
         }
-        for (uint32_t k = 0; k < simples; k += 2)
-            eval_simple2(s, simple + k, OB_MIN(2u, simples - k));
+        for (uint32_t k = 0; k < simples; k += 2) {
+            uint32_t pair = OB_MIN(2u, simples - k);
+            if (eval_simple2(s, simple + k, pair)) continue;
+            for (uint32_t l = 0; l < pair; l++)
+                b.item[b.count++] = (level_item){.slot = simple[k + l], .parent = simple_parent[k + l]};
+        }
         if (b.count > EVAL_BATCH - LEVEL_STEP || (b.count && step_end == end))
             changed |= eval_batch_run(s, &b);
     }

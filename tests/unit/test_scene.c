@@ -4,6 +4,7 @@
 #include "ob_test.h"
 #include "ob_scene.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -678,6 +679,76 @@ static void bad_transform_rejected_once_and_recovers(void **state)
     }
 }
 
+/* Spinning renderable leaves under the root take the update's common
+ * path, two at a time: one with a bad position, scale or orbit is named and dropped on
+ * its own, the leaf sharing its pair is placed as usual, and both come
+ * back once their transform is finite again. */
+static void bad_leaf_rejected_beside_a_good_one(void **state)
+{
+    (void)state;
+    enum { LEAVES = 8 };
+    for (int kind = 0; kind < 3; kind++) {
+        ob_scene *s = new_scene();
+        ob_node *leaf[LEAVES];
+        for (int k = 0; k < LEAVES; k++) {
+            char name[16];
+            snprintf(name, sizeof name, "leaf%d", k);
+            leaf[k] = new_node(s, NULL, name);
+            make_renderable(leaf[k]);
+            ob_node_set_position(leaf[k], (double[3]){k, 0, 0});
+            /* The common path takes a rotation its spin keeps unit. */
+            assert_int_equal(ob_node_add_rotation_controller(leaf[k], (float[3]){0, 1, 0}, 0.5f),
+                             OB_OK);
+        }
+        ob_node *bad = leaf[5];
+        if (kind == 2) /* each input finite, the orbit's position overflows */
+            assert_int_equal(ob_node_add_orbit_controller(bad, (double[3]){DBL_MAX, 0, 0},
+                                                          (float[3]){0, 1, 0}, 0.75 * DBL_MAX,
+                                                          0.0f, 0.0f),
+                             OB_OK);
+        char expect[96];
+        snprintf(expect, sizeof expect, "entity 'leaf5' (id %u): non-finite transform; not rendered",
+                 ob_node_id(bad));
+        ob_test_log_clear();
+        assert_int_equal(ob_scene_update(s, 0.0), OB_OK);
+        uint32_t count;
+        ob_scene_renderables(s, &count);
+        assert_int_equal(count, kind == 2 ? LEAVES - 1 : LEAVES);
+        assert_int_equal(ob_test_log_count(OB_LOG_ERROR), kind == 2);
+        if (kind == 2) assert_true(ob_test_log_has(expect, NULL));
+        ob_test_log_clear();
+        if (kind == 0) ob_node_set_position(bad, (double[3]){NAN, 0, 0});
+        if (kind == 1) ob_node_set_scale(bad, (float[3]){1, INFINITY, 1});
+        for (int k = 0; k < LEAVES; k++)
+            if (leaf[k] != bad) ob_node_set_position(leaf[k], (double[3]){k, 2, 0});
+        assert_int_equal(ob_scene_update(s, 1.0 / 60.0), OB_OK);
+        /* Named once: at its first bad update. */
+        assert_int_equal(ob_test_log_count(OB_LOG_ERROR), kind != 2);
+        if (kind != 2 && !ob_test_log_has(expect, NULL))
+            fail_msg("kind %d: missing '%s'", kind, expect);
+        assert_false(ob_node_is_renderable(bad));
+        ob_scene_renderables(s, &count);
+        assert_int_equal(count, LEAVES - 1);
+        for (int k = 0; k < LEAVES; k++) {
+            if (leaf[k] == bad) continue;
+            double p[3];
+            ob_node_world_position(leaf[k], p);
+            assert_true(p[0] == k && p[1] == 2 && p[2] == 0);
+            assert_true(ob_node_is_renderable(leaf[k]));
+        }
+        if (kind == 0) ob_node_set_position(bad, (double[3]){5, 2, 0});
+        if (kind == 1) ob_node_set_scale(bad, (float[3]){1, 1, 1});
+        if (kind != 2) {
+            assert_int_equal(ob_scene_update(s, 1.0 / 60.0), OB_OK);
+            assert_true(ob_node_is_renderable(bad));
+            ob_scene_renderables(s, &count);
+            assert_int_equal(count, LEAVES);
+            assert_true(ob_test_log_has("leaf5", "finite again", NULL));
+        }
+        ob_scene_destroy(s);
+    }
+}
+
 static void bad_update_arguments_refused(void **state)
 {
     (void)state;
@@ -1168,6 +1239,7 @@ int main(void)
         cmocka_unit_test(controller_state_kept_by_the_node),
         cmocka_unit_test(builtin_controllers_kept_apart_move_the_same),
         cmocka_unit_test(bad_transform_rejected_once_and_recovers),
+        cmocka_unit_test(bad_leaf_rejected_beside_a_good_one),
         cmocka_unit_test(bad_update_arguments_refused),
         cmocka_unit_test(cameras_and_lights),
         cmocka_unit_test(look_at_aims_forward),
