@@ -48,11 +48,13 @@ void ob_orbit_controller_step(ob_node *n, double dt, void *user);
 /* The built-in controllers run on two nodes at once, as lanes of GCC and
  * Clang vector types: two doubles fill an SSE2 register, which every
  * x86-64 CPU has (four-wide ones were built through the stack there and
- * cost more than they saved). Each lane does exactly the operations of the
- * one-node form, in the same order and without fused multiply-adds (ISO C
- * mode: no contraction), so a node moves by the same bits whichever node
- * shares its pair: the update stays deterministic for any thread count and
- * chunking. */
+ * cost more than they saved); where the CPU has AVX2 (asked at run time),
+ * the update's usual step runs four at once in a function built for it.
+ * Each lane does exactly the operations of the one-node form, in the same
+ * order and without fused multiply-adds (ISO C mode: no contraction; the
+ * AVX2 target adds no FMA), so a node moves by the same bits whichever
+ * nodes share its group and whatever the width: the update stays
+ * deterministic for any thread count, chunking and CPU. */
 typedef double ob_v2d __attribute__((vector_size(16)));
 typedef uint64_t ob_v2u __attribute__((vector_size(16)));
 /* Both lanes' square roots: the correctly rounded root either way, one
@@ -100,114 +102,54 @@ ob_rotation_store_unusual(node_xf *const x[2], const ob_v2d q[4], ob_v2d n2, ob_
     }
 }
 
-/* q = q * step(axis, rate * dt) for nodes x[0..n) (n 1 or 2; an unused
- * lane repeats lane 0, and node 0 takes its stores again). The caller
- * marks the nodes dirty. Inlined always, as the orbit's: the caller's
- * loop keeps the lanes in registers. */
-static inline __attribute__((always_inline)) void
-ob_rotation_kernel2(node_xf *const x[2], ob_rotation_state *const st[2], uint32_t n, double dt)
+/* The kernels two nodes at once (every x86-64 CPU has SSE2) and, where
+ * the CPU has AVX2, four (the update's usual step): ob_motion_lanes.h. */
+#define OB_LANES 2
+#define OB_VD ob_v2d
+#define OB_VU ob_v2u
+#define OB_LANE(name) name##2
+#define OB_LANE_TARGET
+#define OB_LANE_SQRT OB_V2D_SQRT
+static inline __attribute__((always_inline)) void ob_lanes_store2(double *const d[2], ob_v2d v)
 {
-    for (uint32_t l = 0; l < n; l++) {
-        if (dt == st[l]->step_dt) continue;
-        ob_dquat_from_axis_angle(st[l]->axis, st[l]->rate * dt, st[l]->step);
-        st[l]->step_dt = dt;
-    }
-    uint32_t i1 = n > 1 ? 1 : 0;
-#define A(c) (ob_v2d){x[0]->rotation[c], x[i1]->rotation[c]}
-#define B(c) (ob_v2d){st[0]->step[c], st[i1]->step[c]}
-    ob_v2d a[4] = {A(0), A(1), A(2), A(3)}, b[4] = {B(0), B(1), B(2), B(3)};
-#undef A
-#undef B
-    /* ob_dquat_mul(rotation, step), then ob_dquat_normalize's usual case. */
-    ob_v2d q[4] = {OB_QUAT_MUL_X(a, b), OB_QUAT_MUL_Y(a, b), OB_QUAT_MUL_Z(a, b),
-                   OB_QUAT_MUL_W(a, b)};
-    ob_v2d n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    ob_v2d inv = 1.0 / OB_V2D_SQRT(n2);
-    if (__builtin_expect(!(OB_DQUAT_NORM2_USUAL(n2[0]) && OB_DQUAT_NORM2_USUAL(n2[1])), 0)) {
-        ob_rotation_store_unusual(x, q, n2, inv, n);
-        return;
-    }
-    /* The usual case in both lanes (an unused lane repeats lane 0): the
-     * one-node form's multiplications, in the lanes. */
-    for (int c = 0; c < 4; c++) {
-        q[c] *= inv;
-        ob_v2d_store2(&x[0]->rotation[c], &x[i1]->rotation[c], q[c]);
-    }
-    x[0]->flags |= XF_ROTATION_UNIT;
-    x[i1]->flags |= XF_ROTATION_UNIT;
+    ob_v2d_store2(d[0], d[1], v);
 }
+#include "ob_motion_lanes.h"
+#undef OB_LANES
+#undef OB_VD
+#undef OB_VU
+#undef OB_LANE
+#undef OB_LANE_TARGET
+#undef OB_LANE_SQRT
 
-/* sin and cos of two orbit angles (|x| < 2pi, where the state keeps them;
- * NaN for a non-finite x), within an ulp of libm's: fdlibm's reduction by
- * pi/2 in three parts and its kernels on [-pi/4, pi/4], inline and without
- * libm's range checks and calls, which cost the update more than anything
- * else of the orbit (about a fifth of a warm update at 50k objects).
- * Inlined always: called from two places, GCC made it a function whose
- * arguments go through memory. */
-static inline __attribute__((always_inline)) void
-orbit_sincos2(const ob_v2d *in_x, ob_v2d *out_s, ob_v2d *out_c)
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define OB_MOTION_LANES4 1
+typedef double ob_v4d __attribute__((vector_size(32)));
+typedef uint64_t ob_v4u __attribute__((vector_size(32)));
+static inline __attribute__((always_inline, target("avx2"))) void
+ob_lanes_store4(double *const d[4], ob_v4d v)
 {
-    ob_v2d x = *in_x;
-    static const double two_over_pi = 6.36619772367581382433e-01;
-    static const double pio2_1 = 1.57079632673412561417e+00;  /* first 33 bits of pi/2 */
-    static const double pio2_2 = 6.07710050630396597660e-11;  /* the next 33 bits */
-    static const double pio2_2t = 2.02226624879595063154e-21; /* pi/2 - pio2_1 - pio2_2 */
-    static const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                        S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                        S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
-    static const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                        C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                        C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-    /* Rounded to the nearest integer k by the addition (round to nearest),
-     * which leaves k mod 4 in the two low bits of kb's mantissa. Outside
-     * |x| < 8 (NaN, infinite: never in the range) the lane's result is
-     * replaced by x - x below. */
-    ob_v2d kb = x * two_over_pi + 0x1.8p52;
-    ob_v2d k = kb - 0x1.8p52;
-    ob_v2d t = x - k * pio2_1, w = k * pio2_2, r = t - w;
-    r -= k * pio2_2t - ((t - r) - w);
-    ob_v2d z = r * r;
-    ob_v2d sr = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
-    ob_v2d cp = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
-    ob_v2d hz = 0.5 * z, one_hz = 1.0 - hz;
-    ob_v2d cr = one_hz + (((1.0 - one_hz) - hz) + z * cp);
-    /* The quadrant picks and signs them without a branch: it differs from
-     * one object to the next, and a mispredicted branch on it cost the
-     * update a twentieth of its time. */
-    ob_v2u q = (ob_v2u)kb & 3u, swap = -(q & 1u), sb = (ob_v2u)sr, cb = (ob_v2u)cr;
-    ob_v2u s_bits = ((sb & ~swap) | (cb & swap)) ^ ((q >> 1) << 63);
-    ob_v2u c_bits = ((cb & ~swap) | (sb & swap)) ^ ((((q + 1u) >> 1) & 1u) << 63);
-    ob_v2u abs_x = (ob_v2u)x & ~((ob_v2u){1, 1} << 63);
-    ob_v2u bad = (ob_v2u)((ob_v2u)((ob_v2d)abs_x < 8.0) == 0), nan = (ob_v2u)(x - x);
-    *out_s = (ob_v2d)((s_bits & ~bad) | (nan & bad));
-    *out_c = (ob_v2d)((c_bits & ~bad) | (nan & bad));
+    __m128d lo = _mm256_castpd256_pd128((__m256d)v), hi = _mm256_extractf128_pd((__m256d)v, 1);
+    _mm_storel_pd(d[0], lo);
+    _mm_storeh_pd(d[1], lo);
+    _mm_storel_pd(d[2], hi);
+    _mm_storeh_pd(d[3], hi);
 }
-
-/* position = center + radius (cos a u + sin a v), a += rate * dt, for
- * nodes x[0..n) (n 1 or 2, as for ob_rotation_kernel2). The caller marks
- * the nodes dirty. */
-static inline __attribute__((always_inline)) void
-ob_orbit_kernel2(node_xf *const x[2], ob_orbit_state *const st[2], uint32_t n, double dt)
-{
-    uint32_t i1 = n > 1 ? 1 : 0;
-#define F(field) (ob_v2d){st[0]->field, st[i1]->field}
-    ob_v2d angle = F(angle) + F(rate) * dt, radius = F(radius);
-    ob_v2d center[3] = {F(center[0]), F(center[1]), F(center[2])};
-    ob_v2d u[3] = {F(u[0]), F(u[1]), F(u[2])}, v[3] = {F(v[0]), F(v[1]), F(v[2])};
-#undef F
-    /* fmod is exact, and the identity below 2pi: called only above. */
-    /* Both lanes: an unused one must stay equal to lane 0. */
-    if (!(fabs(angle[0]) < 2.0 * OB_PI && fabs(angle[1]) < 2.0 * OB_PI))
-        for (uint32_t l = 0; l < 2; l++)
-            if (!(fabs(angle[l]) < 2.0 * OB_PI)) angle[l] = fmod(angle[l], 2.0 * OB_PI);
-    ob_v2d_store2(&st[0]->angle, &st[i1]->angle, angle);
-    ob_v2d sin_a, cos_a;
-    orbit_sincos2(&angle, &sin_a, &cos_a);
-    ob_v2d c = cos_a * radius, s = sin_a * radius;
-    ob_v2d p[3];
-    for (int k = 0; k < 3; k++) p[k] = center[k] + c * u[k] + s * v[k];
-    for (int k = 0; k < 3; k++) ob_v2d_store2(&x[0]->position[k], &x[i1]->position[k], p[k]);
-}
+#define OB_LANES 4
+#define OB_VD ob_v4d
+#define OB_VU ob_v4u
+#define OB_LANE(name) name##4
+#define OB_LANE_TARGET __attribute__((target("avx2")))
+#define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
+#include "ob_motion_lanes.h"
+#undef OB_LANES
+#undef OB_VD
+#undef OB_VU
+#undef OB_LANE
+#undef OB_LANE_TARGET
+#undef OB_LANE_SQRT
+#endif
 
 /* The one-node forms (a group of one). */
 static inline void ob_rotation_kernel(node_xf *x, ob_rotation_state *st, double dt)

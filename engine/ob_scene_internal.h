@@ -174,6 +174,8 @@ struct ob_scene {
     bool in_update;
     bool order_dirty;
     bool snapshot_dirty;           /* the next update rebuilds the whole snapshot */
+    bool motion_lanes2;            /* the built-in controllers two nodes at a time even
+                                      where the CPU has four-wide lanes (tests) */
     uint32_t serial_nodes;         /* nodes with a controller that is not parallel-safe */
 
     /* Slot arrays, by_id_count long (holes: by_id NULL). */

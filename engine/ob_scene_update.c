@@ -33,6 +33,7 @@ typedef struct update_ctx {
     const level_item *items;    /* the current loop's nodes */
     uint32_t count;
     bool controllers;           /* the level loop runs the parallel-safe controllers */
+    bool lanes4;                /* the built-in controllers' usual step in AVX2's four lanes */
     uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
 } update_ctx;
 
@@ -486,11 +487,40 @@ static bool eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
 
 /* ------------------------------------------------------------------ loops */
 
+#if defined(OB_MOTION_LANES4)
+_Static_assert(LEVEL_STEP == 4, "the usual step fills AVX2's four lanes");
+/* Both built-in controllers of four nodes in AVX2's four lanes (the same
+ * bits as two at a time); a rotation outside the usual norm range, two at
+ * a time. */
+static __attribute__((target("avx2"), noinline)) void
+motion_step4(node_xf *const x[4], ob_orbit_state *const orbit[4], ob_rotation_state *const spin[4],
+             double dt)
+{
+    ob_orbit_kernel4(x, orbit, 4, dt);
+    if (!ob_rotation_kernel4(x, spin, 4, dt)) {
+        ob_rotation_kernel2(x, spin, 2, dt);
+        ob_rotation_kernel2(x + 2, spin + 2, 2, dt);
+    }
+}
+#endif
+
+/* Whether this update runs the usual step four nodes at once. */
+static bool motion_lanes4(const ob_scene *s)
+{
+#if defined(OB_MOTION_LANES4)
+    return !s->motion_lanes2 && __builtin_cpu_supports("avx2");
+#else
+    (void)s;
+    return false;
+#endif
+}
+
 /* The parallel-safe controllers of up to LEVEL_STEP nodes: those in
- * scene->motion (NODE_MOTION) two nodes at a time, the others in each
- * node's list in order; keep_world as for ob_controller_run. */
+ * scene->motion (NODE_MOTION) two nodes at a time (a step of four that
+ * each have both, four at a time with lanes4), the others in each node's
+ * list in order; keep_world as for ob_controller_run. */
 static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t count, double dt,
-                                  bool keep_world)
+                                  bool keep_world, bool lanes4)
 {
     node_xf *orbit_x[LEVEL_STEP], *spin_x[LEVEL_STEP];
     ob_orbit_state *orbit[LEVEL_STEP];
@@ -509,6 +539,14 @@ static void run_batch_controllers(ob_scene *s, const level_item *items, uint32_t
             spin[j] = &m->spin;
             s->state[slot] |= NODE_DIRTY;
         }
+#if defined(OB_MOTION_LANES4)
+        if (lanes4) {
+            motion_step4(orbit_x, orbit, spin, dt);
+            return;
+        }
+#else
+        (void)lanes4;
+#endif
         for (uint32_t k = 0; k < LEVEL_STEP; k += 2) {
             ob_orbit_kernel2(orbit_x + k, orbit + k, 2, dt);
             ob_rotation_kernel2(orbit_x + k, spin + k, 2, dt);
@@ -550,7 +588,8 @@ static void run_parallel_controller_loop(void *user, uint32_t chunk, uint32_t th
     ob_scene *s = c->s;
     uint32_t end = chunk_end(c->count, chunk, c->grain);
     for (uint32_t i = chunk * c->grain; i < end; i += LEVEL_STEP)
-        run_batch_controllers(s, c->items + i, OB_MIN(end, i + LEVEL_STEP) - i, c->dt, true);
+        run_batch_controllers(s, c->items + i, OB_MIN(end, i + LEVEL_STEP) - i, c->dt, true,
+                              c->lanes4);
 }
 
 /* Levels of at least this many nodes have their data asked for ahead:
@@ -631,7 +670,8 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
             to = OB_MIN(end, step_end + LEVEL_STEP);
             prefetch_proxies(s, c->items + from, to - from);
         }
-        if (c->controllers) run_batch_controllers(s, c->items + i, step_end - i, c->dt, false);
+        if (c->controllers)
+            run_batch_controllers(s, c->items + i, step_end - i, c->dt, false, c->lanes4);
         uint32_t simple[LEVEL_STEP], simple_parent[LEVEL_STEP], simples = 0;
         for (uint32_t j = i; j < step_end; j++) {
             level_item it = c->items[j];
@@ -797,7 +837,8 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
     if (r != OB_OK) return r;
 
     s->in_update = true;
-    update_ctx c = {.s = s, .dt = dt, .par = par, .grain = grain, .counts = s->chunk_counts};
+    update_ctx c = {.s = s, .dt = dt, .par = par, .grain = grain, .counts = s->chunk_counts,
+                    .lanes4 = motion_lanes4(s)};
     /* Serial controllers may read any node's local transform, so every
      * parallel-safe one must have run before them, and every transform
      * after them. Without any, a node's controllers run right before its
