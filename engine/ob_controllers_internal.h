@@ -115,12 +115,6 @@ static inline __attribute__((always_inline)) void ob_lanes_store2(double *const 
     ob_v2d_store2(d[0], d[1], v);
 }
 #include "ob_motion_lanes.h"
-#undef OB_LANES
-#undef OB_VD
-#undef OB_VU
-#undef OB_LANE
-#undef OB_LANE_TARGET
-#undef OB_LANE_SQRT
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -143,12 +137,6 @@ ob_lanes_store4(double *const d[4], ob_v4d v)
 #define OB_LANE_TARGET __attribute__((target("avx2")))
 #define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
 #include "ob_motion_lanes.h"
-#undef OB_LANES
-#undef OB_VD
-#undef OB_VU
-#undef OB_LANE
-#undef OB_LANE_TARGET
-#undef OB_LANE_SQRT
 #endif
 
 /* The one-node forms (a group of one). */

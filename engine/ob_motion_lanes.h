@@ -7,7 +7,7 @@
  *   OB_LANE_TARGET    the function attribute the width's instructions need
  *   OB_LANE_SQRT(v)   every lane's correctly rounded square root
  * and a function OB_LANE(ob_lanes_store)(double *const d[OB_LANES], OB_VD v)
- * that stores lane l of v at d[l].
+ * that stores lane l of v at d[l]. It undefines those macros at its end.
  *
  * Each lane does exactly the one-node form's operations in the same order,
  * without fused multiply-adds (ISO C mode: no contraction; and the wider
@@ -147,3 +147,9 @@ OB_LANE(ob_rotation_kernel)(node_xf *const x[OB_LANES], ob_rotation_state *const
 #undef OB_LANE_PTRS
 #undef OB_LANE_PTRS_2
 #undef OB_LANE_PTRS_4
+#undef OB_LANES
+#undef OB_VD
+#undef OB_VU
+#undef OB_LANE
+#undef OB_LANE_TARGET
+#undef OB_LANE_SQRT
