@@ -392,98 +392,24 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
            (st & (NODE_IN_RENDERABLES | NODE_IN_LIGHTS)) == NODE_IN_RENDERABLES;
 }
 
-/* proxy_write_world's float 3x3 of two worlds, lanes 0 and 1 of m, into
- * p[0] and p[1], and whether each mirrors (bit l): ob_det3_negative of the
- * floats stored. With SSE2 both lanes convert at once and the determinant
- * runs in the lanes on the same values, so the same answer. */
-static int proxy_linear2(ob_render_proxy *const p[2], const ob_v2d m[9])
-{
-#if defined(__SSE2__)
-    ob_v2d lf[9];
-    __m128 f[9];
-    for (int k = 0; k < 9; k++) {
-        f[k] = _mm_cvtpd_ps(m[k]);
-        lf[k] = _mm_cvtps_pd(f[k]);
-    }
-    for (int k = 0; k < 8; k += 2) {
-        __m128 pair = _mm_unpacklo_ps(f[k], f[k + 1]); /* k and k + 1 of lane 0, then lane 1 */
-        _mm_storel_pi((__m64 *)&p[0]->linear[k], pair);
-        _mm_storeh_pi((__m64 *)&p[1]->linear[k], pair);
-    }
-    _mm_store_ss(&p[0]->linear[8], f[8]);
-    _mm_store_ss(&p[1]->linear[8], _mm_shuffle_ps(f[8], f[8], 1));
-    ob_v2d det = OB_DET3_COLUMNS(lf, lf + 3, lf + 6);
-    return _mm_movemask_pd(_mm_cmplt_pd(det, _mm_setzero_pd()));
-#else
-    int mirrors = 0;
-    for (uint32_t l = 0; l < 2; l++) {
-        for (int k = 0; k < 9; k++) p[l]->linear[k] = (float)m[k][l];
-        mirrors |= ob_det3_negative(p[l]->linear, 3, 1) << l;
-    }
-    return mirrors;
+/* The common node's evaluation, two nodes at once and, where the CPU has
+ * AVX2, four (ob_update_lanes.h): eval_simple2 and eval_simple4. */
+#define OB_LANES 2
+#define OB_VD ob_v2d
+#define OB_VU ob_v2u
+#define OB_LANE(name) name##2
+#define OB_LANE_TARGET
+#define OB_LANE_SQRT OB_V2D_SQRT
+#include "ob_update_lanes.h"
+#if defined(OB_MOTION_LANES4)
+#define OB_LANES 4
+#define OB_VD ob_v4d
+#define OB_VU ob_v4u
+#define OB_LANE(name) name##4
+#define OB_LANE_TARGET __attribute__((target("avx2")))
+#define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
+#include "ob_update_lanes.h"
 #endif
-}
-
-/* Evaluates simple nodes slots[0..n), n 1 or 2 (an unused lane repeats
- * lane 0). False, with nothing written, when a position or scale is not
- * finite: those nodes take node_eval's way, which names them. */
-static bool eval_simple2(ob_scene *s, const uint32_t *slots, uint32_t n)
-{
-    node_xf *x[2] = {&s->xf[slots[0]], &s->xf[slots[n > 1]]};
-#define L(e) (ob_v2d){x[0]->e, x[1]->e}
-    ob_v2d t[3] = {L(position[0]), L(position[1]), L(position[2])};
-    ob_v2d sc[3] = {L(scale[0]), L(scale[1]), L(scale[2])};
-    /* ob_scene_xf_local's test, in the lanes: v - v is 0 for a finite v
-     * and NaN otherwise (a float's double is finite when it is). */
-    ob_v2d bad = ((t[0] - t[0]) + (t[1] - t[1])) + ((t[2] - t[2]) + (sc[0] - sc[0])) +
-                 ((sc[1] - sc[1]) + (sc[2] - sc[2]));
-    if (__builtin_expect(!(bad[0] == 0.0 && bad[1] == 0.0), 0)) return false;
-    /* ob_daffine_from_trs(position, rotation, scale): the rotation is unit */
-    ob_v2d m[9];
-    OB_QUAT_TO_MAT3_SCALED(ob_v2d, L(rotation[0]), L(rotation[1]), L(rotation[2]), L(rotation[3]),
-                           sc[0], sc[1], sc[2], m);
-    /* node_world_bound */
-    ob_v2d cx = L(local_center[0]), cy = L(local_center[1]), cz = L(local_center[2]);
-    ob_v2d center[3];
-    for (int r = 0; r < 3; r++) center[r] = OB_AFFINE_ROW(m, t, r, cx, cy, cz);
-    ob_v2d best = {0.0, 0.0};
-    for (int c = 0; c < 3; c++) {
-        /* ob_daffine_max_scale's choice: d where d > best, else best */
-        ob_v2d d = OB_COLUMN_LENGTH2(m, c);
-        ob_v2u more = (ob_v2u)(d > best);
-        best = (ob_v2d)(((ob_v2u)d & more) | ((ob_v2u)best & ~more));
-    }
-    ob_v2d scale = OB_V2D_SQRT(best);
-    ob_v2d radius = L(local_radius) * scale;
-#undef L
-    /* Both lanes stored, from the registers: when n is 1 the second repeats
-     * the first node's stores with the same values. */
-    ob_render_proxy *p[2] = {&s->proxies[x[0]->proxy_index], &s->proxies[x[1]->proxy_index]};
-    int mirrors = proxy_linear2(p, m);
-    uint32_t i0 = x[0]->proxy_index, i1 = x[1]->proxy_index;
-    for (int k = 0; k < 9; k++) ob_v2d_store2(&x[0]->world.m[k], &x[1]->world.m[k], m[k]);
-    for (int k = 0; k < 3; k++) {
-        ob_v2d_store2(&x[0]->world.t[k], &x[1]->world.t[k], t[k]);
-        ob_v2d_store2(&p[0]->world_t[k], &p[1]->world_t[k], t[k]);
-    }
-    ob_v2d_store2(&s->soa_x[i0], &s->soa_x[i1], center[0]);
-    ob_v2d_store2(&s->soa_y[i0], &s->soa_y[i1], center[1]);
-    ob_v2d_store2(&s->soa_z[i0], &s->soa_z[i1], center[2]);
-    for (uint32_t l = 0; l < 2; l++) {
-        node_xf *xl = x[l];
-        uint32_t slot = slots[n > 1 ? l : 0], i = l ? i1 : i0;
-        float r = (float)radius[l];
-        xl->flags = (xl->flags & ~(uint32_t)(XF_EFFECTIVE_HIDDEN | XF_IDENTITY)) | XF_WORLD_VALID |
-                    XF_WORLD_ROT_LOCAL;
-        s->state[slot] =
-            (uint8_t)((s->state[slot] & ~(NODE_DIRTY | NODE_IN_LIGHTS)) | NODE_CHANGED);
-        s->soa_radius[i] = r;
-        s->soa_flags[i] = zero_scale_flag(xl, r);
-        p[l]->finite = linear_finite(p[l]->linear, scale[l]);
-        p[l]->mirrors = (uint8_t)((mirrors >> l) & 1);
-    }
-    return true;
-}
 
 /* ------------------------------------------------------------------ loops */
 
@@ -687,7 +613,12 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
                 state[it.slot] = (uint8_t)(st & ~NODE_CHANGED);
             }
         }
-        for (uint32_t k = 0; k < simples; k += 2) {
+        uint32_t k = 0;
+#if defined(OB_MOTION_LANES4)
+        /* A whole step of them in four lanes; one not finite, in pairs. */
+        if (simples == LEVEL_STEP && c->lanes4 && eval_simple4(s, simple, LEVEL_STEP)) k = simples;
+#endif
+        for (; k < simples; k += 2) {
             uint32_t pair = OB_MIN(2u, simples - k);
             if (eval_simple2(s, simple + k, pair)) continue;
             for (uint32_t l = 0; l < pair; l++)

@@ -1120,9 +1120,8 @@ static void builtin_controllers_same_bits_in_four_lanes(void **state)
  * light on the same node sends it through the general evaluation. Both
  * give the same world, proxy and bound bits, at any scale: mirrored, zero,
  * in one axis, so large or so small that the normal matrix rescales. */
-static void common_nodes_evaluate_as_any_other(void **state)
+static void common_nodes_check(bool spin_all)
 {
-    (void)state;
     enum { NODES = 9, STEPS = 40 };
     static const float scales[NODES][3] = {
         {1, 1, 1},  {-1, 2, 0.5f},           {0, 0, 0},          {3e30f, 1e30f, 2e30f},
@@ -1141,7 +1140,7 @@ static void common_nodes_evaluate_as_any_other(void **state)
                                                           (float[3]){0, 1, 0}, 2 + k, 0.7f,
                                                           0.2f * (float)k),
                              OB_OK);
-            if (k % 3)
+            if (k % 3 || spin_all)
                 assert_int_equal(ob_node_add_rotation_controller(n[v][k],
                                                                  (float[3]){1, 2, (float)k}, 1.1f),
                                  OB_OK);
@@ -1166,6 +1165,7 @@ static void common_nodes_evaluate_as_any_other(void **state)
             assert_memory_equal(block[0], block[1], sizeof block[0]);
             assert_memory_equal(p[0][k].world_t, p[1][k].world_t, sizeof p[0][k].world_t);
             assert_int_equal(p[0][k].finite, p[1][k].finite);
+            assert_int_equal(p[0][k].mirrors, p[1][k].mirrors);
             assert_memory_equal(&soa[0].x[k], &soa[1].x[k], sizeof soa[0].x[k]);
             assert_memory_equal(&soa[0].y[k], &soa[1].y[k], sizeof soa[0].y[k]);
             assert_memory_equal(&soa[0].z[k], &soa[1].z[k], sizeof soa[0].z[k]);
@@ -1176,12 +1176,28 @@ static void common_nodes_evaluate_as_any_other(void **state)
             ob_node_world_affine(n[1][k], &w[1]);
             assert_memory_equal(&w[0], &w[1], sizeof w[0]);
         }
-        /* a zero scale is flagged; the huge and tiny ones stay finite */
+        /* a zero scale is flagged; the huge and tiny ones stay finite; the
+         * mirrored ones mirror */
         assert_int_equal(soa[0].flags[2], OB_RENDER_ZERO_SCALE);
+        assert_true(p[0][1].mirrors && p[0][7].mirrors && !p[0][0].mirrors);
         assert_true(p[0][3].finite && p[0][4].finite);
     }
     ob_scene_destroy(sc[0]);
     ob_scene_destroy(sc[1]);
+}
+
+static void common_nodes_evaluate_as_any_other(void **state)
+{
+    (void)state;
+    common_nodes_check(false);
+}
+
+/* All of them spinning: where the CPU has AVX2, steps of four common
+ * nodes evaluate in four lanes, with the same bits. */
+static void common_nodes_in_four_lanes_evaluate_as_any_other(void **state)
+{
+    (void)state;
+    common_nodes_check(true);
 }
 
 typedef struct axes_probe {
@@ -1275,6 +1291,7 @@ int main(void)
         cmocka_unit_test(builtin_controllers_same_bits_in_any_pair),
         cmocka_unit_test(builtin_controllers_same_bits_in_four_lanes),
         cmocka_unit_test(common_nodes_evaluate_as_any_other),
+        cmocka_unit_test(common_nodes_in_four_lanes_evaluate_as_any_other),
         cmocka_unit_test(script_controllers_run_in_order_before_world),
         cmocka_unit_test(structure_changes_refused_inside_controllers),
         cmocka_unit_test(destroy_subtree_frees_everything),
