@@ -105,11 +105,6 @@ ob_rotation_store_unusual(node_xf *const x[2], const ob_v2d q[4], ob_v2d n2, ob_
 /* The kernels two nodes at once (every x86-64 CPU has SSE2) and, where
  * the CPU has AVX2, four (the update's usual step): ob_motion_lanes.h. */
 #define OB_LANES 2
-#define OB_VD ob_v2d
-#define OB_VU ob_v2u
-#define OB_LANE(name) name##2
-#define OB_LANE_TARGET
-#define OB_LANE_SQRT OB_V2D_SQRT
 static inline __attribute__((always_inline)) void ob_lanes_store2(double *const d[2], ob_v2d v)
 {
     ob_v2d_store2(d[0], d[1], v);
@@ -131,11 +126,6 @@ ob_lanes_store4(double *const d[4], ob_v4d v)
     _mm_storeh_pd(d[3], hi);
 }
 #define OB_LANES 4
-#define OB_VD ob_v4d
-#define OB_VU ob_v4u
-#define OB_LANE(name) name##4
-#define OB_LANE_TARGET __attribute__((target("avx2")))
-#define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
 #include "ob_motion_lanes.h"
 #endif
 

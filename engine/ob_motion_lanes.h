@@ -1,19 +1,17 @@
 /* ob_motion_lanes.h — the built-in rotation and orbit kernels over
  * OB_LANES nodes at once, included by ob_controllers_internal.h once per
- * lane width (no include guard) with:
- *   OB_LANES          2 or 4
- *   OB_VD, OB_VU      vectors of that many doubles and uint64_t
- *   OB_LANE(name)     the name with the width appended
- *   OB_LANE_TARGET    the function attribute the width's instructions need
- *   OB_LANE_SQRT(v)   every lane's correctly rounded square root
- * and a function OB_LANE(ob_lanes_store)(double *const d[OB_LANES], OB_VD v)
- * that stores lane l of v at d[l]. It undefines those macros at its end.
+ * lane width, OB_LANES defined to it (no include guard; the parameters of
+ * the width: ob_lanes_begin.h). The includer also provides
+ * OB_LANE(ob_lanes_store)(double *const d[OB_LANES], OB_VD v), which
+ * stores lane l of v at d[l].
  *
  * Each lane does exactly the one-node form's operations in the same order,
  * without fused multiply-adds (ISO C mode: no contraction; and the wider
  * form's target adds no FMA), so a node moves by the same bits whatever
  * the width and whichever nodes share its group. Lanes past n repeat lane
  * 0 (its node takes their stores again, with the same values). */
+
+#include "ob_lanes_begin.h"
 
 #define OB_LANES_OF(p, e) OB_LANE(OB_LANES_OF_)(p, e)
 #define OB_LANES_OF_2(p, e) ((OB_VD){(p)[at[0]]->e, (p)[at[1]]->e})
@@ -147,9 +145,4 @@ OB_LANE(ob_rotation_kernel)(node_xf *const x[OB_LANES], ob_rotation_state *const
 #undef OB_LANE_PTRS
 #undef OB_LANE_PTRS_2
 #undef OB_LANE_PTRS_4
-#undef OB_LANES
-#undef OB_VD
-#undef OB_VU
-#undef OB_LANE
-#undef OB_LANE_TARGET
-#undef OB_LANE_SQRT
+#include "ob_lanes_end.h"

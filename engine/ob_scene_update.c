@@ -395,19 +395,9 @@ static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
 /* The common node's evaluation, two nodes at once and, where the CPU has
  * AVX2, four (ob_update_lanes.h): eval_simple2 and eval_simple4. */
 #define OB_LANES 2
-#define OB_VD ob_v2d
-#define OB_VU ob_v2u
-#define OB_LANE(name) name##2
-#define OB_LANE_TARGET
-#define OB_LANE_SQRT OB_V2D_SQRT
 #include "ob_update_lanes.h"
 #if defined(OB_MOTION_LANES4)
 #define OB_LANES 4
-#define OB_VD ob_v4d
-#define OB_VU ob_v4u
-#define OB_LANE(name) name##4
-#define OB_LANE_TARGET __attribute__((target("avx2")))
-#define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
 #include "ob_update_lanes.h"
 #endif
 

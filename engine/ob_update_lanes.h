@@ -1,12 +1,14 @@
 /* ob_update_lanes.h — the scene update's common node (see simple_node in
  * ob_scene_update.c) over OB_LANES nodes at once, included by
- * ob_scene_update.c once per lane width (no include guard) with the
- * parameters ob_motion_lanes.h takes, which it undefines at its end.
+ * ob_scene_update.c once per lane width, OB_LANES defined to it (no
+ * include guard; the parameters of the width: ob_lanes_begin.h).
  *
  * Each lane does exactly the operations of ob_scene_xf_local,
  * node_world_bound, proxy_write_world and proxy_write_finite in their
  * order (the same bits whatever the width), without the stages' flags and
  * stores in between. Lanes past n repeat lane 0. */
+
+#include "ob_lanes_begin.h"
 
 #if OB_LANES == 2
 #define OB_NODE_LANES(e) ((OB_VD){x[0]->e, x[1]->e})
@@ -149,9 +151,4 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slo
 #undef OB_NODE_LANES
 #undef OB_NODE_PTRS
 #undef OB_INDEX_PTRS
-#undef OB_LANES
-#undef OB_VD
-#undef OB_VU
-#undef OB_LANE
-#undef OB_LANE_TARGET
-#undef OB_LANE_SQRT
+#include "ob_lanes_end.h"

@@ -1,0 +1,24 @@
+/* ob_lanes_begin.h — the parameters of a lane template (ob_motion_lanes.h,
+ * ob_update_lanes.h) for the width OB_LANES the includer defined, 2 or 4
+ * (4: only where ob_controllers_internal.h defines OB_MOTION_LANES4):
+ *   OB_VD, OB_VU      vectors of that many doubles and uint64_t
+ *   OB_LANE(name)     the name with the width appended
+ *   OB_LANE_TARGET    the function attribute the width's instructions need
+ *   OB_LANE_SQRT(v)   every lane's correctly rounded square root
+ * No include guard: the template includes ob_lanes_end.h, which undefines
+ * them and OB_LANES. */
+#if OB_LANES == 2
+#define OB_VD ob_v2d
+#define OB_VU ob_v2u
+#define OB_LANE(name) name##2
+#define OB_LANE_TARGET
+#define OB_LANE_SQRT OB_V2D_SQRT
+#elif OB_LANES == 4
+#define OB_VD ob_v4d
+#define OB_VU ob_v4u
+#define OB_LANE(name) name##4
+#define OB_LANE_TARGET __attribute__((target("avx2")))
+#define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
+#else
+#error "OB_LANES is 2 or 4"
+#endif
