@@ -5,6 +5,9 @@
  *   OB_LANE(name)     the name with the width appended
  *   OB_LANE_TARGET    the function attribute the width's instructions need
  *   OB_LANE_SQRT(v)   every lane's correctly rounded square root
+ *   OB_LANES_OF(p, e) the vector of p[l]->e, p an array of OB_LANES pointers
+ *   OB_LANE_PTRS(p, e) the array of the OB_LANES pointers &p[l]->e (the
+ *                     destinations of OB_LANE(ob_lanes_store))
  * No include guard: the template includes ob_lanes_end.h, which undefines
  * them and OB_LANES. */
 #if OB_LANES == 2
@@ -13,12 +16,16 @@
 #define OB_LANE(name) name##2
 #define OB_LANE_TARGET
 #define OB_LANE_SQRT OB_V2D_SQRT
+#define OB_LANES_OF(p, e) ((OB_VD){(p)[0]->e, (p)[1]->e})
+#define OB_LANE_PTRS(p, e) ((double *const[2]){&(p)[0]->e, &(p)[1]->e})
 #elif OB_LANES == 4
 #define OB_VD ob_v4d
 #define OB_VU ob_v4u
 #define OB_LANE(name) name##4
 #define OB_LANE_TARGET __attribute__((target("avx2")))
 #define OB_LANE_SQRT(v) ((ob_v4d)_mm256_sqrt_pd((__m256d)(v)))
+#define OB_LANES_OF(p, e) ((OB_VD){(p)[0]->e, (p)[1]->e, (p)[2]->e, (p)[3]->e})
+#define OB_LANE_PTRS(p, e) ((double *const[4]){&(p)[0]->e, &(p)[1]->e, &(p)[2]->e, &(p)[3]->e})
 #else
 #error "OB_LANES is 2 or 4"
 #endif

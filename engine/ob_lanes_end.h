@@ -6,3 +6,5 @@
 #undef OB_LANE
 #undef OB_LANE_TARGET
 #undef OB_LANE_SQRT
+#undef OB_LANES_OF
+#undef OB_LANE_PTRS

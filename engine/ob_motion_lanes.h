@@ -13,14 +13,6 @@
 
 #include "ob_lanes_begin.h"
 
-#define OB_LANES_OF(p, e) OB_LANE(OB_LANES_OF_)(p, e)
-#define OB_LANES_OF_2(p, e) ((OB_VD){(p)[at[0]]->e, (p)[at[1]]->e})
-#define OB_LANES_OF_4(p, e) ((OB_VD){(p)[at[0]]->e, (p)[at[1]]->e, (p)[at[2]]->e, (p)[at[3]]->e})
-#define OB_LANE_PTRS(p, e) OB_LANE(OB_LANE_PTRS_)(p, e)
-#define OB_LANE_PTRS_2(p, e) ((double *const[2]){&(p)[at[0]]->e, &(p)[at[1]]->e})
-#define OB_LANE_PTRS_4(p, e)                                                                       \
-    ((double *const[4]){&(p)[at[0]]->e, &(p)[at[1]]->e, &(p)[at[2]]->e, &(p)[at[3]]->e})
-
 /* sin and cos of the orbit angles x (|x| < 2pi, where the state keeps them;
  * NaN for a non-finite x), within an ulp of libm's: fdlibm's reduction by
  * pi/2 in three parts and its kernels on [-pi/4, pi/4], inline and without
@@ -70,11 +62,15 @@ OB_LANE(orbit_sincos)(const OB_VD *in_x, OB_VD *out_s, OB_VD *out_c)
 /* position = center + radius (cos a u + sin a v), a += rate * dt, for
  * nodes x[0..n) (1 <= n <= OB_LANES). The caller marks the nodes dirty. */
 static inline __attribute__((always_inline)) OB_LANE_TARGET void
-OB_LANE(ob_orbit_kernel)(node_xf *const x[OB_LANES], ob_orbit_state *const st[OB_LANES], uint32_t n,
-                         double dt)
+OB_LANE(ob_orbit_kernel)(node_xf *const xn[OB_LANES], ob_orbit_state *const stn[OB_LANES],
+                         uint32_t n, double dt)
 {
-    uint32_t at[OB_LANES];
-    for (uint32_t l = 0; l < OB_LANES; l++) at[l] = l < n ? l : 0;
+    node_xf *x[OB_LANES];
+    ob_orbit_state *st[OB_LANES];
+    for (uint32_t l = 0; l < OB_LANES; l++) {
+        x[l] = xn[l < n ? l : 0];
+        st[l] = stn[l < n ? l : 0];
+    }
     OB_VD angle = OB_LANES_OF(st, angle) + OB_LANES_OF(st, rate) * dt;
     OB_VD radius = OB_LANES_OF(st, radius);
     OB_VD center[3] = {OB_LANES_OF(st, center[0]), OB_LANES_OF(st, center[1]),
@@ -103,16 +99,20 @@ OB_LANE(ob_orbit_kernel)(node_xf *const x[OB_LANES], ob_orbit_state *const st[OB
  * lane by lane, and the wider form stores nothing and returns false, for
  * its caller to run the nodes two at a time. */
 static inline __attribute__((always_inline)) OB_LANE_TARGET bool
-OB_LANE(ob_rotation_kernel)(node_xf *const x[OB_LANES], ob_rotation_state *const st[OB_LANES],
+OB_LANE(ob_rotation_kernel)(node_xf *const xn[OB_LANES], ob_rotation_state *const stn[OB_LANES],
                             uint32_t n, double dt)
 {
+    node_xf *x[OB_LANES];
+    ob_rotation_state *st[OB_LANES];
+    for (uint32_t l = 0; l < OB_LANES; l++) {
+        x[l] = xn[l < n ? l : 0];
+        st[l] = stn[l < n ? l : 0];
+    }
     for (uint32_t l = 0; l < n; l++) {
         if (dt == st[l]->step_dt) continue;
         ob_dquat_from_axis_angle(st[l]->axis, st[l]->rate * dt, st[l]->step);
         st[l]->step_dt = dt;
     }
-    uint32_t at[OB_LANES];
-    for (uint32_t l = 0; l < OB_LANES; l++) at[l] = l < n ? l : 0;
     OB_VD a[4], b[4];
     for (int c = 0; c < 4; c++) {
         a[c] = OB_LANES_OF(x, rotation[c]);
@@ -127,7 +127,7 @@ OB_LANE(ob_rotation_kernel)(node_xf *const x[OB_LANES], ob_rotation_state *const
     for (uint32_t l = 0; l < OB_LANES; l++) usual &= OB_DQUAT_NORM2_USUAL(n2[l]);
     if (__builtin_expect(!usual, 0)) {
 #if OB_LANES == 2
-        ob_rotation_store_unusual(x, q, n2, inv, n);
+        ob_rotation_store_unusual(xn, q, n2, inv, n);
         return true;
 #else
         return false;
@@ -135,14 +135,8 @@ OB_LANE(ob_rotation_kernel)(node_xf *const x[OB_LANES], ob_rotation_state *const
     }
     /* The one-node form's multiplications, in the lanes. */
     for (int c = 0; c < 4; c++) OB_LANE(ob_lanes_store)(OB_LANE_PTRS(x, rotation[c]), q[c] * inv);
-    for (uint32_t l = 0; l < OB_LANES; l++) x[at[l]]->flags |= XF_ROTATION_UNIT;
+    for (uint32_t l = 0; l < OB_LANES; l++) x[l]->flags |= XF_ROTATION_UNIT;
     return true;
 }
 
-#undef OB_LANES_OF
-#undef OB_LANES_OF_2
-#undef OB_LANES_OF_4
-#undef OB_LANE_PTRS
-#undef OB_LANE_PTRS_2
-#undef OB_LANE_PTRS_4
 #include "ob_lanes_end.h"

@@ -33,7 +33,8 @@ typedef struct update_ctx {
     const level_item *items;    /* the current loop's nodes */
     uint32_t count;
     bool controllers;           /* the level loop runs the parallel-safe controllers */
-    bool lanes4;                /* the built-in controllers' usual step in AVX2's four lanes */
+    bool lanes4;                /* steps of four usual nodes in AVX2's four lanes: their
+                                   built-in controllers, then their evaluation */
     uint32_t *counts;           /* per chunk: membership changed; the snapshot's offsets */
 } update_ctx;
 
@@ -371,16 +372,17 @@ static bool eval_batch_run(ob_scene *s, eval_batch *b)
     return changed;
 }
 
-/* The common node, two at a time: a renderable leaf whose local transform
- * changed, under the root or another valid, shown identity, itself shown,
- * valid and without a fault to take back, its rotation unit (simple_node)
- * and its position and scale finite (eval_simple2 tests those in its
- * lanes). For it node_eval's outcome is known before it runs: valid, its
- * world its local transform, its world rotation its own, in the snapshot
- * still. So the world, the bound and the proxy are computed in one pass in
- * SSE2 lanes, with exactly the operations of ob_scene_xf_local,
- * node_world_bound, proxy_write_world and proxy_write_finite in their order
- * (the same bits), without the stages' flags and stores in between. */
+/* The common node, two or four at a time: a renderable leaf whose local
+ * transform changed, under the root or another valid, shown identity,
+ * itself shown, valid and without a fault to take back, its rotation unit
+ * (simple_node) and its position and scale finite (eval_simple tests those
+ * in its lanes). For it node_eval's outcome is known before it runs:
+ * valid, its world its local transform, its world rotation its own, in the
+ * snapshot still. So the world, the bound and the proxy are computed in
+ * one pass in vector lanes (ob_update_lanes.h), with exactly the
+ * operations of ob_scene_xf_local, node_world_bound, proxy_write_world and
+ * proxy_write_finite in their order (the same bits), without the stages'
+ * flags and stores in between. */
 static bool simple_node(const ob_scene *s, level_item it, uint8_t st)
 {
     enum { PARENT = XF_IDENTITY | XF_WORLD_VALID | XF_EFFECTIVE_HIDDEN,
@@ -588,17 +590,14 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
         }
         if (c->controllers)
             run_batch_controllers(s, c->items + i, step_end - i, c->dt, false, c->lanes4);
-        uint32_t simple[LEVEL_STEP], simple_parent[LEVEL_STEP], simples = 0;
+        level_item simple[LEVEL_STEP];
+        uint32_t simples = 0;
         for (uint32_t j = i; j < step_end; j++) {
             level_item it = c->items[j];
             uint8_t st = state[it.slot];
             if ((st & NODE_DIRTY) || (it.parent != NO_SLOT && (state[it.parent] & NODE_CHANGED))) {
-                if (simple_node(s, it, st)) {
-                    simple_parent[simples] = it.parent;
-                    simple[simples++] = it.slot;
-                } else {
-                    b.item[b.count++] = it;
-                }
+                if (simple_node(s, it, st)) simple[simples++] = it;
+                else b.item[b.count++] = it;
             } else if (st & NODE_CHANGED) {
                 state[it.slot] = (uint8_t)(st & ~NODE_CHANGED);
             }
@@ -611,8 +610,7 @@ static void run_level(void *user, uint32_t chunk, uint32_t thread)
         for (; k < simples; k += 2) {
             uint32_t pair = OB_MIN(2u, simples - k);
             if (eval_simple2(s, simple + k, pair)) continue;
-            for (uint32_t l = 0; l < pair; l++)
-                b.item[b.count++] = (level_item){.slot = simple[k + l], .parent = simple_parent[k + l]};
+            for (uint32_t l = 0; l < pair; l++) b.item[b.count++] = simple[k + l];
         }
         if (b.count > EVAL_BATCH - LEVEL_STEP || (b.count && step_end == end))
             changed |= eval_batch_run(s, &b);

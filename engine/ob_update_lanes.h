@@ -11,12 +11,8 @@
 #include "ob_lanes_begin.h"
 
 #if OB_LANES == 2
-#define OB_NODE_LANES(e) ((OB_VD){x[0]->e, x[1]->e})
-#define OB_NODE_PTRS(e) ((double *const[2]){&x[0]->e, &x[1]->e})
 #define OB_INDEX_PTRS(a) ((double *const[2]){&(a)[i[0]], &(a)[i[1]]})
 #else
-#define OB_NODE_LANES(e) ((OB_VD){x[0]->e, x[1]->e, x[2]->e, x[3]->e})
-#define OB_NODE_PTRS(e) ((double *const[4]){&x[0]->e, &x[1]->e, &x[2]->e, &x[3]->e})
 #define OB_INDEX_PTRS(a) ((double *const[4]){&(a)[i[0]], &(a)[i[1]], &(a)[i[2]], &(a)[i[3]]})
 #endif
 
@@ -71,21 +67,21 @@ OB_LANE(proxy_linear)(ob_render_proxy *const p[OB_LANES], const OB_VD m[9])
     return mirrors;
 }
 
-/* Evaluates simple nodes slots[0..n) (1 <= n <= OB_LANES). False, with
- * nothing written, when a position or scale is not finite: those nodes
- * take node_eval's way, which names them. */
-static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slots, uint32_t n)
+/* Evaluates the simple nodes of items[0..n) (1 <= n <= OB_LANES). False,
+ * with nothing written, when a position or scale is not finite: those
+ * nodes take node_eval's way, which names them. */
+static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const level_item *items, uint32_t n)
 {
     uint32_t slot[OB_LANES], i[OB_LANES];
     node_xf *x[OB_LANES];
     ob_render_proxy *p[OB_LANES];
     for (uint32_t l = 0; l < OB_LANES; l++) {
-        slot[l] = slots[l < n ? l : 0];
+        slot[l] = items[l < n ? l : 0].slot;
         x[l] = &s->xf[slot[l]];
     }
-    OB_VD t[3] = {OB_NODE_LANES(position[0]), OB_NODE_LANES(position[1]),
-                  OB_NODE_LANES(position[2])};
-    OB_VD sc[3] = {OB_NODE_LANES(scale[0]), OB_NODE_LANES(scale[1]), OB_NODE_LANES(scale[2])};
+    OB_VD t[3] = {OB_LANES_OF(x, position[0]), OB_LANES_OF(x, position[1]),
+                  OB_LANES_OF(x, position[2])};
+    OB_VD sc[3] = {OB_LANES_OF(x, scale[0]), OB_LANES_OF(x, scale[1]), OB_LANES_OF(x, scale[2])};
     /* ob_scene_xf_local's test, in the lanes: v - v is 0 for a finite v
      * and NaN otherwise (a float's double is finite when it is). */
     OB_VD bad = ((t[0] - t[0]) + (t[1] - t[1])) + ((t[2] - t[2]) + (sc[0] - sc[0])) +
@@ -95,12 +91,12 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slo
     if (__builtin_expect(!finite, 0)) return false;
     /* ob_daffine_from_trs(position, rotation, scale): the rotation is unit */
     OB_VD m[9];
-    OB_QUAT_TO_MAT3_SCALED(OB_VD, OB_NODE_LANES(rotation[0]), OB_NODE_LANES(rotation[1]),
-                           OB_NODE_LANES(rotation[2]), OB_NODE_LANES(rotation[3]), sc[0], sc[1],
+    OB_QUAT_TO_MAT3_SCALED(OB_VD, OB_LANES_OF(x, rotation[0]), OB_LANES_OF(x, rotation[1]),
+                           OB_LANES_OF(x, rotation[2]), OB_LANES_OF(x, rotation[3]), sc[0], sc[1],
                            sc[2], m);
     /* node_world_bound */
-    OB_VD cx = OB_NODE_LANES(local_center[0]), cy = OB_NODE_LANES(local_center[1]),
-          cz = OB_NODE_LANES(local_center[2]);
+    OB_VD cx = OB_LANES_OF(x, local_center[0]), cy = OB_LANES_OF(x, local_center[1]),
+          cz = OB_LANES_OF(x, local_center[2]);
     OB_VD center[3];
     for (int r = 0; r < 3; r++) center[r] = OB_AFFINE_ROW(m, t, r, cx, cy, cz);
     OB_VD best = {0.0};
@@ -111,7 +107,7 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slo
         best = (OB_VD)(((OB_VU)d & more) | ((OB_VU)best & ~more));
     }
     OB_VD scale = OB_LANE_SQRT(best);
-    OB_VD radius = OB_NODE_LANES(local_radius) * scale;
+    OB_VD radius = OB_LANES_OF(x, local_radius) * scale;
     /* Every lane stored, from the registers: a repeated lane repeats lane
      * 0's stores with the same values. */
     for (uint32_t l = 0; l < OB_LANES; l++) {
@@ -119,16 +115,10 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slo
         p[l] = &s->proxies[i[l]];
     }
     int mirrors = OB_LANE(proxy_linear)(p, m);
-    for (int k = 0; k < 9; k++) OB_LANE(ob_lanes_store)(OB_NODE_PTRS(world.m[k]), m[k]);
+    for (int k = 0; k < 9; k++) OB_LANE(ob_lanes_store)(OB_LANE_PTRS(x, world.m[k]), m[k]);
     for (int k = 0; k < 3; k++) {
-        OB_LANE(ob_lanes_store)(OB_NODE_PTRS(world.t[k]), t[k]);
-#if OB_LANES == 2
-        OB_LANE(ob_lanes_store)(((double *const[2]){&p[0]->world_t[k], &p[1]->world_t[k]}), t[k]);
-#else
-        OB_LANE(ob_lanes_store)(((double *const[4]){&p[0]->world_t[k], &p[1]->world_t[k],
-                                                    &p[2]->world_t[k], &p[3]->world_t[k]}),
-                                t[k]);
-#endif
+        OB_LANE(ob_lanes_store)(OB_LANE_PTRS(x, world.t[k]), t[k]);
+        OB_LANE(ob_lanes_store)(OB_LANE_PTRS(p, world_t[k]), t[k]);
     }
     OB_LANE(ob_lanes_store)(OB_INDEX_PTRS(s->soa_x), center[0]);
     OB_LANE(ob_lanes_store)(OB_INDEX_PTRS(s->soa_y), center[1]);
@@ -148,7 +138,5 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const uint32_t *slo
     return true;
 }
 
-#undef OB_NODE_LANES
-#undef OB_NODE_PTRS
 #undef OB_INDEX_PTRS
 #include "ob_lanes_end.h"
