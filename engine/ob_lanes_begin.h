@@ -8,8 +8,12 @@
  *   OB_LANES_OF(p, e) the vector of p[l]->e, p an array of OB_LANES pointers
  *   OB_LANE_PTRS(p, e) the array of the OB_LANES pointers &p[l]->e (the
  *                     destinations of OB_LANE(ob_lanes_store))
+ *   OB_LANES_PICK(dst, src, n) dst[l] = src[l] for the n lanes in use,
+ *                     src[0] for the others (an unused lane repeats lane 0)
  * No include guard: the template includes ob_lanes_end.h, which undefines
  * them and OB_LANES. */
+#define OB_LANES_PICK(dst, src, n)                                                                 \
+    for (uint32_t l_ = 0; l_ < OB_LANES; l_++) (dst)[l_] = (src)[l_ < (n) ? l_ : 0]
 #if OB_LANES == 2
 #define OB_VD ob_v2d
 #define OB_VU ob_v2u

@@ -8,3 +8,4 @@
 #undef OB_LANE_SQRT
 #undef OB_LANES_OF
 #undef OB_LANE_PTRS
+#undef OB_LANES_PICK

@@ -67,10 +67,8 @@ OB_LANE(ob_orbit_kernel)(node_xf *const xn[OB_LANES], ob_orbit_state *const stn[
 {
     node_xf *x[OB_LANES];
     ob_orbit_state *st[OB_LANES];
-    for (uint32_t l = 0; l < OB_LANES; l++) {
-        x[l] = xn[l < n ? l : 0];
-        st[l] = stn[l < n ? l : 0];
-    }
+    OB_LANES_PICK(x, xn, n);
+    OB_LANES_PICK(st, stn, n);
     OB_VD angle = OB_LANES_OF(st, angle) + OB_LANES_OF(st, rate) * dt;
     OB_VD radius = OB_LANES_OF(st, radius);
     OB_VD center[3] = {OB_LANES_OF(st, center[0]), OB_LANES_OF(st, center[1]),
@@ -104,10 +102,8 @@ OB_LANE(ob_rotation_kernel)(node_xf *const xn[OB_LANES], ob_rotation_state *cons
 {
     node_xf *x[OB_LANES];
     ob_rotation_state *st[OB_LANES];
-    for (uint32_t l = 0; l < OB_LANES; l++) {
-        x[l] = xn[l < n ? l : 0];
-        st[l] = stn[l < n ? l : 0];
-    }
+    OB_LANES_PICK(x, xn, n);
+    OB_LANES_PICK(st, stn, n);
     for (uint32_t l = 0; l < n; l++) {
         if (dt == st[l]->step_dt) continue;
         ob_dquat_from_axis_angle(st[l]->axis, st[l]->rate * dt, st[l]->step);

@@ -75,8 +75,10 @@ static OB_LANE_TARGET bool OB_LANE(eval_simple)(ob_scene *s, const level_item *i
     uint32_t slot[OB_LANES], i[OB_LANES];
     node_xf *x[OB_LANES];
     ob_render_proxy *p[OB_LANES];
+    level_item it[OB_LANES];
+    OB_LANES_PICK(it, items, n);
     for (uint32_t l = 0; l < OB_LANES; l++) {
-        slot[l] = items[l < n ? l : 0].slot;
+        slot[l] = it[l].slot;
         x[l] = &s->xf[slot[l]];
     }
     OB_VD t[3] = {OB_LANES_OF(x, position[0]), OB_LANES_OF(x, position[1]),
