@@ -24,10 +24,14 @@
 #define SCENE_LOG "scene"
 #define NO_SLOT UINT32_MAX
 
-/* Nodes per index of the update's parallel loops unless ob_parallel.grain
- * says otherwise: a few microseconds of work each, so a loop's hand-out
- * costs little beside it. */
+/* Nodes per index of the update's loops unless ob_parallel.grain says
+ * otherwise: at most UPDATE_GRAIN (tens of microseconds of work, so a
+ * hand-out costs little beside it), and no fewer than UPDATE_GRAIN_MIN
+ * when a parallel loop cuts its nodes finer to give each thread several
+ * indices. A loop is handed out only when each thread gets two
+ * UPDATE_GRAINs' worth. */
 #define UPDATE_GRAIN 1024u
+#define UPDATE_GRAIN_MIN 256u
 
 typedef struct ob_controller_slot {
     ob_controller_fn fn;

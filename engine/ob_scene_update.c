@@ -25,6 +25,13 @@
 #include <emmintrin.h>
 #endif
 
+/* The level loop takes its nodes a few at a time (their controllers, then
+ * the simple ones' evaluation, in pairs), so that a node's data is still
+ * in the core's first cache when its evaluation reads what its controllers
+ * wrote: at 50k moving objects 16 at a time cost 10-15% more. The others
+ * gather into an eval_batch, run once it could fill up. */
+#define LEVEL_STEP 4u
+
 typedef struct update_ctx {
     ob_scene *s;
     double dt;
@@ -49,13 +56,33 @@ static uint32_t chunk_end(uint32_t count, uint32_t k, uint32_t grain)
     return (uint32_t)OB_MIN((uint64_t)count, ((uint64_t)k + 1) * grain);
 }
 
-/* A loop over `items` nodes, grain per index: through par only when each
- * thread gets two indices' worth (a hand-out costs more than a few nodes'
- * work), else on the caller; the result is the same either way. */
-static void update_loop(const update_ctx *c, uint32_t items, ob_task_fn fn)
+/* A loop over `items` nodes, c->grain per index. It goes through par only
+ * when each thread gets two UPDATE_GRAINs' worth (a hand-out costs more
+ * than a few nodes' work), else it runs on the caller; the result is the
+ * same either way. Handed out, the nodes are cut into eight or more
+ * indices a thread (whole steps, UPDATE_GRAIN_MIN or more each): indices
+ * are taken first come, first served, so a thread that wakes late or a
+ * slow index then holds the others up by an eighth of a share, not by
+ * half. A caller's ob_parallel.grain is kept as it is. loop_plan sets
+ * c->grain and says where the loop runs. */
+static const ob_parallel *loop_plan(update_ctx *c, uint32_t items)
 {
-    const ob_parallel *par = ob_parallel_worth(c->par, items, c->grain) ? c->par : NULL;
-    ob_parallel_run(par, chunks_of(items, c->grain), fn, (void *)c);
+    uint32_t fixed = c->par && c->par->grain ? c->par->grain : 0;
+    const ob_parallel *par =
+        ob_parallel_worth(c->par, items, fixed ? fixed : UPDATE_GRAIN) ? c->par : NULL;
+    c->grain = fixed ? fixed : UPDATE_GRAIN;
+    if (par && !fixed) {
+        uint32_t share = items / (8u * par->threads);
+        share = (share + LEVEL_STEP - 1) / LEVEL_STEP * LEVEL_STEP;
+        c->grain = OB_MIN(UPDATE_GRAIN, OB_MAX(UPDATE_GRAIN_MIN, share));
+    }
+    return par;
+}
+
+static void update_loop(update_ctx *c, uint32_t items, ob_task_fn fn)
+{
+    const ob_parallel *par = loop_plan(c, items);
+    ob_parallel_run(par, chunks_of(items, c->grain), fn, c);
 }
 
 /* ------------------------------------------------------------- transforms */
@@ -223,8 +250,9 @@ static void run_snapshot_fill(void *user, uint32_t chunk, uint32_t thread)
     }
 }
 
-static void snapshot_rebuild(ob_scene *s, const update_ctx *c)
+static void snapshot_rebuild(ob_scene *s, update_ctx *c)
 {
+    const ob_parallel *par = loop_plan(c, s->by_id_count);
     uint32_t chunks = chunks_of(s->by_id_count, c->grain), rc = 0, lc = 0;
     for (uint32_t k = 0; k < chunks; k++) {
         uint32_t end = chunk_end(s->by_id_count, k, c->grain), nr = 0, nl = 0;
@@ -237,7 +265,7 @@ static void snapshot_rebuild(ob_scene *s, const update_ctx *c)
         rc += nr / NODE_IN_RENDERABLES;
         lc += nl / NODE_IN_LIGHTS;
     }
-    update_loop(c, s->by_id_count, run_snapshot_fill);
+    ob_parallel_run(par, chunks, run_snapshot_fill, c);
     s->renderable_count = rc;
     s->light_count = lc;
     s->snapshot_dirty = false;
@@ -251,12 +279,6 @@ static void snapshot_rebuild(ob_scene *s, const update_ctx *c)
  * misses) of several nodes overlap instead of queueing one behind another. */
 #define EVAL_BATCH 16u
 
-/* The level loop takes its nodes a few at a time (their controllers, then
- * the simple ones' evaluation, in pairs), so that a node's data is still
- * in the core's first cache when its evaluation reads what its controllers
- * wrote: at 50k moving objects 16 at a time cost 10-15% more. The others
- * gather into an eval_batch, run once it could fill up. */
-#define LEVEL_STEP 4u
 
 typedef struct eval_batch {
     uint32_t count;
@@ -746,7 +768,8 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
         OB_LOG_E(SCENE_LOG, "ob_scene_update called from a controller; refused");
         return OB_ERR_WRONG_STATE;
     }
-    uint32_t grain = par && par->grain ? par->grain : UPDATE_GRAIN;
+    /* The finest cut any loop can take (update_loop). */
+    uint32_t grain = par && par->grain ? par->grain : UPDATE_GRAIN_MIN;
     ob_result r = update_reserve(s, grain);
     if (r != OB_OK) return r;
     ob_scene_intern_trim(s);
@@ -756,7 +779,7 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
     if (r != OB_OK) return r;
 
     s->in_update = true;
-    update_ctx c = {.s = s, .dt = dt, .par = par, .grain = grain, .counts = s->chunk_counts,
+    update_ctx c = {.s = s, .dt = dt, .par = par, .counts = s->chunk_counts,
                     .lanes4 = motion_lanes4(s)};
     /* Serial controllers may read any node's local transform, so every
      * parallel-safe one must have run before them, and every transform
@@ -780,8 +803,8 @@ ob_result ob_scene_update_parallel(ob_scene *s, double dt, const ob_parallel *pa
     for (uint32_t d = 0; d < s->level_count; d++) {
         c.items = s->by_level + s->level_start[d];
         c.count = s->level_start[d + 1] - s->level_start[d];
-        uint32_t chunks = chunks_of(c.count, grain);
         update_loop(&c, c.count, run_level);
+        uint32_t chunks = chunks_of(c.count, c.grain);
         for (uint32_t k = 0; k < chunks; k++) membership_changed |= c.counts[k] != 0;
     }
     s->in_update = false;

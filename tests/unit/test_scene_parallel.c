@@ -1,5 +1,6 @@
 /* ob_scene_update_parallel against ob_scene_update: two scenes built alike
- * (a few thousand nodes, hierarchy up to eight deep, hidden subtrees, a node
+ * (a few thousand nodes, or 24k whose loops the engine cuts by itself;
+ * hierarchy up to eight deep, hidden subtrees, a node
  * whose controller turns its transform to NaN and back, zero scale, lights,
  * parallel-safe and serial controllers) are updated frame by frame, one on
  * the caller and one through a loop that runs its indices on four real
@@ -17,7 +18,10 @@
 
 #define THREADS 4u
 #define NODES 3000u
-#define MAX_NODES (NODES + 64u)
+/* Enough for levels that the engine cuts by itself (ob_parallel.grain 0)
+ * to go to the threads: 2 x UPDATE_GRAIN nodes a thread. */
+#define LARGE_NODES 24000u
+#define MAX_NODES (LARGE_NODES + 64u)
 #define MAX_DEPTH 8u
 #define FRAMES 10u
 
@@ -79,13 +83,17 @@ static void pulse_step(ob_node *n, double dt, void *user)
     ob_node_set_scale(n, (float[3]){k, 1.0f / k, 1.0f});
 }
 
-/* Parallel-safe: NaN in its 4th and 5th updates, then a finite position again. */
+typedef struct glitch_state {
+    uint32_t calls, first; /* NaN in updates first and first + 1 (from 1) */
+} glitch_state;
+
+/* Parallel-safe: NaN in two updates, then a finite position again. */
 static void glitch_step(ob_node *n, double dt, void *user)
 {
     (void)dt;
-    uint32_t *calls = user;
-    ++*calls;
-    ob_node_set_position(n, (double[3]){*calls == 4 || *calls == 5 ? NAN : 1.0 * *calls, 2, 3});
+    glitch_state *g = user;
+    uint32_t c = ++g->calls;
+    ob_node_set_position(n, (double[3]){c == g->first || c == g->first + 1 ? NAN : 1.0 * c, 2, 3});
 }
 
 typedef struct world world;
@@ -100,7 +108,9 @@ struct world {
     ob_node *nodes[MAX_NODES];   /* NULL once destroyed */
     uint32_t depth[MAX_NODES];
     uint32_t count;
-    uint32_t glitch_frame;
+    uint32_t built;              /* nodes world_create made */
+    uint32_t glitch;             /* the node glitch_step drives */
+    glitch_state glitch_at;
     uint64_t seed;
 };
 
@@ -192,7 +202,14 @@ static void add_node(world *w, bool serial)
     }
 }
 
-static world *world_create(bool serial)
+static bool has_child(const world *w, uint32_t i)
+{
+    for (uint32_t k = i + 1; k < w->count; k++)
+        if (ob_node_get_parent(w->nodes[k]) == w->nodes[i]) return true;
+    return false;
+}
+
+static world *world_create(bool serial, uint32_t nodes)
 {
     world *w = calloc(1, sizeof *w);
     assert_non_null(w);
@@ -200,9 +217,25 @@ static world *world_create(bool serial)
     ob_result r;
     w->s = ob_scene_create(&r);
     assert_non_null(w->s);
-    for (uint32_t i = 0; i < NODES; i++) add_node(w, serial);
-    assert_int_equal(ob_node_add_controller(w->nodes[17], &(ob_controller_desc){
-                         .fn = glitch_step, .user = &w->glitch_frame, .parallel = true}),
+    for (uint32_t i = 0; i < nodes; i++) add_node(w, serial);
+    w->built = nodes;
+    w->glitch = 17;
+    w->glitch_at.first = 4;
+    if (nodes > NODES) {
+        /* A top-level leaf late in its level, drawn and shown, in frames
+         * without edits: only one of its level's last chunks can see it
+         * leave the snapshot and come back. (Frame 5's new nodes take
+         * parents among the last 40.) */
+        w->glitch_at.first = 8;
+        w->glitch = nodes - 41;
+        while (w->depth[w->glitch] != 1 || has_child(w, w->glitch)) w->glitch--;
+        assert_int_equal(ob_node_set_renderable(w->nodes[w->glitch], &(ob_renderable){
+                             .material = (struct ob_material *)&materials[0],
+                             .local_radius = 1}), OB_OK);
+        ob_node_set_hidden(w->nodes[w->glitch], false);
+    }
+    assert_int_equal(ob_node_add_controller(w->nodes[w->glitch], &(ob_controller_desc){
+                         .fn = glitch_step, .user = &w->glitch_at, .parallel = true}),
                      OB_OK);
     return w;
 }
@@ -274,7 +307,7 @@ static void assert_same_snapshot(const world *a, const world *b)
     ob_node *const *ra = ob_scene_renderables(a->s, &na);
     ob_node *const *rb = ob_scene_renderables(b->s, &nb);
     assert_int_equal(na, nb);
-    assert_true(na > NODES / 2);
+    assert_true(na > a->built / 2);
     for (uint32_t i = 0; i < na; i++) assert_int_equal(ob_node_id(ra[i]), ob_node_id(rb[i]));
     ob_node *const *la = ob_scene_lights(a->s, &na);
     ob_node *const *lb = ob_scene_lights(b->s, &nb);
@@ -396,11 +429,11 @@ static void assert_worlds_follow_locals(const world *w)
     }
 }
 
-static void run_frames(bool serial, uint32_t grain)
+static void run_frames(bool serial, uint32_t grain, uint32_t nodes, uint32_t threads)
 {
     ob_test_log_set_echo(false);
-    world *a = world_create(serial), *b = world_create(serial);
-    const ob_parallel par = {.run = threads_run, .threads = THREADS, .grain = grain};
+    world *a = world_create(serial, nodes), *b = world_create(serial, nodes);
+    const ob_parallel par = {.run = threads_run, .threads = threads, .grain = grain};
     atomic_store(&loops_on_threads, 0u);
     for (uint32_t frame = 0; frame < FRAMES; frame++) {
         world_edit(a, frame, serial);
@@ -413,12 +446,12 @@ static void run_frames(bool serial, uint32_t grain)
         ob_test_log_clear();
         assert_int_equal(ob_scene_update_parallel(b->s, dt, &par), OB_OK);
         assert_int_equal(ob_test_log_count(OB_LOG_ERROR), errors);
-        if (frame == 3) {
+        if (frame + 1 == b->glitch_at.first) {
             /* The glitching node went NaN: named once, out of the snapshot. */
             assert_int_equal(errors, 1);
-            assert_false(ob_node_transform_is_valid(b->nodes[17]));
+            assert_false(ob_node_transform_is_valid(b->nodes[b->glitch]));
         }
-        if (frame == 5) assert_true(ob_test_log_has("'n'", "finite again", NULL));
+        if (frame == b->glitch_at.first + 1) assert_true(ob_test_log_has("'n'", "finite again", NULL));
         assert_same_snapshot(a, b);
         assert_snapshot_consistent(b);
         assert_worlds_follow_locals(b);
@@ -434,7 +467,7 @@ static void run_frames(bool serial, uint32_t grain)
 static void parallel_safe_controllers_only(void **state)
 {
     (void)state;
-    run_frames(false, 16);
+    run_frames(false, 16, NODES, THREADS);
 }
 
 /* A loop for the parallel-safe controllers, the serial ones on the caller,
@@ -442,7 +475,17 @@ static void parallel_safe_controllers_only(void **state)
 static void with_serial_controllers(void **state)
 {
     (void)state;
-    run_frames(true, 37);
+    run_frames(true, 37, NODES, THREADS);
+}
+
+/* No grain from the caller: each loop cuts its nodes by the thread count
+ * (levels of a few thousand nodes into a few hundred a chunk, the
+ * snapshot's slots into larger chunks), so chunks differ from loop to
+ * loop. */
+static void levels_cut_by_the_engine(void **state)
+{
+    (void)state;
+    run_frames(true, 0, LARGE_NODES, 2);
 }
 
 int main(void)
@@ -451,6 +494,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(parallel_safe_controllers_only),
         cmocka_unit_test(with_serial_controllers),
+        cmocka_unit_test(levels_cut_by_the_engine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
