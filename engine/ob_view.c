@@ -13,6 +13,12 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+/* The frustum test in AVX2's eight lanes where the CPU has them (asked at
+ * each view's setup), in SSE2's four elsewhere. */
+#define OB_CULL_LANES8 1
+#endif
 
 const char *ob_view_type_name(ob_view_type t)
 {
@@ -189,28 +195,85 @@ typedef struct cull_ctx {
     bool lod_ortho;                     /* the view's: the same scale at any distance */
     uint32_t exclude_id;                /* 0: none (ids start at 1) */
     float planes[6][4];                 /* unused planes test nothing */
+    uint32_t lanes;                     /* the frustum test's width: 8, 4 or 1 */
     uint32_t grain;                     /* entities per chunk */
     ob_sort_pair *pairs;                   /* chunk c writes from c * grain */
     cull_chunk *chunks;
 } cull_ctx;
 
+#if defined(OB_CULL_LANES8)
+/* cull_block's test over whole groups of eight, in AVX2; returns how many
+ * it tested. Each lane does the four-lane form's operations (no fused
+ * multiply-add; the ordered compares give false on NaN as SSE's do), so
+ * both keep the same entities with the same distances. */
+__attribute__((target("avx2"), noinline)) static uint32_t
+cull_block8(const cull_ctx *c, const double *x, const double *y, const double *z,
+            const float *rad, uint32_t n, uint8_t *vis, float *d2)
+{
+    const __m256d vox = _mm256_set1_pd(c->v->origin[0]), voy = _mm256_set1_pd(c->v->origin[1]),
+                  voz = _mm256_set1_pd(c->v->origin[2]);
+    const __m256 big = _mm256_set1_ps(FLT_MAX), sign = _mm256_set1_ps(-0.0f);
+    const __m256i one = _mm256_set1_epi32(1), two = _mm256_set1_epi32(2);
+    __m256 pl[6][4];
+    for (int p = 0; p < 6; p++)
+        for (int k = 0; k < 4; k++) pl[p][k] = _mm256_set1_ps(c->planes[p][k]);
+    uint32_t j = 0;
+/* Eight coordinates relative to the origin, in double, then in float. */
+#define CULL_REL8(a, o)                                                                            \
+    _mm256_insertf128_ps(                                                                          \
+        _mm256_castps128_ps256(_mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd((a) + j), o))),        \
+        _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd((a) + j + 4), o)), 1)
+    for (; j + 8 <= n; j += 8) {
+        __m256 rx = CULL_REL8(x, vox), ry = CULL_REL8(y, voy), rz = CULL_REL8(z, voz);
+        __m256 r = _mm256_loadu_ps(rad + j), nr = _mm256_xor_ps(r, sign);
+        __m256 fin = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps(_mm256_andnot_ps(sign, rx), big, _CMP_LE_OQ),
+                          _mm256_cmp_ps(_mm256_andnot_ps(sign, ry), big, _CMP_LE_OQ)),
+            _mm256_and_ps(_mm256_cmp_ps(_mm256_andnot_ps(sign, rz), big, _CMP_LE_OQ),
+                          _mm256_cmp_ps(_mm256_andnot_ps(sign, r), big, _CMP_LE_OQ)));
+        __m256 out = _mm256_setzero_ps();
+        for (int p = 0; p < 6; p++) {
+            __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(pl[p][0], rx),
+                                                                 _mm256_mul_ps(pl[p][1], ry)),
+                                                   _mm256_mul_ps(pl[p][2], rz)),
+                                     pl[p][3]);
+            out = _mm256_or_ps(out, _mm256_cmp_ps(d, nr, _CMP_LT_OQ));
+        }
+        _mm256_storeu_ps(d2 + j, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx),
+                                                             _mm256_mul_ps(ry, ry)),
+                                               _mm256_mul_ps(rz, rz)));
+        /* vis = 2 where not finite, else 1 where inside: packed to bytes. */
+        __m256i f = _mm256_castps_si256(fin), in = _mm256_andnot_si256(_mm256_castps_si256(out), f);
+        __m256i v = _mm256_or_si256(_mm256_and_si256(in, one), _mm256_andnot_si256(f, two));
+        __m128i v16 = _mm_packs_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+        _mm_storel_epi64((__m128i *)(void *)(vis + j), _mm_packus_epi16(v16, v16));
+    }
+#undef CULL_REL8
+    return j;
+}
+#endif
+
 /* Frustum and range test of a block: vis[j] 1 inside, 0 outside, 2 not
  * finite in float relative to the origin; d2[j] the squared distance. The
  * arithmetic is ob_frustum_test_sphere's, operation for operation, so the
- * SIMD and scalar forms keep exactly the same entities. */
+ * SIMD and scalar forms keep exactly the same entities. Eight at a time,
+ * then four, then one, as wide as c->lanes allows. */
 static void cull_block(const cull_ctx *c, uint32_t first, uint32_t n, uint8_t *vis, float *d2)
 {
     const double *x = c->soa.x + first, *y = c->soa.y + first, *z = c->soa.z + first;
     const float *rad = c->soa.radius + first;
     const double ox = c->v->origin[0], oy = c->v->origin[1], oz = c->v->origin[2];
     uint32_t j = 0;
+#if defined(OB_CULL_LANES8)
+    if (c->lanes == 8) j = cull_block8(c, x, y, z, rad, n, vis, d2);
+#endif
 #if defined(__SSE2__)
     const __m128d vox = _mm_set1_pd(ox), voy = _mm_set1_pd(oy), voz = _mm_set1_pd(oz);
     const __m128 big = _mm_set1_ps(FLT_MAX), sign = _mm_set1_ps(-0.0f);
     __m128 pl[6][4];
     for (int p = 0; p < 6; p++)
         for (int k = 0; k < 4; k++) pl[p][k] = _mm_set1_ps(c->planes[p][k]);
-    for (; j + 4 <= n; j += 4) {
+    for (; c->lanes >= 4 && j + 4 <= n; j += 4) {
         __m128 rx = _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(x + j), vox)),
                                   _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(x + j + 2), vox)));
         __m128 ry = _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(y + j), voy)),
@@ -316,7 +379,7 @@ static uint32_t cull_keep(const cull_ctx *c, cull_chunk *out, uint32_t b, uint32
 #if defined(__SSE2__)
     const __m128i one = _mm_set1_epi8(1), two = _mm_set1_epi8(2), zero = _mm_setzero_si128(),
                   zero_scale = _mm_set1_epi8((char)OB_RENDER_ZERO_SCALE);
-    for (; j + 16 <= n; j += 16) {
+    for (; c->lanes > 1 && j + 16 <= n; j += 16) {
         __m128i v = _mm_loadu_si128((const __m128i *)(vis + j));
         __m128i f = _mm_loadu_si128((const __m128i *)(flags + j));
         __m128i sized = _mm_cmpeq_epi8(_mm_and_si128(f, zero_scale), zero);
@@ -448,6 +511,21 @@ typedef struct cull_wave {
     uint32_t chunks;
 } cull_wave;
 
+/* The frustum test's width for v: the widest the CPU has, unless the
+ * view's cull_lanes (a test's switch) asks for four or one. */
+static uint32_t cull_lanes(const ob_view *v)
+{
+    if (v->cull_lanes == 1) return 1;
+#if defined(OB_CULL_LANES8)
+    if (v->cull_lanes != 4 && __builtin_cpu_supports("avx2")) return 8;
+#endif
+#if defined(__SSE2__)
+    return 4;
+#else
+    return 1;
+#endif
+}
+
 /* Sets up a view of a wave on the render thread: its snapshot, working
  * memory, material table and planes. geo: the wave's geometry table. */
 static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene,
@@ -481,7 +559,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .geo = geo,
         .lod_scale = count <= CULL_INDEX_MASK && isfinite(v->lod_scale) ? v->lod_scale : 0.0f,
-        .lod_ortho = v->lod_ortho,
+        .lod_ortho = v->lod_ortho, .lanes = cull_lanes(v),
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
         .grain = grain, .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
     };

@@ -206,6 +206,10 @@ struct ob_view {
     uint64_t queued_frame;            /* renderer frame serial when last queued */
     uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
     uint64_t cull_ns;                 /* this frame's ob_view_cull time */
+    /* Tests' switch: culling's frustum test as wide as the CPU allows (0),
+     * at most four entities at a time (4), or one at a time (1). The same
+     * entities are kept whichever. */
+    uint8_t cull_lanes;
     bool range_reported;              /* an entity beyond float range was logged
                                          and has not gone away since */
     /* Materials' triangles in this view are drawn as their edges

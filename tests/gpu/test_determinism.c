@@ -25,7 +25,13 @@
  * and the validation layer is silent. Debian 12's layer (1.3.239) does not
  * report a missing barrier between the upload buffer and the primary
  * (checked: no message without it), and lavapipe runs them in order, so
- * the barrier itself is checked by reading record_uploads only. */
+ * the barrier itself is checked by reading record_uploads only.
+ *
+ * Culling's frustum test runs eight entities at a time where the CPU has
+ * AVX2, four with SSE2, one at a time otherwise: on 2,003 spheres of all
+ * sizes in and around the main view's frustum (some far away, one beyond
+ * float range, one of zero size), every width keeps the same items in the
+ * same order with the same keys. */
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -372,6 +378,68 @@ static void renderer_sized_jobs_same_frames(void **state)
     release(&ref);
 }
 
+/* The main view's draw list of one frame: node id, key and level. */
+typedef struct cull_result {
+    uint32_t count, culled;
+    uint32_t node_id[2100];
+    uint64_t key[2100];
+    uint8_t lod[2100];
+} cull_result;
+
+static void cull_frame(ob_test_world *w, uint8_t lanes, cull_result *out)
+{
+    ob_view *v = ob_perspective_view_base(w->main);
+    v->cull_lanes = lanes;
+    const ob_frame_stats *st = ob_test_world_frame(w, OB_THREADING_SINGLE, 0);
+    assert_true(v->item_count <= OB_ARRAY_COUNT(out->node_id));
+    out->count = v->item_count;
+    out->culled = ob_world_view_stats(st, "main")->culled;
+    for (uint32_t i = 0; i < v->item_count; i++) {
+        out->node_id[i] = v->items[i].node_id;
+        out->key[i] = v->items[i].sort_key;
+        out->lod[i] = v->items[i].lod;
+    }
+}
+
+static void frustum_test_same_at_every_width(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, NULL);
+    ob_material *m = ob_world_material(&w, "grey", OB_MATERIAL_LIT, 0.5f, 0.5f, 0.5f, false);
+    uint32_t seed = 7;
+    /* An odd count: the eight- and four-wide loops leave a remainder. */
+    for (uint32_t i = 0; i < 2003; i++) {
+        double x = (random01(&seed) - 0.5) * 80.0, y = (random01(&seed) - 0.5) * 50.0;
+        double z = 15.0 - random01(&seed) * 100.0; /* some behind the camera (z 5) */
+        if (i % 97 == 3) z -= 1e6;  /* far away */
+        if (i == 1000) x = 1e39;    /* beyond float range: named, not drawn */
+        ob_node *n = ob_world_entity(&w, NULL, "s", w.sphere, m, x, y, z);
+        float k = i == 500 ? 0.0f : 0.05f + 6.0f * random01(&seed) * random01(&seed);
+        ob_node_set_scale(n, (float[3]){k, k, k});
+    }
+    cull_result *ref = calloc(3, sizeof *ref);
+    assert_non_null(ref);
+    static const uint8_t lanes[3] = {1, 4, 0};
+    ob_test_log_set_echo(false);
+    ob_test_log_clear();
+    for (int k = 0; k < 3; k++) cull_frame(&w, lanes[k], &ref[k]);
+    assert_true(ob_test_log_has("beyond float range", NULL));
+    ob_test_log_set_echo(true);
+    /* Plenty on either side of the planes. */
+    assert_true(ref[0].count > 300 && ref[0].culled > 300);
+    for (int k = 1; k < 3; k++) {
+        assert_int_equal(ref[k].count, ref[0].count);
+        assert_int_equal(ref[k].culled, ref[0].culled);
+        assert_memory_equal(ref[k].node_id, ref[0].node_id, sizeof(uint32_t) * ref[0].count);
+        assert_memory_equal(ref[k].key, ref[0].key, sizeof(uint64_t) * ref[0].count);
+        assert_memory_equal(ref[k].lod, ref[0].lod, ref[0].count);
+    }
+    free(ref);
+    ob_perspective_view_base(w.main)->cull_lanes = 0;
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -382,6 +450,7 @@ int main(void)
         cmocka_unit_test(staged_ring_same_frames_as_direct),
         cmocka_unit_test(multi_draw_and_direct_runs_same_frames),
         cmocka_unit_test(renderer_sized_jobs_same_frames),
+        cmocka_unit_test(frustum_test_same_at_every_width),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
