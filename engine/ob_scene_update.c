@@ -279,7 +279,6 @@ static void snapshot_rebuild(ob_scene *s, update_ctx *c)
  * misses) of several nodes overlap instead of queueing one behind another. */
 #define EVAL_BATCH 16u
 
-
 typedef struct eval_batch {
     uint32_t count;
     level_item item[EVAL_BATCH];
