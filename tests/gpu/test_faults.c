@@ -309,29 +309,52 @@ static void steady_frame_vulkan(void **state) { walk(PHASE_STEADY_FRAME, false, 
 static void steady_frame_mt_host(void **state) { walk(PHASE_STEADY_FRAME, true, OB_FAULT_HOST_ALLOC, *state); }
 static void steady_frame_mt_vulkan(void **state) { walk(PHASE_STEADY_FRAME, true, OB_FAULT_VK_OBJECT, *state); }
 
-int main(void)
+/* The walks in groups, each its own ctest entry (tests/CMakeLists.txt) so
+ * that the sanitizer builds run them side by side, each within its time
+ * limit: `test_faults GROUP` runs one group, no argument runs them all. */
+typedef struct group_test {
+    const char *group;
+    struct CMUnitTest test;
+} group_test;
+
+#define GROUP_TEST(g, f) {g, cmocka_unit_test(f)}
+
+int main(int argc, char **argv)
 {
     ob_test_setup_log();
     /* Thousands of expected error lines: keep them for the assertions only. */
     ob_test_log_set_echo(getenv("OB_FAULT_ECHO") != NULL);
     /* OB_FAULT_FILTER=first_frame* runs a subset while debugging. */
     if (getenv("OB_FAULT_FILTER")) cmocka_set_test_filter(getenv("OB_FAULT_FILTER"));
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(start_up_host),
-        cmocka_unit_test(start_up_vulkan),
-        cmocka_unit_test(scene_host),
-        cmocka_unit_test(scene_vulkan),
-        cmocka_unit_test(first_frame_host),
-        cmocka_unit_test(first_frame_vulkan),
-        cmocka_unit_test(first_frame_mt_host),
-        cmocka_unit_test(first_frame_mt_vulkan),
-        cmocka_unit_test(steady_frame_host),
-        cmocka_unit_test(steady_frame_vulkan),
-        cmocka_unit_test(steady_frame_mt_host),
-        cmocka_unit_test(steady_frame_mt_vulkan),
-        cmocka_unit_test(first_frame_cube_host),
-        cmocka_unit_test(first_frame_cube_vulkan),
-        cmocka_unit_test(steady_frame_cube_mt_host),
+    static const group_test all[] = {
+        GROUP_TEST("start", start_up_host),
+        GROUP_TEST("start", start_up_vulkan),
+        GROUP_TEST("start", scene_host),
+        GROUP_TEST("start", scene_vulkan),
+        GROUP_TEST("first_host", first_frame_host),
+        GROUP_TEST("first", first_frame_vulkan),
+        GROUP_TEST("first", first_frame_mt_host),
+        GROUP_TEST("first", first_frame_mt_vulkan),
+        GROUP_TEST("steady", steady_frame_host),
+        GROUP_TEST("steady", steady_frame_vulkan),
+        GROUP_TEST("steady", steady_frame_mt_host),
+        GROUP_TEST("steady", steady_frame_mt_vulkan),
+        GROUP_TEST("cube_host", first_frame_cube_host),
+        GROUP_TEST("cube", first_frame_cube_vulkan),
+        GROUP_TEST("cube", steady_frame_cube_mt_host),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    const size_t total = sizeof all / sizeof all[0];
+    const char *group = argc > 1 ? argv[1] : NULL;
+    struct CMUnitTest tests[sizeof all / sizeof all[0]];
+    size_t n = 0;
+    for (size_t i = 0; i < total; i++)
+        if (!group || strcmp(all[i].group, group) == 0) tests[n++] = all[i].test;
+    if (n == 0) {
+        fprintf(stderr, "test_faults: no group '%s'; the groups:", group);
+        for (size_t i = 0; i < total; i++)
+            if (i == 0 || strcmp(all[i].group, all[i - 1].group) != 0) fprintf(stderr, " %s", all[i].group);
+        fprintf(stderr, "\n");
+        return 2;
+    }
+    return _cmocka_run_group_tests(group ? group : "test_faults", tests, n, setup, teardown);
 }
