@@ -626,16 +626,17 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
         far |= ch->far_count > 0;
     }
     v->range_reported = far;
-    ob_sort_pair *sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : pairs;
+    ob_sort_result sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : (ob_sort_result){pairs, NULL};
     uint32_t coarse = 0;
     for (uint32_t j = 0; j < n; j++) {
-        uint32_t i = sorted[j].index & CULL_INDEX_MASK;
-        coarse += sorted[j].index > CULL_INDEX_MASK;
-        v->items[j] = (ob_draw_item){.sort_key = sorted[j].key, .sort_hi = sorted[j].hi,
+        const ob_sort_pair *p = ob_sort_at(sorted, j);
+        uint32_t i = p->index & CULL_INDEX_MASK;
+        coarse += p->index > CULL_INDEX_MASK;
+        v->items[j] = (ob_draw_item){.sort_key = p->key, .sort_hi = p->hi,
                                      .node_id = v->soa.node_id[i], .node = v->soa.node[i],
                                      .proxy = i, .material = v->soa.material[i],
                                      .geometry = v->soa.geometry[i],
-                                     .lod = (uint8_t)(sorted[j].index >> CULL_LOD_SHIFT)};
+                                     .lod = (uint8_t)(p->index >> CULL_LOD_SHIFT)};
     }
     v->item_count = n;
     v->lod_items = coarse;

@@ -125,7 +125,9 @@ static inline __attribute__((always_inline)) uint64_t compact_key(const bit_runs
                                                                   uint32_t hi)
 {
     uint64_t ck = 0;
+#pragma GCC unroll 4
     for (uint32_t k = 0; k < kr; k++) ck |= ((key >> r->shift[k]) & r->mask[k]) << r->dest[k];
+#pragma GCC unroll 2
     for (uint32_t k = KEY_RUNS; k < KEY_RUNS + hr; k++)
         ck |= (((uint64_t)hi >> r->shift[k]) & r->mask[k]) << r->dest[k];
     return ck;
@@ -137,6 +139,7 @@ static inline __attribute__((always_inline)) uint64_t expand_key(const bit_runs 
                                                                  uint64_t fixed, uint64_t ck)
 {
     uint64_t key = fixed;
+#pragma GCC unroll 4
     for (uint32_t k = 0; k < kr; k++) key |= ((ck >> r->dest[k]) & r->mask[k]) << r->shift[k];
     return key;
 }
@@ -172,20 +175,61 @@ static inline __attribute__((always_inline)) void last_pass(const ob_sort_pair *
     }
 }
 
+/* The order of n items whose compact keys fit 32 bits: 8-byte entries
+ * (compact key above, position in a below) in b, radix-sorted between its
+ * halves; the last pass writes the positions alone, as 32-bit words. */
+static inline __attribute__((always_inline)) const uint32_t *
+order_compact(const ob_sort_pair *a, ob_sort_pair *b, uint32_t n, const bit_runs *r, uint32_t kr,
+              uint32_t hr, uint32_t bits, uint32_t passes, uint32_t (*count)[2048])
+{
+    uint64_t *src = (uint64_t *)(void *)b, *dst = src + n;
+    const uint64_t digit = ((uint64_t)1 << bits) - 1;
+    const uint32_t size = 1u << bits;
+    /* At most four passes (32 bits at 8): straight-line counting, the
+     * tests on `passes` the same every item. */
+    for (uint32_t i = 0; i < n; i++) {
+        uint64_t ck = compact_key(r, kr, hr, a[i].key, a[i].hi);
+        src[i] = ck << 32 | i;
+        count[0][ck & digit]++;
+        if (passes > 1) count[1][(ck >> bits) & digit]++;
+        if (passes > 2) count[2][(ck >> (2 * bits)) & digit]++;
+        if (passes > 3) count[3][(ck >> (3 * bits)) & digit]++;
+    }
+    for (uint32_t k = 0;; k++) {
+        uint32_t *c = count[k], sum = 0, shift = 32 + bits * k;
+        for (uint32_t x = 0; x < size; x++) {
+            uint32_t t = c[x];
+            c[x] = sum;
+            sum += t;
+        }
+        if (k + 1 == passes) {
+            uint32_t *order = (uint32_t *)(void *)dst;
+            for (uint32_t i = 0; i < n; i++) order[c[(src[i] >> shift) & digit]++] = (uint32_t)src[i];
+            return order;
+        }
+        for (uint32_t i = 0; i < n; i++) dst[c[(src[i] >> shift) & digit]++] = src[i];
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+}
+
 /* Stable LSD radix sort on (hi, key). Only the bits that differ between
  * items decide the order, so only they are sorted on: one counting pass
- * gathers them into a compact key (stored in place of the key, restored
- * by the last pass), which takes 11 bits per pass on lists long enough for
- * 2048-entry counting tables (8 on shorter ones). On an opaque list the 64
- * bits of (band, state group, mesh, depth) and the 32 of hi shrink to some
- * 30, three passes instead of six or seven over the bytes that differ. The
- * order is the same as sorting the whole (hi, key). Returns the buffer that
- * holds the result (a or b). */
-ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
+ * gathers them into a compact key, which takes 11 bits per pass on lists
+ * long enough for 2048-entry counting tables (8 on shorter ones). On an
+ * opaque list the 64 bits of (band, state group, mesh, depth) and the 32
+ * of hi shrink to some 21: two passes over 8-byte (compact key, position)
+ * entries, whose result is the order, the pairs left in place (half the
+ * bytes moved, and no pass to put the keys back). Past 32 bits the pairs
+ * themselves move, the compact key stored in place of the key and
+ * restored by the last pass. The order is the same as sorting the whole
+ * (hi, key). */
+ob_sort_result ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
 {
     if (n <= 48) {
         sort_pairs_short(a, n);
-        return a;
+        return (ob_sort_result){a, NULL};
     }
     uint64_t kor = 0, kand = ~(uint64_t)0;
     uint32_t hor = 0, hand = ~0u;
@@ -200,9 +244,9 @@ ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
      * the gathering has, the byte digits of the whole. */
     bool compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS, &runs.key_runs) &&
                    add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS, &runs.hi_runs);
-    if (!compact) return sort_pairs_bytes(a, b, n, kor ^ kand, hor ^ hand);
+    if (!compact) return (ob_sort_result){sort_pairs_bytes(a, b, n, kor ^ kand, hor ^ hand), NULL};
     uint32_t total = runs.total;
-    if (total == 0) return a; /* all equal: stable means as they are */
+    if (total == 0) return (ob_sort_result){a, NULL}; /* all equal: stable means as they are */
     uint64_t fixed = kand;
     uint32_t kr = runs.key_runs, hr = runs.hi_runs;
     for (uint32_t k = 0; k < kr; k++) fixed &= ~(runs.mask[k] << runs.shift[k]);
@@ -210,7 +254,15 @@ ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
     uint32_t passes = (total + bits - 1) / bits;
     uint32_t count[8][2048]; /* 64 bits at 8 a pass */
     for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
-    /* The usual lists (opaque: hi all equal) get loops of their own. */
+    if (total <= 32) {
+        /* The usual lists (opaque: hi all equal) get loops of their own. */
+        const uint32_t *order;
+        if (hr == 0 && kr == 1) order = order_compact(a, b, n, &runs, 1, 0, bits, passes, count);
+        else if (hr == 0 && kr == 2) order = order_compact(a, b, n, &runs, 2, 0, bits, passes, count);
+        else if (hr == 0 && kr == 3) order = order_compact(a, b, n, &runs, 3, 0, bits, passes, count);
+        else order = order_compact(a, b, n, &runs, KEY_RUNS, HI_RUNS, bits, passes, count);
+        return (ob_sort_result){a, order};
+    }
     if (hr == 0 && kr == 1) count_compact(a, n, &runs, 1, 0, bits, passes, count);
     else if (hr == 0 && kr == 2) count_compact(a, n, &runs, 2, 0, bits, passes, count);
     else if (hr == 0 && kr == 3) count_compact(a, n, &runs, 3, 0, bits, passes, count);
@@ -235,6 +287,5 @@ ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
         src = dst;
         dst = t;
     }
-    return src;
+    return (ob_sort_result){src, NULL};
 }
-

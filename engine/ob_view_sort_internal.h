@@ -19,12 +19,26 @@ typedef struct ob_sort_pair {
     uint32_t index;
 } ob_sort_pair;
 
-/* Sorts a[0..n) by (hi, key), stably, using b (n pairs) as the other
- * buffer; returns the one that holds the result (a or b). Only the bits
- * that differ between the items are sorted on (see ob_view_sort.c), in
- * three passes of 11 bits for a typical opaque view of thousands of items.
+/* A sorted list: pairs in order, or (order not NULL) pairs as they were
+ * with order[j] the position of the jth. */
+typedef struct ob_sort_result {
+    const ob_sort_pair *pairs;
+    const uint32_t *order;
+} ob_sort_result;
+
+/* The jth pair of a sorted list. */
+static inline const ob_sort_pair *ob_sort_at(ob_sort_result s, uint32_t j)
+{
+    return s.order ? &s.pairs[s.order[j]] : &s.pairs[j];
+}
+
+/* Sorts a[0..n) by (hi, key), stably, using b (n pairs) as room; the
+ * result lies in a or b. Only the bits that differ between the items are
+ * sorted on (see ob_view_sort.c): for a typical opaque view of thousands
+ * of items, some 21 bits, two passes of 11 over 8-byte (bits, position)
+ * entries that leave a's pairs where they are and return their order.
  * [any thread; a and b the caller's] */
-ob_sort_pair *ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n);
+ob_sort_result ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n);
 
 #pragma GCC visibility pop
 

@@ -1,7 +1,8 @@
 /* The draw list's sort (engine/ob_view_sort.c) against a comparison sort:
  * the same order, stable, for lists of every length and every pattern of
- * differing bits: the compact-key path (8- and 11-bit passes, runs in the
- * key and in hi), the byte-wise fallback (more runs, or more than 64
+ * differing bits: the compact-key paths (8- and 11-bit passes, runs in the
+ * key and in hi; up to 32 bits an order of the pairs left in place, past
+ * that the pairs moved), the byte-wise fallback (more runs, or more than 64
  * differing bits), all-equal lists and the short insertion sort. Fixed
  * seeds: the same lists every run. */
 #include "ob_test.h"
@@ -34,6 +35,9 @@ static int compare(const void *pa, const void *pb)
     return a->index < b->index ? -1 : a->index > b->index;
 }
 
+/* Lists sorted by their order (the pairs left in place). */
+static uint32_t orders;
+
 /* n pairs whose keys vary in the bits of kmask and his in those of hmask,
  * over `values` distinct draws (few: many ties), sorted both ways. */
 static void check(uint32_t n, uint64_t kmask, uint32_t hmask, uint32_t values)
@@ -49,13 +53,26 @@ static void check(uint32_t n, uint64_t kmask, uint32_t hmask, uint32_t values)
         want[i] = a[i];
     }
     qsort(want, n, sizeof *want, compare);
-    const ob_sort_pair *got = ob_sort_pairs(a, b, n);
-    assert_true(got == a || got == b);
+    ob_sort_result got = ob_sort_pairs(a, b, n);
+    assert_true(got.pairs == a || got.pairs == b);
+    if (got.order) {
+        orders++;
+        /* The order of a's pairs, left where they were: every position once. */
+        assert_ptr_equal(got.pairs, a);
+        static uint8_t seen[MAX_N];
+        memset(seen, 0, n);
+        for (uint32_t i = 0; i < n; i++) {
+            assert_true(got.order[i] < n);
+            assert_false(seen[got.order[i]]);
+            seen[got.order[i]] = 1;
+        }
+    }
     for (uint32_t i = 0; i < n; i++) {
-        if (got[i].key != want[i].key || got[i].hi != want[i].hi || got[i].index != want[i].index)
+        const ob_sort_pair *g = ob_sort_at(got, i);
+        if (g->key != want[i].key || g->hi != want[i].hi || g->index != want[i].index)
             fail_msg("n %u, key mask %016llx, hi mask %08x: item %u is (%08x, %016llx, %u), "
                      "want (%08x, %016llx, %u)", n, (unsigned long long)kmask, hmask, i,
-                     got[i].hi, (unsigned long long)got[i].key, got[i].index, want[i].hi,
+                     g->hi, (unsigned long long)g->key, g->index, want[i].hi,
                      (unsigned long long)want[i].key, want[i].index);
     }
 }
@@ -67,11 +84,16 @@ static void view_like_lists(void **state)
     (void)state;
     rng_state = 0x2545F4914F6CDD1Dull;
     const uint64_t opaque = 0xfc01c0007fffff00ull;  /* the sweep's differing bits */
+    /* 8 x 10k's main view: 21 bits in three runs, sorted by order. */
+    const uint64_t bench = 0x0403c003bffc0000ull;
+    orders = 0;
     for (uint32_t n = 2; n <= 12000; n = n * 3 + 1) {
+        check(n, bench, 0, 100000);
         check(n, opaque, 0, 100000);
         check(n, opaque, 0x80000003u, 100000); /* and blended, with priorities */
         check(n, 0xffffffff0003000full, 0, 7);  /* blended: many equal keys */
     }
+    assert_true(orders >= 6); /* n = 53 .. 12000 of the bench's bits at least */
 }
 
 /* Random bit patterns: any number of runs, up to all 96 bits differing
