@@ -10,6 +10,7 @@
 #include "ob_view_sort_internal.h"
 
 #include <float.h>
+#include <stdatomic.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -502,6 +503,7 @@ typedef struct cull_view {
     uint32_t count;
     uint64_t ns;                /* its tasks' time, summed */
     ob_result res;
+    atomic_uint chunks_left;    /* of its chunk tasks; the one that ends them finishes the view */
 } cull_view;
 
 /* Every view of a wave culls the same snapshot, so each has the same
@@ -576,30 +578,14 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     return OB_OK;
 }
 
-static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
+/* A view's chunks side by side (in chunk order, so ascending id), the sort
+ * and the draw items. */
+static void wave_finish_view(const cull_wave *w, cull_view *cv)
 {
-    const cull_wave *w = user;
-    cull_view *cv = &w->views[task / w->chunks];
-    if (cv->res != OB_OK) return;
-    uint32_t chunk = task % w->chunks;
-    uint64_t t0 = ob_time_ns();
-    cull_chunk_run(&cv->c, chunk, thread);
-    cv->c.chunks[chunk].ns = ob_time_ns() - t0;
-}
-
-/* A view's chunks side by side (in chunk order, so ascending id), the log
- * of entities beyond float range, the sort and the draw items. */
-static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
-{
-    (void)thread;
-    const cull_wave *w = user;
-    cull_view *cv = &w->views[k];
     ob_view *v = cv->v;
-    if (cv->res != OB_OK) return;
     uint64_t t0 = ob_time_ns();
     ob_sort_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
     uint32_t n = 0;
-    bool far = false;
     uint64_t chunk_ns = 0;
     for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
@@ -608,24 +594,7 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
             memmove(pairs + n, pairs + (size_t)k2 * cv->c.grain, sizeof *pairs * ch->kept);
         n += ch->kept;
         v->culled += ch->culled;
-        for (uint32_t f = 0; f < OB_MIN(ch->far_count, CULL_LOG_MAX) && !v->range_reported; f++) {
-            uint32_t i = ch->far[f];
-            /* Finite in double, not in float: no matrix the GPU could take
-             * places it, and as a "visible" shadow caster it would blow up
-             * the light's fit. */
-            OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
-                     "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
-                     v->name, ob_node_name(v->soa.node[i]), v->soa.node_id[i],
-                     v->soa.x[i] - v->origin[0], v->soa.y[i] - v->origin[1],
-                     v->soa.z[i] - v->origin[2], (double)v->soa.radius[i]);
-        }
-        if (ch->far_count > CULL_LOG_MAX && !v->range_reported)
-            OB_LOG_E("view", "view '%s': %u more entities after id %u lie beyond float range "
-                     "from the view's origin; not drawn", v->name, ch->far_count - CULL_LOG_MAX,
-                     v->soa.node_id[ch->far[CULL_LOG_MAX - 1]]);
-        far |= ch->far_count > 0;
     }
-    v->range_reported = far;
     ob_sort_result sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : (ob_sort_result){pairs, NULL};
     uint32_t coarse = 0;
     for (uint32_t j = 0; j < n; j++) {
@@ -664,6 +633,52 @@ static void wave_finish_task(void *user, uint32_t k, uint32_t thread)
     cv->ns = chunk_ns + (ob_time_ns() - t0);
 }
 
+static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
+{
+    const cull_wave *w = user;
+    cull_view *cv = &w->views[task / w->chunks];
+    if (cv->res != OB_OK) return;
+    uint32_t chunk = task % w->chunks;
+    uint64_t t0 = ob_time_ns();
+    cull_chunk_run(&cv->c, chunk, thread);
+    cv->c.chunks[chunk].ns = ob_time_ns() - t0;
+    /* The last of a view's chunks to end finishes the view on its thread
+     * (acquire-release: the other chunks' results are seen). Views are
+     * sorted while later ones still cull, with no barrier and no second
+     * wake of the pool between; tasks go out in view order, so the first
+     * views finish first. */
+    if (atomic_fetch_sub_explicit(&cv->chunks_left, 1, memory_order_acq_rel) == 1)
+        wave_finish_view(w, cv);
+}
+
+/* The entities of a view beyond float range, logged on the caller in view
+ * and chunk order (so in the same order whatever the thread count), once
+ * until the view has none again. */
+static void wave_report_far(const cull_wave *w, cull_view *cv)
+{
+    ob_view *v = cv->v;
+    bool far = false;
+    for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
+        const cull_chunk *ch = &cv->c.chunks[k2];
+        for (uint32_t f = 0; f < OB_MIN(ch->far_count, CULL_LOG_MAX) && !v->range_reported; f++) {
+            uint32_t i = ch->far[f];
+            /* Finite in double, not in float: no matrix the GPU could take
+             * places it, and as a "visible" shadow caster it would blow up
+             * the light's fit. */
+            OB_LOG_E("view", "view '%s': entity '%s' (id %u) lies beyond float range from "
+                     "the view's origin (bound at %.3g, %.3g, %.3g, radius %.3g); not drawn",
+                     v->name, ob_node_name(v->soa.node[i]), v->soa.node_id[i],
+                     v->soa.x[i] - v->origin[0], v->soa.y[i] - v->origin[1],
+                     v->soa.z[i] - v->origin[2], (double)v->soa.radius[i]);
+        }
+        if (ch->far_count > CULL_LOG_MAX && !v->range_reported)
+            OB_LOG_E("view", "view '%s': %u more entities after id %u lie beyond float range "
+                     "from the view's origin; not drawn", v->name, ch->far_count - CULL_LOG_MAX,
+                     v->soa.node_id[ch->far[CULL_LOG_MAX - 1]]);
+        far |= ch->far_count > 0;
+    }
+    v->range_reported = far;
+}
 
 ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *const *views,
                             uint32_t count)
@@ -727,12 +742,18 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         cull_view *cv = &w.views[k];
         cv->v = views[k];
         cv->res = cull_setup(cv, r, scene, mi, geo, grain);
+        atomic_init(&cv->chunks_left, w.chunks);
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
     }
     if (!ob_parallel_worth(&par, (uint64_t)entities * count, grain)) par.threads = 1;
     ob_parallel_run(&par, w.chunks * count, wave_chunk_task, &w);
-    ob_parallel_run(&par, count, wave_finish_task, &w);
-    for (uint32_t k = 0; k < count; k++) w.views[k].v->cull_ns = w.views[k].ns;
+    for (uint32_t k = 0; k < count; k++) {
+        cull_view *cv = &w.views[k];
+        if (cv->res != OB_OK) continue;
+        if (w.chunks == 0) wave_finish_view(&w, cv); /* no entities: an empty list */
+        wave_report_far(&w, cv);
+        cv->v->cull_ns = cv->ns;
+    }
     ob_free(w.views);
     return first_error;
 }
