@@ -47,6 +47,7 @@
 typedef struct bench_options {
     bool quick, progress;
     bool perf, stability;      /* which sections run */
+    bool sweep_only;           /* --sweep-only: of the performance sections, the sweep */
     bool no_instancing;        /* --no-instancing: one draw per entity */
     bool no_lod;               /* --no-lod: the sweep's shapes at level 0 everywhere */
     bool cpu_device;           /* the device is a CPU (lavapipe): big frames get fewer frames */
@@ -71,6 +72,8 @@ static const char usage_text[] =
     "                     ST,2,auto, and 50000 objects in 1 view only)\n"
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
+    "  --sweep-only       only the sweep (the per-configuration table): no per-draw rerun,\n"
+    "                     mirror scene, raw baseline, quality, lights or stability (profiling)\n"
     "  --no-instancing    one draw per entity (the per-draw push block), for comparison\n"
     "  --no-lod           the sweep's shapes at full detail however small (levels of detail\n"
     "                     off), for comparison\n"
@@ -195,6 +198,9 @@ static bool parse_options(int argc, char **argv, bench_options *o, int *out_exit
             o->no_lod = true;
             takes = false;
         } else if (!strcmp(a, "--no-stability")) {
+            o->stability = takes = false;
+        } else if (!strcmp(a, "--sweep-only")) {
+            o->sweep_only = true;
             o->stability = takes = false;
         } else if (!v) {
             fprintf(stderr, "obelisk-bench: %s needs a value (or is unknown)\n%s", a, usage_text);
@@ -743,9 +749,11 @@ static int run(bench_options *o)
     uint64_t quality_configs = qd.env_count + qd.shadow_count - 1 + o->mode_count - 1 + 3 +
                                (qd.env_cube ? qd.env_count : 0);
     uint64_t total = 0;
+    bool rest = o->perf && !o->sweep_only;
     if (o->perf) {
         /* scene200: three modes. */
-        total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
+        if (rest)
+            total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
                  quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) + qd.image_frames;
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
@@ -757,7 +765,7 @@ static int run(bench_options *o)
                                   (rounds * fc.passes * (fc.settle + 1) + fc.flight + 1);
                 total += frames * frame_weight(o->views[v], o->objects[n]);
                 /* The per-draw rerun of 10k x 8 views: ST only. */
-                if (o->views[v] == 8 && o->objects[n] == 10000 && !o->no_instancing)
+                if (o->views[v] == 8 && o->objects[n] == 10000 && !o->no_instancing && rest)
                     total += frames / o->mode_count * frame_weight(8, 10000);
             }
         }
@@ -772,7 +780,7 @@ static int run(bench_options *o)
     rep.lights_height = ld.height;
     rep.lights_frames = ld.frames;
     rep.lights_rounds = ld.rounds;
-    if (o->perf) total += ob_bench_lights_frames(&ld);
+    if (rest) total += ob_bench_lights_frames(&ld);
     ob_bench_progress prog;
     ob_bench_progress_init(&prog, total, o->progress);
     qd.tick = ob_bench_progress_tick;
@@ -796,7 +804,7 @@ static int run(bench_options *o)
     }
     /* The GPU time one draw per entity costs, next to instancing's: the
      * 10k x 8 views frame again, ST only, per-draw. */
-    if (r == OB_OK && o->perf && !o->no_instancing && find_entry(&rep, 8, 10000)) {
+    if (r == OB_OK && rest && !o->no_instancing && find_entry(&rep, 8, 10000)) {
         bench_options po = *o;
         po.no_instancing = true;
         po.mode_count = 1;
@@ -806,15 +814,15 @@ static int run(bench_options *o)
         r = sweep_config(&po, &rep, 8, 10000, &prog, &rep.per_draw_10k_8views);
     }
     prog.unit = 1;
-    if (r == OB_OK && o->perf) {
+    if (r == OB_OK && rest) {
         ob_bench_progress_label(&prog, "mirror scene, 200 objects: ST / MT / auto");
         r = scene200(o, &rep, &prog);
     }
-    if (r == OB_OK && o->perf) {
+    if (r == OB_OK && rest) {
         ob_bench_progress_label(&prog, "quality and threading check (mirror scene)");
         r = ob_bench_quality_run(&qd, &rep.quality, &rep.quality_count);
     }
-    if (r == OB_OK && o->perf) {
+    if (r == OB_OK && rest) {
         ob_bench_progress_label(&prog, "lights: 0 to 256 point lights, grid and every light");
         ld.tick_user = &prog;
         r = ob_bench_lights_run(&ld, &rep.lights, &rep.lights_count);
