@@ -181,11 +181,24 @@ typedef struct cull_geometry {
     uint32_t mesh;
 } cull_geometry;
 
-/* A pair's index holds the snapshot index below this bit and the level of
- * detail from it up (snapshots stay far below 2^28 entities: culling draws
- * level 0 beyond). */
+/* A payload's proxy_lod holds the snapshot index below this bit and the
+ * level of detail from it up (snapshots stay far below 2^28 entities:
+ * culling draws level 0 beyond). */
 #define CULL_LOD_SHIFT 28u
 #define CULL_INDEX_MASK ((1u << CULL_LOD_SHIFT) - 1u)
+
+/* What a kept entity's draw item takes from the snapshot besides its key,
+ * written by the chunk beside its pair, at the same position. The chunk
+ * reads the snapshot in order, where each line it loads serves several
+ * entities; the draw list, in key order, would read it scattered (four
+ * arrays, an entity's fields on four lines): at 8 views x 10k, that
+ * gather cost as much as the sort. */
+typedef struct cull_payload {
+    ob_node *node;
+    uint32_t node_id;
+    uint32_t proxy_lod;                 /* snapshot index | level << CULL_LOD_SHIFT */
+    uint32_t material, geometry;
+} cull_payload;
 
 typedef struct cull_ctx {
     const ob_view *v;
@@ -198,7 +211,8 @@ typedef struct cull_ctx {
     float planes[6][4];                 /* unused planes test nothing */
     uint32_t lanes;                     /* the frustum test's width: 8, 4 or 1 */
     uint32_t grain;                     /* entities per chunk */
-    ob_sort_pair *pairs;                   /* chunk c writes from c * grain */
+    ob_sort_pair *pairs;                /* chunk c writes from c * grain, */
+    cull_payload *payload;              /* both */
     cull_chunk *chunks;
 } cull_ctx;
 
@@ -418,6 +432,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     uint32_t type_bit = 1u << c->v->type;
     cull_chunk *out = &c->chunks[chunk];
     ob_sort_pair *pairs = c->pairs + first;
+    cull_payload *payload = c->payload + first;
     *out = (cull_chunk){0};
     if (first >= end) return;
     uint8_t vis[CULL_BLOCK];
@@ -429,8 +444,9 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         uint32_t nk = cull_keep(c, out, b, n, vis, type_bit, keep);
         for (uint32_t t = 0; t < nk; t++) {
             uint32_t j = keep[t], i = b + j;
-            const ob_view_material *m = &c->mt[c->soa.material[i]];
-            const cull_geometry *g = &c->geo[c->soa.geometry[i]];
+            uint32_t material = c->soa.material[i], geometry = c->soa.geometry[i];
+            const ob_view_material *m = &c->mt[material];
+            const cull_geometry *g = &c->geo[geometry];
             /* The coarsest level whose error, seen from the nearest point of
              * the bound, stays within the tolerance. */
             uint32_t level = 0;
@@ -444,11 +460,17 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
                 float base = c->lod_ortho ? 0.0f : r, reach2 = c->lod_ortho ? 1.0f : d2[j];
                 level = lod_levels_passing(g->rel_error, t_err, base, reach2);
             }
-            pairs[out->kept++] = (ob_sort_pair){
+            uint32_t at = out->kept++;
+            /* The pair's index: where it and its payload lie (the view's
+             * merge keeps that true as it moves them). */
+            pairs[at] = (ob_sort_pair){
                 .key = item_key(m->sort_hi, m->state, g->mesh | level, d2[j]),
                 .hi = m->sort_hi,
-                .index = i | level << CULL_LOD_SHIFT,
+                .index = first + at,
             };
+            payload[at] = (cull_payload){.node = c->soa.node[i], .node_id = c->soa.node_id[i],
+                                         .proxy_lod = i | level << CULL_LOD_SHIFT,
+                                         .material = material, .geometry = geometry};
         }
         out->culled += n - nk;
     }
@@ -480,10 +502,10 @@ static ob_result cull_materials(ob_view *v, const ob_scene *scene, const ob_mate
 }
 
 /* Working memory: two pair arrays of `count` (the chunks' output and the
- * sort's other buffer) and the chunk records. */
+ * sort's other buffer), the payloads and the chunk records. */
 static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks)
 {
-    size_t need = 2 * sizeof(ob_sort_pair) * (size_t)OB_MAX(count, 1u) +
+    size_t need = (2 * sizeof(ob_sort_pair) + sizeof(cull_payload)) * (size_t)OB_MAX(count, 1u) +
                   sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u);
     need = (need + 63) & ~(size_t)63;
     if (need <= v->cull_mem_size) return OB_OK;
@@ -558,12 +580,14 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
         return res;
     }
     ob_sort_pair *pairs = v->cull_mem, *other = pairs + OB_MAX(count, 1u);
+    cull_payload *payload = (cull_payload *)(void *)(other + OB_MAX(count, 1u));
     cv->c = (cull_ctx){
         .v = v, .soa = v->soa, .mt = v->materials, .geo = geo,
         .lod_scale = count <= CULL_INDEX_MASK && isfinite(v->lod_scale) ? v->lod_scale : 0.0f,
         .lod_ortho = v->lod_ortho, .lanes = cull_lanes(v),
         .exclude_id = v->cull_exclude ? ob_node_id(v->cull_exclude) : 0u,
-        .grain = grain, .pairs = pairs, .chunks = (cull_chunk *)(other + OB_MAX(count, 1u)),
+        .grain = grain, .pairs = pairs, .payload = payload,
+        .chunks = (cull_chunk *)(void *)(payload + OB_MAX(count, 1u)),
     };
     /* Planes the frustum lacks (all of them without one) test nothing. */
     for (int p = 0; p < 6; p++) {
@@ -578,40 +602,35 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     return OB_OK;
 }
 
-/* A view's chunks side by side (in chunk order, so ascending id), the sort
- * and the draw items. */
+/* A view's chunks side by side (in chunk order, so ascending id), the sort,
+ * the draw items and the list of one item per material. */
 static void wave_finish_view(const cull_wave *w, cull_view *cv)
 {
     ob_view *v = cv->v;
     uint64_t t0 = ob_time_ns();
     ob_sort_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
+    cull_payload *payload = cv->c.payload;
     uint32_t n = 0;
     uint64_t chunk_ns = 0;
     for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
+        uint32_t from = k2 * cv->c.grain;
         chunk_ns += ch->ns;
-        if (n != k2 * cv->c.grain)
-            memmove(pairs + n, pairs + (size_t)k2 * cv->c.grain, sizeof *pairs * ch->kept);
+        if (n != from) {
+            /* Down, so a forward copy is safe where the ranges overlap. */
+            for (uint32_t t = 0; t < ch->kept; t++) {
+                pairs[n + t] = pairs[from + t];
+                pairs[n + t].index = n + t;
+            }
+            memmove(payload + n, payload + from, sizeof *payload * ch->kept);
+        }
         n += ch->kept;
         v->culled += ch->culled;
     }
     ob_sort_result sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : (ob_sort_result){pairs, NULL};
-    uint32_t coarse = 0;
-    for (uint32_t j = 0; j < n; j++) {
-        const ob_sort_pair *p = ob_sort_at(sorted, j);
-        uint32_t i = p->index & CULL_INDEX_MASK;
-        coarse += p->index > CULL_INDEX_MASK;
-        v->items[j] = (ob_draw_item){.sort_key = p->key, .sort_hi = p->hi,
-                                     .node_id = v->soa.node_id[i], .node = v->soa.node[i],
-                                     .proxy = i, .material = v->soa.material[i],
-                                     .geometry = v->soa.geometry[i],
-                                     .lod = (uint8_t)(p->index >> CULL_LOD_SHIFT)};
-    }
-    v->item_count = n;
-    v->lod_items = coarse;
     /* The items the view's post-cull work visits (for_each_material_item):
-     * a short list, found here on the pool rather than by a pass over the
-     * draw list per use on the render thread. */
+     * a short list, found here on the pool, in the same pass, rather than
+     * by a pass over the draw list per use on the render thread. */
     v->material_item_count = 0;
     v->material_items_valid =
         ob_array_reserve((void **)&v->material_items, &v->material_item_cap, OB_MAX(n, 1u),
@@ -619,17 +638,30 @@ static void wave_finish_view(const cull_wave *w, cull_view *cv)
     if (!v->material_items_valid)
         OB_LOG_W("view", "view '%s': no memory for its list of one item per material; its "
                  "PreRender asks every item's material this frame", v->name);
-    if (v->material_items_valid) {
-        for (uint32_t k2 = 0; k2 < v->material_count; k2++) v->materials[k2].seen = 0;
-        for (uint32_t j = 0; j < n; j++) {
-            const ob_draw_item *it = &v->items[j];
-            ob_view_material *m = &v->materials[it->material];
-            if (m->seen && !m->per_entity) continue;
-            m->seen = 1;
-            v->material_items[v->material_item_count++] = (ob_view_material_item){
-                .node = it->node, .material = v->soa.materials[it->material], .item = j};
-        }
+    for (uint32_t k2 = 0; k2 < v->material_count; k2++) v->materials[k2].seen = 0;
+    const uint32_t *order = sorted.order;
+    uint32_t coarse = 0, listed = 0;
+    for (uint32_t j = 0; j < n; j++) {
+        /* The pair and its payload lie at the same position. */
+        uint32_t at = order ? order[j] : sorted.pairs[j].index;
+        const ob_sort_pair *p = order ? &sorted.pairs[at] : &sorted.pairs[j];
+        const cull_payload *e = &payload[at];
+        coarse += e->proxy_lod > CULL_INDEX_MASK;
+        v->items[j] = (ob_draw_item){.sort_key = p->key, .sort_hi = p->hi,
+                                     .node_id = e->node_id, .node = e->node,
+                                     .proxy = e->proxy_lod & CULL_INDEX_MASK,
+                                     .material = e->material, .geometry = e->geometry,
+                                     .lod = (uint8_t)(e->proxy_lod >> CULL_LOD_SHIFT)};
+        ob_view_material *m = &v->materials[e->material];
+        if (m->seen && !m->per_entity) continue;
+        m->seen = 1;
+        if (v->material_items_valid)
+            v->material_items[listed++] = (ob_view_material_item){
+                .node = e->node, .material = v->soa.materials[e->material], .item = j};
     }
+    v->item_count = n;
+    v->lod_items = coarse;
+    v->material_item_count = listed;
     cv->ns = chunk_ns + (ob_time_ns() - t0);
 }
 

@@ -9,10 +9,11 @@
 /* Internal: not exported from libobelisk.so (cmake/obelisk.map). */
 #pragma GCC visibility push(hidden)
 
-/* What the sort moves: 16 bytes per visible item. The snapshot index
- * breaks ties: the snapshot is in ascending entity id, each chunk emits
- * its items in that order and the sort is stable, so equal keys stay in id
- * order without sorting on it. */
+/* What the sort moves: 16 bytes per visible item. index is the caller's
+ * (ob_view.c: the item's position before the sort, where its payload lies)
+ * and is not sorted on. Ties keep their order: the snapshot is in ascending
+ * entity id, each chunk emits its items in that order and the sort is
+ * stable, so equal keys stay in id order. */
 typedef struct ob_sort_pair {
     uint64_t key;
     uint32_t hi;
