@@ -212,7 +212,8 @@ typedef struct cull_ctx {
     uint32_t lanes;                     /* the frustum test's width: 8, 4 or 1 */
     uint32_t grain;                     /* entities per chunk */
     ob_sort_pair *pairs;                /* chunk c writes from c * grain, */
-    cull_payload *payload;              /* both */
+    cull_payload *payload;              /* both, */
+    ob_sort_segment *segments;          /* and says where in segments[c] */
     cull_chunk *chunks;
 } cull_ctx;
 
@@ -434,6 +435,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     ob_sort_pair *pairs = c->pairs + first;
     cull_payload *payload = c->payload + first;
     *out = (cull_chunk){0};
+    c->segments[chunk] = (ob_sort_segment){first, 0};
     if (first >= end) return;
     uint8_t vis[CULL_BLOCK];
     _Alignas(16) float d2[CULL_BLOCK];
@@ -461,8 +463,8 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
                 level = lod_levels_passing(g->rel_error, t_err, base, reach2);
             }
             uint32_t at = out->kept++;
-            /* The pair's index: where it and its payload lie (the view's
-             * merge keeps that true as it moves them). */
+            /* The pair's index: where it and its payload lie (the sort may
+             * move pairs, never payloads). */
             pairs[at] = (ob_sort_pair){
                 .key = item_key(m->sort_hi, m->state, g->mesh | level, d2[j]),
                 .hi = m->sort_hi,
@@ -474,6 +476,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         }
         out->culled += n - nk;
     }
+    c->segments[chunk] = (ob_sort_segment){first, out->kept};
 }
 
 /* The view's table of the snapshot's materials: one interface call per
@@ -502,11 +505,12 @@ static ob_result cull_materials(ob_view *v, const ob_scene *scene, const ob_mate
 }
 
 /* Working memory: two pair arrays of `count` (the chunks' output and the
- * sort's other buffer), the payloads and the chunk records. */
+ * sort's other buffer), the payloads, the chunk records and their
+ * segments. */
 static ob_result cull_reserve(ob_view *v, uint32_t count, uint32_t chunks)
 {
     size_t need = (2 * sizeof(ob_sort_pair) + sizeof(cull_payload)) * (size_t)OB_MAX(count, 1u) +
-                  sizeof(cull_chunk) * (size_t)OB_MAX(chunks, 1u);
+                  (sizeof(cull_chunk) + sizeof(ob_sort_segment)) * (size_t)OB_MAX(chunks, 1u);
     need = (need + 63) & ~(size_t)63;
     if (need <= v->cull_mem_size) return OB_OK;
     size_t size = OB_MAX(need, v->cull_mem_size + v->cull_mem_size / 2);
@@ -589,6 +593,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
         .grain = grain, .pairs = pairs, .payload = payload,
         .chunks = (cull_chunk *)(void *)(payload + OB_MAX(count, 1u)),
     };
+    cv->c.segments = (ob_sort_segment *)(void *)(cv->c.chunks + OB_MAX(chunks, 1u));
     /* Planes the frustum lacks (all of them without one) test nothing. */
     for (int p = 0; p < 6; p++) {
         cv->c.planes[p][0] = cv->c.planes[p][1] = cv->c.planes[p][2] = 0.0f;
@@ -602,32 +607,26 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     return OB_OK;
 }
 
-/* A view's chunks side by side (in chunk order, so ascending id), the sort,
- * the draw items and the list of one item per material. */
+/* A view's sort (of its chunks' pieces in chunk order, so ascending id),
+ * draw items and list of one item per material. */
 static void wave_finish_view(const cull_wave *w, cull_view *cv)
 {
     ob_view *v = cv->v;
     uint64_t t0 = ob_time_ns();
     ob_sort_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
-    cull_payload *payload = cv->c.payload;
+    const cull_payload *payload = cv->c.payload;
     uint32_t n = 0;
     uint64_t chunk_ns = 0;
     for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
-        uint32_t from = k2 * cv->c.grain;
         chunk_ns += ch->ns;
-        if (n != from) {
-            /* Down, so a forward copy is safe where the ranges overlap. */
-            for (uint32_t t = 0; t < ch->kept; t++) {
-                pairs[n + t] = pairs[from + t];
-                pairs[n + t].index = n + t;
-            }
-            memmove(payload + n, payload + from, sizeof *payload * ch->kept);
-        }
         n += ch->kept;
         v->culled += ch->culled;
     }
-    ob_sort_result sorted = n > 1 ? ob_sort_pairs(pairs, other, n) : (ob_sort_result){pairs, NULL};
+    /* Sorted where the chunks left them: an order of positions in the
+     * chunks' space, or (other lists) sorted pairs, whose index is that
+     * position still. Either way the payload is found there. */
+    ob_sort_result sorted = ob_sort_pairs_segments(pairs, other, cv->c.segments, w->chunks, n);
     /* The items the view's post-cull work visits (for_each_material_item):
      * a short list, found here on the pool, in the same pass, rather than
      * by a pass over the draw list per use on the render thread. */
@@ -642,7 +641,6 @@ static void wave_finish_view(const cull_wave *w, cull_view *cv)
     const uint32_t *order = sorted.order;
     uint32_t coarse = 0, listed = 0;
     for (uint32_t j = 0; j < n; j++) {
-        /* The pair and its payload lie at the same position. */
         uint32_t at = order ? order[j] : sorted.pairs[j].index;
         const ob_sort_pair *p = order ? &sorted.pairs[at] : &sorted.pairs[j];
         const cull_payload *e = &payload[at];

@@ -175,25 +175,30 @@ static inline __attribute__((always_inline)) void last_pass(const ob_sort_pair *
     }
 }
 
-/* The order of n items whose compact keys fit 32 bits: 8-byte entries
- * (compact key above, position in a below) in b, radix-sorted between its
- * halves; the last pass writes the positions alone, as 32-bit words. */
+/* The order of the n items of a's segments whose compact keys fit 32
+ * bits: 8-byte entries (compact key above, position in a below) in b,
+ * radix-sorted between its halves; the last pass writes the positions
+ * alone, as 32-bit words. */
 static inline __attribute__((always_inline)) const uint32_t *
-order_compact(const ob_sort_pair *a, ob_sort_pair *b, uint32_t n, const bit_runs *r, uint32_t kr,
-              uint32_t hr, uint32_t bits, uint32_t passes, uint32_t (*count)[2048])
+order_compact(const ob_sort_pair *a, ob_sort_pair *b, const ob_sort_segment *seg, uint32_t segs,
+              uint32_t n, const bit_runs *r, uint32_t kr, uint32_t hr, uint32_t bits,
+              uint32_t passes, uint32_t (*count)[2048])
 {
     uint64_t *src = (uint64_t *)(void *)b, *dst = src + n;
     const uint64_t digit = ((uint64_t)1 << bits) - 1;
     const uint32_t size = 1u << bits;
     /* At most four passes (32 bits at 8): straight-line counting, the
      * tests on `passes` the same every item. */
-    for (uint32_t i = 0; i < n; i++) {
-        uint64_t ck = compact_key(r, kr, hr, a[i].key, a[i].hi);
-        src[i] = ck << 32 | i;
-        count[0][ck & digit]++;
-        if (passes > 1) count[1][(ck >> bits) & digit]++;
-        if (passes > 2) count[2][(ck >> (2 * bits)) & digit]++;
-        if (passes > 3) count[3][(ck >> (3 * bits)) & digit]++;
+    uint64_t *w = src;
+    for (uint32_t s = 0; s < segs; s++) {
+        for (uint32_t i = seg[s].start, end = seg[s].start + seg[s].count; i < end; i++) {
+            uint64_t ck = compact_key(r, kr, hr, a[i].key, a[i].hi);
+            *w++ = ck << 32 | i;
+            count[0][ck & digit]++;
+            if (passes > 1) count[1][(ck >> bits) & digit]++;
+            if (passes > 2) count[2][(ck >> (2 * bits)) & digit]++;
+            if (passes > 3) count[3][(ck >> (3 * bits)) & digit]++;
+        }
     }
     for (uint32_t k = 0;; k++) {
         uint32_t *c = count[k], sum = 0, shift = 32 + bits * k;
@@ -227,42 +232,66 @@ order_compact(const ob_sort_pair *a, ob_sort_pair *b, uint32_t n, const bit_runs
  * (hi, key). */
 ob_sort_result ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n)
 {
+    const ob_sort_segment whole = {0, n};
+    return ob_sort_pairs_segments(a, b, &whole, 1, n);
+}
+
+ob_sort_result ob_sort_pairs_segments(ob_sort_pair *a, ob_sort_pair *b, const ob_sort_segment *seg,
+                                      uint32_t segs, uint32_t n)
+{
+    bit_runs runs = {0};
+    uint64_t kor = 0, kand = ~(uint64_t)0;
+    uint32_t hor = 0, hand = ~0u;
+    bool compact = false;
+    if (n > 48) {
+        for (uint32_t s = 0; s < segs; s++) {
+            for (uint32_t i = seg[s].start, end = seg[s].start + seg[s].count; i < end; i++) {
+                kor |= a[i].key;
+                kand &= a[i].key;
+                hor |= a[i].hi;
+                hand &= a[i].hi;
+            }
+        }
+        /* Up to 96 bits can differ, in any pattern: past 64 bits or the
+         * runs the gathering has, the byte digits of the whole. */
+        compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS, &runs.key_runs) &&
+                  add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS, &runs.hi_runs);
+    }
+    const uint32_t bits = n >= 2048 ? 11u : 8u, size = 1u << bits;
+    uint32_t passes = compact ? (runs.total + bits - 1) / bits : 0;
+    uint32_t count[8][2048]; /* 64 bits at 8 a pass */
+    uint32_t kr = runs.key_runs, hr = runs.hi_runs;
+    if (compact && runs.total > 0 && runs.total <= 32) {
+        /* The usual lists (opaque: hi all equal) get loops of their own;
+         * the pieces are read where they lie. */
+        for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
+        const uint32_t *order;
+        if (hr == 0 && kr == 1)
+            order = order_compact(a, b, seg, segs, n, &runs, 1, 0, bits, passes, count);
+        else if (hr == 0 && kr == 2)
+            order = order_compact(a, b, seg, segs, n, &runs, 2, 0, bits, passes, count);
+        else if (hr == 0 && kr == 3)
+            order = order_compact(a, b, seg, segs, n, &runs, 3, 0, bits, passes, count);
+        else
+            order = order_compact(a, b, seg, segs, n, &runs, KEY_RUNS, HI_RUNS, bits, passes, count);
+        return (ob_sort_result){a, order};
+    }
+    /* Every other way sorts a[0..n): the pieces side by side first (each
+     * moves down, or stays). */
+    uint32_t at = 0;
+    for (uint32_t s = 0; s < segs; s++) {
+        if (at != seg[s].start) memmove(a + at, a + seg[s].start, sizeof *a * seg[s].count);
+        at += seg[s].count;
+    }
     if (n <= 48) {
         sort_pairs_short(a, n);
         return (ob_sort_result){a, NULL};
     }
-    uint64_t kor = 0, kand = ~(uint64_t)0;
-    uint32_t hor = 0, hand = ~0u;
-    for (uint32_t i = 0; i < n; i++) {
-        kor |= a[i].key;
-        kand &= a[i].key;
-        hor |= a[i].hi;
-        hand &= a[i].hi;
-    }
-    bit_runs runs = {0};
-    /* Up to 96 bits can differ, in any pattern: past 64 bits or the runs
-     * the gathering has, the byte digits of the whole. */
-    bool compact = add_runs(kor ^ kand, 64, &runs, 0, KEY_RUNS, &runs.key_runs) &&
-                   add_runs(hor ^ hand, 32, &runs, KEY_RUNS, HI_RUNS, &runs.hi_runs);
     if (!compact) return (ob_sort_result){sort_pairs_bytes(a, b, n, kor ^ kand, hor ^ hand), NULL};
-    uint32_t total = runs.total;
-    if (total == 0) return (ob_sort_result){a, NULL}; /* all equal: stable means as they are */
+    if (runs.total == 0) return (ob_sort_result){a, NULL}; /* all equal: stable means as they are */
     uint64_t fixed = kand;
-    uint32_t kr = runs.key_runs, hr = runs.hi_runs;
     for (uint32_t k = 0; k < kr; k++) fixed &= ~(runs.mask[k] << runs.shift[k]);
-    const uint32_t bits = n >= 2048 ? 11u : 8u, size = 1u << bits;
-    uint32_t passes = (total + bits - 1) / bits;
-    uint32_t count[8][2048]; /* 64 bits at 8 a pass */
     for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
-    if (total <= 32) {
-        /* The usual lists (opaque: hi all equal) get loops of their own. */
-        const uint32_t *order;
-        if (hr == 0 && kr == 1) order = order_compact(a, b, n, &runs, 1, 0, bits, passes, count);
-        else if (hr == 0 && kr == 2) order = order_compact(a, b, n, &runs, 2, 0, bits, passes, count);
-        else if (hr == 0 && kr == 3) order = order_compact(a, b, n, &runs, 3, 0, bits, passes, count);
-        else order = order_compact(a, b, n, &runs, KEY_RUNS, HI_RUNS, bits, passes, count);
-        return (ob_sort_result){a, order};
-    }
     if (hr == 0 && kr == 1) count_compact(a, n, &runs, 1, 0, bits, passes, count);
     else if (hr == 0 && kr == 2) count_compact(a, n, &runs, 2, 0, bits, passes, count);
     else if (hr == 0 && kr == 3) count_compact(a, n, &runs, 3, 0, bits, passes, count);

@@ -21,7 +21,7 @@ typedef struct ob_sort_pair {
 } ob_sort_pair;
 
 /* A sorted list: pairs in order, or (order not NULL) pairs as they were
- * with order[j] the position of the jth. */
+ * with order[j] the position in pairs of the jth. */
 typedef struct ob_sort_result {
     const ob_sort_pair *pairs;
     const uint32_t *order;
@@ -40,6 +40,20 @@ static inline const ob_sort_pair *ob_sort_at(ob_sort_result s, uint32_t j)
  * entries that leave a's pairs where they are and return their order.
  * [any thread; a and b the caller's] */
 ob_sort_result ob_sort_pairs(ob_sort_pair *a, ob_sort_pair *b, uint32_t n);
+
+/* A piece of a list held in pieces: a[start .. start + count). */
+typedef struct ob_sort_segment {
+    uint32_t start, count;
+} ob_sort_segment;
+
+/* ob_sort_pairs of the list whose n pairs lie in a's segments, in
+ * segment order (ascending starts, disjoint): the culling chunks' outputs,
+ * sorted where they lie without being moved side by side first. With an
+ * order, its positions are a's (up to the last segment's end); every other
+ * way the pieces are first moved to a[0..n), and the result is sorted
+ * pairs. b: room for n pairs. [any thread; a and b the caller's] */
+ob_sort_result ob_sort_pairs_segments(ob_sort_pair *a, ob_sort_pair *b, const ob_sort_segment *seg,
+                                      uint32_t segs, uint32_t n);
 
 #pragma GCC visibility pop
 
