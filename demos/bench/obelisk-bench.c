@@ -73,7 +73,7 @@ static const char usage_text[] =
     "  --stability-only   only the numerical stability and extreme cases section\n"
     "  --no-stability     leave that section out\n"
     "  --sweep-only       only the sweep (the per-configuration table): no per-draw rerun,\n"
-    "                     mirror scene, raw baseline, quality, lights or stability (profiling)\n"
+    "                     mirror scene, quality, lights or stability (profiling)\n"
     "  --no-instancing    one draw per entity (the per-draw push block), for comparison\n"
     "  --no-lod           the sweep's shapes at full detail however small (levels of detail\n"
     "                     off), for comparison\n"
@@ -754,7 +754,8 @@ static int run(bench_options *o)
         /* scene200: three modes. */
         if (rest)
             total += 3 * ((o->warmup + o->rounds) * o->passes * (o->settle + 1) + 2 * o->flight + 1) +
-                 quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) + qd.image_frames;
+                     quality_configs * (qd.image_frames + qd.rounds + qd.flight + 1) +
+                     qd.image_frames;
         for (uint32_t n = 0; n < o->object_count; n++) {
             for (uint32_t v = 0; v < o->view_count; v++) {
                 if (!config_runs(o, o->views[v], o->objects[n])) continue;
