@@ -163,7 +163,7 @@ static uint64_t item_key(uint32_t sort_hi, uint32_t state, uint32_t mesh, float 
 
 typedef struct cull_chunk {
     uint64_t ns;                        /* the chunk's time */
-    uint32_t kept, culled;
+    uint32_t culled;                    /* what it kept: segments[chunk].count */
     uint32_t far_count;                 /* beyond float range */
     uint32_t far[CULL_LOG_MAX];         /* the first ones, snapshot indices */
 } cull_chunk;
@@ -435,8 +435,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
     ob_sort_pair *pairs = c->pairs + first;
     cull_payload *payload = c->payload + first;
     *out = (cull_chunk){0};
-    c->segments[chunk] = (ob_sort_segment){first, 0};
-    if (first >= end) return;
+    uint32_t kept = 0;
     uint8_t vis[CULL_BLOCK];
     _Alignas(16) float d2[CULL_BLOCK];
     for (uint32_t b = first; b < end; b += CULL_BLOCK) {
@@ -462,7 +461,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
                 float base = c->lod_ortho ? 0.0f : r, reach2 = c->lod_ortho ? 1.0f : d2[j];
                 level = lod_levels_passing(g->rel_error, t_err, base, reach2);
             }
-            uint32_t at = out->kept++;
+            uint32_t at = kept++;
             /* The pair's index: where it and its payload lie (the sort may
              * move pairs, never payloads). */
             pairs[at] = (ob_sort_pair){
@@ -476,7 +475,7 @@ static void cull_chunk_run(void *user, uint32_t chunk, uint32_t thread)
         }
         out->culled += n - nk;
     }
-    c->segments[chunk] = (ob_sort_segment){first, out->kept};
+    c->segments[chunk] = (ob_sort_segment){first, kept};
 }
 
 /* The view's table of the snapshot's materials: one interface call per
@@ -620,7 +619,7 @@ static void wave_finish_view(const cull_wave *w, cull_view *cv)
     for (uint32_t k2 = 0; k2 < w->chunks; k2++) {
         const cull_chunk *ch = &cv->c.chunks[k2];
         chunk_ns += ch->ns;
-        n += ch->kept;
+        n += cv->c.segments[k2].count;
         v->culled += ch->culled;
     }
     /* Sorted where the chunks left them: an order of positions in the

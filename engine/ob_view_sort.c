@@ -261,10 +261,10 @@ ob_sort_result ob_sort_pairs_segments(ob_sort_pair *a, ob_sort_pair *b, const ob
     uint32_t passes = compact ? (runs.total + bits - 1) / bits : 0;
     uint32_t count[8][2048]; /* 64 bits at 8 a pass */
     uint32_t kr = runs.key_runs, hr = runs.hi_runs;
+    for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
     if (compact && runs.total > 0 && runs.total <= 32) {
         /* The usual lists (opaque: hi all equal) get loops of their own;
          * the pieces are read where they lie. */
-        for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
         const uint32_t *order;
         if (hr == 0 && kr == 1)
             order = order_compact(a, b, seg, segs, n, &runs, 1, 0, bits, passes, count);
@@ -291,7 +291,6 @@ ob_sort_result ob_sort_pairs_segments(ob_sort_pair *a, ob_sort_pair *b, const ob
     if (runs.total == 0) return (ob_sort_result){a, NULL}; /* all equal: stable means as they are */
     uint64_t fixed = kand;
     for (uint32_t k = 0; k < kr; k++) fixed &= ~(runs.mask[k] << runs.shift[k]);
-    for (uint32_t k = 0; k < passes; k++) memset(count[k], 0, sizeof(uint32_t) * size);
     if (hr == 0 && kr == 1) count_compact(a, n, &runs, 1, 0, bits, passes, count);
     else if (hr == 0 && kr == 2) count_compact(a, n, &runs, 2, 0, bits, passes, count);
     else if (hr == 0 && kr == 3) count_compact(a, n, &runs, 3, 0, bits, passes, count);
