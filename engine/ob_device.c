@@ -601,7 +601,9 @@ static bool driver_heap_wanted(int requested)
  * allocator refuses it (returns 0), and the device then says so. */
 static void keep_driver_heap(ob_device *dev, int requested)
 {
-    if (dev->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU || !driver_heap_wanted(requested)) return;
+    /* The setting is read on every device, so a wrong value is reported
+     * where it has no effect too (the GPU run of 2026-11-28 found it silent). */
+    if (!driver_heap_wanted(requested) || dev->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return;
 #if defined(__GLIBC__) && defined(M_TRIM_THRESHOLD)
     static atomic_int state;   /* 0 not tried, 1 set, -1 refused */
     if (atomic_load(&state) == 0) {

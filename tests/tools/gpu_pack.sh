@@ -16,14 +16,20 @@
 #
 # Usage: tests/tools/gpu_pack.sh        (after ./setup.sh build, or cmake --build build)
 #   KEEP="test_a test_b"  the test executables to carry (default: every one
-#                         that ctest labels gpu; xz keeps the copies of the
+#                         that a test ctest labels gpu runs; xz keeps the copies of the
 #                         static glslang in them to ~0.4 MB each)
 #   DEST=DIR              where to write (default .gpu)
 set -euo pipefail
 PROJ=${PROJ:-$(git -C "$(dirname "$0")" rev-parse --show-toplevel)}
 DEST=${DEST:-$PROJ/.gpu}
 [ -x "$PROJ/build/bin/obelisk-view" ] || { echo "gpu_pack: build first (no $PROJ/build/bin/obelisk-view)" >&2; exit 2; }
-KEEP=${KEEP:-$(ctest --test-dir "$PROJ/build" -N -L gpu | sed -n 's/.*Test *#[0-9]*: \(test_[a-z0-9_]*\)$/\1/p' | tr '\n' ' ')}
+# The executables, not the test names: one executable may run as several
+# tests (test_faults as test_faults_start, _first, ...), which a list of names
+# left behind (the H200 run of 2026-11-28: six fault groups "Not Run").
+KEEP=${KEEP:-$(ctest --test-dir "$PROJ/build" -N -L gpu --show-only=json-v1 | python3 -c '
+import json, os, sys
+names = {os.path.basename(t["command"][0]) for t in json.load(sys.stdin)["tests"] if t.get("command")}
+print(" ".join(sorted(n for n in names if n.startswith("test_"))))')}
 [ -n "${KEEP// /}" ] || { echo "gpu_pack: ctest lists no gpu tests in $PROJ/build" >&2; exit 2; }
 
 stage=$(mktemp -d); trap 'rm -rf "$stage"' EXIT
