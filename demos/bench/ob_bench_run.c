@@ -16,7 +16,8 @@ typedef struct sample {
     uint32_t mode, round, pass;
     sample_kind kind;
     double update_ms, update_cpu_ms, pre_render_ms, record_ms, assemble_ms, submit_ms;
-    double cpu_frame_ms, cpu_no_update_ms, record_total_ms, gpu_ms, wall_ms;
+    double cpu_frame_ms, cpu_no_update_ms, record_total_ms, gpu_ms, gpu_views_ms, wall_ms;
+    double upload_mb;
     double serial_fraction;
     double draws, views, vertices, lod_items;
     double cpu_render_ms, cpu_workers_ms, cpu_max_worker_ms, host_allocs_per_object;
@@ -45,6 +46,13 @@ static void on_stats(void *user, const ob_frame_stats *st)
     for (uint32_t i = c->count; i-- > 0;) {
         if (c->samples[i].serial == st->frame) {
             c->samples[i].gpu_ms = st->gpu_ms >= 0.0 ? st->gpu_ms : NAN;
+            /* The views' own stamps, summed: what the frame's GPU time
+             * holds besides them is the uploads and the barriers between
+             * views (NAN unless every view was stamped). */
+            double views = st->view_count ? 0.0 : NAN;
+            for (uint32_t v = 0; v < st->view_count; v++)
+                views += st->views[v].gpu_ms >= 0.0 ? st->views[v].gpu_ms : NAN;
+            c->samples[i].gpu_views_ms = views;
             return;
         }
     }
@@ -120,7 +128,8 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
         .record_ms = st->record_ns * 1e-6, .assemble_ms = st->assemble_ns * 1e-6,
         .submit_ms = st->submit_ns * 1e-6, .cpu_frame_ms = st->frame_ns * 1e-6,
         .record_total_ms = (st->record_ns + st->assemble_ns) * 1e-6,
-        .gpu_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
+        .gpu_ms = NAN, .gpu_views_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
+        .upload_mb = (double)st->ring_upload_bytes / (1024.0 * 1024.0),
         .vertices = (double)st->pm.vertices, .lod_items = st->lod_items,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
         .serial_fraction = NAN,
@@ -493,6 +502,8 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->record_total_ms = MEDIAN(m, SAMPLE_IDLE, record_total_ms);
         o->cpu_frame_ms = MEDIAN(m, SAMPLE_IDLE, cpu_no_update_ms) + o->update_ms;
         o->gpu_ms = MEDIAN(m, SAMPLE_IDLE, gpu_ms);
+        o->gpu_views_ms = MEDIAN(m, SAMPLE_IDLE, gpu_views_ms);
+        o->upload_mb = MEDIAN(m, SAMPLE_IDLE, upload_mb);
         o->frame_ms = MEDIAN(m, SAMPLE_FLIGHT, wall_ms);
         o->draws_per_s = o->record_total_ms > 0.0 ? o->draws / (o->record_total_ms * 1e-3) : NAN;
         o->record_cpu_render_ms = MEDIAN(m, SAMPLE_IDLE, cpu_render_ms);

@@ -111,6 +111,9 @@ typedef struct ob_bench_result {
     double cpu_frame_ms;       /* the renderer's frame_ns with the device idle (its update
                                   replaced by update_ms) */
     double gpu_ms;             /* timestamps (NAN if unavailable) */
+    double gpu_views_ms;       /* the views' stamps summed (NAN unless every view was
+                                  stamped: --gpu-timing views) */
+    double upload_mb;          /* the staged ring's copy to device memory (0 unstaged) */
     double draws_per_s;        /* draws / record_total */
     double frame_ms;           /* in-flight frame period (median), NAN without the loop */
     double speedup_record;     /* median over idle rounds of (reference mode's record_total /
