@@ -96,7 +96,6 @@ struct ob_pipeline_manager {
     uint32_t set_cache_limit;   /* SET_CACHE_LIMIT unless a test lowers it */
     uint64_t chunk_size;
     bool staged;                /* desc.staged */
-    bool device_local;          /* desc.device_local, unstaged */
     ob_instance_runs runs;      /* desc.runs, AUTO taken as INSTANCED */
     uint32_t max_draw_indirect; /* draws one multi-draw indirect may hold */
     uint32_t ubo_align;
@@ -175,7 +174,6 @@ ob_pipeline_manager *ob_pipeline_manager_create(const ob_pipeline_manager_desc *
     if (pm->frames_in_flight > MAX_FRAME_SLOTS) pm->frames_in_flight = MAX_FRAME_SLOTS;
     pm->chunk_size = desc->ring_chunk_size ? desc->ring_chunk_size : (4u << 20);
     pm->staged = desc->staged;
-    pm->device_local = desc->device_local && !desc->staged;
     pm->runs = desc->runs == OB_INSTANCE_RUNS_AUTO ? OB_INSTANCE_RUNS_INSTANCED : desc->runs;
     /* $OB_SET_CACHE_LIMIT lowers the bound for tests (tests/gpu/test_pipeline_manager.c)
      * that cannot afford a thousand programs. */
@@ -212,14 +210,13 @@ static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
 /* A chunk of uniform blocks and per-instance blocks, through the resources'
  * one buffer path: a host-visible, coherent, persistently mapped buffer the
  * draws read, or, staged, such a buffer that the frame copies to a
- * device-local one the draws read. A discrete GPU's device-local
- * host-visible (BAR) memory only when asked (device_local,
- * OB_RING_STAGING_DEVICE): on the H100 machine that memory is mapped
+ * device-local one the draws read. Never a discrete GPU's device-local
+ * host-visible (BAR) memory: on the H100 machine that memory is mapped
  * uncached, and recording 8 views x 10k took 14.2 ms there instead of 2.7
- * while the hash still read blocks back from the ring (the GPU's reads got
- * faster: 5.9 ms against 10.7 from host memory). The host now only writes
- * the ring, never reads it (blocks are packed in pm->pack_scratch and
- * copied): NVIDIA's host-visible memory is write-combined. [own thread] */
+ * (the GPU's reads got faster: 5.9 ms against 10.7 from host memory). The
+ * host only writes the ring, never reads it (blocks are packed in
+ * pm->pack_scratch and copied): NVIDIA's host-visible memory is
+ * write-combined. [own thread] */
 static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
 {
     ob_res_vk_buffer host, dev;
@@ -229,8 +226,7 @@ static ob_result chunk_create(ob_pipeline_manager *pm, ring_chunk *c)
     ob_result r = ob_res_vk_buffer_make(pm->dev, pm->chunk_size,
                                         pm->staged ? VK_BUFFER_USAGE_TRANSFER_SRC_BIT : read,
                                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                            VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
-                                            (pm->device_local ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0),
+                                            VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                                         true, pm->staged ? "uniform ring (host side) of pipeline manager"
                                                          : "uniform ring of pipeline manager",
                                         pm->name, &host);

@@ -77,9 +77,6 @@ typedef struct ob_pipeline_manager_desc {
      * that ob_pipeline_manager_record_uploads makes, before the frame's
      * draws (ob_renderer_desc.ring_staging). */
     bool staged;
-    /* Unstaged, the ring is device-local host-visible memory
-     * (OB_RING_STAGING_DEVICE) rather than any host-visible memory. */
-    bool device_local;
     /* How instance runs are drawn (ob_renderer_desc.instance_runs, which
      * the renderer resolves for the device; AUTO here is INSTANCED). */
     ob_instance_runs runs;

@@ -102,30 +102,15 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
     memset(fs, 0, sizeof *fs);
 }
 
-/* desc.ring_staging for this device, never AUTO; $OB_RING_STAGING=
- * on|off|device overrides AUTO (to run a suite staged on lavapipe, or
- * direct on a GPU). DEVICE without device-local host-visible memory is
- * staged. */
-static ob_ring_staging ring_staging(ob_ring_staging asked, const ob_device *dev)
+/* desc.ring_staging for this device; $OB_RING_STAGING=on|off overrides
+ * AUTO (to run a suite staged on lavapipe, or direct on a GPU). */
+static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
 {
     const char *env = getenv("OB_RING_STAGING");
-    if (asked == OB_RING_STAGING_AUTO && env && *env) {
-        if (!strcmp(env, "on")) asked = OB_RING_STAGING_ON;
-        else if (!strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
-        else if (!strcmp(env, "device")) asked = OB_RING_STAGING_DEVICE;
-        else OB_LOG_W("renderer", "OB_RING_STAGING='%s' is none of on, off, device: ignored", env);
-    }
-    if (asked == OB_RING_STAGING_AUTO)
-        return ob_device_host_memory_is_device_local(dev) ? OB_RING_STAGING_OFF : OB_RING_STAGING_ON;
-    if (asked == OB_RING_STAGING_DEVICE &&
-        ob_device_memory_type(dev, UINT32_MAX, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                   VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
-                                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) == UINT32_MAX) {
-        OB_LOG_W("renderer", "device-local ring asked for, but '%s' has no device-local host-visible "
-                 "coherent memory: staged instead", ob_device_name(dev));
-        return OB_RING_STAGING_ON;
-    }
-    return asked;
+    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "on")) asked = OB_RING_STAGING_ON;
+    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
+    if (asked == OB_RING_STAGING_AUTO) return !ob_device_host_memory_is_device_local(dev);
+    return asked == OB_RING_STAGING_ON;
 }
 
 /* desc.instance_runs for this device (never AUTO); $OB_INSTANCE_RUNS=
@@ -179,8 +164,7 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
 
     r->dev = ob_device_create(&d.device, &res);
     if (!r->dev) goto fail_free_renderer;
-    r->ring_staging = ring_staging(d.ring_staging, r->dev);
-    r->ring_staged = r->ring_staging == OB_RING_STAGING_ON;
+    r->ring_staged = ring_staged(d.ring_staging, r->dev);
     r->instance_runs = instance_runs(d.instance_runs, r->dev);
     r->reg = ob_param_registry_create(&(ob_param_registry_desc){.slot_count = 1 + r->worker_count}, &res);
     if (!r->reg) goto fail_destroy_renderer;
@@ -197,7 +181,6 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
         .frames_in_flight = r->frames_in_flight,
         .name = "immediate",
         .staged = r->ring_staged,
-        .device_local = r->ring_staging == OB_RING_STAGING_DEVICE,
         .runs = r->instance_runs,
     };
     r->immediate = ob_pipeline_manager_create(&pmd, &res);
@@ -242,7 +225,6 @@ void ob_renderer_destroy(ob_renderer *r)
 
 ob_device *ob_renderer_device(ob_renderer *r) { return r->dev; }
 ob_instance_runs ob_renderer_instance_runs(const ob_renderer *r) { return r->instance_runs; }
-ob_ring_staging ob_renderer_ring_staging(const ob_renderer *r) { return r->ring_staging; }
 ob_param_registry *ob_renderer_registry(ob_renderer *r) { return r->reg; }
 ob_params *ob_renderer_params(ob_renderer *r) { return &r->params0; }
 uint32_t ob_renderer_worker_count(const ob_renderer *r) { return r->worker_count; }

@@ -76,7 +76,7 @@ typedef enum ob_gpu_timing {
 typedef enum ob_ring_staging {
     /* Staged where the device's host-visible memory is not device-local (a
      * discrete GPU), direct where it is (lavapipe, integrated GPUs).
-     * $OB_RING_STAGING=on|off|device overrides it. */
+     * $OB_RING_STAGING=on|off overrides it. */
     OB_RING_STAGING_AUTO = 0,
     /* Written in host memory, copied to device-local memory at the start of
      * the frame's command buffers: the GPU reads its own memory (on an
@@ -86,13 +86,6 @@ typedef enum ob_ring_staging {
     OB_RING_STAGING_ON,
     /* Written where the draws read them, host-visible memory. */
     OB_RING_STAGING_OFF,
-    /* Written straight into device-local host-visible memory (a discrete
-     * GPU's BAR, or all of its memory with resizable BAR): the GPU reads
-     * its own memory with no copy in its frame, and the host writes across
-     * the bus, whole blocks at a time into write-combined memory (it never
-     * reads the ring). Where the device has no such memory, staged, with a
-     * warning. $OB_RING_STAGING=device asks for it. */
-    OB_RING_STAGING_DEVICE,
 } ob_ring_staging;
 
 typedef struct ob_renderer_desc {
@@ -239,9 +232,6 @@ ob_device *ob_renderer_device(ob_renderer *r);
 /* How instance runs are drawn: desc.instance_runs resolved for the device
  * (never AUTO). */
 ob_instance_runs ob_renderer_instance_runs(const ob_renderer *r);
-/* Where the ring of uniform and per-instance blocks lives: desc.ring_staging
- * resolved for the device (never AUTO). */
-ob_ring_staging ob_renderer_ring_staging(const ob_renderer *r);
 ob_param_registry *ob_renderer_registry(ob_renderer *r);
 /* The immediate parameter manager (slot 0). */
 ob_params *ob_renderer_params(ob_renderer *r);

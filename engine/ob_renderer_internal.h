@@ -120,8 +120,7 @@ struct ob_renderer {
     uint32_t cpu_count;
     bool no_affinity;           /* desc.no_thread_affinity */
     ob_gpu_timing gpu_timing;   /* desc.gpu_timing */
-    ob_ring_staging ring_staging; /* desc.ring_staging resolved for the device (never AUTO) */
-    bool ring_staged;           /* ring_staging == ON */
+    bool ring_staged;           /* desc.ring_staging resolved for the device */
     ob_instance_runs instance_runs;  /* desc.instance_runs resolved (never AUTO) */
     uint32_t chunk_draws;
     uint32_t parallel_grain;    /* desc.parallel_grain (0: each loop's own) */

@@ -34,7 +34,6 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
         .frames_in_flight = r->frames_in_flight,
         .name = name,
         .staged = r->ring_staged,
-        .device_local = r->ring_staging == OB_RING_STAGING_DEVICE,
         .runs = r->instance_runs,
     };
     w->pm = ob_pipeline_manager_create(&pmd, &res);

@@ -164,13 +164,10 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
                "frame(s), %u warm-up, %u in flight; spdup = median over rounds of ST rec+asm / this, "
                "[p25,p75]; cpu-rt, cpu-wk, cpu-wmx = recording CPU time of the render thread, "
                "all workers, busiest worker (nan: not reported by the engine); levels of detail "
-               "%s, instancing %s%s; blocks %s\n",
+               "%s, instancing %s%s\n",
             rep->rounds, rep->passes, rep->settle, rep->warmup, rep->flight, rep->big_draws,
             rep->big_rounds, rep->big_passes, rep->big_warmup, rep->big_flight,
-            rep->lod ? "on" : "off", rep->instancing ? "on" : "off", runs,
-            rep->ring == OB_RING_STAGING_ON       ? "staged (copied to device memory)"
-            : rep->ring == OB_RING_STAGING_DEVICE ? "written to device-local host-visible memory"
-                                                  : "read from host-visible memory");
+            rep->lod ? "on" : "off", rep->instancing ? "on" : "off", runs);
     print_header(f);
     for (uint32_t i = 0; i < rep->sweep_count; i++) print_entry(f, &rep->sweep[i]);
     fprintf(f, "\nmirror scene, 200 objects (auto vs best):\n");
@@ -480,11 +477,6 @@ static void json_summary(FILE *f, const ob_bench_report *rep)
             rep->instance_runs == OB_INSTANCE_RUNS_MULTI_DRAW ? "multi"
             : rep->instance_runs == OB_INSTANCE_RUNS_DIRECT   ? "direct"
                                                               : "instanced");
-    /* $OB_RING_STAGING's words */
-    fprintf(f, "\"ring_staging\":\"%s\",",
-            rep->ring == OB_RING_STAGING_ON       ? "on"
-            : rep->ring == OB_RING_STAGING_DEVICE ? "device"
-                                                  : "off");
     fprintf(f, "\"driver_heap_kept\":%s,", rep->driver_heap_kept ? "true" : "false");
     fputs("\"device\":{\"name\":", f);
     json_str(f, rep->device_name);

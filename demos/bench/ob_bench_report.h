@@ -112,7 +112,6 @@ typedef struct ob_bench_report {
     uint32_t view_width, view_height;              /* sweep view size */
     bool lod, instancing;                          /* the sweep's levels of detail, instancing */
     ob_instance_runs instance_runs;                /* how the renderer draws instance runs */
-    ob_ring_staging ring;                          /* where the renderer's ring lives */
     bool driver_heap_kept;                         /* ob_device_keeps_driver_heap */
     uint32_t image_width, image_height, image_frames;
     double seconds;                                /* whole run, wall clock */

@@ -434,7 +434,6 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
         snprintf(rep->driver_info, sizeof rep->driver_info, "%s", ob_device_driver_info(dev));
         rep->validation = ob_device_validation_enabled(dev);
         rep->instance_runs = ob_renderer_instance_runs(d.world.r);
-        rep->ring = ob_renderer_ring_staging(d.world.r);
         rep->driver_heap_kept = ob_device_keeps_driver_heap(dev);
     }
     if (r == OB_OK) r = ob_bench_scene_build(&s, &d, &sd);
