@@ -213,7 +213,10 @@ static void chunk_destroy(ob_pipeline_manager *pm, ring_chunk *c)
  * device-local one the draws read. Never a discrete GPU's device-local
  * host-visible (BAR) memory: on the H100 machine that memory is mapped
  * uncached, and recording 8 views x 10k took 14.2 ms there instead of 2.7
- * (the GPU's reads got faster: 5.9 ms against 10.7 from host memory). The
+ * (the GPU's reads got faster: 5.9 ms against 10.7 from host memory). On
+ * the H200 (2026-11-28), with the host only writing whole blocks, it still
+ * took 14-15 ms against 2.0 staged, and the GPU time of 16 views x 100k
+ * grew from 11.4 ms staged to 30.5 (docs/benchmark.md, session 21). The
  * host only writes the ring, never reads it (blocks are packed in
  * pm->pack_scratch and copied): NVIDIA's host-visible memory is
  * write-combined. [own thread] */

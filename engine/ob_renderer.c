@@ -107,8 +107,11 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
 static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
 {
     const char *env = getenv("OB_RING_STAGING");
-    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "on")) asked = OB_RING_STAGING_ON;
-    if (asked == OB_RING_STAGING_AUTO && env && !strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
+    if (asked == OB_RING_STAGING_AUTO && env && *env) {
+        if (!strcmp(env, "on")) asked = OB_RING_STAGING_ON;
+        else if (!strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
+        else OB_LOG_W("renderer", "OB_RING_STAGING='%s' is neither 'on' nor 'off': ignored", env);
+    }
     if (asked == OB_RING_STAGING_AUTO) return !ob_device_host_memory_is_device_local(dev);
     return asked == OB_RING_STAGING_ON;
 }
