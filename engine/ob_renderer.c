@@ -121,9 +121,13 @@ static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
 static ob_instance_runs instance_runs(ob_instance_runs asked, const ob_device *dev)
 {
     const char *env = getenv("OB_INSTANCE_RUNS");
-    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "instanced")) asked = OB_INSTANCE_RUNS_INSTANCED;
-    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "multi")) asked = OB_INSTANCE_RUNS_MULTI_DRAW;
-    if (asked == OB_INSTANCE_RUNS_AUTO && env && !strcmp(env, "direct")) asked = OB_INSTANCE_RUNS_DIRECT;
+    if (asked == OB_INSTANCE_RUNS_AUTO && env && *env) {
+        if (!strcmp(env, "instanced")) asked = OB_INSTANCE_RUNS_INSTANCED;
+        else if (!strcmp(env, "multi")) asked = OB_INSTANCE_RUNS_MULTI_DRAW;
+        else if (!strcmp(env, "direct")) asked = OB_INSTANCE_RUNS_DIRECT;
+        else OB_LOG_W("renderer", "OB_INSTANCE_RUNS='%s' is none of instanced, multi, direct: ignored",
+                      env);
+    }
     const ob_device_caps *caps = ob_device_get_caps(dev);
     bool can = caps->multi_draw_indirect && caps->draw_indirect_first_instance;
     if (asked == OB_INSTANCE_RUNS_AUTO)

@@ -719,6 +719,34 @@ static void material_without_effect_is_culled(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A mistyped $OB_RING_STAGING or $OB_INSTANCE_RUNS is named in a warning
+ * and the device's defaults are kept (where the blocks live, how runs are
+ * drawn), as for no setting at all. */
+static void unknown_ring_and_run_settings_are_reported(void **state)
+{
+    (void)state;
+    ob_test_log_clear();
+    setenv("OB_RING_STAGING", "sometimes", 1);
+    setenv("OB_INSTANCE_RUNS", "batched", 1);
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 2});
+    unsetenv("OB_RING_STAGING");
+    unsetenv("OB_INSTANCE_RUNS");
+    assert_logged("OB_RING_STAGING='sometimes'", "ignored");
+    assert_logged("OB_INSTANCE_RUNS='batched'", "ignored");
+    mixed_scene(&w);
+    const ob_frame_stats *st = ob_test_world_frame(&w, OB_THREADING_MULTI, 2);
+    ob_device *dev = ob_renderer_device(w.r);
+    /* staged exactly where mapped memory is not device-local */
+    assert_int_equal(st->ring_upload_bytes > 0, !ob_device_host_memory_is_device_local(dev));
+    const ob_device_caps *caps = ob_device_get_caps(dev);
+    bool multi = caps->multi_draw_indirect && caps->draw_indirect_first_instance && !ob_device_is_cpu(dev);
+    assert_int_equal(ob_renderer_instance_runs(w.r),
+                     multi ? OB_INSTANCE_RUNS_MULTI_DRAW : OB_INSTANCE_RUNS_INSTANCED);
+    assert_true(st->draws > 0);
+    ob_test_world_destroy(&w);
+}
+
 int main(void)
 {
     ob_test_setup_log();
@@ -734,6 +762,7 @@ int main(void)
         cmocka_unit_test(a_view_of_many_chunks_draws_everything),
         cmocka_unit_test(stale_texture_skips_the_draw),
         cmocka_unit_test(material_without_effect_is_culled),
+        cmocka_unit_test(unknown_ring_and_run_settings_are_reported),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
