@@ -336,7 +336,8 @@ static void json_result(FILE *f, const ob_bench_result *r)
                                         "update_cpu_ms", "frame_cpu_speedup",
                                         "frame_cpu_speedup_p25", "frame_cpu_speedup_p75",
                                         "serial_fraction", "serial_fraction_p25",
-                                        "serial_fraction_p75", "gpu_views_ms", "upload_mb"};
+                                        "serial_fraction_p75", "gpu_views_ms", "upload_mb",
+                                        "gpu_flight_ms"};
     const double values[] = {r->update_ms, r->pre_render_ms, r->record_ms, r->assemble_ms,
                              r->submit_ms, r->record_total_ms, r->cpu_frame_ms, r->gpu_ms,
                              r->frame_ms, r->draws_per_s, r->speedup_record, r->speedup_frame,
@@ -349,7 +350,7 @@ static void json_result(FILE *f, const ob_bench_result *r)
                              r->frame_cpu_speedup.median, r->frame_cpu_speedup.p25,
                              r->frame_cpu_speedup.p75, r->serial_fraction.median,
                              r->serial_fraction.p25, r->serial_fraction.p75, r->gpu_views_ms,
-                             r->upload_mb};
+                             r->upload_mb, r->gpu_flight_ms};
     _Static_assert(OB_ARRAY_COUNT(names) == OB_ARRAY_COUNT(values), "a name per value");
     for (size_t i = 0; i < OB_ARRAY_COUNT(names); i++) {
         fprintf(f, ",\"%s\":", names[i]);

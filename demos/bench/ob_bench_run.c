@@ -503,6 +503,7 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->cpu_frame_ms = MEDIAN(m, SAMPLE_IDLE, cpu_no_update_ms) + o->update_ms;
         o->gpu_ms = MEDIAN(m, SAMPLE_IDLE, gpu_ms);
         o->gpu_views_ms = MEDIAN(m, SAMPLE_IDLE, gpu_views_ms);
+        o->gpu_flight_ms = MEDIAN(m, SAMPLE_FLIGHT, gpu_ms);
         o->upload_mb = MEDIAN(m, SAMPLE_IDLE, upload_mb);
         o->frame_ms = MEDIAN(m, SAMPLE_FLIGHT, wall_ms);
         o->draws_per_s = o->record_total_ms > 0.0 ? o->draws / (o->record_total_ms * 1e-3) : NAN;

@@ -114,6 +114,8 @@ typedef struct ob_bench_result {
     double gpu_views_ms;       /* the views' stamps summed (NAN unless every view was
                                   stamped: --gpu-timing views) */
     double upload_mb;          /* the staged ring's copy to device memory (0 unstaged) */
+    double gpu_flight_ms;      /* timestamps of the frames in flight (a real GPU idle
+                                  between frames may run them at lower clocks) */
     double draws_per_s;        /* draws / record_total */
     double frame_ms;           /* in-flight frame period (median), NAN without the loop */
     double speedup_record;     /* median over idle rounds of (reference mode's record_total /
