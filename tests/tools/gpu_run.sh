@@ -15,7 +15,8 @@
 #   scale  test_extreme_scale alone (the scale invariance cases)
 #   images BoxTextured and 2CylinderEngine at 640x480, 4x MSAA, into $OUT
 #   bench  obelisk-bench --quick (frame periods on the GPU)
-#   frame16  16 views x 100k objects, ST against 2..16 workers and auto, instancing
+#   frame16  16 views x 100k objects, ST against 2..16 workers and auto (each
+#          mode's CPU phases and ST's over them in the summary), instancing
 #          on (runs as the device's default: multi-draw indirect on a GPU), then
 #          runs as instanced draws (OB_INSTANCE_RUNS=instanced), as a direct
 #          draw per instance (OB_INSTANCE_RUNS=direct), then one draw
@@ -103,6 +104,13 @@ for s in $steps; do
         --no-stability --no-progress --json "$OUT/frame16_$n.json" >"$OUT/frame16_$n.log" 2>&1
       say "frame16 $n rc=$?"
       grep -E '^ +16 +100000 ' "$OUT/frame16_$n.log" | tee -a "$OUT/summary.txt"
+      # The CPU phases (update + pre-render + record + assemble + submit) of
+      # each mode and ST's over them, from the medians (the JSON has the
+      # per-round figure, frame_cpu_speedup; no python here).
+      grep -E '^ +16 +100000 ' "$OUT/frame16_$n.log" |
+        awk '{c = $6 + $7 + $8 + $9 + $10; if ($3 == "ST") st = c;
+              printf "       %-5s cpu phases %.2f ms, ST / this %.2f\n", $3, c, st ? st / c : 0}' |
+        tee -a "$OUT/summary.txt"
     done ;;
   custom)
     # .gpu/custom.sh, if the pack has one: a prepared measurement with this
