@@ -473,6 +473,22 @@ uint32_t ob_edit_distance(const char *a, const char *b)
     return prev[m];
 }
 
+int ob_env_choice(const char *name, const char *const *words, uint32_t count, const char *module,
+                  const char *otherwise)
+{
+    const char *env = getenv(name);
+    if (!env || !*env) return -1;
+    char list[128] = "";
+    for (uint32_t i = 0; i < count; i++) {
+        if (strcmp(env, words[i]) == 0) return (int)i;
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s'%s'", i ? ", " : "", words[i]);
+    }
+    ob_log_write(OB_LOG_WARN, module, __FILE__, __LINE__, "%s='%s' is none of %s: %s", name, env, list,
+                 otherwise);
+    return -1;
+}
+
 const char *ob_closest_name(const char *name, const char *const *candidates, uint32_t count,
                             uint32_t max_distance)
 {

@@ -269,6 +269,12 @@ uint32_t ob_edit_distance(const char *a, const char *b);
  * [any thread] */
 const char *ob_closest_name(const char *name, const char *const *candidates, uint32_t count,
                             uint32_t max_distance);
+/* Which of words[0..count) the environment variable `name` holds: its
+ * index, or -1 when it is unset or empty. Any other value is named in a
+ * warning from `module` with the words it may be and `otherwise` (what the
+ * caller then does: "ignored"), and gives -1. [any thread] */
+int ob_env_choice(const char *name, const char *const *words, uint32_t count, const char *module,
+                  const char *otherwise);
 
 /* One index of a parallel loop. `thread` (0 .. threads-1; 0 is the calling
  * thread) names the thread running it, for per-thread scratch: two calls

@@ -584,11 +584,8 @@ fail_destroy_instance:
 static bool driver_heap_wanted(int requested)
 {
     if (requested) return requested > 0;
-    const char *env = getenv("OB_DRIVER_HEAP");
-    if (!env || !*env || strcmp(env, "keep") == 0) return true;
-    if (strcmp(env, "system") == 0) return false;
-    OB_LOG_W("device", "OB_DRIVER_HEAP='%s' is neither 'keep' nor 'system': keeping the heap", env);
-    return true;
+    static const char *const words[] = {"keep", "system"};
+    return ob_env_choice("OB_DRIVER_HEAP", words, 2, "device", "keeping the heap") != 1;
 }
 
 /* The driver runs in this process on a CPU device, and llvmpipe frees its

@@ -106,11 +106,11 @@ static void destroy_frame_slot(ob_renderer *r, ob_frame_slot *fs)
  * AUTO (to run a suite staged on lavapipe, or direct on a GPU). */
 static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
 {
-    const char *env = getenv("OB_RING_STAGING");
-    if (asked == OB_RING_STAGING_AUTO && env && *env) {
-        if (!strcmp(env, "on")) asked = OB_RING_STAGING_ON;
-        else if (!strcmp(env, "off")) asked = OB_RING_STAGING_OFF;
-        else OB_LOG_W("renderer", "OB_RING_STAGING='%s' is neither 'on' nor 'off': ignored", env);
+    static const char *const words[] = {"on", "off"};
+    static const ob_ring_staging values[] = {OB_RING_STAGING_ON, OB_RING_STAGING_OFF};
+    if (asked == OB_RING_STAGING_AUTO) {
+        int k = ob_env_choice("OB_RING_STAGING", words, 2, "renderer", "ignored");
+        if (k >= 0) asked = values[k];
     }
     if (asked == OB_RING_STAGING_AUTO) return !ob_device_host_memory_is_device_local(dev);
     return asked == OB_RING_STAGING_ON;
@@ -120,13 +120,12 @@ static bool ring_staged(ob_ring_staging asked, const ob_device *dev)
  * instanced|multi|direct overrides AUTO. */
 static ob_instance_runs instance_runs(ob_instance_runs asked, const ob_device *dev)
 {
-    const char *env = getenv("OB_INSTANCE_RUNS");
-    if (asked == OB_INSTANCE_RUNS_AUTO && env && *env) {
-        if (!strcmp(env, "instanced")) asked = OB_INSTANCE_RUNS_INSTANCED;
-        else if (!strcmp(env, "multi")) asked = OB_INSTANCE_RUNS_MULTI_DRAW;
-        else if (!strcmp(env, "direct")) asked = OB_INSTANCE_RUNS_DIRECT;
-        else OB_LOG_W("renderer", "OB_INSTANCE_RUNS='%s' is none of instanced, multi, direct: ignored",
-                      env);
+    static const char *const words[] = {"instanced", "multi", "direct"};
+    static const ob_instance_runs values[] = {OB_INSTANCE_RUNS_INSTANCED, OB_INSTANCE_RUNS_MULTI_DRAW,
+                                              OB_INSTANCE_RUNS_DIRECT};
+    if (asked == OB_INSTANCE_RUNS_AUTO) {
+        int k = ob_env_choice("OB_INSTANCE_RUNS", words, 3, "renderer", "ignored");
+        if (k >= 0) asked = values[k];
     }
     const ob_device_caps *caps = ob_device_get_caps(dev);
     bool can = caps->multi_draw_indirect && caps->draw_indirect_first_instance;
