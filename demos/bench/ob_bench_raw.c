@@ -1,9 +1,11 @@
 #include "ob_bench_raw.h"
 
 #include <cglm/cglm.h>
+#include <math.h>
 #include <string.h>
 
 #include "ob_bench_run.h"
+#include "ob_renderer_layer.h"
 
 #define COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 #define DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
@@ -11,6 +13,9 @@
 #define ROW_FLOATS 12u              /* the engine's per-instance block (OB_INSTANCE_FLOATS) */
 #define ROW_SIZE (4u * ROW_FLOATS)
 
+/* The per-draw loop's: its WorldMatrix is the view's view-projection times
+ * the world matrix (clip from model), so the draws land where the engine's
+ * do and a timed execution prices the same triangles. */
 static const char raw_vert[] =
     "#version 450\n"
     "layout(push_constant, std430) uniform PerDraw { mat4 WorldMatrix; mat4 NormalMatrix; };\n"
@@ -21,10 +26,12 @@ static const char raw_vert[] =
     "    gl_Position = WorldMatrix * vec4(inPosition, 1.0);\n"
     "}\n";
 /* The instanced loop's: the engine's per-instance block, the world
- * matrix's three rows from binding 1, and the normal matrix derived from it
- * as the standard shaders do (ob_normal_matrix, common.glsl). */
+ * matrix's three rows from binding 1, the normal matrix derived from it
+ * as the standard shaders do (ob_normal_matrix, common.glsl), and the
+ * view-projection pushed once. */
 static const char raw_vert_instanced[] =
     "#version 450\n"
+    "layout(push_constant, std430) uniform PerRun { mat4 ViewProj; };\n"
     "layout(location = 0) in vec3 inPosition;\n"
     "layout(location = 8) in vec4 r0;\n"
     "layout(location = 9) in vec4 r1;\n"
@@ -39,7 +46,7 @@ static const char raw_vert_instanced[] =
     "    if (big > 0.0) m *= 1.0 / big;\n"
     "    vNormal = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1])) *\n"
     "              vec3(0.0, 1.0, 0.0);\n"
-    "    gl_Position = w * vec4(inPosition, 1.0);\n"
+    "    gl_Position = ViewProj * (w * vec4(inPosition, 1.0));\n"
     "}\n";
 static const char raw_frag[] =
     "#version 450\n"
@@ -50,7 +57,8 @@ static const char raw_frag[] =
 /* What one draw needs, gathered before timing. */
 typedef struct raw_draw {
     VkBuffer vb, ib;
-    uint32_t index_count;
+    uint32_t index_count, first_index;  /* the level of detail the engine drew */
+    int32_t vertex_offset;
 } raw_draw;
 
 struct ob_bench_raw {
@@ -68,6 +76,12 @@ struct ob_bench_raw {
     float *rows;               /* ROW_FLOATS per draw: the world matrix's rows */
     uint32_t count;
     uint32_t width, height;    /* the view's, for viewport and scissor */
+    float view_proj[16];       /* the view's (relative to its origin) */
+    /* GPU timing (ob_bench_raw_gpu_ms): view-sized targets of the recording's
+     * formats, a timestamp pair, nanoseconds per tick (0: no timestamps). */
+    ob_image color, depth;
+    VkQueryPool queries;
+    double tick_ns;
     /* The pool's allocator: the engine's own (a recording pool's), so that
      * the two loops record into memory managed the same way and the raw
      * figure prices Vulkan, not glibc malloc's state; it counts the
@@ -103,10 +117,9 @@ static ob_result make_pipeline(ob_demo *d, raw_state *s, bool instanced)
     if (r == OB_OK && !s->frag)
         r = make_module(d, "bench_raw.frag", raw_frag, OB_SHADER_FRAGMENT, &s->frag);
     if (r != OB_OK) return r;
-    VkPushConstantRange range = {VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE};
+    VkPushConstantRange range = {VK_SHADER_STAGE_VERTEX_BIT, 0, instanced ? 64u : PUSH_SIZE};
     VkPipelineLayoutCreateInfo lci = {.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-                                      .pushConstantRangeCount = instanced ? 0u : 1u,
-                                      .pPushConstantRanges = &range};
+                                      .pushConstantRangeCount = 1, .pPushConstantRanges = &range};
     VkPipelineLayout *layout = instanced ? &s->layout_instanced : &s->layout;
     VkResult vr = OB_VK_CHECK(vkCreatePipelineLayout(s->vk, &lci, NULL, layout));
     if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
@@ -185,7 +198,8 @@ static ob_result make_commands(ob_demo *d, raw_state *s)
     return ob_result_from_vk(vr);
 }
 
-/* World and normal matrices as the engine computes them for v. */
+/* World and normal matrices as the engine computes them for v; the
+ * per-draw push block's world matrix with v's view-projection applied. */
 static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
 {
     ob_device *dev = ob_renderer_device(d->world.r);
@@ -198,17 +212,21 @@ static ob_result gather(ob_demo *d, const ob_view *v, raw_state *s)
         const ob_renderable *rd = ob_node_get_renderable(n);
         const ob_geometry *g = rd ? (const ob_geometry *)rd->geometry : NULL;
         if (!g || ob_geometry_index_count(g) == 0) continue;
-        float *world = &s->push[32 * s->count], *normal = world + 16;
+        float *clip = &s->push[32 * s->count], *normal = clip + 16;
+        float world[16];
         ob_node_world_relative(n, v->origin, world);
         mat4 inv;
         glm_mat4_inv((vec4 *)world, inv);
         glm_mat4_transpose_to(inv, (vec4 *)normal);
+        ob_mat4_mul(v->view_proj, world, clip);
         float *rows = &s->rows[ROW_FLOATS * s->count];
         for (uint32_t r = 0; r < 3; r++)
             for (uint32_t c = 0; c < 4; c++) rows[4 * r + c] = world[4 * c + r];
-        s->draws[s->count++] = (raw_draw){ob_buffer_vk(dev, ob_geometry_vertex_buffer(g)),
-                                          ob_buffer_vk(dev, ob_geometry_index_buffer(g)),
-                                          ob_geometry_index_count(g)};
+        ob_draw_data dd;
+        ob_geometry_iface_get()->draw_data((const struct ob_geometry *)g, v->items[i].lod, &dd);
+        s->draws[s->count++] = (raw_draw){ob_buffer_vk(dev, dd.vertex_buffer),
+                                          ob_buffer_vk(dev, dd.index_buffer), dd.count, dd.first,
+                                          dd.vertex_offset};
     }
     return s->count ? OB_OK : OB_ERR_INVALID_ARGUMENT;
 }
@@ -247,7 +265,10 @@ static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instance
         VkBuffer inst = ob_buffer_vk(s->dev, s->instances);
         VkDeviceSize zero = 0;
         vkCmdBindVertexBuffers(s->cmd, 1, 1, &inst, &zero);
+        vkCmdPushConstants(s->cmd, s->layout_instanced, VK_SHADER_STAGE_VERTEX_BIT, 0, 64,
+                           s->view_proj);
         binds++;
+        commands++;
     }
     /* Buffers bound when the mesh changes; per draw the push block and the
      * draw, or, instanced, a run of one mesh in one draw. */
@@ -267,14 +288,17 @@ static ob_result record(ob_bench_raw *s, ob_bench_raw_sample *out, bool instance
         uint32_t j = i + 1;
         if (instanced) {
             while (j < s->count && s->draws[j].vb == vb && s->draws[j].ib == ib &&
-                   s->draws[j].index_count == dr->index_count)
+                   s->draws[j].index_count == dr->index_count &&
+                   s->draws[j].first_index == dr->first_index &&
+                   s->draws[j].vertex_offset == dr->vertex_offset)
                 j++;
         } else {
             vkCmdPushConstants(s->cmd, s->layout, VK_SHADER_STAGE_VERTEX_BIT, 0, PUSH_SIZE,
                                &s->push[32 * i]);
             commands++;
         }
-        vkCmdDrawIndexed(s->cmd, dr->index_count, j - i, 0, 0, instanced ? i : 0);
+        vkCmdDrawIndexed(s->cmd, dr->index_count, j - i, dr->first_index, dr->vertex_offset,
+                         instanced ? i : 0);
         commands++;
         i = j;
     }
@@ -297,9 +321,114 @@ ob_result ob_bench_raw_record_instanced(ob_bench_raw *s, ob_bench_raw_sample *ou
     return record(s, out, true);
 }
 
+/* The targets and the timestamp pair of ob_bench_raw_gpu_ms. */
+static ob_result make_timing(raw_state *s)
+{
+    ob_result r = OB_OK;
+    s->color = ob_image_create(s->dev, &(ob_image_desc){
+        .width = s->width, .height = s->height, .format = COLOR_FORMAT,
+        .usage = OB_IMAGE_COLOR_TARGET, .name = "raw baseline color"}, &r);
+    if (r == OB_OK)
+        s->depth = ob_image_create(s->dev, &(ob_image_desc){
+            .width = s->width, .height = s->height, .format = DEPTH_FORMAT,
+            .usage = OB_IMAGE_DEPTH_TARGET, .name = "raw baseline depth"}, &r);
+    s->tick_ns = ob_device_timestamp_period_ns(s->dev);
+    if (r != OB_OK || s->tick_ns <= 0.0) return r;
+    VkQueryPoolCreateInfo qci = {.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+                                 .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 2};
+    return ob_result_from_vk(OB_VK_CHECK(vkCreateQueryPool(s->vk, &qci, NULL, &s->queries)));
+}
+
+/* Executes the recording in the secondary: the targets cleared (their old
+ * contents discarded: UNDEFINED, after the last execution's writes), the
+ * secondary inside dynamic rendering, a timestamp on each side; submitted
+ * and waited for. */
+static ob_result execute(raw_state *s, double *out_ms)
+{
+    *out_ms = NAN;
+    if (!s->queries) return OB_OK;
+    VkCommandBuffer cmd;
+    ob_result r = ob_device_oneshot_begin(s->dev, &cmd);
+    if (r != OB_OK) return r;
+    vkCmdResetQueryPool(cmd, s->queries, 0, 2);
+    VkImageMemoryBarrier2 barriers[2] = {
+        {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
+         .srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+         .srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+         .dstStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+         .dstAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
+                          VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT,
+         .oldLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+         .newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+         .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+         .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+         .image = ob_image_vk(s->dev, s->color),
+         .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1}},
+        {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
+         .srcStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+         .srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+         .dstStageMask = VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+         .dstAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
+         .oldLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+         .newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+         .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+         .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+         .image = ob_image_vk(s->dev, s->depth),
+         .subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1}},
+    };
+    vkCmdPipelineBarrier2(cmd, &(VkDependencyInfo){.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                                                   .imageMemoryBarrierCount = 2,
+                                                   .pImageMemoryBarriers = barriers});
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, s->queries, 0);
+    VkRenderingAttachmentInfo color = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(s->dev, s->color),
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE};
+    VkRenderingAttachmentInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = ob_image_view(s->dev, s->depth),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE};
+    /* Reversed Z: the far plane at depth 0. */
+    depth.clearValue.depthStencil.depth = 0.0f;
+    vkCmdBeginRendering(cmd, &(VkRenderingInfo){
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .flags = VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT,
+        .renderArea = {{0, 0}, {s->width, s->height}}, .layerCount = 1,
+        .colorAttachmentCount = 1, .pColorAttachments = &color, .pDepthAttachment = &depth});
+    vkCmdExecuteCommands(cmd, 1, &s->cmd);
+    vkCmdEndRendering(cmd);
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, s->queries, 1);
+    r = ob_device_oneshot_submit(s->dev, cmd);
+    if (r != OB_OK) return r;
+    uint64_t ts[2];
+    VkResult vr = OB_VK_CHECK(vkGetQueryPoolResults(s->vk, s->queries, 0, 2, sizeof ts, ts,
+                                                    sizeof ts[0], VK_QUERY_RESULT_64_BIT |
+                                                                      VK_QUERY_RESULT_WAIT_BIT));
+    if (vr != VK_SUCCESS) return ob_result_from_vk(vr);
+    *out_ms = (double)(ts[1] - ts[0]) * s->tick_ns * 1e-6;
+    return OB_OK;
+}
+
+ob_result ob_bench_raw_gpu_ms(ob_bench_raw *s, bool instanced, double *out_ms)
+{
+    ob_bench_raw_sample sample;
+    ob_result r = record(s, &sample, instanced);
+    if (r == OB_OK) r = execute(s, out_ms);
+    else *out_ms = NAN;
+    return r;
+}
+
 void ob_bench_raw_destroy(ob_bench_raw *s)
 {
     if (!s) return;
+    if (s->queries) vkDestroyQueryPool(s->vk, s->queries, NULL);
+    if (s->color.id) ob_image_destroy(s->dev, s->color);
+    if (s->depth.id) ob_image_destroy(s->dev, s->depth);
     if (s->pool) vkDestroyCommandPool(s->vk, s->pool, &s->pool_alloc.callbacks);
     ob_arena_allocator_release(&s->pool_alloc);
     if (s->pipeline) vkDestroyPipeline(s->vk, s->pipeline, NULL);
@@ -331,6 +460,7 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
     }
     *s = (ob_bench_raw){.vk = ob_device_vk(ob_renderer_device(d->world.r)),
                         .dev = ob_renderer_device(d->world.r), .width = v->width, .height = v->height};
+    memcpy(s->view_proj, v->view_proj, sizeof s->view_proj);
     ob_result r = gather(d, v, s);
     if (r == OB_OK) r = make_pipeline(d, s, false);
     if (r == OB_OK) r = make_pipeline(d, s, true);
@@ -341,6 +471,7 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
         s->instance_data = ob_buffer_mapped(s->dev, s->instances);
     }
     if (r == OB_OK) r = make_commands(d, s);
+    if (r == OB_OK) r = make_timing(s);
     *out_result = r;
     if (r == OB_OK) return s;
     OB_LOG_E("bench", "raw baseline on view '%s' failed: %s", v->name, ob_result_name(r));

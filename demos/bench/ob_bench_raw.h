@@ -10,8 +10,11 @@
  * no descriptor sets) bound once, viewport and scissor once, vertex and
  * index buffers only when the geometry changes from the previous draw, and
  * per object vkCmdPushConstants (128 bytes: world + normal matrix, the
- * engine's push block) + vkCmdDrawIndexed. Only recording is timed (begin to
- * end); nothing is submitted. The pool allocates through counting
+ * engine's push block; its world matrix with the view's view-projection
+ * applied, so the triangles land where the engine's do) + vkCmdDrawIndexed.
+ * A recording is timed begin to end and not submitted; ob_bench_raw_gpu_ms
+ * records again and executes, for the driver's own GPU-time floor. The pool
+ * allocates through counting
  * callbacks, so a recording also says how many host allocations the driver
  * made for it, and how many vkCmd calls it made.
  *
@@ -56,9 +59,19 @@ ob_bench_raw *ob_bench_raw_create(ob_demo *d, const ob_view *v, ob_result *out_r
 ob_result ob_bench_raw_record(ob_bench_raw *raw, ob_bench_raw_sample *out);
 /* The same draws instanced: the world matrices' rows (the engine's 48-byte
  * per-instance block) copied as instance data into a mapped buffer
- * (binding 1) at each recording, as a scene that moves must, and a run of
- * one mesh as one vkCmdDrawIndexed. */
+ * (binding 1) at each recording, as a scene that moves must, the
+ * view-projection pushed once, and a run of one mesh as one
+ * vkCmdDrawIndexed. */
 ob_result ob_bench_raw_record_instanced(ob_bench_raw *raw, ob_bench_raw_sample *out);
+/* Records the per-draw or instanced loop again (untimed) and executes it
+ * on the device into view-sized targets of its own, cleared first: *out_ms
+ * is the GPU time between timestamps around the draws (NAN where the queue
+ * has no timestamps). It prices what the driver does with the same draws
+ * and triangles without an engine around them: instanced over per-draw is
+ * the lowest GPU-time ratio the engine's instancing can reach on this
+ * device. Failure: the oneshot submission's or the query's result (logged),
+ * *out_ms NAN. Submits and waits: the recordings it makes are not timed. */
+ob_result ob_bench_raw_gpu_ms(ob_bench_raw *raw, bool instanced, double *out_ms);
 /* Destroys what create made. NULL ok. */
 void ob_bench_raw_destroy(ob_bench_raw *raw);
 

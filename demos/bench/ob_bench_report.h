@@ -75,6 +75,10 @@ typedef struct ob_bench_summary {
      * their ratio. */
     double gpu_ms_10k_8views, gpu_ms_10k_8views_per_draw;
     double gpu_time_instanced_vs_per_draw_10k_8views;
+    /* The same ratio for the raw loops (ob_bench_raw_gpu_ms: the raw
+     * baseline's view, same draws and triangles, no engine), per round
+     * [p25, p75]: the floor the driver puts under the engine's. */
+    ob_bench_spread raw_gpu_instanced_vs_per_draw;
     /* ST, 10k x 8 views: vertices submitted per entity drawn, and the share
      * of entities drawn at a coarser level of detail. */
     double vertices_per_draw_10k_8views, lod_share_10k_8views;
@@ -125,6 +129,9 @@ typedef struct ob_bench_report {
     ob_bench_spread engine_vs_raw;                 /* per-round ratio of the two per draw */
     ob_bench_raw_result raw_instanced;             /* the raw loop instanced, same rounds */
     ob_bench_spread engine_vs_raw_instanced;
+    /* The raw loops executed, GPU ms (medians), and their per-round ratio. */
+    double raw_gpu_ms, raw_gpu_instanced_ms;
+    ob_bench_spread raw_gpu_instanced_vs_per_draw;
     ob_bench_quality_row *quality;
     uint32_t quality_count;
     ob_bench_sweep_entry scene200;                 /* mirror scene: ST, MT, auto */

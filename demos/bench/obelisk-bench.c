@@ -348,6 +348,9 @@ typedef struct raw_rounds {
     uint32_t round_engine_draws;
     double *raw_ms, *allocs_per_draw, *engine_vs_raw;  /* one per measured round */
     double *raw_instanced_ms, *engine_vs_raw_instanced;
+    /* Each measured round's GPU time of the two loops, executed after its
+     * last pass (ob_bench_raw_gpu_ms), and their ratio. */
+    double *raw_gpu_ms, *raw_gpu_instanced_ms, *raw_gpu_ratio;
     uint32_t n, cap;
 } raw_rounds;
 
@@ -382,8 +385,13 @@ static ob_result raw_round(void *user, uint32_t round, uint32_t pass, bool measu
     rr->engine_vs_raw[rr->n] = engine_ns / raw_ns;
     rr->raw_instanced_ms[rr->n] = rr->round_raw_instanced_ns * 1e-6;
     rr->engine_vs_raw_instanced[rr->n] = engine_ns / (rr->round_raw_instanced_ns / rr->last.draws);
+    /* Executed after the round's timed recordings, so none of them follows
+     * an execution in its pass. */
+    r = ob_bench_raw_gpu_ms(rr->raw, false, &rr->raw_gpu_ms[rr->n]);
+    if (r == OB_OK) r = ob_bench_raw_gpu_ms(rr->raw, true, &rr->raw_gpu_instanced_ms[rr->n]);
+    rr->raw_gpu_ratio[rr->n] = rr->raw_gpu_instanced_ms[rr->n] / rr->raw_gpu_ms[rr->n];
     rr->n++;
-    return OB_OK;
+    return r;
 }
 
 /* The raw result and the per-round engine/raw ratio from the rounds. */
@@ -395,8 +403,13 @@ static void raw_results(raw_rounds *rr, ob_bench_report *rep)
     ob_bench_spread_of(rr->allocs_per_draw, rr->n, &allocs);
     ob_bench_spread_of(rr->engine_vs_raw, rr->n, &rep->engine_vs_raw);
     ob_bench_spread_of(rr->engine_vs_raw_instanced, rr->n, &rep->engine_vs_raw_instanced);
-    ob_bench_spread ims;
+    ob_bench_spread ims, gpu, gpu_instanced;
     ob_bench_spread_of(rr->raw_instanced_ms, rr->n, &ims);
+    ob_bench_spread_of(rr->raw_gpu_ms, rr->n, &gpu);
+    ob_bench_spread_of(rr->raw_gpu_instanced_ms, rr->n, &gpu_instanced);
+    ob_bench_spread_of(rr->raw_gpu_ratio, rr->n, &rep->raw_gpu_instanced_vs_per_draw);
+    rep->raw_gpu_ms = gpu.median;
+    rep->raw_gpu_instanced_ms = gpu_instanced.median;
     rep->raw_instanced = (ob_bench_raw_result){
         .draws = rr->last_instanced.draws, .reps = rr->n,
         .buffer_binds = rr->last_instanced.buffer_binds, .record_ms = ims.median,
@@ -451,12 +464,15 @@ static ob_result sweep_config(const bench_options *o, ob_bench_report *rep, uint
     if (r == OB_OK && raw) {
         rr.view = s.views[0];
         rr.cap = rd.rounds;
-        rr.raw_ms = ob_calloc(5 * (size_t)rr.cap, sizeof *rr.raw_ms);
+        rr.raw_ms = ob_calloc(8 * (size_t)rr.cap, sizeof *rr.raw_ms);
         if (rr.raw_ms) {
             rr.allocs_per_draw = rr.raw_ms + rr.cap;
             rr.engine_vs_raw = rr.raw_ms + 2 * rr.cap;
             rr.raw_instanced_ms = rr.raw_ms + 3 * rr.cap;
             rr.engine_vs_raw_instanced = rr.raw_ms + 4 * rr.cap;
+            rr.raw_gpu_ms = rr.raw_ms + 5 * rr.cap;
+            rr.raw_gpu_instanced_ms = rr.raw_ms + 6 * rr.cap;
+            rr.raw_gpu_ratio = rr.raw_ms + 7 * rr.cap;
             rd.round_hook = raw_round;
             rd.round_user = &rr;
         } else {
@@ -628,6 +644,7 @@ static void summarize(ob_bench_report *rep)
     s->engine_vs_raw_per_object = rep->engine_vs_raw;
     s->engine_vs_raw_instanced_per_object = rep->engine_vs_raw_instanced;
     s->commands_per_object_raw_instanced = rep->raw_instanced.commands_per_object;
+    s->raw_gpu_instanced_vs_per_draw = rep->raw_gpu_instanced_vs_per_draw;
     /* Per visible object is per draw in ST: the old name keeps its meaning. */
     s->engine_vs_raw_per_draw = rep->engine_vs_raw.median;
     const ob_bench_result *r200 = rep->scene200.results;
@@ -720,7 +737,8 @@ static int run(bench_options *o)
     rep.pool_workers = pool_size(o, rep.cores);
     if (check_effects(o, rep.pool_workers) != OB_OK) return 6;
     /* Unknown until the raw configuration has run (it may not be in the lists). */
-    rep.engine_vs_raw = (ob_bench_spread){NAN, NAN, NAN};
+    rep.engine_vs_raw = rep.raw_gpu_instanced_vs_per_draw = (ob_bench_spread){NAN, NAN, NAN};
+    rep.raw_gpu_ms = rep.raw_gpu_instanced_ms = NAN;
     rep.raw = (ob_bench_raw_result){.record_ms = NAN, .ns_per_draw = NAN,
                                     .commands_per_object = NAN, .host_allocs_per_object = NAN};
     rep.engine_ns_per_draw = NAN;

@@ -78,9 +78,9 @@ endforeach()
 # per-object pre-render and update costs: each a number, or null where the
 # run could not compute it.
 set(frame_fields amdahl_speedup_16_cores gpu_ms_10k_8views gpu_ms_10k_8views_per_draw
-    gpu_time_instanced_vs_per_draw_10k_8views)
+    gpu_time_instanced_vs_per_draw_10k_8views raw_gpu_ms raw_gpu_instanced_ms)
 foreach(field frame_cpu_speedup_10k_8views serial_fraction_10k_8views prerender_ns_per_object_view
-        update_ns_per_object)
+        update_ns_per_object raw_gpu_instanced_vs_per_draw)
   list(APPEND frame_fields ${field} ${field}_p25 ${field}_p75)
 endforeach()
 foreach(field ${frame_fields})
