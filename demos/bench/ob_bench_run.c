@@ -17,6 +17,7 @@ typedef struct sample {
     sample_kind kind;
     double update_ms, update_cpu_ms, pre_render_ms, record_ms, assemble_ms, submit_ms;
     double cpu_frame_ms, cpu_no_update_ms, record_total_ms, gpu_ms, gpu_views_ms, wall_ms;
+    double gpu_rest_ms;        /* gpu_ms - gpu_views_ms of this frame */
     double upload_mb;
     double serial_fraction;
     double draws, views, vertices, lod_items;
@@ -53,6 +54,7 @@ static void on_stats(void *user, const ob_frame_stats *st)
             for (uint32_t v = 0; v < st->view_count; v++)
                 views += st->views[v].gpu_ms >= 0.0 ? st->views[v].gpu_ms : NAN;
             c->samples[i].gpu_views_ms = views;
+            c->samples[i].gpu_rest_ms = c->samples[i].gpu_ms - views;
             return;
         }
     }
@@ -128,7 +130,7 @@ static ob_result frame(ob_bench_scene *s, const ob_bench_run_desc *desc, collect
         .record_ms = st->record_ns * 1e-6, .assemble_ms = st->assemble_ns * 1e-6,
         .submit_ms = st->submit_ns * 1e-6, .cpu_frame_ms = st->frame_ns * 1e-6,
         .record_total_ms = (st->record_ns + st->assemble_ns) * 1e-6,
-        .gpu_ms = NAN, .gpu_views_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
+        .gpu_ms = NAN, .gpu_views_ms = NAN, .gpu_rest_ms = NAN, .wall_ms = NAN, .draws = st->draws, .views = st->view_count,
         .upload_mb = (double)st->ring_upload_bytes / (1024.0 * 1024.0),
         .vertices = (double)st->pm.vertices, .lod_items = st->lod_items,
         .workers = st->workers, .pm = st->pm, .hash = st->frame_hash,
@@ -503,6 +505,7 @@ static void summarize(const ob_bench_run_desc *desc, collector *c, double *buf,
         o->cpu_frame_ms = MEDIAN(m, SAMPLE_IDLE, cpu_no_update_ms) + o->update_ms;
         o->gpu_ms = MEDIAN(m, SAMPLE_IDLE, gpu_ms);
         o->gpu_views_ms = MEDIAN(m, SAMPLE_IDLE, gpu_views_ms);
+        o->gpu_rest_ms = MEDIAN(m, SAMPLE_IDLE, gpu_rest_ms);
         o->gpu_flight_ms = MEDIAN(m, SAMPLE_FLIGHT, gpu_ms);
         o->upload_mb = MEDIAN(m, SAMPLE_IDLE, upload_mb);
         o->frame_ms = MEDIAN(m, SAMPLE_FLIGHT, wall_ms);

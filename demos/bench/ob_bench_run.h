@@ -112,7 +112,10 @@ typedef struct ob_bench_result {
                                   replaced by update_ms) */
     double gpu_ms;             /* timestamps (NAN if unavailable) */
     double gpu_views_ms;       /* the views' stamps summed (NAN unless every view was
-                                  stamped: --gpu-timing views) */
+                                  stamped: --gpu-timing views; with the default
+                                  sampling, the median of the frames that were) */
+    double gpu_rest_ms;        /* median over those frames of their GPU time less
+                                  their views' (uploads, barriers, clears) */
     double upload_mb;          /* the staged ring's copy to device memory (0 unstaged) */
     double gpu_flight_ms;      /* timestamps of the frames in flight (a real GPU idle
                                   between frames may run them at lower clocks) */

@@ -148,7 +148,7 @@ foreach(field speedup_record_p25 speedup_record_p75 vs_best_fixed_record record_
         record_cpu_workers_ms record_cpu_max_worker_ms cmd_host_allocs_per_object
         commands_per_object update_cpu_ms frame_cpu_speedup frame_cpu_speedup_p25
         frame_cpu_speedup_p75 serial_fraction serial_fraction_p25 serial_fraction_p75
-        gpu_views_ms upload_mb gpu_flight_ms)
+        gpu_views_ms upload_mb gpu_flight_ms gpu_rest_ms)
   string(JSON type ERROR_VARIABLE err TYPE "${json}" sweep 0 modes 0 ${field})
   if(err OR NOT (type STREQUAL "NUMBER" OR type STREQUAL "NULL"))
     message(FATAL_ERROR "sweep[0].modes[0].${field} is missing: ${type} ${err}")
