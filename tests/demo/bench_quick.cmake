@@ -90,10 +90,23 @@ foreach(field ${frame_fields})
     message(FATAL_ERROR "summary.${field} is missing or not a number: '${value}' (${type}) ${err}")
   endif()
 endforeach()
+# Where the device has timestamps (the engine's frame has a GPU time), the
+# raw loops were executed and timed too: their times are positive numbers.
+string(JSON type TYPE "${json}" summary gpu_ms_10k_8views)
+if(type STREQUAL "NUMBER")
+  foreach(field raw_gpu_ms raw_gpu_instanced_ms raw_gpu_instanced_vs_per_draw)
+    string(JSON type TYPE "${json}" summary ${field})
+    string(JSON value GET "${json}" summary ${field})
+    if(NOT type STREQUAL "NUMBER" OR value LESS_EQUAL 0)
+      message(FATAL_ERROR "summary.${field} is '${value}' (${type}): the raw loops were not timed "
+                          "on a device with timestamps")
+    endif()
+  endforeach()
+endif()
 # Spreads in order (p25 <= median <= p75) wherever all three are numbers.
 foreach(spread mt_speedup_record_10k_8views engine_vs_raw_per_object auto_vs_best_200
         auto_vs_best_10k_8views frame_cpu_speedup_10k_8views serial_fraction_10k_8views
-        prerender_ns_per_object_view update_ns_per_object)
+        prerender_ns_per_object_view update_ns_per_object raw_gpu_instanced_vs_per_draw)
   string(JSON t_lo TYPE "${json}" summary ${spread}_p25)
   string(JSON t_mid TYPE "${json}" summary ${spread})
   string(JSON t_hi TYPE "${json}" summary ${spread}_p75)
