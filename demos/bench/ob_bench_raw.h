@@ -13,7 +13,7 @@
  * engine's push block; its world matrix with the view's view-projection
  * applied, so the triangles land where the engine's do) + vkCmdDrawIndexed.
  * A recording is timed begin to end and not submitted; ob_bench_raw_gpu_ms
- * records again and executes, for the driver's own GPU-time floor. The pool
+ * records again and executes, for bare Vulkan's GPU time. The pool
  * allocates through counting
  * callbacks, so a recording also says how many host allocations the driver
  * made for it, and how many vkCmd calls it made.
@@ -68,8 +68,8 @@ ob_result ob_bench_raw_record_instanced(ob_bench_raw *raw, ob_bench_raw_sample *
  * is the GPU time between timestamps around the draws (NAN where the queue
  * has no timestamps). It prices what the driver does with the same draws
  * and triangles without an engine around them: instanced over per-draw is
- * the lowest GPU-time ratio the engine's instancing can reach on this
- * device. Failure: the oneshot submission's or the query's result (logged),
+ * what instancing gives on this device with the cheapest shaders, the
+ * measure to read the engine's ratio against. Failure: the oneshot submission's or the query's result (logged),
  * *out_ms NAN. Submits and waits: the recordings it makes are not timed. */
 ob_result ob_bench_raw_gpu_ms(ob_bench_raw *raw, bool instanced, double *out_ms);
 /* Destroys what create made. NULL ok. */

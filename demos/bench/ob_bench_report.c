@@ -236,7 +236,7 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
             s->gpu_ms_10k_8views, s->gpu_ms_10k_8views_per_draw);
     fputc('\n', f);
     print_spread(f, "raw_gpu_instanced_vs_per_draw", s->raw_gpu_instanced_vs_per_draw);
-    fprintf(f, " (the raw loops' GPU time, %u views x %u objects: the driver's floor)",
+    fprintf(f, " (the raw loops' GPU time, %u views x %u objects: bare Vulkan's on this device)",
             rep->raw_views, rep->raw_objects);
     fprintf(f, "\n  %-30s %.1f (ST, 10k x 8: vertices submitted per entity drawn; %.1f%% of "
                "them at a coarser level of detail)", "vertices_per_draw",

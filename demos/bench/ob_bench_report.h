@@ -77,7 +77,8 @@ typedef struct ob_bench_summary {
     double gpu_time_instanced_vs_per_draw_10k_8views;
     /* The same ratio for the raw loops (ob_bench_raw_gpu_ms: the raw
      * baseline's view, same draws and triangles, no engine), per round
-     * [p25, p75]: the floor the driver puts under the engine's. */
+     * [p25, p75]: what bare Vulkan gets on this device, to read the
+     * engine's against. */
     ob_bench_spread raw_gpu_instanced_vs_per_draw;
     /* ST, 10k x 8 views: vertices submitted per entity drawn, and the share
      * of entities drawn at a coarser level of detail. */
