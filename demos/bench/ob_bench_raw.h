@@ -14,9 +14,9 @@
  * applied, so the triangles land where the engine's do) + vkCmdDrawIndexed.
  * A recording is timed begin to end and not submitted; ob_bench_raw_gpu_ms
  * records again and executes, for bare Vulkan's GPU time. The pool
- * allocates through counting
- * callbacks, so a recording also says how many host allocations the driver
- * made for it, and how many vkCmd calls it made.
+ * allocates through counting callbacks, so a recording also says how many
+ * host allocations the driver made for it, and how many vkCmd calls it
+ * made.
  *
  * Lifecycle: create (from the view's draw list of the last frame) → record
  * once per measuring round, interleaved with the engine's frames → destroy.
@@ -69,8 +69,9 @@ ob_result ob_bench_raw_record_instanced(ob_bench_raw *raw, ob_bench_raw_sample *
  * has no timestamps). It prices what the driver does with the same draws
  * and triangles without an engine around them: instanced over per-draw is
  * what instancing gives on this device with the cheapest shaders, the
- * measure to read the engine's ratio against. Failure: the oneshot submission's or the query's result (logged),
- * *out_ms NAN. Submits and waits: the recordings it makes are not timed. */
+ * measure to read the engine's ratio against. Failure: the one-shot
+ * submission's or the query's result (logged), *out_ms NAN. Submits and
+ * waits: the recordings it makes are not timed. */
 ob_result ob_bench_raw_gpu_ms(ob_bench_raw *raw, bool instanced, double *out_ms);
 /* Destroys what create made. NULL ok. */
 void ob_bench_raw_destroy(ob_bench_raw *raw);

@@ -389,7 +389,8 @@ static ob_result raw_round(void *user, uint32_t round, uint32_t pass, bool measu
      * an execution in its pass. */
     r = ob_bench_raw_gpu_ms(rr->raw, false, &rr->raw_gpu_ms[rr->n]);
     if (r == OB_OK) r = ob_bench_raw_gpu_ms(rr->raw, true, &rr->raw_gpu_instanced_ms[rr->n]);
-    rr->raw_gpu_ratio[rr->n] = rr->raw_gpu_instanced_ms[rr->n] / rr->raw_gpu_ms[rr->n];
+    rr->raw_gpu_ratio[rr->n] = r == OB_OK ? rr->raw_gpu_instanced_ms[rr->n] / rr->raw_gpu_ms[rr->n]
+                                          : NAN;
     rr->n++;
     return r;
 }
