@@ -145,7 +145,9 @@ ob_renderer *ob_renderer_create(const ob_renderer_desc *desc, ob_result *out_res
 {
     ob_renderer_desc d = desc ? *desc : (ob_renderer_desc){0};
     ob_result res = OB_OK;
-    ob_renderer *r = ob_calloc(1, sizeof *r);
+    /* Aligned for its cache-line-aligned members (the loop's task blocks). */
+    ob_renderer *r = ob_aligned_alloc(_Alignof(ob_renderer), sizeof *r);
+    if (r) memset(r, 0, sizeof *r);
     if (!r) {
         res = OB_ERR_OUT_OF_HOST_MEMORY;
         goto fail_log;
@@ -201,7 +203,7 @@ fail_destroy_renderer:
     r = NULL;
     goto fail_log;
 fail_free_renderer:
-    ob_free(r);
+    ob_aligned_free(r);
     r = NULL;
 fail_log:
     OB_LOG_E("renderer", "renderer not created: %s", ob_result_name(res));
@@ -226,7 +228,7 @@ void ob_renderer_destroy(ob_renderer *r)
     ob_device_destroy(r->dev);
     ob_free(r->jobs);
     ob_free(r->attachments);
-    ob_free(r);
+    ob_aligned_free(r);
 }
 
 ob_device *ob_renderer_device(ob_renderer *r) { return r->dev; }

@@ -16,6 +16,14 @@
 
 #define OB_MAX_VIEW_STACK 32
 
+/* A thread's block of a parallel loop's indices, [next, end) packed as
+ * next | end << 32: its owner takes from the front, a thread whose own
+ * block is empty from the back. One cache line each: the owner's takes
+ * stay in its own cache. */
+typedef struct ob_task_block {
+    _Alignas(64) atomic_ullong range;
+} ob_task_block;
+
 /* One unit of recording: a chunk of one layer of one view. */
 typedef struct ob_job {
     ob_view *view;
@@ -171,11 +179,14 @@ struct ob_renderer {
     bool undo_overflow;
 
     /* The parallel loop being run (ob_renderer_parallel): a pool thread
-     * woken while task_fn is set runs loop indices instead of jobs. */
+     * woken while task_fn is set runs loop indices instead of jobs. The
+     * indices are cut into one contiguous block per thread of the loop
+     * (task_blocks), its home: see run_tasks. */
     ob_task_fn task_fn;
     void *task_user;
     uint32_t task_count;
-    atomic_uint next_task;
+    uint32_t task_block_count;
+    ob_task_block task_blocks[OB_MAX_WORKERS + 1];
     bool in_parallel;           /* a loop is running: a nested one runs inline */
     /* Whether a batch went to the pool threads since begin_frame, and
      * whether the last frame sent any (then the next wakes them early:

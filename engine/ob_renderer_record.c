@@ -195,15 +195,58 @@ static void record_batch(ob_renderer *r, ob_worker *w)
     w->cpu_ns = ob_thread_cpu_ns() - c0;
 }
 
-/* Indices of the running parallel loop, taken one at a time from the
- * shared counter until none is left. `thread` is the caller's loop thread
- * number (0 = the render thread). */
+#define TASK_NONE UINT32_MAX
+
+/* The next index of block b from its front (the owner's end), or
+ * TASK_NONE once it is empty. */
+static uint32_t task_take_front(ob_task_block *b)
+{
+    unsigned long long v = atomic_load_explicit(&b->range, memory_order_relaxed);
+    for (;;) {
+        uint32_t next = (uint32_t)v, end = (uint32_t)(v >> 32);
+        if (next >= end) return TASK_NONE;
+        if (atomic_compare_exchange_weak_explicit(&b->range, &v, v + 1, memory_order_relaxed,
+                                                  memory_order_relaxed))
+            return next;
+    }
+}
+
+/* The last index of block b (a thread stealing from another's block). */
+static uint32_t task_take_back(ob_task_block *b)
+{
+    unsigned long long v = atomic_load_explicit(&b->range, memory_order_relaxed);
+    for (;;) {
+        uint32_t next = (uint32_t)v, end = (uint32_t)(v >> 32);
+        if (next >= end) return TASK_NONE;
+        unsigned long long w = (unsigned long long)(end - 1) << 32 | next;
+        if (atomic_compare_exchange_weak_explicit(&b->range, &v, w, memory_order_relaxed,
+                                                  memory_order_relaxed))
+            return end - 1;
+    }
+}
+
+/* Indices of the running parallel loop. `thread` is the caller's loop
+ * thread number (0 = the render thread, pool thread i is i), which is also
+ * its home block: the same share of every loop's indices, frame after
+ * frame. The update's loops and culling cut the entities into indices
+ * alike (in id order), so a thread updates, culls and, next frame,
+ * updates again the entities whose data its own caches hold. Taken first
+ * come, first served, an index went to either thread, and each entity's
+ * lines moved between the cores: on the 2-core VM while its cores were far
+ * apart (a cache line's round trip 450-500 ns), the update at 8 views x
+ * 10k took 0.30 ms on two threads against 0.39 on one; with home blocks
+ * 0.24 (medians of interleaved runs, docs/benchmark.md session 23). A
+ * thread done with its block takes from the back of the others', so a
+ * late or slow thread's share still spreads as before. */
 static void run_tasks(ob_renderer *r, uint32_t thread)
 {
-    for (;;) {
-        uint32_t i = atomic_fetch_add_explicit(&r->next_task, 1, memory_order_relaxed);
-        if (i >= r->task_count) break;
+    uint32_t blocks = r->task_block_count;
+    uint32_t home = thread % blocks;
+    for (uint32_t i; (i = task_take_front(&r->task_blocks[home])) != TASK_NONE;)
         r->task_fn(r->task_user, i, thread);
+    for (uint32_t k = 1; k < blocks; k++) {
+        ob_task_block *b = &r->task_blocks[(home + k) % blocks];
+        for (uint32_t i; (i = task_take_back(b)) != TASK_NONE;) r->task_fn(r->task_user, i, thread);
     }
 }
 
@@ -479,7 +522,15 @@ static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
     r->task_fn = fn;
     r->task_user = user;
     r->task_count = count;
-    atomic_store_explicit(&r->next_task, 0, memory_order_relaxed);
+    /* One block per thread that may join, in thread order; published by
+     * hand_out's batch_state store. */
+    uint32_t blocks = helpers + 1;
+    r->task_block_count = blocks;
+    for (uint32_t b = 0; b < blocks; b++) {
+        unsigned long long first = (unsigned long long)count * b / blocks;
+        unsigned long long end = (unsigned long long)count * (b + 1) / blocks;
+        atomic_store_explicit(&r->task_blocks[b].range, end << 32 | first, memory_order_relaxed);
+    }
     hand_out(r, helpers, own_tasks, NULL);
     r->task_fn = NULL;
     r->in_parallel = false;

@@ -533,9 +533,15 @@ typedef struct cull_view {
 
 /* Every view of a wave culls the same snapshot, so each has the same
  * number of chunks: chunk task t is chunk t % chunks of view t / chunks. */
+/* The wave's tasks: chunks x view_count, numbered by thread group. The
+ * chunks (entity ranges in id order) fall into `groups` runs of
+ * chunks / groups, one per thread of the loop, and a group's tasks are
+ * its run's chunks of every view, view by view: the loop's home blocks
+ * (run_tasks) then give each thread the same entities in every view, the
+ * ones the update's loops gave it (see wave_task_of). */
 typedef struct cull_wave {
     cull_view *views;
-    uint32_t chunks;
+    uint32_t chunks, view_count, groups;
 } cull_wave;
 
 /* The frustum test's width for v: the widest the CPU has, unless the
@@ -665,17 +671,19 @@ static void wave_finish_view(const cull_wave *w, cull_view *cv)
 static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
 {
     const cull_wave *w = user;
-    cull_view *cv = &w->views[task / w->chunks];
+    uint32_t per = w->chunks / w->groups, group_tasks = per * w->view_count;
+    uint32_t group = task / group_tasks, in_group = task % group_tasks;
+    cull_view *cv = &w->views[in_group / per];
     if (cv->res != OB_OK) return;
-    uint32_t chunk = task % w->chunks;
+    uint32_t chunk = group * per + in_group % per;
     uint64_t t0 = ob_time_ns();
     cull_chunk_run(&cv->c, chunk, thread);
     cv->c.chunks[chunk].ns = ob_time_ns() - t0;
     /* The last of a view's chunks to end finishes the view on its thread
      * (acquire-release: the other chunks' results are seen). Views are
      * sorted while later ones still cull, with no barrier and no second
-     * wake of the pool between; tasks go out in view order, so the first
-     * views finish first. */
+     * wake of the pool between; each thread takes its chunks view by
+     * view, so the first views finish first. */
     if (atomic_fetch_sub_explicit(&cv->chunks_left, 1, memory_order_acq_rel) == 1)
         wave_finish_view(w, cv);
 }
@@ -761,9 +769,23 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
     uint32_t entities = 0;
     ob_scene_render_proxies(scene, &entities);
     uint32_t grain = par.grain;
-    if (!grain) {
+    bool fixed = grain != 0;
+    if (!fixed) {
         uint64_t share = (uint64_t)entities * count / (4u * OB_MAX(par.threads, 1u));
         grain = (uint32_t)OB_MIN(CULL_GRAIN, OB_MAX(CULL_GRAIN_MIN, share));
+    }
+    bool parallel = ob_parallel_worth(&par, (uint64_t)entities * count, grain);
+    w.view_count = count;
+    w.groups = 1;
+    if (parallel && !fixed && entities >= par.threads) {
+        /* As many chunks for each thread, each no bigger than the grain,
+         * so that thread t's group is the t-th share of the entities, as
+         * in the update's loops. */
+        uint64_t per_thread = ((uint64_t)entities + (uint64_t)grain * par.threads - 1) /
+                              ((uint64_t)grain * par.threads);
+        uint32_t chunks = (uint32_t)(per_thread * par.threads);
+        grain = (entities + chunks - 1) / chunks;
+        w.groups = (entities + grain - 1) / grain == chunks ? par.threads : 1;
     }
     w.chunks = (entities + grain - 1) / grain;
     ob_result first_error = OB_OK;
@@ -774,7 +796,7 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         atomic_init(&cv->chunks_left, w.chunks);
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
     }
-    if (!ob_parallel_worth(&par, (uint64_t)entities * count, grain)) par.threads = 1;
+    if (!parallel) par.threads = 1;
     ob_parallel_run(&par, w.chunks * count, wave_chunk_task, &w);
     for (uint32_t k = 0; k < count; k++) {
         cull_view *cv = &w.views[k];
