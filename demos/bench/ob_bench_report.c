@@ -251,10 +251,13 @@ static void print_perf(const ob_bench_report *rep, FILE *f)
             s->commands_per_object_engine, s->commands_per_object_raw, "host_allocs_per_object",
             s->host_allocs_per_object_engine, s->host_allocs_per_object_raw);
     fprintf(f, "  %-30s %s (max abs diff %u, hash mismatches %u)\n"
-               "  %-30s %.0f s (load average %.1f at start, %.1f at end)\n",
+               "  %-30s %.0f s (load average %.1f at start, %.1f at end)\n"
+               "  %-30s %.0f ns at start, %.0f ns at end (a cache line between two CPUs "
+               "and back: every MT figure follows it)\n",
             "threading modes identical", s->threading_identical ? "yes" : "NO",
             s->threading_max_abs_diff, s->hash_mismatches, "run time", rep->seconds,
-            rep->load_start, rep->load_end);
+            rep->load_start, rep->load_end, "core_to_core_round_trip", rep->core_ns_start,
+            rep->core_ns_end);
 }
 
 /* Pixel counts and levels as integers, small errors in %g. */
@@ -556,6 +559,10 @@ ob_result ob_bench_report_json(const ob_bench_report *rep, const char *path)
     json_num(f, rep->load_start);
     fputs(",", f);
     json_num(f, rep->load_end);
+    fputs("],\"core_to_core_round_trip_ns\":[", f);
+    json_num(f, rep->core_ns_start);
+    fputs(",", f);
+    json_num(f, rep->core_ns_end);
     fputs("]},\n", f);
     if (rep->perf) json_perf(f, rep);
     if (rep->perf && rep->stability) fputs(",\n", f);

@@ -121,6 +121,7 @@ typedef struct ob_bench_report {
     uint32_t image_width, image_height, image_frames;
     double seconds;                                /* whole run, wall clock */
     double load_start, load_end;                   /* 1-minute load average (NAN if unknown) */
+    double core_ns_start, core_ns_end;             /* ob_bench_core_to_core_ns (NAN if unknown) */
 
     ob_bench_sweep_entry *sweep;
     uint32_t sweep_count;

@@ -39,6 +39,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "ob_bench_machine.h"
 #include "ob_bench_progress.h"
 #include "ob_bench_report.h"
 
@@ -752,6 +753,7 @@ static int run(bench_options *o)
     rep.big_flight = big.flight;
     uint64_t t0 = ob_time_ns();
     rep.load_start = load_average();
+    rep.core_ns_start = ob_bench_core_to_core_ns();
     static const uint32_t env_full[] = {64, 128, 256, 512}, shadow_full[] = {256, 512, 1024, 2048};
     static const uint32_t env_quick[] = {128, 512}, shadow_quick[] = {512, 2048};
     ob_bench_quality_desc qd = {
@@ -864,6 +866,7 @@ static int run(bench_options *o)
     ob_bench_progress_finish(&prog);
     rep.seconds = (double)(ob_time_ns() - t0) * 1e-9;
     rep.load_end = load_average();
+    rep.core_ns_end = ob_bench_core_to_core_ns();
 
     if (r != OB_OK) {
         fprintf(stderr, "obelisk-bench: failed: %s (%s)\n", ob_result_name(r), ob_result_text(r));

@@ -1,0 +1,23 @@
+/* ob_bench_machine.h — what the machine itself does to the figures.
+ *
+ * The development VM's two cores are sometimes close (a cache line goes
+ * from one to the other and back in 110-180 ns) and sometimes far apart
+ * (450-520 ns), and the placement changes within minutes while the
+ * single-threaded figures stay put. Every multithreaded figure follows it:
+ * the parallel frame hands each entity's data from thread to thread
+ * (session 23: frame_cpu_speedup 1.80-1.83 close, 1.34-1.58 far, the same
+ * binary). So the benchmark measures it at its start and end and prints it
+ * next to the figures, as it does the load average.
+ *
+ * Thread rule: call from one thread; it starts and joins one of its own.
+ */
+#ifndef OB_BENCH_MACHINE_H
+#define OB_BENCH_MACHINE_H
+
+/* The median round trip, in ns, of a cache line written in turn by two
+ * threads pinned to two different CPUs of the process's set (the first
+ * two): 5 batches of 20,000 round trips, some 50 ms at 500 ns. NAN with
+ * fewer than two CPUs, or when a thread cannot be started or pinned. */
+double ob_bench_core_to_core_ns(void);
+
+#endif /* OB_BENCH_MACHINE_H */
