@@ -184,7 +184,6 @@ struct ob_renderer {
      * (task_blocks), its home: see run_tasks. */
     ob_task_fn task_fn;
     void *task_user;
-    uint32_t task_count;
     uint32_t task_block_count;
     ob_task_block task_blocks[OB_MAX_WORKERS + 1];
     bool in_parallel;           /* a loop is running: a nested one runs inline */

@@ -521,7 +521,6 @@ static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
     r->in_parallel = true;
     r->task_fn = fn;
     r->task_user = user;
-    r->task_count = count;
     /* One block per thread that may join, in thread order; published by
      * hand_out's batch_state store. */
     uint32_t blocks = helpers + 1;

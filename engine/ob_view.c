@@ -532,13 +532,13 @@ typedef struct cull_view {
 } cull_view;
 
 /* Every view of a wave culls the same snapshot, so each has the same
- * number of chunks: chunk task t is chunk t % chunks of view t / chunks. */
-/* The wave's tasks: chunks x view_count, numbered by thread group. The
- * chunks (entity ranges in id order) fall into `groups` runs of
- * chunks / groups, one per thread of the loop, and a group's tasks are
- * its run's chunks of every view, view by view: the loop's home blocks
- * (run_tasks) then give each thread the same entities in every view, the
- * ones the update's loops gave it (see wave_task_of). */
+ * number of chunks, and the wave has chunks x view_count tasks, numbered
+ * by thread group: the chunks (entity ranges in id order) fall into
+ * `groups` runs of chunks / groups, one per thread of the loop, and a
+ * group's tasks are its run's chunks of every view, view by view (see
+ * wave_chunk_task). The loop's home blocks (run_tasks) then give each
+ * thread the same entities in every view, the share the update's loops
+ * gave it. One group: task t is chunk t % chunks of view t / chunks. */
 typedef struct cull_wave {
     cull_view *views;
     uint32_t chunks, view_count, groups;

@@ -5,10 +5,13 @@
  * the middle of a frame. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "ob_renderer_layer.h"
 #include "ob_test_adopt.h"
 #include "ob_test_world.h"
 
@@ -174,6 +177,101 @@ static void only_active_workers_record(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A parallel loop's indices on the pool (ob_renderer_parallel): each runs
+ * exactly once, whatever the count and the active workers. Each thread
+ * starts on its own block of the indices (the render thread, loop thread
+ * 0, on the first) and takes it from the front; a thread held up in its
+ * block has the rest of it taken by the others, from the back. */
+#define PROBE_MAX 1000u
+
+typedef struct loop_probe {
+    atomic_uint runs[PROBE_MAX];
+    atomic_uint thread_of[PROBE_MAX];
+    atomic_bool stolen;         /* an index of block 0 ran on a pool thread */
+    uint32_t block0_end;
+    bool hold_first;            /* index 0 waits until that happened */
+} loop_probe;
+
+static void probe_task(void *user, uint32_t i, uint32_t thread)
+{
+    loop_probe *p = user;
+    atomic_fetch_add(&p->runs[i], 1u);
+    atomic_store(&p->thread_of[i], thread);
+    if (i < p->block0_end && thread != 0) atomic_store(&p->stolen, true);
+    if (!p->hold_first || i != 0) return;
+    /* At most 10 s: a pool thread must wake, finish its own block and steal. */
+    for (int k = 0; k < 200000 && !atomic_load(&p->stolen); k++)
+        nanosleep(&(struct timespec){.tv_nsec = 50000}, NULL);
+}
+
+static void probe_reset(loop_probe *p, uint32_t count, uint32_t threads, bool hold)
+{
+    for (uint32_t i = 0; i < PROBE_MAX; i++) {
+        atomic_init(&p->runs[i], 0u);
+        atomic_init(&p->thread_of[i], UINT32_MAX);
+    }
+    atomic_init(&p->stolen, false);
+    p->block0_end = count / threads;
+    p->hold_first = hold;
+}
+
+/* Block b of a loop of `count` indices on n threads (one block for each
+ * thread that may take part) was taken by its owner, thread b, from the
+ * front and by the others from the back: the indices its owner ran come
+ * first. */
+static void check_blocks(const loop_probe *p, uint32_t count, uint32_t n)
+{
+    uint32_t blocks = n < count ? n : count;
+    for (uint32_t b = 0; b < blocks; b++) {
+        uint32_t first = (uint32_t)((uint64_t)count * b / blocks);
+        uint32_t end = (uint32_t)((uint64_t)count * (b + 1) / blocks);
+        bool others = false;
+        for (uint32_t i = first; i < end; i++) {
+            bool own = atomic_load(&p->thread_of[i]) == b;
+            if (own && others)
+                fail_msg("%u threads, %u indices: block %u's index %u ran on its owner after "
+                         "an earlier one ran elsewhere", n, count, b, i);
+            others |= !own;
+        }
+    }
+}
+
+static void parallel_loops_run_each_index_once(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4});
+    static loop_probe p;
+    static const uint32_t counts[] = {1, 2, 3, 5, 17, 64, PROBE_MAX};
+    for (uint32_t n = 1; n <= 4; n++) {
+        assert_int_equal(ob_renderer_set_threading(w.r, OB_THREADING_MULTI, n), OB_OK);
+        for (size_t k = 0; k < OB_ARRAY_COUNT(counts); k++) {
+            ob_parallel par = ob_renderer_parallel(w.r);
+            assert_int_equal(par.threads, n);
+            probe_reset(&p, counts[k], n, false);
+            ob_parallel_run(&par, counts[k], probe_task, &p);
+            for (uint32_t i = 0; i < counts[k]; i++)
+                if (atomic_load(&p.runs[i]) != 1)
+                    fail_msg("%u threads, %u indices: index %u ran %u times", n, counts[k], i,
+                             atomic_load(&p.runs[i]));
+            for (uint32_t i = counts[k]; i < PROBE_MAX; i++) assert_int_equal(atomic_load(&p.runs[i]), 0);
+            for (uint32_t i = 0; i < counts[k]; i++) assert_true(atomic_load(&p.thread_of[i]) < n);
+            if (n > 1) check_blocks(&p, counts[k], n);
+        }
+    }
+    /* Four threads, 64 indices: the render thread begins its block (16)
+     * and holds on its first index until a pool thread has taken one of
+     * the other 15, which only stealing does. */
+    probe_reset(&p, 64, 4, true);
+    ob_parallel par = ob_renderer_parallel(w.r);
+    ob_parallel_run(&par, 64, probe_task, &p);
+    assert_int_equal(atomic_load(&p.thread_of[0]), 0);
+    assert_true(atomic_load(&p.stolen));
+    for (uint32_t i = 0; i < 64; i++) assert_int_equal(atomic_load(&p.runs[i]), 1);
+    check_blocks(&p, 64, 4);
+    ob_test_world_destroy(&w);
+}
+
 /* Renderer creation failing at each host allocation and each Vulkan object
  * creation in turn: a NULL renderer and an error, no thread left running, no
  * memory left (ASan), no validation message from the half-built device. */
@@ -230,6 +328,7 @@ int main(void)
         cmocka_unit_test(threading_change_takes_effect_at_next_frame),
         cmocka_unit_test(only_active_workers_record),
         cmocka_unit_test(auto_measures_both_ways),
+        cmocka_unit_test(parallel_loops_run_each_index_once),
         cmocka_unit_test(failed_creation_leaves_no_worker_behind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
