@@ -17,7 +17,8 @@
 /* The median round trip, in ns, of a cache line written in turn by two
  * threads pinned to two different CPUs of the process's set (the first
  * two): 5 batches of 20,000 round trips, some 50 ms at 500 ns. NAN with
- * fewer than two CPUs, or when a thread cannot be started or pinned. */
+ * fewer than two CPUs, when a thread cannot be started or pinned, or when
+ * the whole takes over 2 s (the threads could not run at once). */
 double ob_bench_core_to_core_ns(void);
 
 #endif /* OB_BENCH_MACHINE_H */
