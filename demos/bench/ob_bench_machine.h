@@ -5,8 +5,8 @@
  * (450-520 ns), and the placement changes within minutes while the
  * single-threaded figures stay put. Every multithreaded figure follows it:
  * the parallel frame hands each entity's data from thread to thread
- * (session 23: frame_cpu_speedup 1.80-1.83 close, 1.34-1.58 far, the same
- * binary). So the benchmark measures it at its start and end and prints it
+ * (session 23, 8 views x 10k: frame_cpu_speedup's median 1.74 close and
+ * 1.51 far over 24 interleaved runs, docs/benchmark.md). So the benchmark measures it at its start and end and prints it
  * next to the figures, as it does the load average.
  *
  * Thread rule: call from one thread; it starts and joins one of its own.
