@@ -420,12 +420,10 @@ ob_result ob_renderer_begin_frame(ob_renderer *r, ob_scene *scene)
     /* The pool threads the frame's loops will use slept since the last
      * frame: woken now, they poll by the time PreRender hands out its first
      * loop (waking one costs some 30-50 us on a 2-core VM, which the rest of
-     * begin_frame and the views' PreRender set-up cover), having first reset
-     * the slot's worker command pools, which the fence above covers. Only
-     * when the last frame handed work out: a small scene's frame runs on
-     * the caller, its workers' pools reset where they are next used. */
+     * begin_frame and the views' PreRender set-up cover). Only when the last
+     * frame handed work out: a small scene's frame runs on the caller. */
     if (r->pending_mode != OB_THREADING_SINGLE && r->frame_used_pool)
-        ob_renderer_workers_prepare(r, ob_renderer_parallel_threads(r));
+        ob_renderer_workers_nudge(r, ob_renderer_parallel_threads(r));
     r->handed_out = false;
     collect_frame(r, fs, &gpu_wait_ns);
     r->serial++;

@@ -43,9 +43,7 @@ typedef struct ob_job {
  * thread itself (it would otherwise sleep while the others record). Only the
  * thread recording a batch touches this state; batches are handed over
  * by hand_out (a ticket the thread polls for, a semaphore once it sleeps),
- * so one thread at a time. Between frames a pool thread may reset the
- * slot's pool of any worker (ob_renderer_workers_prepare); recording waits
- * for those resets first. */
+ * so one thread at a time. */
 typedef struct ob_worker {
     ob_renderer *renderer;
     pthread_t thread;
@@ -58,8 +56,6 @@ typedef struct ob_worker {
     uint32_t seen;              /* tickets it took (its own thread only) */
     atomic_uint gen;            /* the batch its last ticket was for (batch_state's) */
     uint32_t gen_taken;         /* the last batch it looked at (its own thread only) */
-    atomic_int prep;            /* 1: reset its share of the slot's pools (see prepare) */
-    uint64_t prep_cpu_ns;       /* thread CPU time of its last such reset */
     sem_t go;
     bool go_ready;
     uint32_t index;             /* 1-based: parameter slot and pair index */
@@ -214,12 +210,6 @@ struct ob_renderer {
      * nothing when the work is already done. */
     atomic_ullong batch_state;
     uint32_t batch_gen;
-    /* The pools begin_frame has the pool threads reset (see
-     * ob_renderer_workers_prepare): slot prep_slot's of workers
-     * 0..prep_workers-1, worker k's by pool thread k % prep_threads;
-     * prep_pending counts the pool threads not done yet. */
-    uint32_t prep_slot, prep_workers, prep_threads;
-    atomic_uint prep_pending;
     sem_t done;
     bool done_ready;
     atomic_uint next_job;
@@ -243,13 +233,6 @@ ob_result ob_renderer_workers_start(ob_renderer *r);
 /* Wakes pool threads 1..threads-1 that sleep, without a batch: they poll
  * for one as after a batch, so that the next hand-out finds them awake. */
 void ob_renderer_workers_nudge(ob_renderer *r, uint32_t threads);
-/* For a frame that will use `threads` threads, once the slot's fence has
- * signalled: the pool threads reset the slot's command pools of workers
- * 0..threads-1 that hold commands, while the render thread goes on with
- * begin_frame and the views' PreRender set-up (lavapipe frees every
- * command a pool holds, some 40 us a worker at 8 views x 10k objects).
- * Nudges the threads when there is nothing to reset. [render thread] */
-void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads);
 void ob_renderer_workers_stop(ob_renderer *r);
 ob_result ob_renderer_record_frame(ob_renderer *r, ob_view **order, uint32_t count);
 /* Keep img's tracked state from before this frame's first barrier on it, so

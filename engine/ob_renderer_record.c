@@ -15,7 +15,6 @@ static ob_result worker_init(ob_renderer *r, ob_worker *w, uint32_t index)
     w->cpu = -1;
     atomic_init(&w->ticket, 0u);
     atomic_init(&w->gen, 0u);
-    atomic_init(&w->prep, 0);
     atomic_init(&w->sleeping, 0);
     w->seen = 0;
     w->gen_taken = 0;
@@ -65,13 +64,13 @@ static void worker_release(ob_renderer *r, ob_worker *w)
 }
 
 /* Next secondary command buffer of this worker for the current frame slot
- * (allocated once, reused every time the slot comes round). The slot's pool
- * is usually reset already, by a pool thread in begin_frame
- * (ob_renderer_workers_prepare); otherwise (the first frame on the workers,
- * a reset that failed there) the frame's first buffer resets it here, on
- * the thread that records into it: lavapipe walks every command the pool
- * holds to free it (some 40 us a worker at 8 views x 10k objects). The
- * slot's fence was waited for in begin_frame, so nothing in it is pending. On failure
+ * (allocated once, reused every time the slot comes round). The frame's
+ * first buffer resets the slot's pool, on the thread that records into it:
+ * lavapipe walks every command the pool holds to free it (some 40 us a
+ * worker at 8 views x 10k objects), so each recording thread pays for its
+ * own. (Reset ahead by the pool threads in begin_frame, the resets made
+ * them join PreRender's culling wave 50-250 us late on the 2-core VM.)
+ * The slot's fence was waited for in begin_frame, so nothing in it is pending. On failure
  * returns VK_NULL_HANDLE with *out_result set and logged. */
 static VkCommandBuffer worker_next_cmd(ob_renderer *r, ob_worker *w, ob_result *out_result)
 {
@@ -228,9 +227,10 @@ static uint32_t task_take_back(ob_task_block *b)
 /* Indices of the running parallel loop. `thread` is the caller's loop
  * thread number (0 = the render thread, pool thread i is i), which is also
  * its home block: the same share of every loop's indices, frame after
- * frame. The update's loops and culling cut the entities into indices
- * alike (in id order), so a thread updates, culls and, next frame,
- * updates again the entities whose data its own caches hold. Taken first
+ * frame. The update's loops cut the entities in id order, so a thread
+ * updates, next frame, the entities whose data its own caches hold; the
+ * culling wave numbers its chunks view by view, so a thread culls and
+ * sorts whole views (ob_view.c's cull_wave). Taken first
  * come, first served, an index went to either thread, and each entity's
  * lines moved between the cores: on the 2-core VM while its cores were far
  * apart (a cache line's round trip 450-500 ns), the update at 8 views x
@@ -323,7 +323,7 @@ static void wake_sleeper(atomic_int *flag, sem_t *sem)
     if (atomic_load(flag) == 1 && atomic_compare_exchange_strong(flag, &one, 0)) sem_post(sem);
 }
 
-/* Hands worker w a ticket: what it is for (w->gen, w->prep, the quit) is
+/* Hands worker w a ticket: what it is for (w->gen, the quit) is
  * stored before, and the ticket releases it. */
 static void worker_ticket(ob_worker *w)
 {
@@ -371,57 +371,6 @@ void ob_renderer_workers_nudge(ob_renderer *r, uint32_t threads)
         if (r->workers[i].started) wake_sleeper(&r->workers[i].sleeping, &r->workers[i].go);
 }
 
-/* Waits for the pool threads' resets of the last prepare (done long before
- * on any frame that records: they run while the render thread sets up). */
-static void prepare_wait(ob_renderer *r)
-{
-    for (uint32_t k = 1; atomic_load_explicit(&r->prep_pending, memory_order_acquire) != 0; k++) {
-        if ((k & 255u) == 0) sched_yield();
-        else cpu_relax();
-    }
-}
-
-void ob_renderer_workers_prepare(ob_renderer *r, uint32_t threads)
-{
-    prepare_wait(r);
-    uint32_t n = OB_MIN(threads, r->worker_count), helpers = OB_MIN(threads - 1, r->worker_count);
-    bool holding = false, started = true;
-    for (uint32_t k = 0; k < n; k++) holding |= r->workers[k].pool_recorded[r->slot];
-    for (uint32_t i = 0; i < helpers; i++) started &= r->workers[i].started;
-    if (threads < 2 || !holding || !started) {
-        ob_renderer_workers_nudge(r, threads);
-        return;
-    }
-    r->prep_slot = r->slot;
-    r->prep_workers = n;
-    r->prep_threads = helpers;
-    atomic_store(&r->prep_pending, helpers);
-    for (uint32_t i = 0; i < helpers; i++) {
-        ob_worker *w = &r->workers[i];
-        /* release: a thread still awake from its last ticket may take the
-         * flag before this ticket, and must then see prep_slot and the rest */
-        atomic_store_explicit(&w->prep, 1, memory_order_release);
-        worker_ticket(w); /* gen stays, so no batch is joined */
-    }
-}
-
-/* Pool thread w's share of a prepare: the pools of workers k = its own
- * index, then every prep_threads-th. A reset that fails is left to
- * worker_next_cmd, which tries again and reports it. */
-static void worker_prepare(ob_renderer *r, ob_worker *w)
-{
-    uint64_t c0 = ob_thread_cpu_ns();
-    VkDevice vk = ob_device_vk(r->dev);
-    uint32_t f = r->prep_slot;
-    for (uint32_t k = w->index - 1; k < r->prep_workers; k += r->prep_threads) {
-        ob_worker *o = &r->workers[k];
-        if (o->pool_recorded[f] && vkResetCommandPool(vk, o->pools[f], 0) == VK_SUCCESS)
-            o->pool_recorded[f] = false;
-    }
-    w->prep_cpu_ns = ob_thread_cpu_ns() - c0;
-    atomic_fetch_sub_explicit(&r->prep_pending, 1u, memory_order_release);
-}
-
 /* A pool thread's batch is done (its results written before). */
 static void worker_finished(ob_renderer *r)
 {
@@ -447,7 +396,6 @@ static void *worker_main(void *arg)
     ob_renderer *r = w->renderer;
     for (;;) {
         worker_wait(w);
-        if (atomic_exchange(&w->prep, 0)) worker_prepare(r, w);
         if (atomic_load_explicit(&r->quit, memory_order_relaxed)) break;
         if (!worker_join(r, w)) continue;
         if (r->task_fn) {
@@ -553,7 +501,6 @@ ob_result ob_renderer_workers_start(ob_renderer *r)
             if (CPU_ISSET(c, &allowed)) r->cpus[r->cpu_count++] = c;
     atomic_init(&r->finished, 0u);
     atomic_init(&r->batch_state, 0ull);
-    atomic_init(&r->prep_pending, 0u);
     atomic_init(&r->quit, false);
     atomic_init(&r->hold_awake, false);
     atomic_init(&r->waiting, 0);
@@ -578,7 +525,6 @@ ob_result ob_renderer_workers_start(ob_renderer *r)
 
 void ob_renderer_workers_stop(ob_renderer *r)
 {
-    prepare_wait(r);
     atomic_store_explicit(&r->quit, true, memory_order_relaxed); /* the tickets below release it */
     for (uint32_t i = 0; i < r->worker_count; i++)
         if (r->workers[i].started) worker_wake(&r->workers[i], 0);
@@ -1074,7 +1020,6 @@ static ob_result record_frame(ob_renderer *r, ob_view **order, uint32_t count)
     VkDevice vk = ob_device_vk(r->dev);
     VkResult vr;
     uint64_t cpu0 = ob_thread_cpu_ns();
-    prepare_wait(r); /* the pool threads' resets are done before anything reads the pools */
     uint64_t allocs0 = cmd_allocations(r);
     bool is_auto = r->mode == OB_THREADING_AUTO;
     bool multi = r->mode == OB_THREADING_MULTI || (is_auto && r->auto_multi);
@@ -1102,15 +1047,9 @@ static ob_result record_frame(ob_renderer *r, ob_view **order, uint32_t count)
             if (w->error != OB_OK && res == OB_OK) res = w->error;
             w->error = OB_OK;
             /* The render thread's share is in its own CPU time. */
-            if (i + 1 < active) st->record_cpu_ns[i + 1] = w->cpu_ns + w->prep_cpu_ns;
+            if (i + 1 < active) st->record_cpu_ns[i + 1] = w->cpu_ns;
             w->cpu_ns = 0;
         }
-    }
-    /* The pool threads' resets of the slot's pools (begin_frame) are theirs,
-     * outside any hand-out: recording's driver work. */
-    for (uint32_t i = 0; i < r->worker_count; i++) {
-        st->cpu_pool_ns += r->workers[i].prep_cpu_ns;
-        r->workers[i].prep_cpu_ns = 0;
     }
     st->record_ns = multi ? ob_time_ns() - t_record : 0;
 
