@@ -538,6 +538,7 @@ bool ob_renderer_queue_view(ob_renderer *r, ob_view *v)
     v->lod_items = 0;
     v->material_count = 0;    /* what culling knew is last frame's until it runs */
     v->material_items_valid = false;
+    v->cull_thread = OB_VIEW_NO_THREAD;
     r->queued_by[r->queue_count] = consumer ? queue_index(r, consumer) : -1;
     r->queue[r->queue_count++] = v;
     if (consumer) ob_view_add_dependency(consumer, v);

@@ -35,6 +35,8 @@ typedef struct ob_job {
     ob_pipeline_manager_stats stats;
     uint64_t record_ns;
     int32_t worker;
+    uint32_t home;              /* the recording thread it goes to first (record_batch) */
+    atomic_bool taken;          /* claimed by a recording thread this frame */
 } ob_job;
 
 /* Worker i's recording state: pipeline manager i (parameter slot i), a
@@ -212,7 +214,6 @@ struct ob_renderer {
     uint32_t batch_gen;
     sem_t done;
     bool done_ready;
-    atomic_uint next_job;
     atomic_bool quit;           /* read by a pool thread on any ticket, joined or not */
     atomic_bool hold_awake;     /* pool threads poll on past POOL_SPIN_NS (see run_jobs) */
 

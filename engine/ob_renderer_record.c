@@ -179,18 +179,33 @@ static void record_job(ob_renderer *r, ob_worker *w, ob_job *job)
     job->record_ns = ob_time_ns() - t0;
 }
 
-/* Worker w's share of the frame's jobs, taken one at a time from the shared
- * counter until none is left (biggest first: build_jobs sorted them). Runs
- * on w's pool thread or on the render thread. */
-static void record_batch(ob_renderer *r, ob_worker *w)
+/* Job j for the calling thread, unless another took it. */
+static bool job_claim(ob_renderer *r, uint32_t j)
+{
+    return !atomic_load_explicit(&r->jobs[j].taken, memory_order_relaxed) &&
+           !atomic_exchange_explicit(&r->jobs[j].taken, true, memory_order_relaxed);
+}
+
+/* Worker w's share of the frame's jobs, recorded by the loop thread
+ * `thread` (0: the render thread, i: pool thread i): first the jobs whose
+ * home it is (the views whose culling it finished, so whose draw items its
+ * caches hold) and those with none, biggest first (build_jobs sorted
+ * them); then, from the smallest up, the ones left of the other threads'.
+ * Taken from one shared list in cost order instead, each thread read half
+ * its items from the other core. Runs on w's pool thread or on the render
+ * thread. */
+static void record_batch(ob_renderer *r, ob_worker *w, uint32_t thread)
 {
     uint64_t c0 = ob_thread_cpu_ns();
     w->cmd_used = 0;
-    for (;;) {
-        uint32_t j = atomic_fetch_add_explicit(&r->next_job, 1, memory_order_relaxed);
-        if (j >= r->job_count) break;
-        record_job(r, w, &r->jobs[j]);
+    uint32_t n = r->job_count;
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t home = r->jobs[j].home;
+        if ((home == thread || home == OB_VIEW_NO_THREAD) && job_claim(r, j))
+            record_job(r, w, &r->jobs[j]);
     }
+    for (uint32_t j = n; j-- > 0;)
+        if (job_claim(r, j)) record_job(r, w, &r->jobs[j]);
     w->cpu_ns = ob_thread_cpu_ns() - c0;
 }
 
@@ -403,7 +418,7 @@ static void *worker_main(void *arg)
             run_tasks(r, w->index);
             w->cpu_ns = ob_thread_cpu_ns() - c0;
         } else {
-            record_batch(r, w);
+            record_batch(r, w, w->index);
         }
         worker_finished(r);
     }
@@ -563,7 +578,7 @@ static void place_workers(ob_renderer *r, uint32_t helpers)
 /* Hand the frame's jobs to the active workers and wait for all. Only the
  * pool threads that have a job to take are woken; the render thread records
  * the last active worker's share instead of sleeping. */
-static void own_jobs(ob_renderer *r, void *worker) { record_batch(r, worker); }
+static void own_jobs(ob_renderer *r, void *worker) { record_batch(r, worker, 0); }
 
 static void run_jobs(ob_renderer *r, uint32_t active)
 {
@@ -573,7 +588,7 @@ static void run_jobs(ob_renderer *r, uint32_t active)
      * asleep, lavapipe's vkQueueSubmit2, waking its queue thread onto it,
      * took 42 us instead of 7 on the 2-core VM (medians at 8 views x 10k). */
     atomic_store_explicit(&r->hold_awake, true, memory_order_relaxed);
-    atomic_store_explicit(&r->next_job, 0, memory_order_relaxed);
+    for (uint32_t j = 0; j < r->job_count; j++) atomic_init(&r->jobs[j].taken, false);
     hand_out(r, OB_MIN(active - 1, r->job_count - 1), own_jobs, &r->workers[active - 1]);
 }
 
@@ -697,6 +712,7 @@ static ob_result build_jobs(ob_renderer *r, ob_view **order, uint32_t count, uin
                     .count = end - first,
                     .predicted_ns = (compute || v->custom_record) ? 20000 : per_item * (end - first),
                     .worker = -1,
+                    .home = v->cull_thread < active ? v->cull_thread : OB_VIEW_NO_THREAD,
                 };
             }
         }

@@ -37,6 +37,7 @@ void ob_view_init(ob_view *v, const ob_view_vtbl *vtbl, ob_view_type type, const
     snprintf(v->name, sizeof v->name, "%s", name ? name : ob_view_type_name(type));
     v->id = (uint32_t)ob_hash_str(OB_HASH_SEED, v->name);
     v->layer_count = 1;
+    v->cull_thread = OB_VIEW_NO_THREAD;
 }
 
 static VkFormat image_format(const ob_device *dev, ob_image img)
@@ -546,6 +547,7 @@ typedef struct cull_view {
 typedef struct cull_wave {
     cull_view *views;
     uint32_t chunks, view_count;
+    bool parallel;              /* on the pool: the finishing thread is noted */
 } cull_wave;
 
 /* The frustum test's width for v: the widest the CPU has, unless the
@@ -578,6 +580,7 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
     v->material_count = 0;
     v->material_items_valid = false;
     v->cull_ns = 0;
+    v->cull_thread = OB_VIEW_NO_THREAD;
     cv->count = count;
     if (!mi) return OB_ERR_WRONG_STATE;
     uint32_t chunks = (count + grain - 1) / grain;
@@ -618,9 +621,10 @@ static ob_result cull_setup(cull_view *cv, ob_renderer *r, const ob_scene *scene
 
 /* A view's sort (of its chunks' pieces in chunk order, so ascending id),
  * draw items and list of one item per material. */
-static void wave_finish_view(const cull_wave *w, cull_view *cv)
+static void wave_finish_view(const cull_wave *w, cull_view *cv, uint32_t thread)
 {
     ob_view *v = cv->v;
+    v->cull_thread = w->parallel ? thread : OB_VIEW_NO_THREAD;
     uint64_t t0 = ob_time_ns();
     ob_sort_pair *pairs = cv->c.pairs, *other = pairs + OB_MAX(cv->count, 1u);
     const cull_payload *payload = cv->c.payload;
@@ -687,7 +691,7 @@ static void wave_chunk_task(void *user, uint32_t task, uint32_t thread)
      * wake of the pool between; each thread takes its chunks view by
      * view, so its first views finish first. */
     if (atomic_fetch_sub_explicit(&cv->chunks_left, 1, memory_order_acq_rel) == 1)
-        wave_finish_view(w, cv);
+        wave_finish_view(w, cv, thread);
 }
 
 /* The entities of a view beyond float range, logged on the caller in view
@@ -788,11 +792,12 @@ ob_result ob_view_cull_many(ob_renderer *r, const ob_scene *scene, ob_view *cons
         if (cv->res != OB_OK && first_error == OB_OK) first_error = cv->res;
     }
     if (!parallel) par.threads = 1;
+    w.parallel = par.threads > 1;
     ob_parallel_run(&par, w.chunks * count, wave_chunk_task, &w);
     for (uint32_t k = 0; k < count; k++) {
         cull_view *cv = &w.views[k];
         if (cv->res != OB_OK) continue;
-        if (w.chunks == 0) wave_finish_view(&w, cv); /* no entities: an empty list */
+        if (w.chunks == 0) wave_finish_view(&w, cv, 0); /* no entities: an empty list */
         wave_report_far(&w, cv);
         cv->v->cull_ns = cv->ns;
     }

@@ -48,6 +48,7 @@ const char *ob_view_type_name(ob_view_type t);
 #define OB_VIEW_MAX_DEPS 128
 #define OB_VIEW_MAX_INPUTS 8
 #define OB_VIEW_MAX_LAYERS 6
+#define OB_VIEW_NO_THREAD UINT32_MAX  /* ob_view.cull_thread: none */
 
 typedef struct ob_view ob_view;
 
@@ -206,6 +207,11 @@ struct ob_view {
     uint64_t queued_frame;            /* renderer frame serial when last queued */
     uint64_t cost_ns;                 /* measured recording cost last time (chunking) */
     uint64_t cull_ns;                 /* this frame's ob_view_cull time */
+    /* The parallel loop's thread (0: the render thread, i: pool thread i)
+     * that finished this frame's culling, so holds the draw items in its
+     * caches; recording prefers it (build_jobs). OB_VIEW_NO_THREAD: culled
+     * inline, or not this frame. */
+    uint32_t cull_thread;
     /* Tests' switch: culling's frustum test as wide as the CPU allows (0),
      * at most four entities at a time (4), or one at a time (1). The same
      * entities are kept whichever. */
