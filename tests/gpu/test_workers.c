@@ -188,8 +188,9 @@ typedef struct loop_probe {
     atomic_uint runs[PROBE_MAX];
     atomic_uint thread_of[PROBE_MAX];
     atomic_bool stolen;         /* an index of block 0 ran on a pool thread */
+    atomic_bool held;           /* the render thread began its first index */
     uint32_t block0_end;
-    bool hold_first;            /* index 0 waits until that happened */
+    bool hold_first;            /* the render thread's first index waits until stolen */
 } loop_probe;
 
 static void probe_task(void *user, uint32_t i, uint32_t thread)
@@ -198,7 +199,9 @@ static void probe_task(void *user, uint32_t i, uint32_t thread)
     atomic_fetch_add(&p->runs[i], 1u);
     atomic_store(&p->thread_of[i], thread);
     if (i < p->block0_end && thread != 0) atomic_store(&p->stolen, true);
-    if (!p->hold_first || i != 0) return;
+    /* Whichever index the render thread runs first: index 0 unless the
+     * pool threads, running while it was not, took all of its block. */
+    if (!p->hold_first || thread != 0 || atomic_exchange(&p->held, true)) return;
     /* At most 10 s: a pool thread must wake, finish its own block and steal. */
     for (int k = 0; k < 200000 && !atomic_load(&p->stolen); k++)
         nanosleep(&(struct timespec){.tv_nsec = 50000}, NULL);
@@ -211,6 +214,7 @@ static void probe_reset(loop_probe *p, uint32_t count, uint32_t threads, bool ho
         atomic_init(&p->thread_of[i], UINT32_MAX);
     }
     atomic_init(&p->stolen, false);
+    atomic_init(&p->held, false);
     p->block0_end = count / threads;
     p->hold_first = hold;
 }
@@ -261,11 +265,14 @@ static void parallel_loops_run_each_index_once(void **state)
     }
     /* Four threads, 64 indices: the render thread begins its block (16)
      * and holds on its first index until a pool thread has taken one of
-     * the other 15, which only stealing does. */
+     * the others, which only stealing does. (On a loaded machine the pool
+     * threads may run before the render thread takes any index, and then
+     * take its whole block: stolen all the same, and still from the back,
+     * which check_blocks sees. Asserting that index 0 ran on the render
+     * thread failed that way once in the address sanitizer's suite.) */
     probe_reset(&p, 64, 4, true);
     ob_parallel par = ob_renderer_parallel(w.r);
     ob_parallel_run(&par, 64, probe_task, &p);
-    assert_int_equal(atomic_load(&p.thread_of[0]), 0);
     assert_true(atomic_load(&p.stolen));
     for (uint32_t i = 0; i < 64; i++) assert_int_equal(atomic_load(&p.runs[i]), 1);
     check_blocks(&p, 64, 4);
