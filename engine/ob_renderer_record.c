@@ -338,19 +338,13 @@ static void wake_sleeper(atomic_int *flag, sem_t *sem)
     if (atomic_load(flag) == 1 && atomic_compare_exchange_strong(flag, &one, 0)) sem_post(sem);
 }
 
-/* Hands worker w a ticket: what it is for (w->gen, the quit) is
- * stored before, and the ticket releases it. */
-static void worker_ticket(ob_worker *w)
-{
-    atomic_fetch_add(&w->ticket, 1u);
-    wake_sleeper(&w->sleeping, &w->go);
-}
-
-/* Gives worker w its next batch (or the quit), set up in r beforehand. */
+/* Gives worker w its next batch (or the quit), set up in r beforehand: a
+ * ticket, which releases what was stored before it (gen, the quit). */
 static void worker_wake(ob_worker *w, uint32_t gen)
 {
     atomic_store_explicit(&w->gen, gen, memory_order_relaxed);
-    worker_ticket(w);
+    atomic_fetch_add(&w->ticket, 1u);
+    wake_sleeper(&w->sleeping, &w->go);
 }
 
 #define BATCH_CLOSED (1ull << 31)
