@@ -215,6 +215,10 @@ static void broken(tally *t, const char *where, ob_fault_kind kind, uint64_t n, 
 /* Walks every point of `kind` in `ph`; fails the test on the first broken rule. */
 static void walk(phase ph, bool multi, ob_fault_kind kind, const reference *ref)
 {
+    /* Start-up creates and joins the worker threads (and unwinds a pool
+     * half made): the thread sanitizer walks it. The rest of a
+     * single-threaded walk runs on the render thread alone. */
+    if (!multi && ph != PHASE_START) ob_test_skip_under_tsan("a single-threaded walk");
     outcome o;
     run_phase(ph, multi, kind, 0, ref, &o);
     if (o.result != OB_OK) fail_msg("%s: unarmed run failed: %s", phase_names[ph], ob_result_name(o.result));
@@ -266,6 +270,7 @@ static void walk(phase ph, bool multi, ob_fault_kind kind, const reference *ref)
  * scene and start-up phases do not depend on the kind. */
 static void cube_walk(void **state, phase ph, bool multi, ob_fault_kind kind)
 {
+    if (!multi) ob_test_skip_under_tsan("a single-threaded walk");
     reference cube = *(reference *)*state;
     cube.env_map_kind = OB_ENV_MAP_CUBE;
     make_reference(&cube);

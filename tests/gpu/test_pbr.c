@@ -926,6 +926,7 @@ static pbr_outcome pbr_fault_run(const ob_test_vulkan *tv, bool scene, ob_fault_
 static void pbr_scene_survives_every_fault(void **state)
 {
     (void)state;
+    ob_test_skip_under_tsan("every point runs single-threaded");
     /* Each point costs a whole stack (~0.5 s here): every `stride`th point
      * and the last are walked; OB_PBR_FAULT_STRIDE=1 walks them all (it
      * passed when this test was written: 622 points). */

@@ -61,6 +61,21 @@ void ob_test_assert_near(double a, double b, double tol, const char *expr, const
                          int line);
 #define assert_near(a, b, tol) ob_test_assert_near((a), (b), (tol), #a " ~ " #b, __FILE__, __LINE__)
 
+/* Skips the calling test in the thread sanitizer build (tests/CMakeLists.txt
+ * defines OB_TEST_TSAN there): for a fault walk that runs on the render
+ * thread alone, where that sanitizer has no race to find and each point
+ * costs a whole stack several times over. The plain and address builds walk
+ * it (leaks, memory errors, the pictures after each fault). */
+#ifdef OB_TEST_TSAN
+#define ob_test_skip_under_tsan(why)                                                     \
+    do {                                                                                 \
+        print_message("[ skipped  ] under the thread sanitizer: %s\n", why);            \
+        skip();                                                                          \
+    } while (0)
+#else
+#define ob_test_skip_under_tsan(why) ((void)0)
+#endif
+
 /* Largest absolute per-channel difference of two RGBA8 images. */
 uint32_t ob_test_image_max_diff(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h);
 
