@@ -505,6 +505,7 @@ static void test_load_model_lods(void **state)
  * the pyramid left out. */
 static void walk_load_faults(ob_fault_kind kind)
 {
+    ob_test_skip_under_tsan("a load runs on the calling thread alone");
     ob_heap_stats before = ob_heap_stats_now();
     ob_scene_file sf;
     ob_scene_file_error err;
