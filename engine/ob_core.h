@@ -282,6 +282,14 @@ int ob_env_choice(const char *name, const char *const *words, uint32_t count, co
  * thread count are written per index and combined in index order. */
 typedef void (*ob_task_fn)(void *user, uint32_t index, uint32_t thread);
 
+/* Help a loop's thread may give once no index is left to take: work the
+ * indices made that any thread may share (a big view's draw list to
+ * gather), or a short wait for some. Returns false when there is none and
+ * none is coming. Only an offer: every piece of that work must also be
+ * done by the thread that made it, so that the loop is complete whether
+ * helpers come or not, and its results must not depend on who helped. */
+typedef bool (*ob_idle_fn)(void *user, uint32_t thread);
+
 /* A way to run a parallel loop: run(ctx, count, fn, user) calls fn once for
  * every index in [0, count), on at most `threads` threads, and returns when
  * all calls are done. The renderer lends its worker pool this way
@@ -294,6 +302,9 @@ typedef struct ob_parallel {
      * half of what each thread must get for a loop worth handing out; 0:
      * the caller's own default. */
     uint32_t grain;
+    /* run, with every thread calling idle after its last index until it
+     * returns false; NULL: run, then idle on the caller alone. */
+    void (*run_helped)(void *ctx, uint32_t count, ob_task_fn fn, ob_idle_fn idle, void *user);
 } ob_parallel;
 
 /* Whether a loop over `items` (grain per index) is worth handing to par:
@@ -314,6 +325,19 @@ static inline void ob_parallel_run(const ob_parallel *par, uint32_t count, ob_ta
         return;
     }
     for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
+}
+
+/* ob_parallel_run, with the threads helping through idle once the indices
+ * are gone (ob_idle_fn). [any thread] */
+static inline void ob_parallel_run_helped(const ob_parallel *par, uint32_t count, ob_task_fn fn,
+                                          ob_idle_fn idle, void *user)
+{
+    if (par && par->run_helped && par->threads > 1 && count > 1) {
+        par->run_helped(par->ctx, count, fn, idle, user);
+        return;
+    }
+    ob_parallel_run(par, count, fn, user);
+    while (idle(user, 0)) {}
 }
 
 /* Read a whole file into a NUL-terminated buffer (ob_free it). Only a

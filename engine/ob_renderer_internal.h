@@ -181,6 +181,7 @@ struct ob_renderer {
      * indices are cut into one contiguous block per thread of the loop
      * (task_blocks), its home: see run_tasks. */
     ob_task_fn task_fn;
+    ob_idle_fn task_idle;       /* the loop's help after its indices, or NULL */
     void *task_user;
     uint32_t task_block_count;
     ob_task_block task_blocks[OB_MAX_WORKERS + 1];

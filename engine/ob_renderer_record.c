@@ -239,6 +239,15 @@ static uint32_t task_take_back(ob_task_block *b)
     }
 }
 
+static inline void cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    __asm__ __volatile__("yield" ::: "memory");
+#endif
+}
+
 /* Indices of the running parallel loop. `thread` is the caller's loop
  * thread number (0 = the render thread, pool thread i is i), which is also
  * its home block: the same share of every loop's indices, frame after
@@ -263,6 +272,8 @@ static void run_tasks(ob_renderer *r, uint32_t thread)
         ob_task_block *b = &r->task_blocks[(home + k) % blocks];
         for (uint32_t i; (i = task_take_back(b)) != TASK_NONE;) r->task_fn(r->task_user, i, thread);
     }
+    if (r->task_idle)
+        while (r->task_idle(r->task_user, thread)) cpu_relax();
 }
 
 /* How long a pool thread polls for its next batch, and the render thread
@@ -274,14 +285,6 @@ static void run_tasks(ob_renderer *r, uint32_t thread)
  * come costs at most this much CPU before the thread sleeps. */
 #define POOL_SPIN_NS 100000u
 
-static inline void cpu_relax(void)
-{
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#elif defined(__aarch64__)
-    __asm__ __volatile__("yield" ::: "memory");
-#endif
-}
 
 /* How long at most a pool thread polls while the render thread holds the
  * pool awake (ob_renderer.hold_awake), in case it never lets go. */
@@ -463,20 +466,23 @@ static void own_tasks(ob_renderer *r, void *arg)
 }
 
 /* ob_parallel's run for the pool: pool threads 1..threads-1 (only as many as
- * there are indices) are woken, the render thread takes indices too, and
- * the call returns when every index is done. A loop started from inside a
+ * there are indices) are woken, the render thread takes indices too, each
+ * thread then helps through idle (when given) until it says there is
+ * nothing more, and the call returns when every index is done. A loop started from inside a
  * loop, or from a pool thread, runs on the caller. */
-static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
+static void pool_run_helped(void *ctx, uint32_t count, ob_task_fn fn, ob_idle_fn idle, void *user)
 {
     ob_renderer *r = ctx;
     uint32_t threads = ob_renderer_parallel_threads(r);
     if (r->in_parallel || threads < 2 || count < 2) {
         for (uint32_t i = 0; i < count; i++) fn(user, i, 0);
+        while (idle && idle(user, 0)) {}
         return;
     }
     uint32_t helpers = OB_MIN(threads - 1, count - 1);
     r->in_parallel = true;
     r->task_fn = fn;
+    r->task_idle = idle;
     r->task_user = user;
     /* One block per thread that may join, in thread order; published by
      * hand_out's batch_state store. */
@@ -489,15 +495,21 @@ static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
     }
     hand_out(r, helpers, own_tasks, NULL);
     r->task_fn = NULL;
+    r->task_idle = NULL;
     r->in_parallel = false;
     /* Recording reads the workers' cpu_ns as its own: none left from here. */
     for (uint32_t i = 0; i < helpers; i++) r->workers[i].cpu_ns = 0;
 }
 
+static void pool_run(void *ctx, uint32_t count, ob_task_fn fn, void *user)
+{
+    pool_run_helped(ctx, count, fn, NULL, user);
+}
+
 ob_parallel ob_renderer_parallel(ob_renderer *r)
 {
     return (ob_parallel){.run = pool_run, .ctx = r, .threads = ob_renderer_parallel_threads(r),
-                         .grain = r->parallel_grain};
+                         .grain = r->parallel_grain, .run_helped = pool_run_helped};
 }
 
 ob_result ob_renderer_workers_start(ob_renderer *r)

@@ -279,6 +279,83 @@ static void parallel_loops_run_each_index_once(void **state)
     ob_test_world_destroy(&w);
 }
 
+/* A helped loop (ob_parallel_run_helped), as PreRender's culling wave
+ * shares a big view's gather: each index leaves PIECES pieces of work that
+ * any thread may take in idle; the index's own thread takes what is left.
+ * The loop returns with every piece done exactly once, whoever helped. */
+#define HELP_INDICES 24u
+#define PIECES 8u
+
+typedef struct help_probe {
+    atomic_uint ready[HELP_INDICES];     /* pieces published by index i (0 or PIECES) */
+    atomic_uint next[HELP_INDICES];      /* the next piece of index i to take */
+    atomic_uint done[HELP_INDICES][PIECES];
+    atomic_uint left;                    /* pieces not done, over the loop */
+    atomic_uint helped;                  /* pieces taken in idle */
+    atomic_uint idle_calls[OB_MAX_WORKERS + 1];
+} help_probe;
+
+static bool help_take(help_probe *p, uint32_t i)
+{
+    uint32_t ready = atomic_load_explicit(&p->ready[i], memory_order_acquire);
+    uint32_t k = atomic_load(&p->next[i]);
+    while (k < ready)
+        if (atomic_compare_exchange_weak(&p->next[i], &k, k + 1)) {
+            atomic_fetch_add(&p->done[i][k], 1);
+            atomic_fetch_sub_explicit(&p->left, 1, memory_order_release);
+            return true;
+        }
+    return false;
+}
+
+static void help_task(void *user, uint32_t i, uint32_t thread)
+{
+    (void)thread;
+    help_probe *p = user;
+    atomic_store_explicit(&p->ready[i], PIECES, memory_order_release);
+    while (help_take(p, i)) {}
+}
+
+static bool help_idle(void *user, uint32_t thread)
+{
+    help_probe *p = user;
+    atomic_fetch_add(&p->idle_calls[OB_MIN(thread, (uint32_t)OB_MAX_WORKERS)], 1);
+    for (uint32_t i = 0; i < HELP_INDICES; i++)
+        if (help_take(p, i)) {
+            atomic_fetch_add(&p->helped, 1);
+            return true;
+        }
+    return false;
+}
+
+static void helped_loops_do_every_piece_once(void **state)
+{
+    (void)state;
+    ob_test_world w;
+    ob_test_world_create(&w, &(ob_test_world_desc){.workers = 4});
+    static help_probe p;
+    for (uint32_t n = 1; n <= 4; n++) {
+        assert_int_equal(ob_renderer_set_threading(w.r, OB_THREADING_MULTI, n), OB_OK);
+        for (uint32_t round = 0; round < 20; round++) {
+            memset(&p, 0, sizeof p);
+            atomic_store(&p.left, HELP_INDICES * PIECES);
+            ob_parallel par = ob_renderer_parallel(w.r);
+            ob_parallel_run_helped(&par, HELP_INDICES, help_task, help_idle, &p);
+            assert_int_equal(atomic_load_explicit(&p.left, memory_order_acquire), 0);
+            for (uint32_t i = 0; i < HELP_INDICES; i++)
+                for (uint32_t k = 0; k < PIECES; k++)
+                    if (atomic_load(&p.done[i][k]) != 1)
+                        fail_msg("%u threads: piece %u of index %u done %u times", n, k, i,
+                                 atomic_load(&p.done[i][k]));
+            /* Every thread of the loop asked for help before it left; the
+             * caller at least once, whatever the thread count. */
+            assert_true(atomic_load(&p.idle_calls[0]) >= 1);
+            for (uint32_t t = n; t <= OB_MAX_WORKERS; t++) assert_int_equal(atomic_load(&p.idle_calls[t]), 0);
+        }
+    }
+    ob_test_world_destroy(&w);
+}
+
 /* Renderer creation failing at each host allocation and each Vulkan object
  * creation in turn: a NULL renderer and an error, no thread left running, no
  * memory left (ASan), no validation message from the half-built device. */
@@ -336,6 +413,7 @@ int main(void)
         cmocka_unit_test(only_active_workers_record),
         cmocka_unit_test(auto_measures_both_ways),
         cmocka_unit_test(parallel_loops_run_each_index_once),
+        cmocka_unit_test(helped_loops_do_every_piece_once),
         cmocka_unit_test(failed_creation_leaves_no_worker_behind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
