@@ -285,7 +285,6 @@ static void run_tasks(ob_renderer *r, uint32_t thread)
  * come costs at most this much CPU before the thread sleeps. */
 #define POOL_SPIN_NS 100000u
 
-
 /* How long at most a pool thread polls while the render thread holds the
  * pool awake (ob_renderer.hold_awake), in case it never lets go. */
 #define POOL_HOLD_MAX_NS 2000000u
@@ -468,8 +467,8 @@ static void own_tasks(ob_renderer *r, void *arg)
 /* ob_parallel's run for the pool: pool threads 1..threads-1 (only as many as
  * there are indices) are woken, the render thread takes indices too, each
  * thread then helps through idle (when given) until it says there is
- * nothing more, and the call returns when every index is done. A loop started from inside a
- * loop, or from a pool thread, runs on the caller. */
+ * nothing more, and the call returns when every index is done. A loop
+ * started from inside a loop, or from a pool thread, runs on the caller. */
 static void pool_run_helped(void *ctx, uint32_t count, ob_task_fn fn, ob_idle_fn idle, void *user)
 {
     ob_renderer *r = ctx;
