@@ -536,7 +536,6 @@ typedef struct cull_view {
      * itself until none is left. */
     ob_sort_result sorted;
     uint32_t n;                 /* visible items */
-    uint32_t part_items;        /* items per part */
     uint64_t own_ns;            /* the sorting thread's time before the parts */
     atomic_uint parts_ready;    /* 0 until the list is sorted, then the part count */
     atomic_uint part_next;      /* the next part to take */
@@ -708,7 +707,7 @@ static void wave_gather_part(cull_wave *w, cull_view *cv, uint32_t part)
 {
     uint64_t t0 = ob_time_ns();
     ob_view *v = cv->v;
-    uint32_t first = part * cv->part_items, end = OB_MIN(first + cv->part_items, cv->n);
+    uint32_t first = part * w->part_items, end = OB_MIN(first + w->part_items, cv->n);
     uint32_t coarse = 0;
     for (uint32_t j = first; j < end; j++)
         coarse += gather_item(v, cv->sorted, cv->c.payload, j)->proxy_lod > CULL_INDEX_MASK;
@@ -773,7 +772,6 @@ static void wave_finish_view(cull_wave *w, cull_view *cv, uint32_t thread)
     if (w->parallel && n >= 2 * w->part_items) {
         cv->sorted = sorted;
         cv->n = n;
-        cv->part_items = w->part_items;
         uint32_t parts = (n + w->part_items - 1) / w->part_items;
         atomic_store_explicit(&cv->parts_left, parts, memory_order_relaxed);
         cv->own_ns = chunk_ns + (ob_time_ns() - t0);
